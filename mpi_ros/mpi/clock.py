@@ -1,0 +1,100 @@
+"""Feedrate: a supervisor's profile time tau runs at feedrate x real time.
+
+STOP ramps the feedrate to pauseFeedrate over decelTime.stop, so the axes slow down
+along their path and RESUME continues on the same path (DESIGN.md); E_STOP ramps it to
+zero over decelTime.eStop. Frames are written in profile time; the executor reads them
+at tau(t). The feedrate ramps linearly, so tau(t) is piecewise quadratic:
+
+    tau(t) = tau0 + f0 (t - t0) + rate/2 (t - t0)^2    for t0 <= t <= t_end
+    tau(t) = tau(t_end) + f_end (t - t_end)             for t >= t_end
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True, slots=True)
+class ProfileClock:
+    t0: float = 0.0
+    tau0: float = 0.0
+    f0: float = 1.0
+    f1: float = 1.0  # feedrate from t_end on (stored, so a finished ramp is exact)
+    t_end: float = 0.0
+
+    # -- scalar queries -------------------------------------------------------------
+    @property
+    def rate(self) -> float:
+        span = self.t_end - self.t0
+        return (self.f1 - self.f0) / span if span > 0.0 else 0.0
+
+    @property
+    def tau_end(self) -> float:
+        return self.tau0 + 0.5 * (self.f0 + self.f1) * (self.t_end - self.t0)
+
+    def ramping(self, t: float) -> bool:
+        return t < self.t_end
+
+    def feedrate(self, t: float) -> float:
+        if t >= self.t_end:
+            return self.f1
+        return self.f0 + self.rate * (t - self.t0)
+
+    def feedrate_slope(self, t: float) -> float:
+        return self.rate if t < self.t_end else 0.0
+
+    def tau_at(self, t: float) -> float:
+        if t >= self.t_end:
+            return self.tau_end + self.f1 * (t - self.t_end)
+        dt = t - self.t0
+        return self.tau0 + dt * (self.f0 + 0.5 * self.rate * dt)
+
+    # -- vector queries -------------------------------------------------------------
+    def tau(self, t: np.ndarray) -> np.ndarray:
+        rate = self.rate
+        dt = np.minimum(t, self.t_end) - self.t0
+        ramp = self.tau0 + dt * (self.f0 + 0.5 * rate * dt)
+        after = np.maximum(t - self.t_end, 0.0)
+        return ramp + self.f1 * after
+
+    def feedrates(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Feedrate and its time derivative at each time."""
+        rate = self.rate
+        in_ramp = t < self.t_end
+        f = np.where(in_ramp, self.f0 + rate * (t - self.t0), self.f1)
+        df = np.where(in_ramp, rate, 0.0)
+        return f, df
+
+    # -- changes ------------------------------------------------------------------
+    def ramp_to(self, t: float, target: float, duration: float) -> "ProfileClock":
+        """A clock that continues this one and ramps linearly to ``target`` from ``t``."""
+        tau, f = self.tau_at(t), self.feedrate(t)
+        if duration <= 0.0 or f == target:
+            return ProfileClock(t, tau, target, target, t)
+        return ProfileClock(t, tau, f, target, t + duration)
+
+    def time_of_tau(self, tau: float, t_from: float) -> float:
+        """Earliest time >= t_from at which profile time reaches ``tau`` (inf if never)."""
+        if self.tau_at(t_from) >= tau:
+            return t_from
+        if t_from < self.t_end and self.tau_end >= tau:
+            # tau0 + f0 x + rate/2 x^2 = tau with x = t - t0, on the increasing branch.
+            c = self.tau0 - tau
+            rate = self.rate
+            if rate == 0.0:
+                x = -c / self.f0
+            else:
+                root = math.sqrt(max(0.0, self.f0 * self.f0 - 2.0 * rate * c))
+                denominator = self.f0 + root
+                x = (-2.0 * c) / denominator if denominator > 0.0 else (root - self.f0) / rate
+            return max(t_from, self.t0 + x)
+        if self.f1 <= 0.0:
+            return math.inf
+        return max(t_from, self.t_end + (tau - self.tau_end) / self.f1)
+
+    def local_quadratic(self, t: float) -> tuple[float, float, float]:
+        """tau(t + s) = q0 + q1 s + q2 s^2 for s within the current clock piece."""
+        return self.tau_at(t), self.feedrate(t), 0.5 * self.feedrate_slope(t)

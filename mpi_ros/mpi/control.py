@@ -1,0 +1,361 @@
+"""Controller: the sample clock, the axes and motion supervisors, I/O, gates, events.
+
+The controller advances in whole samples. Every command takes effect at a sample
+boundary: a command given while the controller is at sample k changes the trajectory
+from time k/rate on, so sample k+1 is the first that shows it (``effective_sample``).
+:meth:`step` advances any number of samples; it computes the axes over a stretch at
+once (vectorised over time) and stops inside it exactly at the samples where something
+discrete happens (a move done, a stop complete, a hold released), so the result does
+not depend on how the samples are batched.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import Callable
+
+import numpy as np
+
+from .axis import Axis
+from .events import Event, MPIEventType
+from .io import IoImage
+from .messages import Message
+from .motion import MotionSupervisor
+from .params import AxisInPosition, ControllerConfig, MotionConfig, PlantConfig
+from .snapshot import AxisSnapshot
+from .status import StatusContext, compute, rising_edges
+from .types import IoSpace, MPIState
+
+MAX_STRETCH = 4096  # samples computed at once
+_EDGE_EVENTS = {
+    "done": MPIEventType.DONE,
+    "in_fine_position": MPIEventType.IN_FINE_POSITION,
+    "in_coarse_position": MPIEventType.IN_COARSE_POSITION,
+    "at_target": MPIEventType.AT_TARGET,
+    "settled": MPIEventType.SETTLED,
+    "at_velocity": MPIEventType.AT_VELOCITY,
+}
+
+EventListener = Callable[[Event], None]
+
+
+class Controller:
+    def __init__(
+        self,
+        config: ControllerConfig | None = None,
+        in_position: AxisInPosition | None = None,
+        plant: PlantConfig | None = None,
+        motion_config: MotionConfig | None = None,
+    ):
+        self.config = config or ControllerConfig()
+        if self.config.sample_rate <= 0.0:
+            raise ValueError("sample_rate must be positive")
+        self.rate = float(self.config.sample_rate)
+        self.sample = 0
+        self.axes = [
+            Axis(n, self.rate, in_position or AxisInPosition(), plant or PlantConfig())
+            for n in range(self.config.axis_count)
+        ]
+        self.io = IoImage(self.config.io_words, self.config.motors)
+        self.motion_defaults = motion_config or MotionConfig()
+        self._supervisors: dict[int, MotionSupervisor] = {}
+        self.events: deque[Event] = deque()
+        self.listeners: list[EventListener] = []
+
+    # -- time -------------------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        """Controller time of the current sample (seconds)."""
+        return self.sample / self.rate
+
+    @property
+    def effective_sample(self) -> int:
+        """The sample at which a command given now takes effect."""
+        return self.sample + 1
+
+    # -- objects ------------------------------------------------------------------------
+    def create_motion(self, number: int = -1, axis: int | None = None) -> tuple[Message, MotionSupervisor | None]:
+        """mpiMotionCreate: -1 selects the next unused supervisor."""
+        if number == -1:
+            free = [n for n in range(self.config.supervisor_count) if n not in self._supervisors]
+            if not free:
+                return Message.MPIMotionMessageMOTION_INVALID, None
+            number = free[0]
+        if not 0 <= number < self.config.supervisor_count:
+            return Message.MPIMotionMessageMOTION_INVALID, None
+        if number in self._supervisors:
+            return Message.MPIMotionMessageMOTION_INVALID, None
+        ms = MotionSupervisor(self, number, self.motion_defaults)
+        if axis is not None:
+            message = ms.axis_append(axis)
+            if not message.ok:
+                return message, None
+        self._supervisors[number] = ms
+        return Message.MPIMessageOK, ms
+
+    def delete_motion(self, ms: MotionSupervisor) -> Message:
+        """mpiMotionDelete (the axes are not deleted)."""
+        if not ms.valid or self._supervisors.get(ms.number) is not ms:
+            return Message.MPIMessageHANDLE_INVALID
+        unmapped = [n for n in ms.axis_list if n not in ms.mapped]
+        if unmapped:
+            return Message.MPIAxisMessageNOT_MAPPED_TO_MS
+        if ms.own_state not in (MPIState.IDLE, MPIState.ERROR):
+            return Message.MPIMotionMessageMOVING if ms.own_state is MPIState.MOVING else Message[
+                f"MPIMotionMessage{ms.own_state.name}"]
+        for axis in self.axes:
+            if axis.owner == ms.number:
+                axis.unload(self.time, ms.clock)
+                axis.owner = -1
+        ms.valid = False
+        del self._supervisors[ms.number]
+        return Message.MPIMessageOK
+
+    def supervisor(self, number: int) -> MotionSupervisor | None:
+        return self._supervisors.get(number)
+
+    @property
+    def supervisors(self) -> list[MotionSupervisor]:
+        return [self._supervisors[n] for n in sorted(self._supervisors)]
+
+    def axis(self, number: int) -> Axis:
+        return self.axes[number]
+
+    # -- axis calls ---------------------------------------------------------------------
+    def _axis_moving(self, axis: Axis) -> bool:
+        owner = self.supervisor(axis.owner)
+        return owner is not None and owner.own_state not in (MPIState.IDLE, MPIState.ERROR)
+
+    def axis_command_position_set(self, number: int, position: float) -> Message:
+        """mpiAxisCommandPositionSet (MPIAxisMessageCOMMAND_NOT_SET while it moves)."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID
+        axis = self.axes[number]
+        if not np.isfinite(position):
+            return Message.MPIMessagePARAM_INVALID
+        if not axis.can_set_command(self._axis_moving(axis)):
+            return Message.MPIAxisMessageCOMMAND_NOT_SET
+        axis.set_command_position(float(position), self.time)
+        return Message.MPIMessageOK
+
+    def axis_actual_position_set(self, number: int, position: float) -> Message:
+        """mpiAxisActualPositionSet."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID
+        return self.axes[number].set_actual_position(float(position), self.time)
+
+    def axis_origin_set(self, number: int, origin: float) -> Message:
+        """mpiAxisOriginSet."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID
+        return self.axes[number].set_origin(float(origin))
+
+    def axis_in_position_set(self, number: int, in_position: AxisInPosition) -> Message:
+        """mpiAxisConfigSet (inPosition)."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID
+        values = [in_position.position_fine, in_position.velocity, in_position.settling_time]
+        if not all(np.isfinite(v) and v >= 0.0 for v in values) or in_position.position_coarse < 0:
+            return Message.MPIMessagePARAM_INVALID
+        self.axes[number].in_position = in_position.copy()
+        return Message.MPIMessageOK
+
+    def frame_count(self, number: int) -> int:
+        """Frames in an axis' buffer: the rest of the move it runs and the ones queued."""
+        axis = self.axes[number]
+        count = 0
+        if axis.plan is not None:
+            count += axis.plan.frames_left(axis.rel if np.isfinite(axis.rel) else 0.0)
+        owner = self.supervisor(axis.owner)
+        if owner is not None:
+            if axis.holding and owner.current is not None and owner.current.plan_for(number) is not None:
+                count += owner.current.plan_for(number).frame_count
+            count += sum(m.frame_counts.get(number, 0) for m in owner.queue)
+        return count
+
+    def axis_snapshot(self, number: int) -> AxisSnapshot:
+        """mpiAxisStatus."""
+        axis = self.axes[number]
+        owner = self.supervisor(axis.owner)
+        bits = axis.status
+        return AxisSnapshot(
+            sample=self.sample,
+            number=number,
+            state=owner.own_state if owner is not None else MPIState.IDLE,
+            command_position=axis.command_position,
+            actual_position=axis.actual_position,
+            position_error=axis.position_error,
+            target_position=axis.target_position,
+            origin=axis.origin,
+            command_velocity=axis.cmd_v,
+            actual_velocity=axis.act_v,
+            command_acceleration=axis.cmd_a,
+            done=bits.done,
+            at_target=bits.at_target,
+            in_fine_position=bits.in_fine_position,
+            in_coarse_position=bits.in_coarse_position,
+            settled=bits.settled,
+            at_velocity=bits.at_velocity,
+            trajectory_complete=bits.trajectory_complete,
+            amp_enabled=axis.amp_enabled,
+            move_id=axis.move_id,
+            element_id=axis.element_id,
+            frame_count=self.frame_count(number),
+            supervisor=axis.owner,
+        )
+
+    # -- gates and I/O -------------------------------------------------------------------
+    def gate_set(self, gate: int, closed: bool) -> Message:
+        """meiControlGateSet: opening a gate releases the moves held on it."""
+        message = self.io.gate_set(gate, closed)
+        if message.ok:
+            self._io_changed()
+        return message
+
+    def gate_get(self, gate: int) -> tuple[Message, bool]:
+        return self.io.gate_get(gate)
+
+    def io_set(self, space: IoSpace, index: int, value: int, mask: int = -1) -> Message:
+        message = self.io.set(space, index, value, mask)
+        if message.ok:
+            self._io_changed()
+        return message
+
+    def io_get(self, space: IoSpace, index: int) -> tuple[Message, int]:
+        return self.io.get(space, index)
+
+    def _io_changed(self) -> None:
+        for ms in self.supervisors:
+            ms.release_holds(self.io)
+
+    # -- events -------------------------------------------------------------------------
+    def emit(self, kind: MPIEventType, supervisor: int = -1, axis: int = -1, move_id: int = 0,
+             element_id: int = 0, detail: str = "", extra_mask: MPIEventType = MPIEventType.NONE,
+             sample: int | None = None) -> None:
+        """Latch the event on every supervisor it concerns and notify those that asked."""
+        sample = self.sample if sample is None else sample
+        targets = self._event_targets(supervisor, axis)
+        for ms in targets:
+            ms.latched |= kind
+            if kind & (ms.notify_mask | (extra_mask if ms.number == supervisor else MPIEventType.NONE)):
+                self._deliver(Event(sample, kind, ms.number, axis, move_id, element_id, detail))
+        if not targets:
+            self._deliver(Event(sample, kind, supervisor, axis, move_id, element_id, detail))
+
+    def _event_targets(self, supervisor: int, axis: int) -> list[MotionSupervisor]:
+        """spec 000 mpiMotionAxisAppend: supervisors sharing axes both get the events."""
+        targets = []
+        own = self.supervisor(supervisor)
+        if own is not None:
+            targets.append(own)
+        axes = {axis} if axis >= 0 else (set(own.mapped) if own is not None else set())
+        for ms in self.supervisors:
+            if ms is not own and axes & set(ms.mapped):
+                targets.append(ms)
+        return targets
+
+    def _deliver(self, event: Event) -> None:
+        self.events.append(event)
+        for listener in self.listeners:
+            listener(event)
+
+    def drain_events(self) -> list[Event]:
+        out = list(self.events)
+        self.events.clear()
+        return out
+
+    # -- stepping -----------------------------------------------------------------------
+    def step(self, samples: int = 1) -> None:
+        """Advance ``samples`` samples."""
+        if samples < 0:
+            raise ValueError("samples must be >= 0")
+        end = self.sample + int(samples)
+        while self.sample < end:
+            self._advance(min(end, self.sample + MAX_STRETCH))
+
+    def run_until(self, condition: Callable[["Controller"], bool], max_samples: int, chunk: int = 1) -> bool:
+        """Step ``chunk`` samples at a time until ``condition`` holds (True) or
+        ``max_samples`` have passed (False)."""
+        limit = self.sample + max_samples
+        while not condition(self):
+            if self.sample >= limit:
+                return False
+            self.step(min(chunk, limit - self.sample))
+        return True
+
+    def _clock(self, axis: Axis):
+        owner = self.supervisor(axis.owner)
+        return owner.clock if owner is not None else None
+
+    def _context(self, axis: Axis) -> StatusContext:
+        plan = axis.plan
+        return StatusContext(
+            mode=axis.status_mode,
+            target=axis.target,
+            in_position=axis.in_position,
+            sample_rate=self.rate,
+            holding=axis.holding,
+            plan_duration=plan.duration if plan is not None else 0.0,
+            velocity_target=plan.velocity_target if plan is not None else None,
+            ramp_end=plan.ramp_end if plan is not None else 0.0,
+            has_plan=plan is not None,
+        )
+
+    def _advance(self, k1: int) -> None:
+        k0 = self.sample
+        traces = {a.number: a.trace(k0, k1, self._clock(a)) for a in self.axes}
+        statuses = {a.number: compute(traces[a.number], self._context(a), a.counters) for a in self.axes}
+        samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
+        t = samples / self.rate
+        stop = len(samples) - 1
+        event_at = None
+        for ms in self.supervisors:
+            hits = ms.scan(samples, t, traces, statuses)
+            if hits is not None:
+                found = np.flatnonzero(hits)
+                if len(found) and found[0] <= stop:
+                    stop = int(found[0])
+                    event_at = stop
+        self._status_events(stop, traces, statuses)
+        for ms in self.supervisors:
+            if ms.log is not None and not ms.log.full:
+                ms.log.record(samples[: stop + 1], ms.state.name,
+                              [(traces[n].cmd_p[: stop + 1] - self.axes[n].origin,
+                                traces[n].act_p[: stop + 1] - self.axes[n].origin,
+                                traces[n].cmd_v[: stop + 1]) for n in ms.mapped])
+        for axis in self.axes:
+            axis.commit(traces[axis.number], stop)
+            axis.status = statuses[axis.number].at(stop)
+            axis.counters = statuses[axis.number].counters_at(stop)
+        self.sample = int(samples[stop])
+        if event_at is not None:
+            for ms in self.supervisors:
+                ms.transition(stop, samples, t, traces, statuses)
+
+    def _status_events(self, stop: int, traces, statuses) -> None:
+        """Events for status bits that turn on in samples up to ``stop``, in sample order."""
+        found: list[tuple[int, int, int, MPIEventType, str]] = []  # sample, axis, rank, type, detail
+        for axis in self.axes:
+            status = statuses[axis.number]
+            samples = traces[axis.number].samples
+            for rank, (name, kind) in enumerate(_EDGE_EVENTS.items()):
+                for i in rising_edges(getattr(axis.status, name), status.bits[name][: stop + 1]):
+                    found.append((int(samples[i]), axis.number, rank, kind, ""))
+            plan = axis.plan
+            if plan is not None and plan.truncated and axis.rel < plan.duration:
+                crossed = np.flatnonzero(traces[axis.number].rel[: stop + 1] >= plan.duration)
+                if len(crossed):
+                    found.append((int(samples[crossed[0]]), axis.number, -1, MPIEventType.FRAME_TIME_LIMIT,
+                                  "a frame reached 16,384,000 samples: the axis stopped abruptly"))
+        for sample, number, _, kind, detail in sorted(found, key=lambda e: e[:3]):
+            axis = self.axes[number]
+            self.emit(kind, supervisor=axis.owner, axis=number, move_id=axis.move_id,
+                      element_id=axis.element_id, detail=detail, sample=sample)
+        for ms in self.supervisors:
+            index = ms.at_velocity_index(statuses, stop)
+            if index is not None:
+                ms.at_velocity_reached(int(samples_of(traces)[index]))
+
+
+def samples_of(traces) -> np.ndarray:
+    return next(iter(traces.values())).samples

@@ -1,0 +1,127 @@
+"""Moves as the controller buffers them: per-axis frames, and frame-buffer accounting.
+
+A move compiles, for each axis, into constant-jerk segments in profile time (motion,
+DELAY and SYNC wait frames alike) plus one final frame that holds the end state; a
+HOLD adds one hold frame in front. Those frames occupy the axis' frame buffer
+(128 by default) from the moment the move is loaded until the axis has executed them.
+spec 000 mpiMotionStart: "Each axis has a 128 frame buffer (FIFO)".
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from .events import MPIEventType
+from .params import Hold, Output
+from .profiles.segment import Segment, SegmentTable
+from .types import MotionAttr, MPIMotionType
+
+_serials = itertools.count(1)
+
+
+def next_serial() -> int:
+    return next(_serials)
+
+
+@dataclass(slots=True)
+class AxisPlan:
+    """One axis' part of a move; times are profile time from the axis' start."""
+
+    axis: int
+    segments: list[Segment]
+    start_position: float
+    target: float  # raw (origin-free) position where the plan ends
+    final_velocity: float = 0.0
+    hold: Hold | None = None
+    outputs: list[Output] = field(default_factory=list)
+    velocity_target: float | None = None  # VELOCITY moves: the commanded velocity
+    ramp_end: float = 0.0  # VELOCITY moves: profile time at which the ramp is done
+    truncated: bool = False  # a frame hit the 16,384,000-sample limit
+    table: SegmentTable = field(init=False)
+    duration: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        if not self.segments:
+            self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
+        self.table = SegmentTable(self.segments)
+        self.duration = float(self.table.end[-1])
+
+    @property
+    def is_velocity(self) -> bool:
+        return self.velocity_target is not None
+
+    @property
+    def frame_count(self) -> int:
+        """Frames this plan loads: its segments, the final frame, and a hold frame."""
+        return len(self.segments) + 1 + (1 if self.hold is not None else 0)
+
+    def frames_left(self, rel: float) -> int:
+        """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
+        done = int(np.searchsorted(self.table.end, rel, side="right"))
+        return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
+
+    def evaluate(self, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, d/dtau and d2/dtau2 of the plan at relative profile times."""
+        inside = np.minimum(rel, self.duration)
+        p, v, a, _ = self.table.evaluate(inside)
+        past = rel > self.duration
+        if past.any():
+            extra = rel - self.duration
+            p = np.where(past, self.target + self.final_velocity * extra, p)
+            v = np.where(past, self.final_velocity, v)
+            a = np.where(past, 0.0, a)
+        # Exactly on target once complete (spec: AT_TARGET is "command = target").
+        p = np.where(rel == self.duration, self.target, p) if self.final_velocity == 0.0 else p
+        return p, v, a
+
+    def segment_poly(self, rel: float) -> tuple[float, list[float]]:
+        """(start time, polynomial coefficients in time from it) of the piece at ``rel``."""
+        if rel >= self.duration:
+            return self.duration, [self.target, self.final_velocity]
+        i = min(int(np.searchsorted(self.table.end, rel, side="right")), self.table.count - 1)
+        seg = self.segments[i]
+        return float(self.table.start[i]), [seg.p, seg.v, seg.a / 2.0, seg.j / 6.0]
+
+    def boundaries(self) -> np.ndarray:
+        """Relative profile times at which the command polynomial changes."""
+        return self.table.end
+
+
+@dataclass(slots=True)
+class Move:
+    """A started (or appended) move of a supervisor."""
+
+    supervisor: int
+    type: MPIMotionType
+    attributes: MotionAttr
+    plans: list[AxisPlan]
+    id: int = 0
+    element_id: int = 0
+    event_mask: MPIEventType = MPIEventType.NONE
+    serial: int = field(default_factory=next_serial)
+
+    @property
+    def is_velocity(self) -> bool:
+        return any(plan.is_velocity for plan in self.plans)
+
+    @property
+    def axes(self) -> list[int]:
+        return [plan.axis for plan in self.plans]
+
+    def plan_for(self, axis: int) -> AxisPlan | None:
+        for plan in self.plans:
+            if plan.axis == axis:
+                return plan
+        return None
+
+    @property
+    def frame_counts(self) -> dict[int, int]:
+        return {plan.axis: plan.frame_count for plan in self.plans}
+
+
+def frames_needed(moves: Sequence[Move], axis: int) -> int:
+    return sum(move.frame_counts.get(axis, 0) for move in moves)

@@ -1,0 +1,948 @@
+"""MotionSupervisor: the Motion object of spec 000 (mpiMotion*).
+
+Every method answers a :class:`Message` (and a value where the C API writes one). A
+refused call changes nothing. State transitions follow spec 000 and the table in
+DESIGN.md; the controller calls :meth:`scan`/:meth:`transition` while it steps so
+motion-driven transitions (DONE, stop complete, hold release) happen at the exact
+sample their condition is met.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+
+from . import validate
+from .axis import Axis, CommandMode
+from .clock import ProfileClock
+from .events import MPIEventType
+from .frames import Move, frames_needed
+from .holds import HoldWait
+from .log import MotionLog
+from .messages import STATE_MESSAGES, Message
+from .params import MAX_COORD_AXES, USER_LABEL_MAX, MotionConfig, MotionParams
+from .planner import AxisStart, PlanError, compile_move
+from .snapshot import FrameBufferStatus, MotionSnapshot
+from .status import StatusMode
+from .types import (
+    STATE_SEVERITY,
+    VELOCITY_TYPES,
+    ActionSource,
+    MotionAttr,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    OutputType,
+    IoSpace,
+)
+
+if TYPE_CHECKING:
+    from .control import Controller
+
+OK = Message.MPIMessageOK
+ActionCallback = Callable[["MotionSupervisor", MPIMotionType, MPIAction], object]
+
+
+class MotionSupervisor:
+    def __init__(self, controller: "Controller", number: int, config: MotionConfig):
+        self._ctl = controller
+        self.number = number
+        self.valid = True
+        self.axis_list: list[int] = []
+        self.mapped: list[int] = []
+        self.config = config.copy()
+        self.stored_params = MotionParams()
+        self.stored_type = MPIMotionType.INVALID
+        self.notify_mask = controller.config.event_notify
+        self.latched = MPIEventType.NONE
+        t = controller.time
+        self.clock = ProfileClock(t, t, self.config.normal_feedrate, self.config.normal_feedrate, t)
+        self.own_state = MPIState.IDLE
+        self.last_action = "NONE"
+        self.action_source = ActionSource.USER
+        self.current: Move | None = None
+        self.queue: deque[Move] = deque()
+        self.last_move: Move | None = None
+        self._stop_end = math.inf  # time at which the stop/e-stop ramp ends
+        self._abort_after_stop = False
+        self._error_at: int | None = None  # sample at which an ABORT completes
+        self._aborted = False
+        self._holds: dict[int, HoldWait] = {}
+        self._at_velocity_sent = False
+        self.log: MotionLog | None = None
+        self.action_callback: ActionCallback | None = None
+        self.move_ends: list[tuple[int, Message, int, str]] = []  # (serial, message, sample, detail)
+
+    # ================================================================= handles ====
+    def validate(self) -> Message:
+        """mpiMotionValidate."""
+        return OK if self.valid else Message.MPIMessageHANDLE_INVALID
+
+    def _axis(self, number: int) -> Axis:
+        return self._ctl.axes[number]
+
+    @property
+    def axes(self) -> list[Axis]:
+        return [self._axis(n) for n in self.mapped]
+
+    # ================================================================= state ====
+    @property
+    def state(self) -> MPIState:
+        """The most severe of this supervisor's state and the states of the supervisors
+        commanding its axes (spec 000: status is derived from each axis' status)."""
+        states = [self.own_state]
+        for number in self.mapped:
+            owner = self._axis(number).owner
+            if owner not in (-1, self.number):
+                other = self._ctl.supervisor(owner)
+                if other is not None:
+                    states.append(other.own_state)
+        return max(states, key=STATE_SEVERITY.__getitem__)
+
+    def _state_message(self) -> Message:
+        return STATE_MESSAGES[self.state.name]
+
+    def _set_state(self, state: MPIState, action: str, source: ActionSource) -> None:
+        self.own_state = state
+        self.last_action = action
+        self.action_source = source
+
+    # ================================================================= axis list ====
+    def _check_axis(self, number: int) -> Message:
+        if not 0 <= number < len(self._ctl.axes):
+            return Message.MPIMessageHANDLE_INVALID
+        if not self._axis(number).enabled:
+            return Message.MPIMessageOBJECT_NOT_ENABLED
+        return OK
+
+    def axis_append(self, number: int) -> Message:
+        """mpiMotionAxisAppend."""
+        return self.axis_insert(self.axis_list[-1] if self.axis_list else None, number)
+
+    def axis_insert(self, after: int | None, number: int) -> Message:
+        """mpiMotionAxisInsert: insert ``number`` just after axis ``after`` (None: first)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        message = self._check_axis(number)
+        if not message.ok:
+            return message
+        if number in self.axis_list:
+            return Message.MPIMessageOBJECT_ON_LIST
+        if len(self.axis_list) >= MAX_COORD_AXES:
+            return Message.MPIMessageUNSUPPORTED
+        if after is None:
+            self.axis_list.insert(0, number)
+            return OK
+        if after not in self.axis_list:
+            return Message.MPIMotionMessageAXIS_NOT_FOUND
+        self.axis_list.insert(self.axis_list.index(after) + 1, number)
+        return OK
+
+    def axis_remove(self, number: int) -> Message:
+        """mpiMotionAxisRemove."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        message = self._check_axis(number)
+        if not message.ok:
+            return message
+        if number not in self.axis_list:
+            return Message.MPIMotionMessageAXIS_NOT_FOUND
+        if number not in self.mapped:
+            # spec 002 MPIAxisMessageNOT_MAPPED_TO_MS: on the list but not mapped.
+            return Message.MPIAxisMessageNOT_MAPPED_TO_MS
+        if self.own_state not in (MPIState.IDLE, MPIState.ERROR):
+            return self._state_message()
+        self.axis_list.remove(number)
+        return OK
+
+    def axis_list_set(self, numbers: list[int]) -> Message:
+        """mpiMotionAxisListSet: the coordinate system is completely replaced."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        if len(numbers) > MAX_COORD_AXES:
+            return Message.MPIMessageUNSUPPORTED
+        if len(set(numbers)) != len(numbers):
+            return Message.MPIMessageOBJECT_ON_LIST
+        for number in numbers:
+            message = self._check_axis(number)
+            if not message.ok:
+                return message
+        if self.own_state not in (MPIState.IDLE, MPIState.ERROR, MPIState.STOPPED):
+            return self._state_message()
+        self.axis_list = list(numbers)
+        return OK
+
+    def axis_list_get(self) -> tuple[Message, list[int]]:
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, []
+        return OK, list(self.axis_list)
+
+    def axis_count(self) -> int:
+        """mpiMotionAxisCount: -1 if the handle is invalid."""
+        return len(self.axis_list) if self.valid else -1
+
+    def axis_index(self, number: int) -> int:
+        """mpiMotionAxisIndex: -1 if invalid or not on the list."""
+        if not self.valid or number not in self.axis_list:
+            return -1
+        return self.axis_list.index(number)
+
+    def axis_at(self, index: int) -> tuple[Message, int | None]:
+        """mpiMotionAxis: the axis at ``index`` (None = MPIHandleVOID)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, None
+        if not 0 <= index < len(self.axis_list):
+            return Message.MEIListMessageELEMENT_NOT_FOUND, None
+        return OK, self.axis_list[index]
+
+    def axis_first(self) -> tuple[Message, int | None]:
+        return self.axis_at(0) if self.axis_list or not self.valid else (OK, None)
+
+    def axis_last(self) -> tuple[Message, int | None]:
+        return self.axis_at(len(self.axis_list) - 1) if self.axis_list or not self.valid else (OK, None)
+
+    def axis_next(self, number: int) -> tuple[Message, int | None]:
+        return self._neighbour(number, +1)
+
+    def axis_previous(self, number: int) -> tuple[Message, int | None]:
+        return self._neighbour(number, -1)
+
+    def _neighbour(self, number: int, step: int) -> tuple[Message, int | None]:
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, None
+        if number not in self.axis_list:
+            return Message.MPIMessageHANDLE_INVALID, None
+        index = self.axis_list.index(number) + step
+        return OK, self.axis_list[index] if 0 <= index < len(self.axis_list) else None
+
+    def _map(self) -> None:
+        """Write the axis list to the controller (MEIActionMAP)."""
+        self.mapped = list(self.axis_list)
+        self.config.axis_numbers = list(self.mapped)
+
+    # ================================================================= config ====
+    def config_get(self) -> tuple[Message, MotionConfig]:
+        config = self.config.copy()
+        config.axis_numbers = list(self.mapped)
+        return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), config
+
+    def config_set(self, config: MotionConfig) -> Message:
+        """mpiMotionConfigSet; a new normal feedrate applies on the fly (ramped over the
+        stop time while moving)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        numbers = [config.decel_time.stop, config.decel_time.e_stop, config.normal_feedrate,
+                   config.pause_feedrate, config.blend_limit]
+        if not all(math.isfinite(x) for x in numbers):
+            return Message.MPIMessagePARAM_INVALID
+        if config.decel_time.stop <= 0.0 or config.decel_time.e_stop <= 0.0:
+            return Message.MPIMessagePARAM_INVALID
+        if config.normal_feedrate <= 0.0 or config.pause_feedrate < 0.0:
+            return Message.MPIMessagePARAM_INVALID
+        if not -1.0 <= config.blend_limit <= 1.0 or len(config.user_label) > USER_LABEL_MAX:
+            return Message.MPIMessagePARAM_INVALID
+        old_normal = self.config.normal_feedrate
+        kept_axes = self.config.axis_numbers
+        self.config = config.copy()
+        self.config.axis_numbers = kept_axes
+        if config.normal_feedrate != old_normal and self.own_state is MPIState.MOVING:
+            t = self._ctl.time
+            self._rebase(t)
+            self.clock = self.clock.ramp_to(t, config.normal_feedrate, config.decel_time.stop)
+        elif self.own_state is MPIState.IDLE:
+            t = self._ctl.time
+            self._rebase(t)
+            self.clock = self.clock.ramp_to(t, config.normal_feedrate, 0.0)
+        return OK
+
+    # ================================================================= params ====
+    def params_get(self) -> tuple[Message, MotionParams]:
+        """mpiMotionParamsGet: the parameters a start with null params uses."""
+        return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.stored_params.copy()
+
+    def params_set(self, params: MotionParams) -> Message:
+        """mpiMotionParamsSet."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        self.stored_params = params.copy()
+        return OK
+
+    # ================================================================= positions ====
+    def position_get(self) -> tuple[Message, list[float], list[float]]:
+        """mpiMotionPositionGet: (actual, command), one value per axis."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, [], []
+        axes = self._list_axes()
+        return OK, [a.actual_position for a in axes], [a.command_position for a in axes]
+
+    def position_set(self, actual: list[float], command: list[float]) -> Message:
+        """mpiMotionPositionSet: both arrays one value per axis; the command position can
+        only be set while the axes rest (MPIAxisMessageCOMMAND_NOT_SET otherwise)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        axes = self._list_axes()
+        if not axes:
+            return Message.MPIMotionMessageAXIS_COUNT
+        if len(actual) != len(axes) or len(command) != len(axes):
+            return Message.MPIMessagePARAM_INVALID
+        if not all(math.isfinite(x) for x in list(actual) + list(command)):
+            return Message.MPIMessagePARAM_INVALID
+        moving = self.state is not MPIState.IDLE
+        if any(not a.can_set_command(moving) for a in axes):
+            return Message.MPIAxisMessageCOMMAND_NOT_SET
+        t = self._ctl.time
+        for axis, act, cmd in zip(axes, actual, command):
+            axis.set_actual_position(act, t)
+            axis.set_command_position(cmd, t)
+        return OK
+
+    def _list_axes(self) -> list[Axis]:
+        return [self._axis(n) for n in self.axis_list]
+
+    def trajectory(self) -> tuple[Message, list[tuple[float, float]]]:
+        """mpiMotionTrajectory: (velocity, acceleration) per axis; deceleration,
+        jerkPercent and the jerks cannot be read and are zero."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, []
+        return OK, [(a.cmd_v, a.cmd_a) for a in self._list_axes()]
+
+    # ================================================================= events ====
+    def event_notify_get(self) -> tuple[Message, MPIEventType]:
+        return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.notify_mask
+
+    def event_notify_set(self, mask: MPIEventType) -> Message:
+        """mpiMotionEventNotifySet (also maps the axes, spec 002 NOT_MAPPED_TO_MS)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        self.notify_mask = MPIEventType(mask)
+        if self.own_state in (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR):
+            self._map()
+        return OK
+
+    def event_reset(self, mask: MPIEventType) -> Message:
+        """mpiMotionEventReset: clear latched events."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        self.latched &= ~MPIEventType(mask)
+        return OK
+
+    def frame_buffer_status(self) -> tuple[Message, list[FrameBufferStatus]]:
+        """meiMotionFrameBufferStatus for each mapped axis."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, []
+        size = self._ctl.config.frame_buffer_size
+        return OK, [FrameBufferStatus(a.number, size, self._ctl.frame_count(a.number)) for a in self.axes]
+
+    # ================================================================= log ====
+    def log_open(self, max_entries: int) -> Message:
+        """meiMotionLogOpen."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        if max_entries <= 0:
+            return Message.MPIMessagePARAM_INVALID
+        self.log = MotionLog(max_entries)
+        return OK
+
+    def log_print(self, filename: str) -> Message:
+        """meiMotionLogPrint."""
+        if self.log is None:
+            return Message.MPIMessageHANDLE_INVALID
+        return self.log.write(filename, self.mapped)
+
+    def log_close(self) -> Message:
+        """meiMotionLogClose."""
+        self.log = None
+        return OK
+
+    def action_function(self, callback: ActionCallback | None) -> ActionCallback | None:
+        """meiMotionActionFunction: returns the previous callback."""
+        previous, self.action_callback = self.action_callback, callback
+        return previous
+
+    def _notify_action(self, motion_type: MPIMotionType, action: MPIAction) -> None:
+        if self.action_callback is not None:
+            self.action_callback(self, motion_type, action)
+
+    # ================================================================= start/modify ====
+    def start(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
+              params: MotionParams | None = None) -> Message:
+        """mpiMotionStart (params None: the parameters stored with params_set)."""
+        message, _ = self._command(motion_type, attrs, params, modify=False)
+        return message
+
+    def modify(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
+               params: MotionParams | None = None) -> Message:
+        """mpiMotionModify."""
+        message, _ = self._command(motion_type, attrs, params, modify=True)
+        return message
+
+    def command(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
+                modify: bool) -> tuple[Message, str, int]:
+        """Start or modify; returns (message, detail, serial of the move it made or changed)."""
+        message, detail = self._command(motion_type, attrs, params, modify)
+        serial = self.current.serial if self.current is not None else 0
+        if message in (OK, Message.MPIMotionMessageAUTO_START) and attrs & MotionAttr.APPEND and self.queue:
+            serial = self.queue[-1].serial
+        return message, detail, serial
+
+    def _command(self, motion_type, attrs, params, modify) -> tuple[Message, str]:
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, "invalid motion handle"
+        self._notify_action(motion_type, MPIAction.NONE)
+        if params is None:
+            params = self.stored_params
+        if not self.axis_list:
+            return Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes"
+        verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21)
+        if not verdict.ok:
+            return verdict.message, verdict.detail
+        state = self._state_for(self.axis_list)
+        append = MotionAttr.APPEND in attrs
+        auto_start = False
+        if modify:
+            if state is MPIState.IDLE:
+                if MotionAttr.AUTO_START not in attrs:
+                    return Message.MPIMotionMessageIDLE, "no motion in progress to modify"
+                auto_start = True
+            elif state is not MPIState.MOVING and not (append and state is MPIState.STOPPED):
+                return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
+        elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
+            return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
+        verdict = validate.check_attributes(motion_type, attrs, params, modify and not auto_start)
+        if not verdict.ok:
+            return verdict.message, verdict.detail
+        verdict = validate.check_params(
+            motion_type, attrs, params, len(self.axis_list), self._ctl.config.io_words,
+            self._ctl.config.motors, len(self._ctl.axes))
+        if not verdict.ok:
+            return verdict.message, verdict.detail
+        queued = append and (self.current is not None or bool(self.queue)) and state is not MPIState.IDLE
+        try:
+            move, notes = compile_move(
+                self.number, motion_type, attrs, params, self._starts(queued, state, modify and not auto_start),
+                self._ctl.rate, moving=modify and not auto_start and not queued)
+        except PlanError as exc:
+            return exc.message, exc.detail
+        if queued:
+            message = self._check_frames(list(self.queue) + ([self.current] if self.current else []) + [move])
+        else:
+            message = self._check_frames([move])
+        if not message.ok:
+            return message, "the move does not fit in the frame buffer"
+        self._map()
+        for kind, detail in notes.events:
+            self._emit(kind, detail=detail, move=move)
+        if queued:
+            self.queue.append(move)
+        elif modify and not auto_start:
+            self._replace(move)
+        else:
+            self._begin(move)
+        if auto_start:
+            return Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)"
+        return OK, ""
+
+    def _state_for(self, numbers: list[int]) -> MPIState:
+        """State as a command on ``numbers`` sees it (other supervisors' axes included)."""
+        states = [self.own_state]
+        for n in numbers:
+            owner = self._axis(n).owner
+            if owner not in (-1, self.number):
+                other = self._ctl.supervisor(owner)
+                if other is not None and other.own_state is not MPIState.IDLE:
+                    states.append(other.own_state)
+        return max(states, key=STATE_SEVERITY.__getitem__)
+
+    def _starts(self, queued: bool, state: MPIState, moving: bool) -> list[AxisStart]:
+        """Where the new profile of each axis starts."""
+        starts = []
+        last = self.queue[-1] if self.queue else self.current
+        for n in self.axis_list:
+            axis = self._axis(n)
+            if queued and last is not None and last.plan_for(n) is not None:
+                plan = last.plan_for(n)
+                starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.origin))
+            elif moving:
+                f = self.clock.feedrate(self._ctl.time)
+                velocity = axis.cmd_v / f if f > 0.0 else 0.0
+                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.origin))
+            else:
+                starts.append(AxisStart(n, axis.cmd_p, 0.0, axis.origin))
+        return starts
+
+    def _check_frames(self, moves: list[Move]) -> Message:
+        size = self._ctl.config.frame_buffer_size
+        for n in self.axis_list:
+            if frames_needed(moves, n) > size:
+                return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
+        return OK
+
+    def _rebase(self, t: float) -> None:
+        for axis in self.axes:
+            if axis.owner == self.number:
+                axis.rebase(t, self.clock)
+
+    def _end_move(self, move: Move, message: Message, detail: str) -> None:
+        self.move_ends.append((move.serial, message, self._ctl.sample, detail))
+
+    def _drop_pending(self, message: Message, detail: str) -> None:
+        for move in list(self.queue):
+            self._end_move(move, message, detail)
+        self.queue.clear()
+        if self.current is not None:
+            self._end_move(self.current, message, detail)
+            self.last_move = self.current
+            self.current = None
+        self._holds.clear()
+
+    def _begin(self, move: Move) -> None:
+        """A start: whatever is pending is dropped and ``move`` runs from now."""
+        t = self._ctl.time
+        self._rebase(t)
+        self._drop_pending(Message.MPIMotionMessageSTOPPED, "replaced by a new start")
+        self.clock = self.clock.ramp_to(t, self.config.normal_feedrate, 0.0)
+        self._stop_end = math.inf
+        self._set_state(MPIState.MOVING, "START", ActionSource.USER)
+        self._load(move)
+
+    def _replace(self, move: Move) -> None:
+        """A modify: the move in progress (and anything appended) becomes ``move``."""
+        t = self._ctl.time
+        self._rebase(t)
+        previous = self.current
+        for queued in list(self.queue):
+            self._end_move(queued, Message.MPIMotionMessageSTOPPED, "replaced by a modify")
+        self.queue.clear()
+        self._holds.clear()
+        if previous is not None:
+            move.serial = previous.serial
+            if not MotionAttr.ID & move.attributes:
+                move.id = previous.id
+        self._load(move)
+
+    def _load(self, move: Move) -> None:
+        """Put ``move`` on its axes now (held axes wait for their trigger)."""
+        t, sample = self._ctl.time, self._ctl.sample
+        self.current = move
+        self.last_move = move
+        self._at_velocity_sent = False
+        tau = self.clock.tau_at(t)
+        for plan in move.plans:
+            axis = self._axis(plan.axis)
+            axis.rebase(t, self._clock_of(axis))
+            axis.owner = self.number
+            axis.move_id = move.id
+            axis.element_id = move.element_id
+            axis.mode = CommandMode.SERVO if axis.amp_enabled else axis.mode
+            axis.status_mode = StatusMode.VELOCITY if plan.is_velocity else StatusMode.POINT_TO_POINT
+            if plan.hold is not None:
+                axis.unload(t, self._clock_of(axis))
+                axis.holding = True
+                axis.target = axis.rest
+                self._holds[plan.axis] = HoldWait.begin(
+                    plan, move.attributes, sample, self._ctl.rate, self._hold_position(plan.hold))
+            else:
+                axis.load(plan, tau, t, self.clock)
+                self._fire_outputs(plan)
+        self._emit(MPIEventType.MOTION_START, move=move)
+        self.release_holds(self._ctl.io)
+
+    def _clock_of(self, axis: Axis) -> ProfileClock | None:
+        owner = self._ctl.supervisor(axis.owner) if axis.owner >= 0 else None
+        return owner.clock if owner is not None else None
+
+    def _hold_position(self, hold) -> float:
+        axis = self._axis(hold.number) if 0 <= hold.number < len(self._ctl.axes) else None
+        if axis is None:
+            return 0.0
+        from .types import HoldType  # local: only position holds need it
+        return axis.actual_position if hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.command_position
+
+    def _fire_outputs(self, plan) -> None:
+        for output in plan.outputs:
+            if output.type is OutputType.MOTOR:
+                self._ctl.io.apply_masks(IoSpace.MOTOR_GENERAL_IO, output.motor, output.on_mask, output.off_mask)
+            elif output.type is OutputType.OUTPUT:
+                self._ctl.io.apply_masks(IoSpace.IO, output.address, output.on_mask, output.off_mask)
+
+    # ================================================================= actions ====
+    def action(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Message:
+        """mpiMotionAction."""
+        message, _ = self.action_detail(action, source)
+        return message
+
+    def action_detail(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> tuple[Message, str]:
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, "invalid motion handle"
+        self._notify_action(self.current.type if self.current else MPIMotionType.INVALID, action)
+        if not self.axis_list and not self.mapped:
+            return Message.MEIMotionMessageNO_AXES_MAPPED, "no axes mapped to the motion supervisor"
+        handler = {
+            MPIAction.STOP: self._stop,
+            MPIAction.RESUME: self._resume,
+            MPIAction.E_STOP: self._e_stop,
+            MPIAction.ABORT: self._abort,
+            MPIAction.E_STOP_ABORT: self._e_stop_abort,
+            MPIAction.RESET: self._reset,
+            MPIAction.MAP: self._map_action,
+        }.get(action)
+        if handler is None:
+            return Message.MPIMessagePARAM_INVALID, f"unknown action {action!r}"
+        return handler(source)
+
+    def _refuse(self, allowed: tuple[MPIState, ...]) -> tuple[Message, str] | None:
+        state = self.state
+        if state in allowed:
+            return None
+        return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
+
+    def _stop(self, source: ActionSource) -> tuple[Message, str]:
+        refused = self._refuse((MPIState.MOVING,))
+        if refused:
+            return refused
+        t = self._ctl.time
+        self._rebase(t)
+        self.clock = self.clock.ramp_to(t, self.config.pause_feedrate, self.config.decel_time.stop)
+        self._stop_end = t + self.config.decel_time.stop
+        self._set_status_mode(StatusMode.STOP)
+        self._set_state(MPIState.STOPPING, "STOP", source)
+        self._emit(MPIEventType.STOP)
+        return OK, ""
+
+    def _resume(self, source: ActionSource) -> tuple[Message, str]:
+        refused = self._refuse((MPIState.STOPPED,))
+        if refused:
+            return refused
+        t = self._ctl.time
+        self._rebase(t)
+        self.clock = self.clock.ramp_to(t, self.config.normal_feedrate, self.config.decel_time.stop)
+        self._stop_end = math.inf
+        for axis in self.axes:
+            if axis.owner == self.number:
+                plan = axis.plan
+                axis.status_mode = StatusMode.VELOCITY if plan is not None and plan.is_velocity else StatusMode.POINT_TO_POINT
+        self._set_state(MPIState.MOVING, "RESUME", source)
+        self._emit(MPIEventType.RESUME)
+        return OK, ""
+
+    def _e_stop(self, source: ActionSource, then_abort: bool = False) -> tuple[Message, str]:
+        self._map_if_unmapped()
+        t = self._ctl.time
+        if self.own_state is MPIState.ERROR:
+            if then_abort and not self._aborted:
+                self._disable_amps(t)
+            return OK, "already in ERROR"
+        if self.own_state is MPIState.STOPPING_ERROR:
+            self._abort_after_stop |= then_abort
+            return OK, "already stopping on error"
+        self._rebase(t)
+        e_stop = self.config.decel_time.e_stop
+        self.clock = self.clock.ramp_to(t, 0.0, e_stop)
+        self._stop_end = t + e_stop
+        self._abort_after_stop = then_abort
+        self._claim_axes()
+        for axis in self.axes:
+            axis.status_mode = StatusMode.E_STOP
+            if axis.in_position.settle_on_estop_cmd_eq_act and axis.amp_enabled:
+                axis.follow_actual(t, self.clock)
+        self._set_state(MPIState.STOPPING_ERROR, "E_STOP_ABORT" if then_abort else "E_STOP", source)
+        self._emit(MPIEventType.E_STOP)
+        return OK, ""
+
+    def _e_stop_abort(self, source: ActionSource) -> tuple[Message, str]:
+        return self._e_stop(source, then_abort=True)
+
+    def _abort(self, source: ActionSource) -> tuple[Message, str]:
+        self._map_if_unmapped()
+        t = self._ctl.time
+        self._claim_axes()
+        self._rebase(t)
+        self._disable_amps(t)
+        if self.own_state is not MPIState.ERROR:
+            self._set_state(MPIState.STOPPING_ERROR, "ABORT", source)
+            self._error_at = self._ctl.sample + 1
+        self._emit(MPIEventType.ABORT)
+        return OK, ""
+
+    def _disable_amps(self, t: float) -> None:
+        self._aborted = True
+        for axis in self.axes:
+            axis.disable(t, self._clock_of(axis))
+            axis.status_mode = StatusMode.ABORT
+
+    def _claim_axes(self) -> None:
+        """Safety actions act on every mapped axis, whoever commanded it last."""
+        t = self._ctl.time
+        for axis in self.axes:
+            if axis.owner != self.number:
+                axis.rebase(t, self._clock_of(axis))
+                if axis.owner >= 0 and axis.plan is not None:
+                    # keep the motion going on this supervisor's clock from the same state
+                    axis.unload(t, self._clock_of(axis))
+                axis.owner = self.number
+
+    def _reset(self, source: ActionSource) -> tuple[Message, str]:
+        state = self.state
+        if state is MPIState.IDLE:
+            self._map()
+            return OK, "already IDLE"
+        refused = self._refuse((MPIState.STOPPED, MPIState.ERROR))
+        if refused:
+            return refused
+        t = self._ctl.time
+        self._rebase(t)
+        self._drop_pending(STATE_MESSAGES[state.name], f"dropped by RESET in {state.name}")
+        for axis in self.axes:
+            if axis.owner == self.number or axis.owner == -1:
+                axis.unload(t, self._clock_of(axis))
+                if not axis.amp_enabled or axis.mode is CommandMode.FOLLOW_ACTUAL:
+                    axis.enable(t, command_equals_actual=self._aborted or axis.mode is CommandMode.FOLLOW_ACTUAL)
+                axis.status_mode = StatusMode.POINT_TO_POINT
+                axis.target = axis.rest
+        self.clock = self.clock.ramp_to(t, self.config.normal_feedrate, 0.0)
+        self._stop_end = math.inf
+        self._aborted = False
+        self._error_at = None
+        self._abort_after_stop = False
+        self._map()
+        self._set_state(MPIState.IDLE, "RESET", source)
+        self._emit(MPIEventType.RESET)
+        return OK, ""
+
+    def _map_action(self, source: ActionSource) -> tuple[Message, str]:
+        refused = self._refuse((MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR))
+        if refused:
+            return refused
+        if not self.axis_list:
+            return Message.MEIMotionMessageNO_AXES_MAPPED, "the axis list is empty"
+        self._map()
+        return OK, ""
+
+    def _map_if_unmapped(self) -> None:
+        if not self.mapped:
+            self._map()
+
+    def _set_status_mode(self, mode: StatusMode) -> None:
+        for axis in self.axes:
+            if axis.owner == self.number:
+                axis.status_mode = mode
+
+    # ================================================================= stepping ====
+    def scan(self, samples: np.ndarray, t: np.ndarray, traces, statuses) -> np.ndarray | None:
+        """Per sample: does a transition of this supervisor happen there?"""
+        state = self.own_state
+        if state is MPIState.MOVING:
+            return self._scan_moving(samples, traces, statuses)
+        if state is MPIState.STOPPING:
+            return self._stop_complete(t, statuses, settle=lambda a: a.in_position.settle_on_stop)
+        if state is MPIState.STOPPING_ERROR:
+            if self._error_at is not None:
+                return samples >= self._error_at
+            return self._stop_complete(t, statuses, settle=lambda a: a.in_position.settle_on_estop)
+        if state is MPIState.STOPPED and self._holds:
+            return self._hold_triggers(samples, traces)
+        return None
+
+    def _scan_moving(self, samples, traces, statuses) -> np.ndarray | None:
+        out = None
+        if self._holds:
+            out = self._hold_triggers(samples, traces)
+        if self.current is not None and not self._holds:
+            blend = bool(self.queue) and any(p.final_velocity != 0.0 for p in self.current.plans)
+            key = "trajectory_complete" if blend else "done"
+            complete = np.ones(len(samples), dtype=bool)
+            for plan in self.current.plans:
+                complete &= statuses[plan.axis].bits[key]
+            out = complete if out is None else out | complete
+        return out
+
+    def _stop_complete(self, t, statuses, settle) -> np.ndarray:
+        ready = t >= self._stop_end - 1e-12
+        for axis in self.axes:
+            if settle(axis) and axis.number in statuses:
+                ready = ready & statuses[axis.number].bits["done"]
+        return ready
+
+    def _hold_triggers(self, samples, traces) -> np.ndarray:
+        out = np.zeros(len(samples), dtype=bool)
+        for wait in self._holds.values():
+            out |= self._hold_trigger(wait, samples, traces)
+        return out
+
+    def _hold_trigger(self, wait: HoldWait, samples, traces) -> np.ndarray:
+        if wait.watches_position:
+            from .types import HoldType  # noqa: WPS433
+            trace = traces[wait.hold.number]
+            origin = self._axis(wait.hold.number).origin
+            raw = trace.act_p if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else trace.cmd_p
+            fired = wait.position_trigger(raw - origin)
+        else:
+            fired = np.full(len(samples), wait.static_trigger(self._ctl.io))
+        return fired | wait.timed_out(samples)
+
+    def transition(self, index: int, samples, t, traces, statuses) -> None:
+        """Apply what happens at trace sample ``index`` (the controller is there now)."""
+        state = self.own_state
+        sample = int(samples[index])
+        if self._holds and state in (MPIState.MOVING, MPIState.STOPPED):
+            self._release_at(index, samples, traces)
+        if state is MPIState.MOVING and self.current is not None and not self._holds:
+            blend = bool(self.queue) and any(p.final_velocity != 0.0 for p in self.current.plans)
+            key = "trajectory_complete" if blend else "done"
+            if all(statuses[p.axis].bits[key][index] for p in self.current.plans):
+                self._move_done()
+        elif state is MPIState.STOPPING:
+            if self._stop_complete(t[index:index + 1], {k: _Row(v, index) for k, v in statuses.items()},
+                                   settle=lambda a: a.in_position.settle_on_stop)[0]:
+                self._set_state(MPIState.STOPPED, self.last_action, self.action_source)
+        elif state is MPIState.STOPPING_ERROR:
+            if self._error_at is not None and sample >= self._error_at:
+                self._enter_error()
+            elif self._error_at is None and self._stop_complete(
+                    t[index:index + 1], {k: _Row(v, index) for k, v in statuses.items()},
+                    settle=lambda a: a.in_position.settle_on_estop)[0]:
+                if self._abort_after_stop:
+                    self._disable_amps(self._ctl.time)
+                for axis in self.axes:
+                    if axis.mode is CommandMode.FOLLOW_ACTUAL:
+                        axis.disable(self._ctl.time, None)
+                        axis.status_mode = StatusMode.ABORT
+                self._enter_error()
+
+    def _enter_error(self) -> None:
+        self._error_at = None
+        t = self._ctl.time
+        self._rebase(t)
+        self._drop_pending(Message.MPIMotionMessageERROR, f"{self.last_action} by {self.action_source.value}")
+        for axis in self.axes:
+            if axis.owner == self.number and axis.plan is not None:
+                axis.unload(t, self.clock)
+        self._set_state(MPIState.ERROR, self.last_action, self.action_source)
+
+    def _move_done(self) -> None:
+        move = self.current
+        self._emit(MPIEventType.MOTION_DONE, move=move)
+        self._end_move(move, OK, "motion done")
+        self.current = None
+        if self.queue:
+            self._load(self.queue.popleft())
+        else:
+            self._set_state(MPIState.IDLE, self.last_action, self.action_source)
+
+    def _release_at(self, index: int, samples, traces) -> None:
+        for axis_number, wait in list(self._holds.items()):
+            fired = self._hold_trigger(wait, samples[index:index + 1], _sliced(traces, index))[0]
+            if fired:
+                self._release(axis_number, wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
+
+    def release_holds(self, io) -> None:
+        """Release holds whose (static) trigger is already true now."""
+        if not self._holds:
+            return
+        for axis_number, wait in list(self._holds.items()):
+            if not wait.watches_position and wait.static_trigger(io):
+                self._release(axis_number, wait, timed_out=False)
+            elif wait.watches_position:
+                axis = self._axis(wait.hold.number)
+                from .types import HoldType
+                position = axis.actual_position if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.command_position
+                if wait.position_trigger(np.array([position]))[0]:
+                    self._release(axis_number, wait, timed_out=False)
+
+    def _release(self, axis_number: int, wait: HoldWait, timed_out: bool) -> None:
+        del self._holds[axis_number]
+        t = self._ctl.time
+        axis = self._axis(axis_number)
+        axis.load(wait.plan, self.clock.tau_at(t), t, self.clock)
+        self._fire_outputs(wait.plan)
+        kind = MPIEventType.HOLD_TIMEOUT if timed_out else MPIEventType.HOLD_RELEASED
+        self._emit(kind, axis=axis_number, move=self.current, detail=wait.hold.type.name)
+
+    # ================================================================= status ====
+    def at_velocity_index(self, statuses, upto: int) -> int | None:
+        move = self.current
+        if move is None or self._at_velocity_sent or not move.is_velocity or self.own_state is not MPIState.MOVING:
+            return None
+        together = None
+        for plan in move.plans:
+            bits = statuses[plan.axis].bits["at_velocity"][: upto + 1]
+            together = bits if together is None else together & bits
+        hits = np.flatnonzero(together) if together is not None else []
+        return int(hits[0]) if len(hits) else None
+
+    def at_velocity_reached(self, sample: int) -> None:
+        self._at_velocity_sent = True
+        self._emit(MPIEventType.MOTION_AT_VELOCITY, sample=sample)
+
+    def snapshot(self) -> MotionSnapshot:
+        """mpiMotionStatus."""
+        axes = tuple(self._ctl.axis_snapshot(n) for n in self.mapped)
+        move = self.current or self.last_move
+        done = all(a.done for a in axes) if axes else True
+        return MotionSnapshot(
+            sample=self._ctl.sample,
+            number=self.number,
+            state=self.state,
+            axis_numbers=tuple(self.mapped),
+            axes=axes,
+            done=done and self.own_state is not MPIState.MOVING,
+            at_target=all(a.at_target for a in axes) if axes else True,
+            settled=all(a.settled for a in axes) if axes else True,
+            move_id=move.id if move else 0,
+            element_id=move.element_id if move else 0,
+            feedrate=self.clock.feedrate(self._ctl.time),
+            last_action=self.last_action,
+            action_source=self.action_source.value,
+            moves_pending=len(self.queue),
+            motion_type=move.type.name if move else "",
+            progress=self.progress(),
+            latched_events=tuple(self.latched.names()),
+        )
+
+    def progress(self) -> float:
+        """0..1 along the current move (profile time over its duration)."""
+        move = self.current
+        if move is None:
+            return 1.0 if self.last_move is not None else 0.0
+        fractions = []
+        for plan in move.plans:
+            axis = self._axis(plan.axis)
+            if axis.plan is not plan:
+                fractions.append(0.0)
+            elif plan.is_velocity:
+                fractions.append(1.0 if plan.ramp_end <= 0.0 else min(1.0, max(0.0, axis.rel / plan.ramp_end)))
+            else:
+                fractions.append(1.0 if plan.duration <= 0.0 else min(1.0, max(0.0, axis.rel / plan.duration)))
+        return min(fractions) if fractions else 0.0
+
+    # ================================================================= events ====
+    def _emit(self, kind: MPIEventType, axis: int = -1, move: Move | None = None, detail: str = "",
+              sample: int | None = None) -> None:
+        move = move or self.current
+        self._ctl.emit(kind, supervisor=self.number, axis=axis,
+                       move_id=move.id if move else 0, element_id=move.element_id if move else 0,
+                       detail=detail, extra_mask=move.event_mask if move else MPIEventType.NONE,
+                       sample=sample)
+
+
+class _Row:
+    """One sample of a StatusTrace, shaped like a StatusTrace of length 1."""
+
+    def __init__(self, status, index: int):
+        self.bits = {k: v[index:index + 1] for k, v in status.bits.items()}
+
+
+def _sliced(traces, index: int):
+    class _One:
+        pass
+
+    out = {}
+    for key, trace in traces.items():
+        one = _One()
+        one.act_p = trace.act_p[index:index + 1]
+        one.cmd_p = trace.cmd_p[index:index + 1]
+        out[key] = one
+    return out

@@ -1,0 +1,254 @@
+"""Compile a validated start/modify request into a Move: per-axis frames.
+
+Multi-axis rules (spec 000 MPIMotionAttrMask remarks, MPIMotionSCurve):
+- without SYNC_START/SYNC_END the first trajectory is the vector's: the axes move on a
+  straight line with one profile along it;
+- with SYNC_START/SYNC_END each axis uses its own trajectory; SYNC_END inserts wait
+  frames before the shorter profiles so all end together, SYNC_START adds delay frames
+  after them;
+- DELAY inserts a wait frame of delay[i] seconds before axis i's profile.
+Quirks kept from the firmware (spec 000 mpiMotionStart): a frame may not last more than
+16,384,000 samples (the axis stops abruptly there), and the fraction of a RELATIVE
+distance is truncated. Both are reported through ``notes``.
+
+Decision (the spec is silent): a vector modify whose current velocity is not along the
+new line cannot stay on one line; each axis is then planned from its own state with the
+vector's limits scaled by the axis' share of the new displacement (never less than its
+share of the current velocity).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .events import MPIEventType
+from .frames import AxisPlan, Move
+from .messages import Message
+from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, MotionParams, Trajectory
+from .profiles.point_to_point import point_to_point, reverses, velocity_move
+from .profiles.ramps import ProfileError
+from .profiles.segment import Segment
+from .types import MotionAttr, MPIMotionType
+
+A = MotionAttr
+
+
+class PlanError(Exception):
+    def __init__(self, message: Message, detail: str):
+        super().__init__(detail)
+        self.message = message
+        self.detail = detail
+
+
+@dataclass(slots=True)
+class AxisStart:
+    """Where an axis' new profile starts: raw position and velocity in profile time."""
+
+    axis: int
+    position: float
+    velocity: float = 0.0
+    origin: float = 0.0
+
+
+@dataclass(slots=True)
+class PlanNotes:
+    """Quirks that applied, as (event type, detail) to report."""
+
+    events: list[tuple[MPIEventType, str]] = field(default_factory=list)
+
+
+def _truncate_id(value: int, notes: PlanNotes) -> int:
+    half = 1 << (ID_BITS - 1)
+    truncated = ((int(value) + half) % (1 << ID_BITS)) - half
+    if truncated != value:
+        notes.events.append(
+            (MPIEventType.ID_TRUNCATED, f"id {value} stored as {truncated} (16-bit on the controller)")
+        )
+    return truncated
+
+
+def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
+    """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
+    targets = []
+    for start, value in zip(starts, params.position):
+        if A.RELATIVE in attrs:
+            distance = float(math.trunc(value))
+            if distance != value:
+                notes.events.append(
+                    (MPIEventType.RELATIVE_TRUNCATED,
+                     f"axis {start.axis}: relative distance {value!r} truncated to {distance:g}")
+                )
+            targets.append(start.position + distance)
+        else:
+            targets.append(value + start.origin)
+    return targets
+
+
+def _cap_frames(segments: list[Segment], sample_rate: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
+    """Cut the plan at the first frame longer than 16,384,000 samples."""
+    limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
+    for i, seg in enumerate(segments):
+        if seg.duration > limit:
+            notes.events.append(
+                (MPIEventType.FRAME_TIME_LIMIT,
+                 f"axis {axis}: a frame of {seg.duration:.1f} s exceeds {VELOCITY_FRAME_LIMIT_SAMPLES} samples;"
+                 " the axis will stop abruptly after it")
+            )
+            cut = Segment(limit, seg.p, seg.v, seg.a, seg.j)
+            return segments[:i] + [cut], True
+    return segments, False
+
+
+def _wait(position: float, duration: float) -> list[Segment]:
+    return [Segment(duration, position, 0.0, 0.0, 0.0)] if duration > 0.0 else []
+
+
+def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float, v_final: float, traj: Trajectory):
+    jerk_percent = traj.jerk_percent if motion_type is MPIMotionType.S_CURVE else 0.0
+    return point_to_point(
+        start.position, start.velocity, target, v_final,
+        traj.velocity, traj.acceleration, traj.deceleration, jerk_percent,
+    )
+
+
+def _vector_profiles(motion_type, starts, targets, finals, traj) -> list[list[Segment]]:
+    """One profile along the straight line from the start to the targets."""
+    p0 = np.array([s.position for s in starts])
+    v0 = np.array([s.velocity for s in starts])
+    delta = np.array(targets) - p0
+    length = float(np.linalg.norm(delta))
+    speed = float(np.linalg.norm(v0))
+    final = np.array(finals)
+    if length > 0.0:
+        unit = delta / length
+    elif speed > 0.0:
+        unit = v0 / speed
+    else:
+        return [[] for _ in starts]
+    along = float(v0 @ unit)
+    final_along = float(final @ unit)
+    parallel = np.allclose(v0, along * unit, rtol=1e-9, atol=1e-9 * (1.0 + speed))
+    final_parallel = np.allclose(final, final_along * unit, rtol=1e-9, atol=1e-9 * (1.0 + abs(final_along)))
+    if not final_parallel:
+        raise PlanError(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
+    if parallel:
+        line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along), length, final_along, traj)
+        return [[seg.scaled(float(u), float(p)) for seg in line] for u, p in zip(unit, p0)]
+    # Not on one line: each axis with its share of the vector's limits.
+    out = []
+    for i, start in enumerate(starts):
+        share = max(abs(float(unit[i])), abs(float(v0[i])) / speed if speed > 0.0 else 0.0, 1e-6)
+        scaled = Trajectory(traj.velocity * share, traj.acceleration * share, traj.deceleration * share,
+                            traj.jerk_percent)
+        out.append(_scalar_profile(motion_type, start, targets[i], float(final[i]), scaled))
+    return out
+
+
+def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], attrs: MotionAttr):
+    durations = [sum(s.duration for s in prof) for prof in profiles]
+    longest = max(durations, default=0.0)
+    out = []
+    for prof, start, target, duration in zip(profiles, starts, targets, durations):
+        pad = longest - duration
+        if A.SYNC_END in attrs and start.velocity == 0.0:
+            prof = _wait(start.position, pad) + prof
+        elif A.SYNC_START in attrs:
+            prof = prof + _wait(target, pad)
+        out.append(prof)
+    return out
+
+
+def compile_move(
+    supervisor: int,
+    motion_type: MPIMotionType,
+    attrs: MotionAttr,
+    params: MotionParams,
+    starts: list[AxisStart],
+    sample_rate: float,
+    moving: bool,
+) -> tuple[Move, PlanNotes]:
+    """The frames of a request for the axes ``starts`` (in the supervisor's order).
+
+    ``moving``: the axes are in motion (a modify), so a non-zero DELAY is illegal.
+    Raises PlanError with the spec's message when the profile cannot be made.
+    """
+    notes = PlanNotes()
+    if A.DELAY in attrs and moving and any(d != 0.0 for d in params.delay):
+        raise PlanError(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
+    try:
+        if motion_type in (MPIMotionType.VELOCITY,):
+            plans = _velocity_plans(params, attrs, starts, sample_rate, notes)
+        else:
+            plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
+    except ProfileError as exc:
+        raise PlanError(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
+    move = Move(
+        supervisor=supervisor,
+        type=motion_type,
+        attributes=attrs,
+        plans=plans,
+        id=_truncate_id(params.id, notes) if A.ID in attrs else 0,
+        element_id=int(params.element_id[0]) if A.ELEMENT_ID in attrs and params.element_id else 0,
+        event_mask=params.event_mask if A.EVENT in attrs else MPIEventType.NONE,
+    )
+    return move, notes
+
+
+def _holds_and_outputs(params: MotionParams, attrs: MotionAttr, index: int):
+    hold = params.hold[index] if attrs & (A.HOLD | A.HOLD_LESS | A.HOLD_GREATER) else None
+    outputs = list(params.output) if A.OUTPUT in attrs and index == 0 else []
+    return hold, outputs
+
+
+def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
+    targets = _targets(params, attrs, starts, notes)
+    finals = list(params.final_velocity) if A.FINAL_VEL in attrs else [0.0] * len(starts)
+    if attrs & (A.SYNC_START | A.SYNC_END):
+        profiles = [
+            _scalar_profile(motion_type, start, target, final, traj)
+            for start, target, final, traj in zip(starts, targets, finals, params.trajectory)
+        ]
+        profiles = _sync(profiles, starts, targets, attrs)
+    elif len(starts) == 1:
+        profiles = [_scalar_profile(motion_type, starts[0], targets[0], finals[0], params.trajectory[0])]
+    else:
+        profiles = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
+    plans = []
+    for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles)):
+        if A.NO_REVERSAL in attrs and reverses(prof, start.velocity):
+            raise PlanError(Message.MPIMotionMessagePROFILE_ERROR,
+                            f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
+        if A.DELAY in attrs:
+            prof = _wait(start.position, params.delay[i]) + prof
+        prof, truncated = _cap_frames(prof, sample_rate, start.axis, notes)
+        end = prof[-1].end_state() if prof else (target, final, 0.0)
+        hold, outputs = _holds_and_outputs(params, attrs, i)
+        plans.append(AxisPlan(
+            axis=start.axis, segments=prof, start_position=start.position,
+            target=end[0] if truncated else target,
+            final_velocity=0.0 if truncated else final,
+            hold=hold, outputs=outputs, truncated=truncated,
+        ))
+    return plans
+
+
+def _velocity_plans(params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
+    limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
+    trajs = params.trajectory if len(params.trajectory) == len(starts) else params.trajectory * len(starts)
+    plans = []
+    for i, (start, traj) in enumerate(zip(starts, trajs)):
+        delay = params.delay[i] if A.DELAY in attrs else 0.0
+        prof, ramp_time = velocity_move(start.position, start.velocity, traj.velocity, traj.acceleration,
+                                        traj.jerk_percent, limit if traj.velocity != 0.0 else 0.0)
+        prof = _wait(start.position, delay) + prof
+        end = prof[-1].end_state() if prof else (start.position, 0.0, 0.0)
+        hold, outputs = _holds_and_outputs(params, attrs, i)
+        plans.append(AxisPlan(
+            axis=start.axis, segments=prof, start_position=start.position, target=end[0],
+            final_velocity=0.0, hold=hold, outputs=outputs, truncated=traj.velocity != 0.0,
+            velocity_target=traj.velocity, ramp_end=delay + ramp_time,
+        ))
+    return plans

@@ -1,0 +1,184 @@
+"""The simulated servo: why actual position lags command and settling takes real time.
+
+The closed position loop is a second-order system with velocity and acceleration
+feed-forward:
+
+    y'' + 2 zeta w y' + w^2 y = w^2 u + 2 zeta w kv u' + ka u''
+
+driven by the command u(t), which is a polynomial in time between breakpoints (frame
+boundaries, feedrate ramps, commands). Between breakpoints the response is exact:
+a polynomial particular solution sum_m g_m u^(m)(t), with g_m the Taylor coefficients
+of the loop's transfer function, plus the decaying homogeneous solution. So the actual
+position at a sample is a function of the command history only, whatever batches the
+controller is stepped in; that is what makes replay exact.
+
+After ABORT the amplifier is off and the motor coasts: y'' = -y'/tau_c.
+The encoder reads y in whole counts (``encoder_resolution``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .params import PlantConfig
+
+_MAX_DEGREE = 6  # cubic segments composed with a quadratic feedrate time warp
+_QUIET = 1e-12  # homogeneous amplitude below which the loop counts as settled (counts)
+
+
+@dataclass(frozen=True, slots=True)
+class Forced:
+    """Particular (steady) solution of the loop for one input piece: y(s), y'(s)."""
+
+    y: list[float]
+    dy: list[float]
+
+
+@dataclass(slots=True)
+class PlantState:
+    """Continuous state of the motor at time ``t``: position and velocity (counts)."""
+
+    t: float
+    y: float
+    dy: float
+
+
+class Plant:
+    def __init__(self, config: PlantConfig):
+        if config.bandwidth_hz <= 0.0 or config.damping <= 0.0:
+            raise ValueError("plant bandwidth and damping must be positive")
+        if config.coast_time_constant <= 0.0:
+            raise ValueError("plant coast time constant must be positive")
+        self.config = config
+        w = 2.0 * math.pi * config.bandwidth_hz
+        z = config.damping
+        self._w2 = w * w
+        self._c = 2.0 * z * w  # damping term
+        self._sigma = -z * w
+        self._kind, self._q = self._modes(z, w)
+        self._gains = self._taylor(
+            num=(w * w, 2.0 * z * w * config.velocity_feedforward, config.acceleration_feedforward),
+            den=(w * w, 2.0 * z * w, 1.0),
+        )
+        self._resolution = config.encoder_resolution
+        self._coast = config.coast_time_constant
+
+    @staticmethod
+    def _modes(z: float, w: float) -> tuple[str, float]:
+        if abs(z - 1.0) < 1e-9:
+            return "critical", 0.0
+        if z < 1.0:
+            return "under", w * math.sqrt(1.0 - z * z)
+        return "over", w * math.sqrt(z * z - 1.0)
+
+    @staticmethod
+    def _taylor(num, den) -> np.ndarray:
+        """Coefficients g_0.. of num(s)/den(s) = sum g_m s^m."""
+        g = np.zeros(_MAX_DEGREE + 1)
+        for m in range(_MAX_DEGREE + 1):
+            acc = num[m] if m < len(num) else 0.0
+            for i in range(1, min(m, len(den) - 1) + 1):
+                acc -= den[i] * g[m - i]
+            g[m] = acc / den[0]
+        return g
+
+    # -- servo on ----------------------------------------------------------------
+    def particular(self, u: list[float]) -> list[float]:
+        """Polynomial particular solution for a polynomial input (coefficients, low first)."""
+        out = [0.0] * len(u)
+        deriv = list(u)
+        for g in self._gains[: len(u)]:
+            for i, c in enumerate(deriv):
+                out[i] += g * c
+            deriv = poly_der(deriv)
+        return out
+
+    def _homogeneous(self, e0: float, e1: float, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Free response from error state (e0, e1) after time(s) s."""
+        # (A - sigma I) e for A = [[0, 1], [-w^2, -c]]
+        b0 = -self._sigma * e0 + e1
+        b1 = -self._w2 * e0 + (-self._c - self._sigma) * e1
+        decay = np.exp(self._sigma * s)
+        if self._kind == "under":
+            c, sn = np.cos(self._q * s), np.sin(self._q * s) / self._q
+        elif self._kind == "over":
+            c, sn = np.cosh(self._q * s), np.sinh(self._q * s) / self._q
+        else:
+            c, sn = np.ones_like(s), s
+        return decay * (c * e0 + sn * b0), decay * (c * e1 + sn * b1)
+
+    def prepare(self, u: list[float]) -> "Forced":
+        """The loop's steady response to a polynomial input (reusable for a piece)."""
+        yp = self.particular(u)
+        return Forced(yp, poly_der(yp))
+
+    def response(self, state: PlantState, forced: "Forced", s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Position and velocity at local times ``s`` (from ``state.t``)."""
+        y = poly_eval(forced.y, s)
+        dy = poly_eval(forced.dy, s)
+        e0 = state.y - forced.y[0]
+        e1 = state.dy - forced.dy[0]
+        if abs(e0) + abs(e1) / (-self._sigma) <= _QUIET:
+            return y, dy
+        h0, h1 = self._homogeneous(e0, e1, s)
+        return y + h0, dy + h1
+
+    def quiet(self, state: PlantState, yp: list[float], after: float = 0.0) -> bool:
+        """True if the loop has settled onto the steady solution ``after`` s past ``state``."""
+        dyp0 = yp[1] if len(yp) > 1 else 0.0
+        size = abs(state.y - yp[0]) + abs(state.dy - dyp0) / (-self._sigma)
+        return size * math.exp(self._sigma * after) <= _QUIET
+
+    def advance(self, state: PlantState, forced: "Forced", t: float) -> PlantState:
+        """State at time ``t`` (within the piece that starts at ``state.t``)."""
+        y, dy = self.response(state, forced, np.array([t - state.t]))
+        return PlantState(t, float(y[0]), float(dy[0]))
+
+    # -- servo off (ABORT) ---------------------------------------------------------
+    def coast(self, state: PlantState, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        k = np.exp(-s / self._coast)
+        return state.y + state.dy * self._coast * (1.0 - k), state.dy * k
+
+    def coast_to(self, state: PlantState, t: float) -> PlantState:
+        y, dy = self.coast(state, np.array([t - state.t]))
+        return PlantState(t, float(y[0]), float(dy[0]))
+
+    # -- encoder ---------------------------------------------------------------------
+    def read(self, y: np.ndarray) -> np.ndarray:
+        """Encoder reading of motor position(s)."""
+        if self._resolution <= 0.0:
+            return y
+        return np.floor(y / self._resolution + 0.5) * self._resolution
+
+
+def poly_der(c: list[float]) -> list[float]:
+    return [i * c[i] for i in range(1, len(c))] or [0.0]
+
+
+def poly_eval(c: list[float], s: np.ndarray) -> np.ndarray:
+    out = np.full(len(s), c[-1])
+    for coefficient in reversed(c[:-1]):
+        out *= s
+        out += coefficient
+    return out
+
+
+def _poly_mul(a: list[float], b: list[float]) -> list[float]:
+    out = [0.0] * (len(a) + len(b) - 1)
+    for i, x in enumerate(a):
+        for j, y in enumerate(b):
+            out[i + j] += x * y
+    return out
+
+
+def compose(segment_poly: list[float], quadratic: tuple[float, float, float]) -> list[float]:
+    """segment_poly(q0 + q1 s + q2 s^2) as coefficients in s (low first)."""
+    q = list(quadratic) if quadratic[2] != 0.0 else list(quadratic[:2])
+    out = [segment_poly[-1]]
+    for c in reversed(segment_poly[:-1]):
+        out = _poly_mul(out, q)
+        out[0] += c
+    return out

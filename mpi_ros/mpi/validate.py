@@ -1,0 +1,228 @@
+"""Validation of a start/modify request, before any calculation.
+
+Implements spec 000 "Returns for mpiMotionStart and mpiMotionModify" and the
+"possible causes for receiving an MPIMotionMessageATTRIBUTE_INVALID" lists, plus the
+array-length rules of DESIGN.md. Each check answers the spec's message; the first
+failing check wins and nothing is changed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Iterable
+
+from .messages import Message
+from .params import MAX_COORD_AXES, MAX_GATES, Hold, MotionParams, Output
+from .types import (
+    CAM_ATTRS,
+    CAM_TYPES,
+    HOLD_ATTRS,
+    JERK_TYPES,
+    MODIFIABLE_TYPES,
+    PATH_TYPES,
+    POINT_TO_POINT_TYPES,
+    VELOCITY_TYPES,
+    HoldType,
+    MotionAttr,
+    MPIMotionType,
+    OutputType,
+)
+
+A = MotionAttr
+_PATH_ALLOWED = A.APPEND | A.RELATIVE | A.ID | A.ELEMENT_ID | HOLD_ATTRS | A.OUTPUT
+# spec 000: which attributes each type may carry.
+ALLOWED_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
+    MPIMotionType.PT: _PATH_ALLOWED,
+    MPIMotionType.PTF: _PATH_ALLOWED,
+    MPIMotionType.PVT: _PATH_ALLOWED,
+    MPIMotionType.PVTF: _PATH_ALLOWED,
+    MPIMotionType.SPLINE: _PATH_ALLOWED & ~A.APPEND,
+    MPIMotionType.BESSEL: _PATH_ALLOWED,
+    MPIMotionType.BSPLINE: _PATH_ALLOWED,
+    MPIMotionType.BSPLINE2: _PATH_ALLOWED,
+    MPIMotionType.FRAME: A.APPEND | A.ID,
+}
+# spec 000: "VELOCITY, VELOCITY_JERK Moves are not permitted to have the following".
+FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
+    MPIMotionType.VELOCITY: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,
+    MPIMotionType.VELOCITY_JERK: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,
+}
+# spec 000 mpiMotionStart: the supported list (cams are not on it).
+SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID} - CAM_TYPES
+# Types this simulator executes today; the rest of SUPPORTED_TYPES answer UNSUPPORTED.
+EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES
+
+
+@dataclass(frozen=True, slots=True)
+class Verdict:
+    message: Message
+    detail: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.message is Message.MPIMessageOK
+
+
+OK = Verdict(Message.MPIMessageOK)
+
+
+def _bad(message: Message, detail: str) -> Verdict:
+    return Verdict(message, detail)
+
+
+def check_type(
+    motion_type: MPIMotionType, modify: bool, firmware_option_21: bool
+) -> Verdict:
+    if motion_type is MPIMotionType.INVALID:
+        return _bad(Message.MPIMotionMessageTYPE_INVALID, "motion type INVALID")
+    if motion_type in JERK_TYPES and not firmware_option_21:
+        return _bad(
+            Message.MPIMotionMessagePROFILE_NOT_SUPPORTED,
+            f"{motion_type.name} needs firmware option 21 (controller.firmware_option_21)",
+        )
+    if motion_type not in SUPPORTED_TYPES:
+        return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} is not supported by the controller")
+    if modify and motion_type not in MODIFIABLE_TYPES:
+        return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} moves cannot be modified")
+    if motion_type not in EXECUTED_TYPES:
+        return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} motion is not simulated yet")
+    return OK
+
+
+def check_attributes(
+    motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool
+) -> Verdict:
+    bad = Message.MPIMotionMessageATTRIBUTE_INVALID
+    allowed = ALLOWED_ATTRIBUTES.get(motion_type)
+    if allowed is not None and attrs & ~allowed:
+        return _bad(bad, f"{motion_type.name} moves may not have {(attrs & ~allowed).names()}")
+    forbidden = FORBIDDEN_ATTRIBUTES.get(motion_type, A.NONE) & attrs
+    if forbidden:
+        return _bad(bad, f"{motion_type.name} moves may not have {forbidden.names()}")
+    if motion_type not in CAM_TYPES and attrs & CAM_ATTRS:
+        return _bad(bad, f"{(attrs & CAM_ATTRS).names()} are cam attributes")
+    if A.NO_BACKTRACK in attrs and A.NO_BACKTRACK_HOLD in attrs:
+        return _bad(bad, "NO_BACKTRACK and NO_BACKTRACK_HOLD exclude each other")
+    if modify and attrs & HOLD_ATTRS:
+        return _bad(bad, "HOLD, HOLD_LESS and HOLD_GREATER are not permitted during motion modifies")
+    if A.HOLD_LESS in attrs and A.HOLD_GREATER in attrs:
+        return _bad(bad, "HOLD_LESS and HOLD_GREATER exclude each other")
+    # "attribute specified and its address is NULL": an empty array here.
+    if A.DELAY in attrs and not params.delay:
+        return _bad(bad, "DELAY attribute specified and delay is empty")
+    if A.FINAL_VEL in attrs and not params.final_velocity:
+        return _bad(bad, "FINAL_VEL attribute specified and final_velocity is empty")
+    if attrs & HOLD_ATTRS and not params.hold:
+        return _bad(bad, "HOLD attribute specified and hold is empty")
+    if A.OUTPUT in attrs and not params.output:
+        return _bad(bad, "OUTPUT attribute specified and output is empty")
+    return OK
+
+
+def _finite(values: Iterable[float]) -> bool:
+    return all(math.isfinite(float(v)) for v in values)
+
+
+def check_params(
+    motion_type: MPIMotionType,
+    attrs: MotionAttr,
+    params: MotionParams,
+    axis_count: int,
+    io_words: int,
+    motors: int,
+    axes: int,
+) -> Verdict:
+    bad = Message.MPIMessagePARAM_INVALID
+    if axis_count > MAX_COORD_AXES:
+        return _bad(Message.MPIMessageARG_INVALID, f"{axis_count} axes exceed MEIXmpMAX_COORD_AXES ({MAX_COORD_AXES})")
+    velocity_type = motion_type in VELOCITY_TYPES
+    per_axis = bool(attrs & (A.SYNC_START | A.SYNC_END))
+    counts = {axis_count} if per_axis else ({1, axis_count} if velocity_type else {1})
+    if len(params.trajectory) not in counts:
+        want = " or ".join(str(c) for c in sorted(counts))
+        return _bad(bad, f"trajectory needs {want} element(s), got {len(params.trajectory)}")
+    if not velocity_type and len(params.position) != axis_count:
+        return _bad(bad, f"position needs {axis_count} value(s) (one per axis), got {len(params.position)}")
+    numbers = list(params.position if not velocity_type else [])
+    for traj in params.trajectory:
+        numbers += [traj.velocity, traj.acceleration, traj.deceleration, traj.jerk_percent,
+                    traj.acceleration_jerk, traj.deceleration_jerk]
+    if not _finite(numbers):
+        return _bad(bad, "positions and trajectory values must be finite")
+    for traj in params.trajectory:
+        verdict = _check_trajectory(motion_type, traj)
+        if not verdict.ok:
+            return verdict
+    for name, attr, values in (
+        ("delay", A.DELAY, params.delay),
+        ("final_velocity", A.FINAL_VEL, params.final_velocity),
+        ("hold", HOLD_ATTRS, params.hold),
+    ):
+        if attrs & attr and len(values) != axis_count:
+            return _bad(bad, f"{name} needs {axis_count} value(s) (one per axis), got {len(values)}")
+    if A.DELAY in attrs and not all(math.isfinite(d) and d >= 0.0 for d in params.delay):
+        return _bad(bad, "delays must be finite and >= 0")
+    if A.FINAL_VEL in attrs:
+        if not _finite(params.final_velocity):
+            return _bad(bad, "final velocities must be finite")
+    if attrs & HOLD_ATTRS:
+        for hold in params.hold:
+            verdict = _check_hold(hold, attrs, io_words, motors, axes)
+            if not verdict.ok:
+                return verdict
+    if A.OUTPUT in attrs:
+        for output in params.output:
+            verdict = _check_output(output, io_words, motors)
+            if not verdict.ok:
+                return verdict
+    if A.ELEMENT_ID in attrs and not params.element_id:
+        return _bad(bad, "ELEMENT_ID attribute specified and element_id is empty")
+    return OK
+
+
+def _check_trajectory(motion_type: MPIMotionType, traj) -> Verdict:
+    bad = Message.MPIMessagePARAM_INVALID
+    if motion_type in VELOCITY_TYPES:
+        if traj.acceleration <= 0.0:
+            return _bad(bad, "acceleration must be > 0")
+    else:
+        if traj.velocity <= 0.0 or traj.acceleration <= 0.0 or traj.deceleration <= 0.0:
+            return _bad(bad, "velocity, acceleration and deceleration must be > 0")
+    if motion_type in JERK_TYPES:
+        if traj.acceleration_jerk <= 0.0 or (
+            motion_type is MPIMotionType.S_CURVE_JERK and traj.deceleration_jerk <= 0.0
+        ):
+            return _bad(bad, "acceleration_jerk and deceleration_jerk must be > 0")
+    elif not 0.0 <= traj.jerk_percent <= 100.0:
+        return _bad(bad, "jerk_percent must be within 0..100")
+    return OK
+
+
+def _check_hold(hold: Hold, attrs: MotionAttr, io_words: int, motors: int, axes: int) -> Verdict:
+    bad = Message.MPIMessagePARAM_INVALID
+    if not (math.isfinite(hold.timeout) and hold.timeout >= 0.0 and math.isfinite(hold.position)):
+        return _bad(bad, "hold timeout must be >= 0 and position finite")
+    kind = hold.type
+    if kind is HoldType.INVALID:
+        return _bad(bad, "hold type INVALID")
+    if kind is HoldType.GATE and not 0 <= hold.gate < MAX_GATES:
+        return _bad(bad, f"hold gate must be 0..{MAX_GATES - 1}")
+    if kind in (HoldType.INPUT, HoldType.USER_ADDRESS) and not 0 <= hold.address < io_words:
+        return _bad(bad, f"hold address must be an I/O word 0..{io_words - 1}")
+    if kind in (HoldType.MOTOR_GENERAL_IO, HoldType.MOTOR_DEDICATED_IO) and not 0 <= hold.number < motors:
+        return _bad(bad, f"hold motor must be 0..{motors - 1}")
+    if kind in (HoldType.AXIS_POSITION_ACTUAL, HoldType.AXIS_POSITION_COMMAND) and not 0 <= hold.number < axes:
+        return _bad(bad, f"hold axis must be 0..{axes - 1}")
+    return OK
+
+
+def _check_output(output: Output, io_words: int, motors: int) -> Verdict:
+    bad = Message.MPIMessagePARAM_INVALID
+    if output.type is OutputType.INVALID:
+        return _bad(bad, "output type INVALID")
+    if output.type is OutputType.OUTPUT and not 0 <= output.address < io_words:
+        return _bad(bad, f"output address must be an I/O word 0..{io_words - 1}")
+    if output.type is OutputType.MOTOR and not 0 <= output.motor < motors:
+        return _bad(bad, f"output motor must be 0..{motors - 1}")
+    return OK
