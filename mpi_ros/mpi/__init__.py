@@ -1,4 +1,38 @@
-"""The simulated MPI/XMP motion controller (pure Python + numpy; no ROS here)."""
+"""The simulated MPI/XMP motion controller: pure Python + numpy, no ROS here.
+
+Where each spec concept lives (spec = ../shared/spec; 000 motion objects, 002 axes):
+
+| spec concept                                             | module |
+| -------------------------------------------------------- | ------ |
+| message codes (MPIMessage*, MPIMotionMessage*, MEI...)    | messages.py |
+| MPIState, MPIAction, MPIMotionType, attribute masks,      | types.py |
+|   MEIMotionAttrHoldType, MEIMotionAttrOutputType          |   |
+| MPIEventType / event masks, events with move/element id   | events.py |
+| MPIMotionParams, MPITrajectory, MEIMotionAttrHold/Output, | params.py |
+|   MPIMotionConfig, MPIMotionDecelTime, MPIAxisInPosition  |   |
+| the start/modify return table, ATTRIBUTE_INVALID lists    | validate.py |
+| trapezoid (TRAPEZOIDAL), S-curve reshaping (S_CURVE)      | profiles/ramps.py, profiles/scurve.py |
+| VELOCITY, point-to-point from (p, v) incl. reversal       | profiles/point_to_point.py |
+| S_CURVE_JERK / VELOCITY_JERK (firmware option 21)         | profiles/jerk.py |
+| constant-jerk segments ("frames"), the one representation | profiles/segment.py |
+| vector moves, SYNC_START/END, DELAY, RELATIVE, quirks     | planner.py |
+| frames per axis, the 128-frame buffer accounting          | frames.py |
+| feedrate (STOP ramps it to pauseFeedrate, RESUME back)    | clock.py |
+| simulated servo / encoder (actual lags command)           | plant.py |
+| Axis: positions, origin, command-position-set rules       | axis.py |
+| status bits IN_FINE/IN_COARSE/AT_TARGET/DONE/SETTLED/...  | status.py (002 tables, NOTE 1-3) |
+| HOLD triggers and timeouts                                | holds.py |
+| I/O image, control gates (meiControlGateSet)              | io.py |
+| Motion object: create/delete/validate, axis list, config, | motion.py |
+|   params, position, trajectory, status, events, actions,  |   |
+|   state machine IDLE/MOVING/STOPPING/STOPPED/...          |   |
+| motion log (meiMotionLogOpen/Print/Close)                 | log.py |
+| mpiMotionStatus / mpiAxisStatus / frame buffer status     | snapshot.py |
+| Controller: sample clock, step/run_until, objects, events | control.py |
+
+Start with ``Controller``: create it, ``create_motion``, ``axis_list_set``, ``start``,
+then ``step(n)`` or ``run_until(...)``. Every call answers a ``Message``.
+"""
 
 from .control import Controller
 from .events import Event, MPIEventType

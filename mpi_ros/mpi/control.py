@@ -330,7 +330,7 @@ class Controller:
         self.sample = int(samples[stop])
         if event_at is not None:
             for ms in self.supervisors:
-                ms.transition(stop, samples, t, traces, statuses)
+                ms.transition(stop, samples)
 
     def _status_events(self, stop: int, traces, statuses) -> None:
         """Events for status bits that turn on in samples up to ``stop``, in sample order."""

@@ -35,15 +35,18 @@ from .types import (
     MPIAction,
     MPIMotionType,
     MPIState,
-    OutputType,
+    HoldType,
     IoSpace,
+    OutputType,
 )
 
 if TYPE_CHECKING:
     from .control import Controller
 
 OK = Message.MPIMessageOK
-ActionCallback = Callable[["MotionSupervisor", MPIMotionType, MPIAction], object]
+# meiMotionActionFunction: called with (motion, motion type, action name) on every
+# start ("START"), modify ("MODIFY") and action ("STOP", "E_STOP", ...).
+ActionCallback = Callable[["MotionSupervisor", MPIMotionType, str], object]
 
 
 class MotionSupervisor:
@@ -71,6 +74,7 @@ class MotionSupervisor:
         self._error_at: int | None = None  # sample at which an ABORT completes
         self._aborted = False
         self._holds: dict[int, HoldWait] = {}
+        self._conditions: dict = {}
         self._at_velocity_sent = False
         self.log: MotionLog | None = None
         self.action_callback: ActionCallback | None = None
@@ -362,7 +366,7 @@ class MotionSupervisor:
         previous, self.action_callback = self.action_callback, callback
         return previous
 
-    def _notify_action(self, motion_type: MPIMotionType, action: MPIAction) -> None:
+    def _notify_action(self, motion_type: MPIMotionType, action: str) -> None:
         if self.action_callback is not None:
             self.action_callback(self, motion_type, action)
 
@@ -391,7 +395,7 @@ class MotionSupervisor:
     def _command(self, motion_type, attrs, params, modify) -> tuple[Message, str]:
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID, "invalid motion handle"
-        self._notify_action(motion_type, MPIAction.NONE)
+        self._notify_action(motion_type, "MODIFY" if modify else "START")
         if params is None:
             params = self.stored_params
         if not self.axis_list:
@@ -468,7 +472,8 @@ class MotionSupervisor:
             elif moving:
                 f = self.clock.feedrate(self._ctl.time)
                 velocity = axis.cmd_v / f if f > 0.0 else 0.0
-                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.origin))
+                acceleration = axis.cmd_a / (f * f) if f > 0.0 else 0.0
+                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.origin, acceleration))
             else:
                 starts.append(AxisStart(n, axis.cmd_p, 0.0, axis.origin))
         return starts
@@ -521,9 +526,9 @@ class MotionSupervisor:
             move.serial = previous.serial
             if not MotionAttr.ID & move.attributes:
                 move.id = previous.id
-        self._load(move)
+        self._load(move, announce=False)
 
-    def _load(self, move: Move) -> None:
+    def _load(self, move: Move, announce: bool = True) -> None:
         """Put ``move`` on its axes now (held axes wait for their trigger)."""
         t, sample = self._ctl.time, self._ctl.sample
         self.current = move
@@ -547,7 +552,8 @@ class MotionSupervisor:
             else:
                 axis.load(plan, tau, t, self.clock)
                 self._fire_outputs(plan)
-        self._emit(MPIEventType.MOTION_START, move=move)
+        if announce:
+            self._emit(MPIEventType.MOTION_START, move=move)
         self.release_holds(self._ctl.io)
 
     def _clock_of(self, axis: Axis) -> ProfileClock | None:
@@ -558,7 +564,6 @@ class MotionSupervisor:
         axis = self._axis(hold.number) if 0 <= hold.number < len(self._ctl.axes) else None
         if axis is None:
             return 0.0
-        from .types import HoldType  # local: only position holds need it
         return axis.actual_position if hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.command_position
 
     def _fire_outputs(self, plan) -> None:
@@ -575,12 +580,20 @@ class MotionSupervisor:
         return message
 
     def action_detail(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> tuple[Message, str]:
+        """mpiMotionAction, with why in words."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID, "invalid motion handle"
-        self._notify_action(self.current.type if self.current else MPIMotionType.INVALID, action)
+        handler = self._handlers.get(action)
+        if handler is None:
+            return Message.MPIMessagePARAM_INVALID, f"unknown action {action!r}"
+        self._notify_action(self.current.type if self.current else MPIMotionType.INVALID, MPIAction(action).name)
         if not self.axis_list and not self.mapped:
             return Message.MEIMotionMessageNO_AXES_MAPPED, "no axes mapped to the motion supervisor"
-        handler = {
+        return handler(source)
+
+    @property
+    def _handlers(self):
+        return {
             MPIAction.STOP: self._stop,
             MPIAction.RESUME: self._resume,
             MPIAction.E_STOP: self._e_stop,
@@ -588,10 +601,7 @@ class MotionSupervisor:
             MPIAction.E_STOP_ABORT: self._e_stop_abort,
             MPIAction.RESET: self._reset,
             MPIAction.MAP: self._map_action,
-        }.get(action)
-        if handler is None:
-            return Message.MPIMessagePARAM_INVALID, f"unknown action {action!r}"
-        return handler(source)
+        }
 
     def _refuse(self, allowed: tuple[MPIState, ...]) -> tuple[Message, str] | None:
         state = self.state
@@ -732,32 +742,35 @@ class MotionSupervisor:
 
     # ================================================================= stepping ====
     def scan(self, samples: np.ndarray, t: np.ndarray, traces, statuses) -> np.ndarray | None:
-        """Per sample: does a transition of this supervisor happen there?"""
-        state = self.own_state
-        if state is MPIState.MOVING:
-            return self._scan_moving(samples, traces, statuses)
-        if state is MPIState.STOPPING:
-            return self._stop_complete(t, statuses, settle=lambda a: a.in_position.settle_on_stop)
-        if state is MPIState.STOPPING_ERROR:
-            if self._error_at is not None:
-                return samples >= self._error_at
-            return self._stop_complete(t, statuses, settle=lambda a: a.in_position.settle_on_estop)
-        if state is MPIState.STOPPED and self._holds:
-            return self._hold_triggers(samples, traces)
-        return None
+        """Per sample of a stretch: does a transition of this supervisor happen there?
 
-    def _scan_moving(self, samples, traces, statuses) -> np.ndarray | None:
-        out = None
-        if self._holds:
-            out = self._hold_triggers(samples, traces)
-        if self.current is not None and not self._holds:
-            blend = bool(self.queue) and any(p.final_velocity != 0.0 for p in self.current.plans)
-            key = "trajectory_complete" if blend else "done"
+        The conditions are kept until :meth:`transition` applies them.
+        """
+        self._conditions = conditions = {}
+        state = self.own_state
+        if self._holds and state in (MPIState.MOVING, MPIState.STOPPED):
+            for axis_number, wait in self._holds.items():
+                conditions[("hold", axis_number)] = self._hold_trigger(wait, samples, traces)
+        if state is MPIState.MOVING and self.current is not None and not self._holds:
             complete = np.ones(len(samples), dtype=bool)
+            key = "trajectory_complete" if self._blends() else "done"
             for plan in self.current.plans:
                 complete &= statuses[plan.axis].bits[key]
-            out = complete if out is None else out | complete
-        return out
+            conditions["move_done"] = complete
+        elif state is MPIState.STOPPING:
+            conditions["stopped"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_stop)
+        elif state is MPIState.STOPPING_ERROR:
+            if self._error_at is not None:
+                conditions["error"] = samples >= self._error_at
+            else:
+                conditions["error"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_estop)
+        if not conditions:
+            return None
+        return np.logical_or.reduce(list(conditions.values()))
+
+    def _blends(self) -> bool:
+        """An appended move follows one that ends moving (FINAL_VEL): start it at TC."""
+        return bool(self.queue) and any(p.final_velocity != 0.0 for p in self.current.plans)
 
     def _stop_complete(self, t, statuses, settle) -> np.ndarray:
         ready = t >= self._stop_end - 1e-12
@@ -766,55 +779,45 @@ class MotionSupervisor:
                 ready = ready & statuses[axis.number].bits["done"]
         return ready
 
-    def _hold_triggers(self, samples, traces) -> np.ndarray:
-        out = np.zeros(len(samples), dtype=bool)
-        for wait in self._holds.values():
-            out |= self._hold_trigger(wait, samples, traces)
-        return out
-
     def _hold_trigger(self, wait: HoldWait, samples, traces) -> np.ndarray:
         if wait.watches_position:
-            from .types import HoldType  # noqa: WPS433
             trace = traces[wait.hold.number]
-            origin = self._axis(wait.hold.number).origin
             raw = trace.act_p if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else trace.cmd_p
-            fired = wait.position_trigger(raw - origin)
+            fired = wait.position_trigger(raw - self._axis(wait.hold.number).origin)
         else:
             fired = np.full(len(samples), wait.static_trigger(self._ctl.io))
         return fired | wait.timed_out(samples)
 
-    def transition(self, index: int, samples, t, traces, statuses) -> None:
-        """Apply what happens at trace sample ``index`` (the controller is there now)."""
-        state = self.own_state
-        sample = int(samples[index])
-        if self._holds and state in (MPIState.MOVING, MPIState.STOPPED):
-            self._release_at(index, samples, traces)
-        if state is MPIState.MOVING and self.current is not None and not self._holds:
-            blend = bool(self.queue) and any(p.final_velocity != 0.0 for p in self.current.plans)
-            key = "trajectory_complete" if blend else "done"
-            if all(statuses[p.axis].bits[key][index] for p in self.current.plans):
+    def transition(self, index: int, samples: np.ndarray) -> None:
+        """Apply what :meth:`scan` found at stretch sample ``index`` (the controller is there)."""
+        conditions, self._conditions = self._conditions, {}
+        for key, fired in conditions.items():
+            if not fired[index]:
+                continue
+            if key[0] == "hold":
+                wait = self._holds.get(key[1])
+                if wait is not None:
+                    self._release(key[1], wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
+            elif key == "move_done":
                 self._move_done()
-        elif state is MPIState.STOPPING:
-            if self._stop_complete(t[index:index + 1], {k: _Row(v, index) for k, v in statuses.items()},
-                                   settle=lambda a: a.in_position.settle_on_stop)[0]:
+            elif key == "stopped":
                 self._set_state(MPIState.STOPPED, self.last_action, self.action_source)
-        elif state is MPIState.STOPPING_ERROR:
-            if self._error_at is not None and sample >= self._error_at:
-                self._enter_error()
-            elif self._error_at is None and self._stop_complete(
-                    t[index:index + 1], {k: _Row(v, index) for k, v in statuses.items()},
-                    settle=lambda a: a.in_position.settle_on_estop)[0]:
-                if self._abort_after_stop:
-                    self._disable_amps(self._ctl.time)
-                for axis in self.axes:
-                    if axis.mode is CommandMode.FOLLOW_ACTUAL:
-                        axis.disable(self._ctl.time, None)
-                        axis.status_mode = StatusMode.ABORT
-                self._enter_error()
+            elif key == "error":
+                self._stop_on_error_complete()
 
-    def _enter_error(self) -> None:
-        self._error_at = None
+    def _stop_on_error_complete(self) -> None:
+        """E_STOP (or ABORT) has run its course: disable what must be, enter ERROR."""
         t = self._ctl.time
+        if self._error_at is None:
+            if self._abort_after_stop:
+                self._disable_amps(t)
+            for axis in self.axes:
+                if axis.mode is CommandMode.FOLLOW_ACTUAL:
+                    # settleOnEstopCmdEqAct: "After the Estop time elapses, the axis'
+                    # motors will disable the amplifiers."
+                    axis.disable(t, None)
+                    axis.status_mode = StatusMode.ABORT
+        self._error_at = None
         self._rebase(t)
         self._drop_pending(Message.MPIMotionMessageERROR, f"{self.last_action} by {self.action_source.value}")
         for axis in self.axes:
@@ -832,25 +835,18 @@ class MotionSupervisor:
         else:
             self._set_state(MPIState.IDLE, self.last_action, self.action_source)
 
-    def _release_at(self, index: int, samples, traces) -> None:
-        for axis_number, wait in list(self._holds.items()):
-            fired = self._hold_trigger(wait, samples[index:index + 1], _sliced(traces, index))[0]
-            if fired:
-                self._release(axis_number, wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
-
     def release_holds(self, io) -> None:
-        """Release holds whose (static) trigger is already true now."""
-        if not self._holds:
-            return
+        """Release holds whose trigger is true now (after a gate or I/O change, a load)."""
         for axis_number, wait in list(self._holds.items()):
-            if not wait.watches_position and wait.static_trigger(io):
-                self._release(axis_number, wait, timed_out=False)
-            elif wait.watches_position:
+            if wait.watches_position:
                 axis = self._axis(wait.hold.number)
-                from .types import HoldType
-                position = axis.actual_position if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.command_position
-                if wait.position_trigger(np.array([position]))[0]:
-                    self._release(axis_number, wait, timed_out=False)
+                actual = wait.hold.type is HoldType.AXIS_POSITION_ACTUAL
+                position = axis.actual_position if actual else axis.command_position
+                fired = bool(wait.position_trigger(np.array([position]))[0])
+            else:
+                fired = wait.static_trigger(io)
+            if fired:
+                self._release(axis_number, wait, timed_out=False)
 
     def _release(self, axis_number: int, wait: HoldWait, timed_out: bool) -> None:
         del self._holds[axis_number]
@@ -926,23 +922,3 @@ class MotionSupervisor:
                        move_id=move.id if move else 0, element_id=move.element_id if move else 0,
                        detail=detail, extra_mask=move.event_mask if move else MPIEventType.NONE,
                        sample=sample)
-
-
-class _Row:
-    """One sample of a StatusTrace, shaped like a StatusTrace of length 1."""
-
-    def __init__(self, status, index: int):
-        self.bits = {k: v[index:index + 1] for k, v in status.bits.items()}
-
-
-def _sliced(traces, index: int):
-    class _One:
-        pass
-
-    out = {}
-    for key, trace in traces.items():
-        one = _One()
-        one.act_p = trace.act_p[index:index + 1]
-        one.cmd_p = trace.cmd_p[index:index + 1]
-        out[key] = one
-    return out

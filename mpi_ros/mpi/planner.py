@@ -28,6 +28,7 @@ from .events import MPIEventType
 from .frames import AxisPlan, Move
 from .messages import Message
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, MotionParams, Trajectory
+from .profiles.jerk import point_to_point_jerk, velocity_jerk
 from .profiles.point_to_point import point_to_point, reverses, velocity_move
 from .profiles.ramps import ProfileError
 from .profiles.segment import Segment
@@ -51,6 +52,7 @@ class AxisStart:
     position: float
     velocity: float = 0.0
     origin: float = 0.0
+    acceleration: float = 0.0  # used by the jerk types only (they plan from the full state)
 
 
 @dataclass(slots=True)
@@ -107,6 +109,10 @@ def _wait(position: float, duration: float) -> list[Segment]:
 
 
 def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float, v_final: float, traj: Trajectory):
+    if motion_type is MPIMotionType.S_CURVE_JERK:
+        return point_to_point_jerk(
+            start.position, start.velocity, start.acceleration, target, v_final, traj.velocity,
+            (traj.acceleration, traj.acceleration_jerk), (traj.deceleration, traj.deceleration_jerk))
     jerk_percent = traj.jerk_percent if motion_type is MPIMotionType.S_CURVE else 0.0
     return point_to_point(
         start.position, start.velocity, target, v_final,
@@ -135,7 +141,9 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> list[list[Se
     if not final_parallel:
         raise PlanError(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if parallel:
-        line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along), length, final_along, traj)
+        accel = np.array([s.acceleration for s in starts])
+        line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, float(accel @ unit)), length,
+                               final_along, traj)
         return [[seg.scaled(float(u), float(p)) for seg in line] for u, p in zip(unit, p0)]
     # Not on one line: each axis with its share of the vector's limits.
     out = []
@@ -179,8 +187,8 @@ def compile_move(
     if A.DELAY in attrs and moving and any(d != 0.0 for d in params.delay):
         raise PlanError(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
     try:
-        if motion_type in (MPIMotionType.VELOCITY,):
-            plans = _velocity_plans(params, attrs, starts, sample_rate, notes)
+        if motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
+            plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
             plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
@@ -235,14 +243,20 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     return plans
 
 
-def _velocity_plans(params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
+def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     trajs = params.trajectory if len(params.trajectory) == len(starts) else params.trajectory * len(starts)
     plans = []
     for i, (start, traj) in enumerate(zip(starts, trajs)):
         delay = params.delay[i] if A.DELAY in attrs else 0.0
-        prof, ramp_time = velocity_move(start.position, start.velocity, traj.velocity, traj.acceleration,
-                                        traj.jerk_percent, limit if traj.velocity != 0.0 else 0.0)
+        cruise = limit if traj.velocity != 0.0 else 0.0
+        if motion_type is MPIMotionType.VELOCITY_JERK:
+            prof, ramp_time = velocity_jerk(start.position, start.velocity, start.acceleration, traj.velocity,
+                                            traj.acceleration, traj.acceleration_jerk, traj.deceleration_jerk,
+                                            cruise)
+        else:
+            prof, ramp_time = velocity_move(start.position, start.velocity, traj.velocity, traj.acceleration,
+                                            traj.jerk_percent, cruise)
         prof = _wait(start.position, delay) + prof
         end = prof[-1].end_state() if prof else (start.position, 0.0, 0.0)
         hold, outputs = _holds_and_outputs(params, attrs, i)
