@@ -1,0 +1,289 @@
+"""The suite's configuration (config/default.yaml): controller, axes, supervisors, ROS.
+
+Validated when loaded: every error names its key (``supervisors[1].axes[0]: axis 7
+does not exist (4 axes)``) so a wrong file never starts a half-configured suite. The
+same configuration builds the controller for the ROS suite, the CLI tools and replay.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import sys
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .mpi.control import Controller
+from .mpi.events import MPIEventType
+from .mpi.params import MAX_COORD_AXES, AxisInPosition, ControllerConfig, DecelTime, MotionConfig, PlantConfig
+from .mpi.plant import Plant
+from .mpi.types import MPIAction
+
+
+
+def default_config_path() -> Path:
+    """config/default.yaml: installed under share/mpi_ros/config, or in the source tree."""
+    candidates = [Path(sys.prefix) / "share" / "mpi_ros" / "config" / "default.yaml"]
+    try:
+        from ament_index_python.packages import get_package_share_directory
+
+        candidates.insert(0, Path(get_package_share_directory("mpi_ros")) / "config" / "default.yaml")
+    except Exception:  # noqa: BLE001 - no ament index (plain venv): fall back below
+        pass
+    candidates.append(Path(__file__).resolve().parent.parent / "config" / "default.yaml")
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    raise ConfigError("config/default.yaml not found (looked in " + ", ".join(map(str, candidates)) + ")")
+
+
+class ConfigError(ValueError):
+    """The configuration is invalid; the message names the key."""
+
+
+@dataclass(slots=True)
+class SupervisorSpec:
+    number: int
+    axes: list[int]
+    config: MotionConfig
+    event_notify: MPIEventType
+
+
+@dataclass(slots=True)
+class RosSettings:
+    namespace: str = "/mpi"
+    status_rate: float = 100.0
+    feedback_rate: float = 20.0
+    joint_states_rate: float = 100.0
+    diagnostics_rate: float = 1.0
+    clock_rate: float = 100.0
+    crosscheck: bool = False
+    executor_threads: int = 32
+
+
+@dataclass(slots=True)
+class SuiteConfig:
+    controller: ControllerConfig
+    in_position: list[AxisInPosition]
+    plant: list[PlantConfig]
+    supervisors: list[SupervisorSpec]
+    ros: RosSettings = field(default_factory=RosSettings)
+    source: str = "<defaults>"
+
+    @property
+    def axis_count(self) -> int:
+        return self.controller.axis_count
+
+    def build_controller(self) -> Controller:
+        """A controller with the configured axes and supervisors (axis lists mapped)."""
+        ctl = Controller(self.controller)
+        for axis, in_position, plant in zip(ctl.axes, self.in_position, self.plant):
+            axis.in_position = in_position.copy()
+            axis.plant = Plant(plant)
+        for spec in self.supervisors:
+            _, ms = ctl.create_motion(spec.number)
+            ms.config_set(spec.config)
+            ms.axis_list_set(spec.axes)
+            ms.event_notify_set(spec.event_notify)
+            ms.action(MPIAction.MAP)
+        return ctl
+
+
+def _merge(base: dict, override: dict) -> dict:
+    out = copy.deepcopy(base)
+    for key, value in (override or {}).items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+def _dataclass(cls, data: Any, where: str):
+    """Build dataclass ``cls`` from a mapping, with clear errors for unknown or bad keys."""
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: expected a mapping, got {type(data).__name__}")
+    known = {f.name: f for f in fields(cls)}
+    kwargs = {}
+    for key, value in data.items():
+        if key not in known:
+            raise ConfigError(f"{where}.{key}: unknown key (known: {', '.join(sorted(known))})")
+        default = getattr(cls(), key)
+        kwargs[key] = _coerce(value, default, f"{where}.{key}")
+    return cls(**kwargs)
+
+
+def _coerce(value: Any, default: Any, where: str):
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where}: expected true or false, got {value!r}")
+        return value
+    if isinstance(default, int) and not isinstance(default, bool):
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{where}: expected an integer, got {value!r}")
+        return value
+    if isinstance(default, float):
+        if isinstance(value, str):  # PyYAML reads 1e9 (no exponent sign) as a string
+            try:
+                value = float(value)
+            except ValueError:
+                pass
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ConfigError(f"{where}: expected a finite number, got {value!r}")
+        return float(value)
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise ConfigError(f"{where}: expected a string, got {value!r}")
+        return value
+    return value
+
+
+def _positive(value: float, where: str) -> None:
+    if not value > 0.0:
+        raise ConfigError(f"{where}: must be > 0, got {value!r}")
+
+
+def _controller(raw: dict, axis_count: int, supervisor_count: int) -> ControllerConfig:
+    raw = dict(raw or {})
+    cfg = _dataclass(ControllerConfig, {**raw, "axis_count": axis_count, "supervisor_count": supervisor_count},
+                     "controller")
+    _positive(cfg.sample_rate, "controller.sample_rate")
+    if cfg.frame_buffer_size < 16:
+        raise ConfigError(f"controller.frame_buffer_size: must be >= 16, got {cfg.frame_buffer_size}")
+    if cfg.io_words < 1:
+        raise ConfigError("controller.io_words: must be >= 1")
+    return cfg
+
+
+def _axes(raw: dict) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
+    raw = raw or {}
+    unknown = set(raw) - {"count", "defaults", "overrides"}
+    if unknown:
+        raise ConfigError(f"axes.{sorted(unknown)[0]}: unknown key (known: count, defaults, overrides)")
+    count = raw.get("count", 4)
+    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        raise ConfigError(f"axes.count: expected an integer >= 1, got {count!r}")
+    defaults = raw.get("defaults") or {}
+    overrides = raw.get("overrides") or {}
+    if not isinstance(overrides, dict):
+        raise ConfigError("axes.overrides: expected a mapping of axis number -> settings")
+    in_position, plants = [], []
+    for n in range(count):
+        merged = _merge(defaults, overrides.get(n, overrides.get(str(n), {})))
+        extra = set(merged) - {"in_position", "plant"}
+        if extra:
+            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: in_position, plant)")
+        ip = _dataclass(AxisInPosition, merged.get("in_position"), f"axes[{n}].in_position")
+        plant = _dataclass(PlantConfig, merged.get("plant"), f"axes[{n}].plant")
+        for key in ("position_fine", "velocity", "settling_time"):
+            if getattr(ip, key) < 0.0:
+                raise ConfigError(f"axes[{n}].in_position.{key}: must be >= 0")
+        _positive(plant.bandwidth_hz, f"axes[{n}].plant.bandwidth_hz")
+        _positive(plant.damping, f"axes[{n}].plant.damping")
+        _positive(plant.coast_time_constant, f"axes[{n}].plant.coast_time_constant")
+        if plant.encoder_resolution < 0.0:
+            raise ConfigError(f"axes[{n}].plant.encoder_resolution: must be >= 0")
+        in_position.append(ip)
+        plants.append(plant)
+    return count, in_position, plants
+
+
+def _motion_config(raw: dict, where: str) -> MotionConfig:
+    raw = dict(raw or {})
+    decel = DecelTime(
+        stop=_coerce(raw.pop("decel_time_stop", 0.5), 0.5, f"{where}.decel_time_stop"),
+        e_stop=_coerce(raw.pop("decel_time_e_stop", 0.05), 0.05, f"{where}.decel_time_e_stop"),
+    )
+    cfg = _dataclass(MotionConfig, raw, where)
+    cfg.decel_time = decel
+    _positive(decel.stop, f"{where}.decel_time_stop")
+    _positive(decel.e_stop, f"{where}.decel_time_e_stop")
+    _positive(cfg.normal_feedrate, f"{where}.normal_feedrate")
+    if cfg.pause_feedrate < 0.0:
+        raise ConfigError(f"{where}.pause_feedrate: must be >= 0")
+    return cfg
+
+
+def _supervisors(raw: list, defaults: dict, axis_count: int) -> list[SupervisorSpec]:
+    if not isinstance(raw, list) or not raw:
+        raise ConfigError("supervisors: expected a non-empty list")
+    defaults = defaults or {}
+    specs, seen = [], set()
+    for i, entry in enumerate(raw):
+        where = f"supervisors[{i}]"
+        if not isinstance(entry, dict):
+            raise ConfigError(f"{where}: expected a mapping with number and axes")
+        extra = set(entry) - {"number", "axes", "config", "event_notify"}
+        if extra:
+            raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: axes, config, event_notify, number)")
+        number = entry.get("number", i)
+        if isinstance(number, bool) or not isinstance(number, int) or number < 0:
+            raise ConfigError(f"{where}.number: expected an integer >= 0, got {number!r}")
+        if number in seen:
+            raise ConfigError(f"{where}.number: supervisor {number} is configured twice")
+        seen.add(number)
+        axes = entry.get("axes", [])
+        if not isinstance(axes, list) or not axes:
+            raise ConfigError(f"{where}.axes: expected a non-empty list of axis numbers")
+        if len(axes) > MAX_COORD_AXES:
+            raise ConfigError(f"{where}.axes: at most {MAX_COORD_AXES} axes (MEIXmpMAX_COORD_AXES)")
+        for j, axis in enumerate(axes):
+            if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < axis_count:
+                raise ConfigError(f"{where}.axes[{j}]: axis {axis!r} does not exist ({axis_count} axes)")
+        if len(set(axes)) != len(axes):
+            raise ConfigError(f"{where}.axes: an axis is listed twice")
+        config = _motion_config(_merge(defaults.get("config") or {}, entry.get("config") or {}), f"{where}.config")
+        notify_names = entry.get("event_notify", defaults.get("event_notify", ["ALL"]))
+        mask = MPIEventType.parse(notify_names) if isinstance(notify_names, list) else None
+        if mask is None:
+            raise ConfigError(f"{where}.event_notify: expected a list of event type names, got {notify_names!r}")
+        specs.append(SupervisorSpec(number, list(axes), config, mask))
+    return specs
+
+
+def _ros(raw: dict) -> RosSettings:
+    ros = _dataclass(RosSettings, raw, "ros")
+    for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate"):
+        _positive(getattr(ros, key), f"ros.{key}")
+    if ros.status_rate > 1000.0:
+        raise ConfigError(f"ros.status_rate: at most 1000 Hz, got {ros.status_rate}")
+    if not ros.namespace.startswith("/"):
+        raise ConfigError(f"ros.namespace: must start with '/', got {ros.namespace!r}")
+    if ros.executor_threads < 4:
+        raise ConfigError("ros.executor_threads: must be >= 4")
+    return ros
+
+
+def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
+    """Validate a configuration mapping (as loaded from YAML)."""
+    if not isinstance(data, dict):
+        raise ConfigError(f"{source}: expected a mapping at the top level")
+    known = {"controller", "axes", "supervisors", "supervisor_defaults", "ros"}
+    extra = set(data) - known
+    if extra:
+        raise ConfigError(f"{sorted(extra)[0]}: unknown top-level key (known: {', '.join(sorted(known))})")
+    count, in_position, plants = _axes(data.get("axes"))
+    supervisors = _supervisors(data.get("supervisors", [{"number": 0, "axes": [0]}]),
+                               data.get("supervisor_defaults"), count)
+    supervisor_count = max(s.number for s in supervisors) + 1
+    controller = _controller(data.get("controller"), count, supervisor_count)
+    return SuiteConfig(controller, in_position, plants, supervisors, _ros(data.get("ros")), source)
+
+
+def load(path: str | Path | None = None, overrides: dict | None = None) -> SuiteConfig:
+    """Load and validate a YAML configuration file (the packaged default if None)."""
+    path = Path(path) if path is not None else default_config_path()
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read ({exc.strerror})") from exc
+    try:
+        data = yaml.safe_load(text) or {}
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{path}: not valid YAML ({exc})") from exc
+    return parse(_merge(data, overrides or {}), str(path))

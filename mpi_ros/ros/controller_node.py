@@ -1,0 +1,180 @@
+"""The node that serves the controller as a whole: /<ns>/controller.
+
+Publishes /<ns>/axis<k>/status, /<ns>/events, /joint_states, /diagnostics and /clock
+(controller time, for use_sim_time consumers); serves the axis services
+(/<ns>/axis<k>/config_get|config_set|position_set) and the control's gates and I/O
+(/<ns>/gate_set|gate_get|io_get|io_set).
+"""
+
+from __future__ import annotations
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+
+from mpi_ros.msg import AxisStatus, MotionEvent
+from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisPositionSet, GateGet, GateSet, IoGet, IoSet
+
+from .. import requests as rq
+from ..commands import Command, Reply, io_space
+from ..config import RosSettings
+from ..mpi.messages import Message
+from ..mpi.types import MPIState
+from ..runner import ControllerRunner
+from . import convert
+from .supervisor_node import STATUS_QOS
+
+# Events are never dropped in a burst: reliable and deep.
+EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
+CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE)
+_LEVELS = {
+    MPIState.ERROR: DiagnosticStatus.ERROR,
+    MPIState.STOPPING_ERROR: DiagnosticStatus.ERROR,
+    MPIState.STOPPED: DiagnosticStatus.WARN,
+    MPIState.STOPPING: DiagnosticStatus.WARN,
+}
+
+
+def _level(value: int) -> bytes:
+    return bytes([value]) if isinstance(value, int) else value
+
+
+class ControllerNode(Node):
+    def __init__(self, runner: ControllerRunner, settings: RosSettings, **kwargs):
+        super().__init__("controller", namespace=settings.namespace, **kwargs)
+        self.runner = runner
+        self.settings = settings
+        self._service_group = ReentrantCallbackGroup()
+        count = len(runner.ctl.axes)
+        self._axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
+        for k in range(count):
+            self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp, k=k: self._on_config_get(k, resp))
+            self._service(AxisConfigSet, f"axis{k}/config_set", lambda req, resp, k=k: self._on_config_set(k, req, resp))
+            self._service(AxisPositionSet, f"axis{k}/position_set",
+                          lambda req, resp, k=k: self._on_position_set(k, req, resp))
+        self._service(GateSet, "gate_set", self._on_gate_set)
+        self._service(GateGet, "gate_get", self._on_gate_get)
+        self._service(IoSet, "io_set", self._on_io_set)
+        self._service(IoGet, "io_get", self._on_io_get)
+        self._events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
+        self._joints = self.create_publisher(JointState, "/joint_states", 10)
+        self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        self._clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
+        runner.add_periodic(settings.status_rate, self._collect_axis_status)
+        runner.add_periodic(settings.joint_states_rate, self._collect_joints)
+        runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
+        runner.add_periodic(settings.clock_rate, self._collect_clock)
+        runner.on_event(lambda event: convert.publish(self, self._events, convert.motion_event(event, runner.ctl.rate)))
+
+    def _service(self, srv_type, name, callback):
+        self.create_service(srv_type, name, callback, callback_group=self._service_group)
+
+    # -- periodic topics ------------------------------------------------------------------
+    def _collect_axis_status(self, ctl):
+        messages = [convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate) for a in ctl.axes]
+        return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._axis_status, messages)]
+
+    def _collect_joints(self, ctl):
+        msg = JointState()
+        msg.header.stamp = convert.stamp(ctl.sample, ctl.rate)
+        msg.name = [f"axis{a.number}" for a in ctl.axes]
+        msg.position = [float(a.actual_position) for a in ctl.axes]
+        msg.velocity = [float(a.act_v) for a in ctl.axes]
+        return lambda: convert.publish(self, self._joints, msg)
+
+    def _collect_clock(self, ctl):
+        msg = Clock(clock=convert.stamp(ctl.sample, ctl.rate))
+        return lambda: convert.publish(self, self._clock, msg)
+
+    def _collect_diagnostics(self, ctl):
+        array = DiagnosticArray()
+        array.header.stamp = convert.stamp(ctl.sample, ctl.rate)
+        for ms in ctl.supervisors:
+            array.status.append(self._supervisor_diagnostic(ms))
+        for axis in ctl.axes:
+            array.status.append(self._axis_diagnostic(ctl, axis))
+        return lambda: convert.publish(self, self._diagnostics, array)
+
+    def _supervisor_diagnostic(self, ms) -> DiagnosticStatus:
+        snap = ms.snapshot()
+        status = DiagnosticStatus()
+        status.name = f"{self.settings.namespace.strip('/')}/ms{ms.number}"
+        status.hardware_id = "mpi_ros simulated controller"
+        status.level = _level(_LEVELS.get(snap.state, DiagnosticStatus.OK))
+        status.message = f"{snap.state.name} ({snap.last_action} by {snap.action_source})"
+        status.values = [KeyValue(key=k, value=str(v)) for k, v in (
+            ("state", snap.state.name), ("last_action", snap.last_action), ("action_source", snap.action_source),
+            ("axes", list(snap.axis_numbers)), ("feedrate", f"{snap.feedrate:.3f}"), ("move_id", snap.move_id),
+            ("motion_type", snap.motion_type), ("moves_pending", snap.moves_pending),
+            ("latched_events", ",".join(snap.latched_events)))]
+        return status
+
+    def _axis_diagnostic(self, ctl, axis) -> DiagnosticStatus:
+        snap = ctl.axis_snapshot(axis.number)
+        status = DiagnosticStatus()
+        status.name = f"{self.settings.namespace.strip('/')}/axis{axis.number}"
+        status.hardware_id = "mpi_ros simulated controller"
+        if not snap.amp_enabled:
+            level, message = DiagnosticStatus.ERROR, "amplifier disabled (ABORT): RESET to enable"
+        elif abs(snap.position_error) > axis.in_position.position_coarse:
+            level, message = DiagnosticStatus.WARN, f"position error {snap.position_error:.1f} counts"
+        else:
+            level = _LEVELS.get(snap.state, DiagnosticStatus.OK)
+            message = snap.state.name + (", settled" if snap.settled else "")
+        status.level = _level(level)
+        status.message = message
+        status.values = [KeyValue(key=k, value=str(v)) for k, v in (
+            ("state", snap.state.name), ("command_position", f"{snap.command_position:.3f}"),
+            ("actual_position", f"{snap.actual_position:.3f}"), ("position_error", f"{snap.position_error:.3f}"),
+            ("command_velocity", f"{snap.command_velocity:.3f}"), ("done", snap.done), ("settled", snap.settled),
+            ("in_fine_position", snap.in_fine_position), ("frame_count", snap.frame_count),
+            ("supervisor", snap.supervisor))]
+        return status
+
+    # -- services -------------------------------------------------------------------------
+    @staticmethod
+    def _answer(response, reply: Reply):
+        response.message = reply.message.name
+        response.code = reply.message.code
+        return response
+
+    def _on_config_get(self, k: int, response):
+        cfg = self.runner.read(lambda ctl: ctl.axes[k].in_position.copy())
+        convert.fill(response.in_position, rq.in_position_to_dict(cfg))
+        return self._answer(response, Reply(Message.MPIMessageOK))
+
+    def _on_config_set(self, k: int, request, response):
+        reply, _ = self.runner.submit(Command("axis_config_set", axis=k,
+                                              request={"in_position": convert.to_dict(request.in_position)}))
+        return self._answer(response, reply)
+
+    def _on_position_set(self, k: int, request, response):
+        reply, _ = self.runner.submit(Command("axis_position_set", axis=k,
+                                              request={"which": request.which, "value": request.value}))
+        return self._answer(response, reply)
+
+    def _on_gate_set(self, request, response):
+        reply, _ = self.runner.submit(Command("gate_set", request={"gate": request.gate, "closed": request.closed}))
+        return self._answer(response, reply)
+
+    def _on_gate_get(self, request, response):
+        message, closed = self.runner.read(lambda ctl: ctl.gate_get(request.gate))
+        response.closed = closed
+        return self._answer(response, Reply(message))
+
+    def _on_io_set(self, request, response):
+        reply, _ = self.runner.submit(Command("io_set", request=convert.to_dict(request)))
+        return self._answer(response, reply)
+
+    def _on_io_get(self, request, response):
+        try:
+            space = io_space(request.space)
+        except rq.RequestError as exc:
+            return self._answer(response, Reply(exc.message))
+        message, value = self.runner.read(lambda ctl: ctl.io_get(space, request.index))
+        response.value = int(value)
+        return self._answer(response, Reply(message))
+

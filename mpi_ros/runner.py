@@ -1,0 +1,203 @@
+"""Runs the controller on its own clock thread and serialises access to it.
+
+Python cannot sleep 500 us reliably, so the thread wakes every few milliseconds and
+steps, in one batch, the samples that wall time x scale says are due (DESIGN.md). A
+command first catches the controller up to the sample that is due now and is then
+applied, so it takes effect within one sample of arriving. One lock guards the
+controller; work that talks to ROS (publishing) runs after the lock is released.
+
+Modes: ``time_scale`` 1 = real time, >1 faster, 0 = as fast as possible, None = manual
+(nothing runs by itself; ``step`` advances, as tests and replay do).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import OrderedDict, deque
+from dataclasses import dataclass
+from typing import Callable
+
+from .commands import Command, Reply, apply
+from .mpi.control import Controller
+from .mpi.events import Event
+from .mpi.messages import Message
+
+_log = logging.getLogger("mpi_ros.runner")
+FAST_BATCH = 2000  # samples per batch when running as fast as possible
+_OUTCOMES_KEPT = 100_000
+
+Output = Callable[[], None]  # work to do outside the lock (e.g. publish)
+
+
+@dataclass(frozen=True, slots=True)
+class MoveOutcome:
+    """How a move ended: MPIMessageOK when DONE, else why it was dropped."""
+
+    serial: int
+    message: Message
+    sample: int
+    detail: str
+
+
+@dataclass(slots=True)
+class _Periodic:
+    every: int
+    callback: Callable[[Controller], Output | None]
+    next_sample: int
+
+
+class ControllerRunner:
+    def __init__(self, controller: Controller, time_scale: float | None = 1.0, wake_period: float = 0.005):
+        if time_scale is not None and time_scale < 0:
+            raise ValueError("time_scale must be >= 0 (0: as fast as possible) or None (manual)")
+        self.ctl = controller
+        self.time_scale = time_scale
+        self.wake_period = wake_period
+        self.lock = threading.RLock()
+        self.changed = threading.Condition(self.lock)
+        self.outcomes: OrderedDict[int, MoveOutcome] = OrderedDict()
+        self._periodic: list[_Periodic] = []
+        self._command_listeners: list[Callable[[int, Command, Reply], None]] = []
+        self._event_listeners: list[Callable[[Event], None]] = []
+        self._outputs: deque[Output] = deque()
+        self._flush_lock = threading.Lock()
+        self._thread: threading.Thread | None = None
+        self._running = threading.Event()
+        self._anchor_wall = 0.0
+        self._anchor_sample = 0
+        controller.listeners.append(self._on_event)
+
+    # -- configuration ---------------------------------------------------------------
+    def add_periodic(self, rate_hz: float, callback: Callable[[Controller], Output | None]) -> None:
+        """Call ``callback(controller)`` (under the lock) every 1/rate_hz of controller time,
+        at exact samples; what it returns is run after the lock is released."""
+        every = max(1, round(self.ctl.rate / rate_hz))
+        with self.lock:
+            start = (self.ctl.sample // every + 1) * every
+            self._periodic.append(_Periodic(every, callback, start))
+
+    def on_command(self, listener: Callable[[int, Command, Reply], None]) -> None:
+        """``listener(sample, command, reply)`` for every command applied (under the lock)."""
+        self._command_listeners.append(listener)
+
+    def on_event(self, listener: Callable[[Event], None]) -> None:
+        """``listener(event)`` for every notified event (outside the lock, in order)."""
+        self._event_listeners.append(listener)
+
+    # -- the clock thread ---------------------------------------------------------------
+    def start(self) -> None:
+        if self.time_scale is None or self._thread is not None:
+            return
+        with self.lock:
+            self._anchor_wall = time.monotonic()
+            self._anchor_sample = self.ctl.sample
+        self._running.set()
+        self._thread = threading.Thread(target=self._loop, name="mpi-controller-clock", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._running.clear()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+            self._thread = None
+        self._flush()
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._running.is_set()
+
+    def _loop(self) -> None:
+        fastest = min((p.every for p in self._periodic), default=10**9) / self.ctl.rate
+        period = min(self.wake_period, fastest / max(self.time_scale or 1.0, 1e-9))
+        while self._running.is_set():
+            try:
+                with self.lock:
+                    self._catch_up()
+                self._flush()
+            except Exception:  # noqa: BLE001 - the clock must keep running; the error is logged
+                _log.exception("controller clock: a step or its output failed")
+            if self.time_scale:
+                time.sleep(period)
+
+    def due_sample(self) -> int:
+        """The sample the controller should be at now."""
+        if self.time_scale is None:
+            return self.ctl.sample
+        if self.time_scale == 0:
+            return self.ctl.sample + FAST_BATCH
+        elapsed = time.monotonic() - self._anchor_wall
+        return max(self.ctl.sample, self._anchor_sample + int(elapsed * self.time_scale * self.ctl.rate))
+
+    def _catch_up(self) -> None:
+        if self.running:
+            self._advance_to(self.due_sample())
+
+    # -- stepping ---------------------------------------------------------------------
+    def step(self, samples: int) -> None:
+        """Advance ``samples`` samples now (manual mode, replay, tests)."""
+        with self.lock:
+            self._advance_to(self.ctl.sample + samples)
+        self._flush()
+
+    def _advance_to(self, target: int) -> None:
+        ctl = self.ctl
+        while ctl.sample < target:
+            stop = min([target] + [p.next_sample for p in self._periodic])
+            if stop > ctl.sample:
+                ctl.step(stop - ctl.sample)
+            for periodic in self._periodic:
+                if periodic.next_sample <= ctl.sample:
+                    periodic.next_sample += periodic.every * max(1, (ctl.sample - periodic.next_sample) // periodic.every + 1)
+                    output = periodic.callback(ctl)
+                    if output is not None:
+                        self._outputs.append(output)
+        self._collect_outcomes()
+        self.changed.notify_all()
+
+    def _collect_outcomes(self) -> None:
+        for ms in self.ctl.supervisors:
+            for serial, message, sample, detail in ms.move_ends:
+                self.outcomes[serial] = MoveOutcome(serial, message, sample, detail)
+            ms.move_ends.clear()
+        while len(self.outcomes) > _OUTCOMES_KEPT:
+            self.outcomes.popitem(last=False)
+
+    # -- access -------------------------------------------------------------------------
+    def submit(self, command: Command) -> tuple[Reply, int]:
+        """Apply a command now; returns the reply and the sample it took effect at."""
+        with self.lock:
+            self._catch_up()
+            sample = self.ctl.effective_sample
+            reply = apply(self.ctl, command)
+            for listener in self._command_listeners:
+                listener(sample, command, reply)
+            self._collect_outcomes()
+            self.changed.notify_all()
+        self._flush()
+        return reply, sample
+
+    def read(self, reader: Callable[[Controller], object]):
+        """Run ``reader(controller)`` under the lock (queries; must not change anything)."""
+        with self.lock:
+            return reader(self.ctl)
+
+    def wait(self, predicate: Callable[[Controller], bool], timeout: float) -> bool:
+        """Wait (up to ``timeout`` s) until ``predicate(controller)`` holds."""
+        with self.changed:
+            return self.changed.wait_for(lambda: predicate(self.ctl), timeout)
+
+    # -- events and deferred work ----------------------------------------------------------
+    def _on_event(self, event: Event) -> None:
+        if self._event_listeners:
+            self._outputs.append(lambda e=event: [listener(e) for listener in self._event_listeners])
+
+    def _flush(self) -> None:
+        with self._flush_lock:
+            while self._outputs:
+                try:
+                    output = self._outputs.popleft()
+                except IndexError:
+                    break
+                output()
