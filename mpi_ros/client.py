@@ -32,6 +32,7 @@ from mpi_ros.srv import MotionAction
 
 from .errors import NoResponse, raise_for
 from .ros import convert
+from .ros.supervisor_node import ACTION_QOS
 
 @dataclass(frozen=True)
 class ActionReply:
@@ -80,8 +81,8 @@ class MotionClient:
         self._context = context
         prefix = f"{self.namespace}/ms{supervisor}"
         self.node = Node(node_name or f"mpi_ros_client_ms{supervisor}", context=context)
-        self._start = ActionClient(self.node, MotionStart, f"{prefix}/motion_start")
-        self._modify = ActionClient(self.node, MotionModify, f"{prefix}/motion_modify")
+        self._start = ActionClient(self.node, MotionStart, f"{prefix}/motion_start", **ACTION_QOS)
+        self._modify = ActionClient(self.node, MotionModify, f"{prefix}/motion_modify", **ACTION_QOS)
         self._action = self.node.create_client(MotionAction, f"{prefix}/action")
         self._status: MotionStatus | None = None
         self._status_event = threading.Condition()

@@ -22,23 +22,13 @@ from typing import Callable
 from .commands import Command, Reply, apply
 from .mpi.control import Controller
 from .mpi.events import Event
-from .mpi.messages import Message
+from .mpi.motion import MoveEnd
 
 _log = logging.getLogger("mpi_ros.runner")
 FAST_BATCH = 2000  # samples per batch when running as fast as possible
 _OUTCOMES_KEPT = 100_000
 
 Output = Callable[[], None]  # work to do outside the lock (e.g. publish)
-
-
-@dataclass(frozen=True, slots=True)
-class MoveOutcome:
-    """How a move ended: MPIMessageOK when DONE, else why it was dropped."""
-
-    serial: int
-    message: Message
-    sample: int
-    detail: str
 
 
 @dataclass(slots=True)
@@ -57,7 +47,7 @@ class ControllerRunner:
         self.wake_period = wake_period
         self.lock = threading.RLock()
         self.changed = threading.Condition(self.lock)
-        self.outcomes: OrderedDict[int, MoveOutcome] = OrderedDict()
+        self.outcomes: OrderedDict[int, MoveEnd] = OrderedDict()  # serial -> how the move ended
         self._periodic: list[_Periodic] = []
         self._command_listeners: list[Callable[[int, Command, Reply], None]] = []
         self._event_listeners: list[Callable[[Event], None]] = []
@@ -158,8 +148,8 @@ class ControllerRunner:
 
     def _collect_outcomes(self) -> None:
         for ms in self.ctl.supervisors:
-            for serial, message, sample, detail in ms.move_ends:
-                self.outcomes[serial] = MoveOutcome(serial, message, sample, detail)
+            for end in ms.move_ends:
+                self.outcomes[end.serial] = end
             ms.move_ends.clear()
         while len(self.outcomes) > _OUTCOMES_KEPT:
             self.outcomes.popitem(last=False)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
@@ -49,6 +50,18 @@ OK = Message.MPIMessageOK
 ActionCallback = Callable[["MotionSupervisor", MPIMotionType, str], object]
 
 
+@dataclass(frozen=True, slots=True)
+class MoveEnd:
+    """How a move ended, with the supervisor's axis positions at that sample."""
+
+    serial: int
+    message: Message
+    sample: int
+    detail: str
+    command_position: tuple[float, ...]
+    actual_position: tuple[float, ...]
+
+
 class MotionSupervisor:
     def __init__(self, controller: "Controller", number: int, config: MotionConfig):
         self._ctl = controller
@@ -78,7 +91,7 @@ class MotionSupervisor:
         self._at_velocity_sent = False
         self.log: MotionLog | None = None
         self.action_callback: ActionCallback | None = None
-        self.move_ends: list[tuple[int, Message, int, str]] = []  # (serial, message, sample, detail)
+        self.move_ends: list[MoveEnd] = []  # how each move ended, in order (drained by the owner)
 
     # ================================================================= handles ====
     def validate(self) -> Message:
@@ -415,7 +428,8 @@ class MotionSupervisor:
                 return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
         elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
             return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
-        verdict = validate.check_attributes(motion_type, attrs, params, modify and not auto_start)
+        # spec 000:971: HOLD is impossible with a modify "even when using the AUTO_START attribute"
+        verdict = validate.check_attributes(motion_type, attrs, params, modify)
         if not verdict.ok:
             return verdict.message, verdict.detail
         verdict = validate.check_params(
@@ -475,7 +489,10 @@ class MotionSupervisor:
                 acceleration = axis.cmd_a / (f * f) if f > 0.0 else 0.0
                 starts.append(AxisStart(n, axis.cmd_p, velocity, axis.origin, acceleration))
             else:
-                starts.append(AxisStart(n, axis.cmd_p, 0.0, axis.origin))
+                # A start runs at the normal feedrate from now on. The axis may still move (STOPPED
+                # at a non-zero pauseFeedrate, or past a FINAL_VEL move): start from that velocity.
+                f = self.config.normal_feedrate
+                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.origin, axis.cmd_a / (f * f)))
         return starts
 
     def _check_frames(self, moves: list[Move]) -> Message:
@@ -491,7 +508,10 @@ class MotionSupervisor:
                 axis.rebase(t, self.clock)
 
     def _end_move(self, move: Move, message: Message, detail: str) -> None:
-        self.move_ends.append((move.serial, message, self._ctl.sample, detail))
+        axes = [self._axis(n) for n in self.mapped]
+        self.move_ends.append(MoveEnd(move.serial, message, self._ctl.sample, detail,
+                                      tuple(a.command_position for a in axes),
+                                      tuple(a.actual_position for a in axes)))
 
     def _drop_pending(self, message: Message, detail: str) -> None:
         for move in list(self.queue):

@@ -25,6 +25,8 @@ class GoalEnd:
     message: Message
     detail: str
     sample: int
+    command_position: tuple[float, ...] | None = None  # at `sample`, when the controller recorded it
+    actual_position: tuple[float, ...] | None = None
 
     @property
     def succeeded(self) -> bool:
@@ -53,7 +55,8 @@ class GoalTracker:
         """How the goal ended, or None while it runs (call under the runner's lock)."""
         outcome = self.runner.outcomes.get(self.serial)
         if outcome is not None:
-            return GoalEnd(outcome.message, outcome.detail, outcome.sample)
+            return GoalEnd(outcome.message, outcome.detail, outcome.sample,
+                           outcome.command_position, outcome.actual_position)
         ms, move = self._pending(ctl)
         if ms is None:
             return GoalEnd(Message.MPIMotionMessageMOTION_INVALID, "supervisor deleted", ctl.sample)

@@ -7,7 +7,6 @@ reentrant callback group, apart from the goals, so E_STOP is served while goals 
 
 from __future__ import annotations
 
-import rclpy
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
@@ -44,6 +43,11 @@ from . import convert
 from .goal_tracker import GoalEnd, GoalTracker
 
 STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+# The action's services default to a history of 10: an E_STOP that ends more goals than
+# that at once would drop results. Deep enough for every goal a frame buffer can queue.
+ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+ACTION_QOS = dict(goal_service_qos_profile=ACTION_SERVICE_QOS, result_service_qos_profile=ACTION_SERVICE_QOS,
+                  cancel_service_qos_profile=ACTION_SERVICE_QOS)
 TRIGGER_ACTIONS = {"stop": "STOP", "e_stop": "E_STOP", "abort": "ABORT", "reset": "RESET", "resume": "RESUME"}
 
 
@@ -58,9 +62,11 @@ class SupervisorNode(Node):
         self._service_group = ReentrantCallbackGroup()
         self._actions = [
             ActionServer(self, MotionStart, "~/motion_start", lambda h: self._execute(h, MotionStart, MOTION_START),
-                         goal_callback=self._on_goal, cancel_callback=self._on_cancel, callback_group=self._goal_group),
+                         goal_callback=self._on_goal, cancel_callback=self._on_cancel, callback_group=self._goal_group,
+                         **ACTION_QOS),
             ActionServer(self, MotionModify, "~/motion_modify", lambda h: self._execute(h, MotionModify, MOTION_MODIFY),
-                         goal_callback=self._on_goal, cancel_callback=self._on_cancel, callback_group=self._goal_group),
+                         goal_callback=self._on_goal, cancel_callback=self._on_cancel, callback_group=self._goal_group,
+                         **ACTION_QOS),
         ]
         self._service(MotionAction, "action", self._on_action)
         for name, action in TRIGGER_ACTIONS.items():
@@ -122,7 +128,7 @@ class SupervisorNode(Node):
             end = tracker.wait(period)
             if end is not None:
                 break
-            if self._shutting_down or not rclpy.ok():
+            if self._shutting_down or not self.context.ok():
                 end = GoalEnd(Message.MPIMotionMessageSTOPPED, "the suite is shutting down", sample)
                 break
             handle.publish_feedback(self._feedback(action_type, reply.serial))
@@ -167,8 +173,8 @@ class SupervisorNode(Node):
                 axes = [ctl.axes[n] for n in ms.mapped]
                 result.state = int(ms.state)
                 result.state_name = ms.state.name
-                result.actual_position = [a.actual_position for a in axes]
-                result.command_position = [a.command_position for a in axes]
+                result.actual_position = list(end.actual_position or [a.actual_position for a in axes])
+                result.command_position = list(end.command_position or [a.command_position for a in axes])
                 move = ms.current or ms.last_move
                 result.move_id = move.id if move else 0
             return result
