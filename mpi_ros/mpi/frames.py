@@ -16,7 +16,7 @@ from typing import Sequence
 import numpy as np
 
 from .events import MPIEventType
-from .params import Hold, Output
+from .params import Hold, Output, Trajectory
 from .profiles.segment import Segment, SegmentTable
 from .types import MotionAttr, MPIMotionType
 
@@ -41,6 +41,9 @@ class AxisPlan:
     velocity_target: float | None = None  # VELOCITY moves: the commanded velocity
     ramp_end: float = 0.0  # VELOCITY moves: profile time at which the ramp is done
     truncated: bool = False  # a frame hit the 16,384,000-sample limit
+    limits: Trajectory | None = None  # the limits this axis' profile was planned with
+    start_velocity: float = 0.0  # velocity (profile time) the profile starts from
+    start_acceleration: float = 0.0
     table: SegmentTable = field(init=False)
     duration: float = field(init=False)
 

@@ -120,8 +120,15 @@ def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float,
     )
 
 
-def _vector_profiles(motion_type, starts, targets, finals, traj) -> list[list[Segment]]:
-    """One profile along the straight line from the start to the targets."""
+def _scaled(traj: Trajectory, share: float) -> Trajectory:
+    """An axis' share of the vector's limits (jerk percent is a ratio and stays)."""
+    return Trajectory(traj.velocity * share, traj.acceleration * share, traj.deceleration * share,
+                      traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
+
+
+def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[list[Segment]], list[Trajectory]]:
+    """One profile along the straight line from the start to the targets, and each
+    axis' effective limits (the vector's scaled by the axis' share of the line)."""
     p0 = np.array([s.position for s in starts])
     v0 = np.array([s.velocity for s in starts])
     delta = np.array(targets) - p0
@@ -133,7 +140,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> list[list[Se
     elif speed > 0.0:
         unit = v0 / speed
     else:
-        return [[] for _ in starts]
+        return [[] for _ in starts], [traj for _ in starts]
     along = float(v0 @ unit)
     final_along = float(final @ unit)
     parallel = np.allclose(v0, along * unit, rtol=1e-9, atol=1e-9 * (1.0 + speed))
@@ -144,15 +151,15 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> list[list[Se
         accel = np.array([s.acceleration for s in starts])
         line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, float(accel @ unit)), length,
                                final_along, traj)
-        return [[seg.scaled(float(u), float(p)) for seg in line] for u, p in zip(unit, p0)]
+        profiles = [[seg.scaled(float(u), float(p)) for seg in line] for u, p in zip(unit, p0)]
+        return profiles, [_scaled(traj, abs(float(u))) for u in unit]
     # Not on one line: each axis with its share of the vector's limits.
-    out = []
+    profiles, limits = [], []
     for i, start in enumerate(starts):
         share = max(abs(float(unit[i])), abs(float(v0[i])) / speed if speed > 0.0 else 0.0, 1e-6)
-        scaled = Trajectory(traj.velocity * share, traj.acceleration * share, traj.deceleration * share,
-                            traj.jerk_percent)
-        out.append(_scalar_profile(motion_type, start, targets[i], float(final[i]), scaled))
-    return out
+        limits.append(_scaled(traj, share))
+        profiles.append(_scalar_profile(motion_type, start, targets[i], float(final[i]), limits[-1]))
+    return profiles, limits
 
 
 def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], attrs: MotionAttr):
@@ -220,10 +227,12 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
             for start, target, final, traj in zip(starts, targets, finals, params.trajectory)
         ]
         profiles = _sync(profiles, starts, targets, attrs)
+        limits = list(params.trajectory)
     elif len(starts) == 1:
         profiles = [_scalar_profile(motion_type, starts[0], targets[0], finals[0], params.trajectory[0])]
+        limits = [params.trajectory[0]]
     else:
-        profiles = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
+        profiles, limits = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
     plans = []
     for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles)):
         if A.NO_REVERSAL in attrs and reverses(prof, start.velocity):
@@ -239,6 +248,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
             target=end[0] if truncated else target,
             final_velocity=0.0 if truncated else final,
             hold=hold, outputs=outputs, truncated=truncated,
+            limits=limits[i], start_velocity=start.velocity, start_acceleration=start.acceleration,
         ))
     return plans
 
@@ -264,5 +274,6 @@ def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> l
             axis=start.axis, segments=prof, start_position=start.position, target=end[0],
             final_velocity=0.0, hold=hold, outputs=outputs, truncated=traj.velocity != 0.0,
             velocity_target=traj.velocity, ramp_end=delay + ramp_time,
+            limits=traj, start_velocity=start.velocity, start_acceleration=start.acceleration,
         ))
     return plans
