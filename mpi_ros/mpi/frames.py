@@ -68,17 +68,19 @@ class AxisPlan:
         return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
 
     def evaluate(self, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, d/dtau and d2/dtau2 of the plan at relative profile times."""
+        """Position, d/dtau and d2/dtau2 of the plan at relative profile times.
+
+        From the end on the command is exactly the end state: on target (spec: AT_TARGET
+        is "command = target") at the final velocity, with zero acceleration.
+        """
         inside = np.minimum(rel, self.duration)
         p, v, a, _ = self.table.evaluate(inside)
-        past = rel > self.duration
-        if past.any():
-            extra = rel - self.duration
-            p = np.where(past, self.target + self.final_velocity * extra, p)
-            v = np.where(past, self.final_velocity, v)
-            a = np.where(past, 0.0, a)
-        # Exactly on target once complete (spec: AT_TARGET is "command = target").
-        p = np.where(rel == self.duration, self.target, p) if self.final_velocity == 0.0 else p
+        complete = rel >= self.duration
+        if complete.any():
+            extra = np.maximum(rel - self.duration, 0.0)
+            p = np.where(complete, self.target + self.final_velocity * extra, p)
+            v = np.where(complete, self.final_velocity, v)
+            a = np.where(complete, 0.0, a)
         return p, v, a
 
     def segment_poly(self, rel: float) -> tuple[float, list[float]]:

@@ -89,8 +89,27 @@ def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], n
     return targets
 
 
+def _check_finite(segments: list[Segment], axis: int) -> None:
+    """A profile that overflowed (absurd distances or limits) cannot be calculated."""
+    for seg in segments:
+        values = (seg.duration, seg.p, seg.v, seg.a, seg.j)
+        if not all(math.isfinite(v) for v in values) or not seg.duration >= 0.0:
+            raise ProfileError(f"axis {axis}: the profile cannot be calculated with these values (overflow)")
+
+
+def _check_lands(segments: list[Segment], start: AxisStart, target: float) -> None:
+    """The frames must end on the target: the executor snaps the command onto it when the
+    trajectory completes, which must never be a jump (guards against overflow and any
+    planning fault)."""
+    end = segments[-1].end_state()[0] if segments else start.position
+    scale = max(1.0, abs(target), abs(start.position))
+    if not math.isfinite(end) or abs(end - target) > 1e-9 * scale:
+        raise ProfileError(f"axis {start.axis}: the profile cannot be calculated with these values")
+
+
 def _cap_frames(segments: list[Segment], sample_rate: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
     """Cut the plan at the first frame longer than 16,384,000 samples."""
+    _check_finite(segments, axis)
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     for i, seg in enumerate(segments):
         if seg.duration > limit:
@@ -132,8 +151,10 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
     p0 = np.array([s.position for s in starts])
     v0 = np.array([s.velocity for s in starts])
     delta = np.array(targets) - p0
-    length = float(np.linalg.norm(delta))
-    speed = float(np.linalg.norm(v0))
+    length = math.hypot(*delta)  # no overflow for large components, unlike norm()
+    speed = math.hypot(*v0)
+    if not (math.isfinite(length) and math.isfinite(speed)):
+        raise ProfileError("the move's length cannot be calculated (overflow)")
     final = np.array(finals)
     if length > 0.0:
         unit = delta / length
@@ -240,6 +261,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
         if A.DELAY in attrs:
             prof = _wait(start.position, params.delay[i]) + prof
+        _check_lands(prof, start, target)
         prof, truncated = _cap_frames(prof, sample_rate, start.axis, notes)
         end = prof[-1].end_state() if prof else (target, final, 0.0)
         hold, outputs = _holds_and_outputs(params, attrs, i)
@@ -268,6 +290,7 @@ def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> l
             prof, ramp_time = velocity_move(start.position, start.velocity, traj.velocity, traj.acceleration,
                                             traj.jerk_percent, cruise)
         prof = _wait(start.position, delay) + prof
+        _check_finite(prof, start.axis)
         end = prof[-1].end_state() if prof else (start.position, 0.0, 0.0)
         hold, outputs = _holds_and_outputs(params, attrs, i)
         plans.append(AxisPlan(

@@ -158,6 +158,8 @@ def plan_point_to_point(
 def _absorb_rounding(plan: list[Ramp], distance: float) -> list[Ramp]:
     """Let the cruise (if any) absorb the last rounding error of the distance."""
     error = distance - sum(r.distance for r in plan)
+    if not math.isfinite(error):
+        raise ProfileError("the profile cannot be calculated with these values (overflow)")
     for i, ramp in enumerate(plan):
         if ramp.is_cruise and ramp.v_start != 0.0:
             duration = max(0.0, ramp.duration + error / ramp.v_start)
