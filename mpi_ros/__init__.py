@@ -1,0 +1,12 @@
+"""mpi_ros: a ROS 2 Jazzy node suite for MPI/XMP-style motion controllers.
+
+Each motion supervisor is a ROS 2 node (MotionStart/MotionModify actions, MPI actions as
+services, axis and motion status topics) in front of a faithful simulated controller.
+
+Subpackages: ``mpi_ros.mpi`` (the simulated controller, no rclpy), ``mpi_ros.ros`` (the nodes),
+``mpi_ros.cli`` (the ``mpi-ros`` command), and the generated interfaces ``mpi_ros.msg``,
+``mpi_ros.srv`` and ``mpi_ros.action`` (present only in an installed package, not in the
+source tree). Importing this package must stay cheap: it does not import rclpy.
+"""
+
+__version__ = "0.1.0"

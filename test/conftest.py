@@ -1,0 +1,60 @@
+"""Shared pytest set-up for mpi_ros.
+
+Runs before any test module imports rclpy:
+- every test run gets its own DDS domain (ROS_DOMAIN_ID from the pid, unless already set), so
+  concurrent runs on one machine do not see each other's nodes;
+- discovery stays on this machine (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST);
+- the RMW is rmw_fastrtps_cpp (the one the wheels ship), unless set;
+- generated messages check the types of assigned fields (ROS_PYTHON_CHECK_FIELDS=1).
+Child processes started by tests inherit these variables and so join the same domain.
+
+Fixtures: `ros_context` gives a fresh, initialised rclpy Context that is shut down after the
+test; every test also checks that rclpy's default context was shut down (and shuts it down
+if a test left it running).
+"""
+
+from __future__ import annotations
+
+import os
+
+# Domain IDs 1..100: valid for every RMW on Linux (0 is the default everyone uses).
+os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
+# Generated messages type-check field assignments only with this set (read at import time);
+# without it an int assigned to a float64 field silently serialises garbage.
+os.environ.setdefault("ROS_PYTHON_CHECK_FIELDS", "1")
+
+import sys  # noqa: E402
+
+import pytest  # noqa: E402
+
+
+def pytest_report_header(config):
+    return (f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']} "
+            f"ROS_AUTOMATIC_DISCOVERY_RANGE={os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE']} "
+            f"RMW_IMPLEMENTATION={os.environ['RMW_IMPLEMENTATION']}")
+
+
+@pytest.fixture
+def ros_context():
+    """A fresh rclpy context, initialised for this test and shut down after it."""
+    import rclpy
+
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    try:
+        yield context
+    finally:
+        context.try_shutdown()
+
+
+@pytest.fixture(autouse=True)
+def _shutdown_default_rclpy_context():
+    """After each test: rclpy's default context must not be left running."""
+    yield
+    rclpy = sys.modules.get("rclpy")
+    if rclpy is None:
+        return
+    if rclpy.ok():
+        rclpy.try_shutdown()
