@@ -72,6 +72,7 @@ class SuiteConfig:
     supervisors: list[SupervisorSpec]
     ros: RosSettings = field(default_factory=RosSettings)
     source: str = "<defaults>"
+    raw: dict = field(default_factory=dict)  # the validated mapping (recorded in bags for replay)
 
     @property
     def axis_count(self) -> int:
@@ -90,6 +91,11 @@ class SuiteConfig:
             ms.event_notify_set(spec.event_notify)
             ms.action(MPIAction.MAP)
         return ctl
+
+
+def merge(base: dict, override: dict) -> dict:
+    """``base`` with ``override`` merged in, mapping by mapping (neither is changed)."""
+    return _merge(base, override)
 
 
 def _merge(base: dict, override: dict) -> dict:
@@ -272,7 +278,7 @@ def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
                                data.get("supervisor_defaults"), count)
     supervisor_count = max(s.number for s in supervisors) + 1
     controller = _controller(data.get("controller"), count, supervisor_count)
-    return SuiteConfig(controller, in_position, plants, supervisors, _ros(data.get("ros")), source)
+    return SuiteConfig(controller, in_position, plants, supervisors, _ros(data.get("ros")), source, copy.deepcopy(data))
 
 
 def load(path: str | Path | None = None, overrides: dict | None = None) -> SuiteConfig:

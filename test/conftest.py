@@ -9,7 +9,7 @@ Runs before any test module imports rclpy:
 Child processes started by tests inherit these variables and so join the same domain.
 
 Fixtures: `ros_context` gives a fresh, initialised rclpy Context that is shut down after the
-test; every test also checks that rclpy's default context was shut down (and shuts it down
+test; `probe` a node in it, spun by its own executor thread (subscriptions, service calls); every test also checks that rclpy's default context was shut down (and shuts it down
 if a test left it running).
 """
 
@@ -26,6 +26,7 @@ os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
 os.environ.setdefault("ROS_PYTHON_CHECK_FIELDS", "1")
 
 import sys  # noqa: E402
+import threading  # noqa: E402
 
 import pytest  # noqa: E402
 
@@ -58,3 +59,22 @@ def _shutdown_default_rclpy_context():
         return
     if rclpy.ok():
         rclpy.try_shutdown()
+
+
+@pytest.fixture
+def probe(ros_context):
+    """A node with its own executor thread for subscriptions and service calls."""
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    node = Node("test_probe", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    thread = threading.Thread(target=executor.spin, daemon=True)
+    thread.start()
+    try:
+        yield node
+    finally:
+        executor.shutdown(timeout_sec=2.0)
+        thread.join(timeout=2.0)
+        node.destroy_node()

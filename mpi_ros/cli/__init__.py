@@ -25,6 +25,9 @@ from typing import Sequence
 # name -> module (absolute path). Add a subcommand by writing the module and adding it here.
 COMMANDS: dict[str, str] = {
     "run": "mpi_ros.cli.run",
+    "record": "mpi_ros.cli.record",
+    "replay": "mpi_ros.cli.replay",
+    "play": "mpi_ros.cli.play",
     "version": "mpi_ros.cli.version",
 }
 

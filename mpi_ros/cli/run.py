@@ -16,6 +16,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", help="suite configuration (YAML); default: the installed config/default.yaml")
     parser.add_argument("--time-scale", type=float, default=1.0,
                         help="1 real time, larger is faster, 0 as fast as possible (default 1)")
+    parser.add_argument("--record", metavar="BAG", help="record the run to this bag directory (see mpi-ros record)")
 
 
 def run(args) -> int:
@@ -37,6 +38,17 @@ def run(args) -> int:
     # rclpy's own SIGINT/SIGTERM handling shuts the context down and wakes the executor.
     rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])])
     suite = Suite(cfg, time_scale=args.time_scale)
+    recorder = None
+    if getattr(args, "record", None):
+        from mpi_ros.bag.recorder import Recorder
+
+        try:
+            recorder = Recorder(suite.runner, args.record, cfg)
+        except (OSError, FileExistsError) as exc:
+            print(f"mpi-ros run: cannot record: {exc}", file=sys.stderr)
+            suite.shutdown()
+            rclpy.try_shutdown()
+            return 2
     log = suite.controller_node.get_logger()
     log.info(f"mpi_ros suite up: {len(cfg.supervisors)} supervisor(s), {cfg.axis_count} axes, "
              f"{cfg.controller.sample_rate:g} Hz, time scale {args.time_scale:g}, config {cfg.source}")
@@ -47,6 +59,9 @@ def run(args) -> int:
         pass
     finally:
         suite.shutdown()
+        if recorder is not None:
+            recorder.close()
+            print(f"recorded to {args.record}", file=sys.stderr)
         rclpy.try_shutdown()
     print("mpi_ros suite stopped", file=sys.stderr)
     return 0

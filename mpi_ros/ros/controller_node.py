@@ -78,11 +78,7 @@ class ControllerNode(Node):
         return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._axis_status, messages)]
 
     def _collect_joints(self, ctl):
-        msg = JointState()
-        msg.header.stamp = convert.stamp(ctl.sample, ctl.rate)
-        msg.name = [f"axis{a.number}" for a in ctl.axes]
-        msg.position = [float(a.actual_position) for a in ctl.axes]
-        msg.velocity = [float(a.act_v) for a in ctl.axes]
+        msg = convert.joint_state(ctl)
         return lambda: convert.publish(self, self._joints, msg)
 
     def _collect_clock(self, ctl):

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from builtin_interfaces.msg import Time
 from rclpy._rclpy_pybind11 import RCLError
+from sensor_msgs.msg import JointState
 
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 
@@ -123,6 +124,16 @@ def motion_status(snap: MotionSnapshot, rate: float) -> MotionStatus:
     msg.action_source = snap.action_source
     msg.moves_pending = snap.moves_pending
     msg.motion_type = snap.motion_type
+    return msg
+
+
+def joint_state(ctl) -> JointState:
+    """Every axis as a joint: actual position and velocity."""
+    msg = JointState()
+    msg.header.stamp = stamp(ctl.sample, ctl.rate)
+    msg.name = [f"axis{a.number}" for a in ctl.axes]
+    msg.position = [float(a.actual_position) for a in ctl.axes]
+    msg.velocity = [float(a.act_v) for a in ctl.axes]
     return msg
 
 

@@ -99,25 +99,6 @@ def client1(suite, ros_context):
         ms1.close()
 
 
-@pytest.fixture
-def probe(ros_context):
-    """A node with its own executor thread for subscriptions and service calls."""
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.node import Node
-
-    node = Node("test_probe", context=ros_context)
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    thread = threading.Thread(target=executor.spin, daemon=True)
-    thread.start()
-    try:
-        yield node
-    finally:
-        executor.shutdown(timeout_sec=2.0)
-        thread.join(timeout=2.0)
-        node.destroy_node()
-
-
 def call(node, srv_type, name: str, request, timeout: float = WAIT):
     """Call a service from a probe node and wait for the response."""
     cli = node.create_client(srv_type, name)

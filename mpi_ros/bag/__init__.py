@@ -1,0 +1,10 @@
+"""MCAP recording and exact replay, in the rosbag2 layout (metadata.yaml + .mcap).
+
+schema.py   message definitions (ros2msg) and type hashes for the MCAP schemas
+writer.py   BagWriter: a rosbag2-compatible bag directory
+reader.py   BagReader: messages of a bag directory or a bare .mcap
+recorder.py Recorder: what the controller did, sample for sample, from the runner
+replay.py   replay(): the recorded commands into a fresh controller, compared
+scenario.py scripted runs (the regression fixtures are recorded from them)
+playback.py play(): a bag's topics onto the ROS graph with their original timing
+"""

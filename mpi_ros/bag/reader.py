@@ -1,0 +1,83 @@
+"""Read a bag this project (or rosbag2) wrote: a bag directory or a bare .mcap file."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable, Iterator
+
+import yaml
+from mcap.reader import make_reader
+
+from . import schema
+
+
+@dataclass(frozen=True, slots=True)
+class Recorded:
+    topic: str
+    type: str  # pkg/msg/Type
+    log_time: int  # ns
+    data: bytes  # CDR
+
+    def decode(self):
+        """The message as its generated Python class (the package must be installed)."""
+        from rclpy.serialization import deserialize_message
+
+        return deserialize_message(self.data, schema.message_class(self.type))
+
+
+def mcap_path(path: str | Path) -> Path:
+    """The .mcap file of a bag directory (from its metadata.yaml), or ``path`` itself."""
+    path = Path(path)
+    if path.is_file():
+        return path
+    metadata = path / "metadata.yaml"
+    if metadata.is_file():
+        info = yaml.safe_load(metadata.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+        return path / info["relative_file_paths"][0]
+    files = sorted(path.glob("*.mcap"))
+    if not files:
+        raise FileNotFoundError(f"{path}: no metadata.yaml and no .mcap file")
+    return files[0]
+
+
+class BagReader:
+    def __init__(self, path: str | Path):
+        self.path = mcap_path(path)
+
+    def _reader(self, stream):
+        return make_reader(stream)
+
+    def metadata(self, name: str) -> dict[str, str] | None:
+        """An MCAP metadata record's data, by name."""
+        with open(self.path, "rb") as stream:
+            for record in self._reader(stream).iter_metadata():
+                if record.name == name:
+                    return dict(record.metadata)
+        return None
+
+    def topics(self) -> dict[str, str]:
+        """topic -> pkg/msg/Type."""
+        with open(self.path, "rb") as stream:
+            summary = self._reader(stream).get_summary()
+        if summary is None:
+            return {}
+        return {ch.topic: summary.schemas[ch.schema_id].name for ch in summary.channels.values()}
+
+    def messages(self, topics: Iterable[str] | None = None) -> Iterator[Recorded]:
+        """Messages in log-time order."""
+        wanted = list(topics) if topics is not None else None
+        with open(self.path, "rb") as stream:
+            for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted, log_time_order=True):
+                yield Recorded(channel.topic, schema_.name, message.log_time, message.data)
+
+    def decoded(self, topics: Iterable[str] | None = None) -> Iterator[tuple[Recorded, Any]]:
+        for recorded in self.messages(topics):
+            yield recorded, recorded.decode()
+
+    def counts(self) -> dict[str, int]:
+        with open(self.path, "rb") as stream:
+            summary = self._reader(stream).get_summary()
+        if summary is None or summary.statistics is None:
+            return {}
+        return {summary.channels[cid].topic: n for cid, n in summary.statistics.channel_message_counts.items()}
