@@ -39,7 +39,7 @@ class _Periodic:
 
 
 class ControllerRunner:
-    def __init__(self, controller: Controller, time_scale: float | None = 1.0, wake_period: float = 0.005):
+    def __init__(self, controller: Controller, time_scale: float | None = 1.0, wake_period: float = 0.01):
         if time_scale is not None and time_scale < 0:
             raise ValueError("time_scale must be >= 0 (0: as fast as possible) or None (manual)")
         self.ctl = controller

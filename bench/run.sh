@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Run every benchmark and write bench/RESULTS.md (the figures quoted in the issues' notes).
+#   bench/run.sh
+set -euo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$repo/scripts/setup.sh"
+py="$repo/.venv/bin/python"
+out="$repo/bench/RESULTS.md"
+cd "$repo/bench"
+{
+    echo "# Benchmark results"
+    echo
+    echo "Measured with \`bench/run.sh\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $(uname -m), Python $("$py" -c 'import platform; print(platform.python_version())'))."
+    echo "Load on the machine during the run: $(cut -d' ' -f1-3 /proc/loadavg) (1/5/15 min)."
+    echo
+    echo "## Controller stepping (bench/bench_controller.py)"
+    echo
+    "$py" -P bench_controller.py
+    echo
+    echo "## Planning a start (bench/bench_planning.py)"
+    echo
+    "$py" -P bench_planning.py
+    echo
+    echo "## The ROS suite in real time (bench/bench_ros.py)"
+    echo
+    "$py" -P bench_ros.py
+} > "$out.tmp"
+mv "$out.tmp" "$out"
+cat "$out"
