@@ -18,6 +18,7 @@ class Recorded:
     type: str  # pkg/msg/Type
     log_time: int  # ns
     data: bytes  # CDR
+    sequence: int = 0  # the writer's count on the topic: the order messages were written in
 
     def decode(self):
         """The message as its generated Python class (the package must be installed)."""
@@ -69,7 +70,7 @@ class BagReader:
         wanted = list(topics) if topics is not None else None
         with open(self.path, "rb") as stream:
             for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted, log_time_order=True):
-                yield Recorded(channel.topic, schema_.name, message.log_time, message.data)
+                yield Recorded(channel.topic, schema_.name, message.log_time, message.data, message.sequence)
 
     def decoded(self, topics: Iterable[str] | None = None) -> Iterator[tuple[Recorded, Any]]:
         for recorded in self.messages(topics):

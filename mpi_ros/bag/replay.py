@@ -128,17 +128,19 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     ns = cfg.ros.namespace.rstrip("/")
     recorded_events = []
     timeline = []  # (controller sample, 0 status / 1 command, order, topic, type, msg)
-    for order, (item, msg) in enumerate(reader.decoded()):
+    for item, msg in reader.decoded():
         if item.topic == COMMANDS_TOPIC:
             # applied while the controller was one sample before the one it took effect at
-            timeline.append((msg.sample - 1, 1, order, item.topic, item.type, msg))
+            timeline.append((msg.sample - 1, 1, item.sequence, item.topic, item.type, msg))
         elif item.topic == f"{ns}/events":
             if msg.type not in NOT_REPLAYED:
-                recorded_events.append(msg)
+                recorded_events.append((item.sequence, msg))
         elif item.type in ("mpi_ros/msg/MotionStatus", "mpi_ros/msg/AxisStatus"):
             # statuses at a sample were taken before commands given at that sample
-            timeline.append((msg.sample, 0, order, item.topic, item.type, msg))
+            timeline.append((msg.sample, 0, item.sequence, item.topic, item.type, msg))
     timeline.sort(key=lambda entry: entry[:3])
+    # the order they were written in, which ties in log time may not keep
+    recorded_events = [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0])]
     for sample, kind, _, topic, msg_type, msg in timeline:
         _step_to(ctl, sample)
         if kind == 1:

@@ -65,6 +65,7 @@ class ControllerNode(Node):
         self._clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
         runner.add_periodic(settings.status_rate, self._collect_axis_status)
         runner.add_periodic(settings.joint_states_rate, self._collect_joints)
+        self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
         runner.add_periodic(settings.clock_rate, self._collect_clock)
         runner.on_event(lambda event: convert.publish(self, self._events, convert.motion_event(event, runner.ctl.rate)))
@@ -92,7 +93,14 @@ class ControllerNode(Node):
             array.status.append(self._supervisor_diagnostic(ms))
         for axis in ctl.axes:
             array.status.append(self._axis_diagnostic(ctl, axis))
+        for provider in self.diagnostic_providers:
+            array.status.extend(provider(ctl))
         return lambda: convert.publish(self, self._diagnostics, array)
+
+    def add_diagnostic(self, provider) -> None:
+        """``provider(controller) -> [DiagnosticStatus, ...]``, called (under the runner lock)
+        with every /diagnostics message; keep it cheap (e.g. the cross-check's counts)."""
+        self.diagnostic_providers.append(provider)
 
     def _supervisor_diagnostic(self, ms) -> DiagnosticStatus:
         snap = ms.snapshot()
@@ -131,46 +139,40 @@ class ControllerNode(Node):
         return status
 
     # -- services -------------------------------------------------------------------------
-    @staticmethod
-    def _answer(response, reply: Reply):
-        response.message = reply.message.name
-        response.code = reply.message.code
-        return response
-
     def _on_config_get(self, k: int, response):
         cfg = self.runner.read(lambda ctl: ctl.axes[k].in_position.copy())
         convert.fill(response.in_position, rq.in_position_to_dict(cfg))
-        return self._answer(response, Reply(Message.MPIMessageOK))
+        return convert.answer(response, Reply(Message.MPIMessageOK))
 
     def _on_config_set(self, k: int, request, response):
         reply, _ = self.runner.submit(Command("axis_config_set", axis=k,
                                               request={"in_position": convert.to_dict(request.in_position)}))
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
     def _on_position_set(self, k: int, request, response):
         reply, _ = self.runner.submit(Command("axis_position_set", axis=k,
                                               request={"which": request.which, "value": request.value}))
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
     def _on_gate_set(self, request, response):
         reply, _ = self.runner.submit(Command("gate_set", request={"gate": request.gate, "closed": request.closed}))
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
     def _on_gate_get(self, request, response):
         message, closed = self.runner.read(lambda ctl: ctl.gate_get(request.gate))
         response.closed = closed
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 
     def _on_io_set(self, request, response):
         reply, _ = self.runner.submit(Command("io_set", request=convert.to_dict(request)))
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
     def _on_io_get(self, request, response):
         try:
             space = io_space(request.space)
         except rq.RequestError as exc:
-            return self._answer(response, Reply(exc.message))
+            return convert.answer(response, Reply(exc.message))
         message, value = self.runner.read(lambda ctl: ctl.io_get(space, request.index))
         response.value = int(value)
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 

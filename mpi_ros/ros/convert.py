@@ -65,6 +65,13 @@ def _message_class(namespaced_type):
     return getattr(module, namespaced_type.name)
 
 
+def answer(response, reply):
+    """Put a controller reply's message (name and code) into a service response."""
+    response.message = reply.message.name
+    response.code = reply.message.code
+    return response
+
+
 def stamp(sample: int, rate: float) -> Time:
     """Controller time of a sample."""
     nanoseconds = int(round(sample * 1e9 / rate))

@@ -186,15 +186,9 @@ class SupervisorNode(Node):
         reply, _ = self.runner.submit(Command(operation, self.number, request=request))
         return reply
 
-    @staticmethod
-    def _answer(response, reply: Reply):
-        response.message = reply.message.name
-        response.code = reply.message.code
-        return response
-
     def _on_action(self, request, response):
         reply, sample = self.runner.submit(Command(ACTION, self.number, request={"action": request.action}))
-        self._answer(response, reply)
+        convert.answer(response, reply)
         response.state = int(reply.state)
         response.state_name = reply.state.name
         response.sample = sample
@@ -212,59 +206,59 @@ class SupervisorNode(Node):
     def _on_config_get(self, _request, response):
         message, config = self._read_ms(lambda ms: ms.config_get())
         convert.fill(response.config, rq.motion_config_to_dict(config))
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 
     def _on_config_set(self, request, response):
-        return self._answer(response, self._submit("config_set", {"config": convert.to_dict(request.config)}))
+        return convert.answer(response, self._submit("config_set", {"config": convert.to_dict(request.config)}))
 
     def _on_params_get(self, _request, response):
         message, params = self._read_ms(lambda ms: ms.params_get())
         response.params = convert.fill(MotionParamsMsg(), rq.params_to_dict(params))
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 
     def _on_params_set(self, request, response):
-        return self._answer(response, self._submit("params_set", {"params": convert.to_dict(request.params)}))
+        return convert.answer(response, self._submit("params_set", {"params": convert.to_dict(request.params)}))
 
     def _on_axis_list_get(self, _request, response):
         message, numbers, mapped = self._read_ms(lambda ms: (*ms.axis_list_get(), list(ms.mapped)))
         response.axis_numbers = numbers
         response.mapped_axis_numbers = mapped
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 
     def _on_axis_list_set(self, request, response):
         reply = self._submit("axis_list_set", {"axis_numbers": list(request.axis_numbers), "map": request.map})
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
     def _on_axis_list_edit(self, request, response):
         reply = self._submit("axis_list_edit", convert.to_dict(request))
         response.axis_numbers = list(reply.value or [])
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
     def _on_position_get(self, _request, response):
         message, actual, command = self._read_ms(lambda ms: ms.position_get())
         response.actual = [float(x) for x in actual]
         response.command = [float(x) for x in command]
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 
     def _on_position_set(self, request, response):
         reply = self._submit("position_set", {"actual": list(request.actual), "command": list(request.command)})
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
     def _on_frame_buffer_status(self, _request, response):
         message, statuses = self._read_ms(lambda ms: ms.frame_buffer_status())
         response.axes = [FrameBufferStatusMsg(axis=s.axis, size=s.size, frame_count=s.frame_count) for s in statuses]
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 
     def _on_event_notify_get(self, _request, response):
         message, mask = self._read_ms(lambda ms: ms.event_notify_get())
         response.event_types = mask.names()
-        return self._answer(response, Reply(message))
+        return convert.answer(response, Reply(message))
 
     def _on_event_notify_set(self, request, response):
-        return self._answer(response, self._submit("event_notify_set", {"event_types": list(request.event_types)}))
+        return convert.answer(response, self._submit("event_notify_set", {"event_types": list(request.event_types)}))
 
     def _on_event_reset(self, request, response):
         reply = self._submit("event_reset", {"event_types": list(request.event_types)})
         response.latched_event_types = list(reply.value or [])
-        return self._answer(response, reply)
+        return convert.answer(response, reply)
 
