@@ -19,7 +19,7 @@ import numpy as np
 from .axis import Axis
 from .events import Event, MPIEventType
 from .io import IoImage
-from .messages import Message
+from .messages import STATE_MESSAGES, Message
 from .motion import MotionSupervisor
 from .params import AxisInPosition, ControllerConfig, MotionConfig, PlantConfig
 from .snapshot import AxisSnapshot
@@ -101,8 +101,7 @@ class Controller:
         if unmapped:
             return Message.MPIAxisMessageNOT_MAPPED_TO_MS
         if ms.own_state not in (MPIState.IDLE, MPIState.ERROR):
-            return Message.MPIMotionMessageMOVING if ms.own_state is MPIState.MOVING else Message[
-                f"MPIMotionMessage{ms.own_state.name}"]
+            return STATE_MESSAGES[ms.own_state.name]
         for axis in self.axes:
             if axis.owner == ms.number:
                 axis.unload(self.time, ms.clock)

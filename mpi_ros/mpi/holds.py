@@ -47,9 +47,14 @@ class HoldWait:
             greater = position_now <= hold.position
         return cls(plan.axis, plan, hold, deadline, greater)
 
+    @staticmethod
+    def watches(hold: Hold) -> bool:
+        """Does ``hold`` trigger on an axis position?"""
+        return hold.type in (HoldType.AXIS_POSITION_ACTUAL, HoldType.AXIS_POSITION_COMMAND)
+
     @property
     def watches_position(self) -> bool:
-        return self.hold.type in (HoldType.AXIS_POSITION_ACTUAL, HoldType.AXIS_POSITION_COMMAND)
+        return self.watches(self.hold)
 
     def static_trigger(self, io: IoImage) -> bool:
         """Trigger state of a non-position hold (constant between commands)."""

@@ -568,7 +568,8 @@ class MotionSupervisor:
                 axis.holding = True
                 axis.target = axis.rest
                 self._holds[plan.axis] = HoldWait.begin(
-                    plan, move.attributes, sample, self._ctl.rate, self._hold_position(plan.hold))
+                    plan, move.attributes, sample, self._ctl.rate,
+                    self._position_of(plan.hold) if HoldWait.watches(plan.hold) else 0.0)
             else:
                 axis.load(plan, tau, t, self.clock)
                 self._fire_outputs(plan)
@@ -580,10 +581,9 @@ class MotionSupervisor:
         owner = self._ctl.supervisor(axis.owner) if axis.owner >= 0 else None
         return owner.clock if owner is not None else None
 
-    def _hold_position(self, hold) -> float:
-        axis = self._axis(hold.number) if 0 <= hold.number < len(self._ctl.axes) else None
-        if axis is None:
-            return 0.0
+    def _position_of(self, hold) -> float:
+        """The position (user units) a position hold watches: actual or command."""
+        axis = self._axis(hold.number)
         return axis.actual_position if hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.command_position
 
     def _fire_outputs(self, plan) -> None:
@@ -859,10 +859,7 @@ class MotionSupervisor:
         """Release holds whose trigger is true now (after a gate or I/O change, a load)."""
         for axis_number, wait in list(self._holds.items()):
             if wait.watches_position:
-                axis = self._axis(wait.hold.number)
-                actual = wait.hold.type is HoldType.AXIS_POSITION_ACTUAL
-                position = axis.actual_position if actual else axis.command_position
-                fired = bool(wait.position_trigger(np.array([position]))[0])
+                fired = bool(wait.position_trigger(np.array([self._position_of(wait.hold)]))[0])
             else:
                 fired = wait.static_trigger(io)
             if fired:
