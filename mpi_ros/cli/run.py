@@ -25,33 +25,36 @@ def run(args) -> int:
     if args.time_scale < 0:
         print("mpi-ros run: --time-scale must be >= 0", file=sys.stderr)
         return 2
-    try:
-        cfg = suite_config.load(args.config)
-    except suite_config.ConfigError as exc:
-        print(f"mpi-ros run: invalid configuration: {exc}", file=sys.stderr)
-        return 2
 
     import rclpy
 
+    from mpi_ros.ros import parameters
     from mpi_ros.ros.suite import Suite
 
     # rclpy's own SIGINT/SIGTERM handling shuts the context down and wakes the executor.
     rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])])
-    suite = Suite(cfg, time_scale=args.time_scale)
+    try:
+        cfg, time_scale = parameters.resolve(None, args.config, args.time_scale)
+    except suite_config.ConfigError as exc:
+        print(f"mpi-ros run: invalid configuration: {exc}", file=sys.stderr)
+        rclpy.try_shutdown()
+        return 2
+    suite = Suite(cfg, time_scale=time_scale)
+    parameters.show(suite.controller_node, cfg, time_scale)
     recorder = None
     if getattr(args, "record", None):
         from mpi_ros.bag.recorder import Recorder
 
         try:
             recorder = Recorder(suite.runner, args.record, cfg)
-        except (OSError, FileExistsError) as exc:
+        except OSError as exc:
             print(f"mpi-ros run: cannot record: {exc}", file=sys.stderr)
             suite.shutdown()
             rclpy.try_shutdown()
             return 2
     log = suite.controller_node.get_logger()
     log.info(f"mpi_ros suite up: {len(cfg.supervisors)} supervisor(s), {cfg.axis_count} axes, "
-             f"{cfg.controller.sample_rate:g} Hz, time scale {args.time_scale:g}, config {cfg.source}")
+             f"{cfg.controller.sample_rate:g} Hz, time scale {time_scale:g}, config {cfg.source}")
     suite.start(spin_in_thread=False)
     try:
         suite.spin()

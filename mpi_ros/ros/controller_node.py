@@ -49,7 +49,7 @@ class ControllerNode(Node):
         self.settings = settings
         self._service_group = ReentrantCallbackGroup()
         count = len(runner.ctl.axes)
-        self._axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
+        self._pub_axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
         for k in range(count):
             self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp, k=k: self._on_config_get(k, resp))
             self._service(AxisConfigSet, f"axis{k}/config_set", lambda req, resp, k=k: self._on_config_set(k, req, resp))
@@ -59,16 +59,16 @@ class ControllerNode(Node):
         self._service(GateGet, "gate_get", self._on_gate_get)
         self._service(IoSet, "io_set", self._on_io_set)
         self._service(IoGet, "io_get", self._on_io_get)
-        self._events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
-        self._joints = self.create_publisher(JointState, "/joint_states", 10)
-        self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self._clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
+        self._pub_events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
+        self._pub_joints = self.create_publisher(JointState, "/joint_states", 10)
+        self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
         runner.add_periodic(settings.status_rate, self._collect_axis_status)
         runner.add_periodic(settings.joint_states_rate, self._collect_joints)
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
         runner.add_periodic(settings.clock_rate, self._collect_clock)
-        runner.on_event(lambda event: convert.publish(self, self._events, convert.motion_event(event, runner.ctl.rate)))
+        runner.on_event(lambda event: convert.publish(self, self._pub_events, convert.motion_event(event, runner.ctl.rate)))
 
     def _service(self, srv_type, name, callback):
         self.create_service(srv_type, name, callback, callback_group=self._service_group)
@@ -76,15 +76,15 @@ class ControllerNode(Node):
     # -- periodic topics ------------------------------------------------------------------
     def _collect_axis_status(self, ctl):
         messages = [convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate) for a in ctl.axes]
-        return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._axis_status, messages)]
+        return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._pub_axis_status, messages)]
 
     def _collect_joints(self, ctl):
         msg = convert.joint_state(ctl)
-        return lambda: convert.publish(self, self._joints, msg)
+        return lambda: convert.publish(self, self._pub_joints, msg)
 
     def _collect_clock(self, ctl):
         msg = Clock(clock=convert.stamp(ctl.sample, ctl.rate))
-        return lambda: convert.publish(self, self._clock, msg)
+        return lambda: convert.publish(self, self._pub_clock, msg)
 
     def _collect_diagnostics(self, ctl):
         array = DiagnosticArray()
@@ -95,7 +95,7 @@ class ControllerNode(Node):
             array.status.append(self._axis_diagnostic(ctl, axis))
         for provider in self.diagnostic_providers:
             array.status.extend(provider(ctl))
-        return lambda: convert.publish(self, self._diagnostics, array)
+        return lambda: convert.publish(self, self._pub_diagnostics, array)
 
     def add_diagnostic(self, provider) -> None:
         """``provider(controller) -> [DiagnosticStatus, ...]``, called (under the runner lock)

@@ -84,7 +84,7 @@ class SupervisorNode(Node):
         self._service(EventNotifyGet, "event_notify_get", self._on_event_notify_get)
         self._service(EventNotifySet, "event_notify_set", self._on_event_notify_set)
         self._service(EventReset, "event_reset", self._on_event_reset)
-        self._status = self.create_publisher(MotionStatus, "~/status", STATUS_QOS)
+        self._pub_status = self.create_publisher(MotionStatus, "~/status", STATUS_QOS)
         runner.add_periodic(settings.status_rate, self._collect_status)
 
     def _service(self, srv_type, name, callback):
@@ -102,7 +102,7 @@ class SupervisorNode(Node):
         if ms is None:
             return None
         msg = convert.motion_status(ms.snapshot(), ctl.rate)
-        return lambda: convert.publish(self, self._status, msg)
+        return lambda: convert.publish(self, self._pub_status, msg)
 
     # -- goals ------------------------------------------------------------------------
     def _on_goal(self, _goal) -> GoalResponse:
