@@ -10,6 +10,7 @@ f = 0 is the trapezoid itself.
 
 from __future__ import annotations
 
+import math
 from typing import Sequence
 
 from .ramps import ProfileError, Ramp
@@ -19,12 +20,17 @@ from .segment import Segment
 def ramp_pieces(ramp: Ramp, fraction: float) -> list[tuple[float, float, float]]:
     """(duration, start acceleration, jerk) pieces of one ramp or cruise."""
     dv = ramp.v_end - ramp.v_start
-    if ramp.is_cruise or fraction <= 0.0:
-        return [(ramp.duration, dv / ramp.duration if ramp.duration > 0.0 else 0.0, 0.0)]
+    trapezoid = [(ramp.duration, dv / ramp.duration if ramp.duration > 0.0 else 0.0, 0.0)]
     jerk_time = 0.5 * fraction * ramp.duration
+    # a cruise, f = 0, or jerk phases too short to represent (tiny jerkPercent, or a ramp of ~1e-324 s)
+    if ramp.is_cruise or jerk_time <= 0.0:
+        return trapezoid
     flat_time = (1.0 - fraction) * ramp.duration
     peak = dv / (ramp.duration * (1.0 - 0.5 * fraction))
     jerk = peak / jerk_time
+    if not math.isfinite(jerk):
+        # jerkPercent so small (~1e-308) that the jerk overflows: it would make the positions NaN.
+        return trapezoid
     return [(jerk_time, 0.0, jerk), (flat_time, peak, 0.0), (jerk_time, peak, -jerk)]
 
 

@@ -1,0 +1,148 @@
+"""The Controller (mpi_ros/mpi/control.py): objects, the sample clock, stepping, gates and I/O."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from mpi_ros.mpi import Controller, ControllerConfig, IoSpace, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi.messages import Message
+
+T = MPIMotionType
+M = Message
+
+
+def test_defaults():
+    # issue 3: "sample rate (default 2000 Hz) ... frame buffer size (128)"; spec 000:628 "With the
+    # sample rate configured for 2000 (default)"; DESIGN.md config/default.yaml 4 axes, 2 supervisors
+    ctl = Controller()
+    assert ctl.rate == 2000.0 and ctl.config.frame_buffer_size == 128
+    assert len(ctl.axes) == 4 and ctl.config.supervisor_count == 2 and not ctl.config.firmware_option_21
+
+
+def test_sample_rate_must_be_positive():
+    # issue 3: the controller advances in whole samples of a positive rate
+    with pytest.raises(ValueError):
+        Controller(ControllerConfig(sample_rate=0.0))
+
+
+def test_create_selects_the_next_unused_supervisor():
+    # spec 000:135 "If number is -1, MotionCreate selects the next unused motion supervisor"
+    ctl = Controller()
+    _, a = ctl.create_motion(-1)
+    _, b = ctl.create_motion(-1)
+    assert (a.number, b.number) == (0, 1)
+    assert ctl.create_motion(-1) == (M.MPIMotionMessageMOTION_INVALID, None)  # none left
+
+
+@pytest.mark.parametrize("number", [-2, 2, 100])
+def test_create_out_of_range(number):
+    # spec 000:2158 MOTION_INVALID "if the motion supervisor number is less than zero or greater
+    # than or equal to MEIXmpMAX_MSs"; 000:140 MPIHandleVOID
+    assert Controller().create_motion(number) == (M.MPIMotionMessageMOTION_INVALID, None)
+
+
+def test_create_twice_the_same_number():
+    # spec 000:140 "MPIHandleVOID if the object could not be created"
+    ctl = Controller()
+    ctl.create_motion(1)
+    assert ctl.create_motion(1) == (M.MPIMotionMessageMOTION_INVALID, None)
+
+
+def test_validate_after_create_and_delete(ctl, ms):
+    # spec 000:182 "Always call mpiMotionValidate after creating"; 000:158 delete "invalidates its
+    # handle"; 000:160 "does not delete any of the Axis objects"
+    assert ms.validate().ok
+    assert ctl.delete_motion(ms).ok
+    assert ms.validate() is M.MPIMessageHANDLE_INVALID
+    assert ctl.supervisor(0) is None and len(ctl.axes) == 4
+    assert ctl.delete_motion(ms) is M.MPIMessageHANDLE_INVALID
+    assert ms.start(T.TRAPEZOIDAL) is M.MPIMessageHANDLE_INVALID
+    assert ms.action(MPIAction.STOP) is M.MPIMessageHANDLE_INVALID
+    assert ctl.create_motion(0)[0].ok  # the number is free again
+
+
+def test_delete_while_moving(ctl, ms, bring):
+    # spec 000:9 the supervisor's axis map is not changed while the axes move
+    bring(MPIState.MOVING)
+    assert ctl.delete_motion(ms) is M.MPIMotionMessageMOVING
+    assert ms.validate().ok
+
+
+def test_a_command_takes_effect_at_the_next_sample(ctl, ms, params):
+    # DESIGN.md: "A command ... is applied at the first sample after the controller's current one
+    # and recorded with that sample's index"
+    ctl.step(17)
+    assert ctl.effective_sample == 18
+    ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0)))
+    assert ctl.axes[0].cmd_p == 0.0
+    ctl.step(1)
+    assert ctl.axes[0].cmd_p == pytest.approx(0.5 * 10_000.0 * (1 / 2000.0) ** 2)
+    assert ctl.time == 18 / 2000.0
+
+
+def test_step_counts_samples(ctl):
+    # DESIGN.md: "it advances in whole samples"
+    ctl.step(0)
+    assert ctl.sample == 0
+    ctl.step(12_345)
+    assert ctl.sample == 12_345
+    with pytest.raises(ValueError):
+        ctl.step(-1)
+
+
+def test_run_until(ctl, ms, params):
+    # issue 3 "Stepping API for tests and tools: step N samples, run until a condition"
+    ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0)))
+    assert ctl.run_until(lambda c: c.axes[0].cmd_p >= 50.0, 10_000)
+    assert ctl.axes[0].cmd_p >= 50.0
+    k = ctl.sample
+    assert not ctl.run_until(lambda c: False, 250, chunk=100)
+    assert ctl.sample == k + 250  # stops exactly at the limit
+
+
+def test_a_long_move_simulates_far_faster_than_real_time(ctl, ms, params):
+    # issue 3: "a fast path that advances many samples at once (vectorised over time) so long moves
+    # simulate far faster than real time": ten simulated minutes in one call
+    ms.start(T.TRAPEZOIDAL, params=params((600_000.0, 0.0)))
+    started = time.perf_counter()
+    ctl.step(600 * 2000)
+    assert time.perf_counter() - started < 60.0  # 10x real time at the very least (measured: ~100x more)
+    assert ctl.axes[0].command_position == pytest.approx(599_950.0)
+
+
+def test_gates_and_io(ctl):
+    # spec 000:1740 meiControlGateGet/Set; io.py: the simulated I/O image
+    assert ctl.gate_set(3, True).ok and ctl.gate_get(3) == (M.MPIMessageOK, True)
+    assert ctl.gate_get(32)[0] is M.MPIMessagePARAM_INVALID
+    assert ctl.io_set(IoSpace.MOTOR_DEDICATED_IO, 3, 0b101).ok
+    assert ctl.io_get(IoSpace.MOTOR_DEDICATED_IO, 3) == (M.MPIMessageOK, 0b101)
+    assert ctl.io_set(IoSpace.IO, 1, 0b111, mask=0b010).ok
+    assert ctl.io_get(IoSpace.IO, 1) == (M.MPIMessageOK, 0b010)
+
+
+def test_supervisors_are_listed_by_number(ctl):
+    # spec 000:1110 mpiMotionNumber: the index of a Motion object
+    _, b = ctl.create_motion(1)
+    _, a = ctl.create_motion(0)
+    assert [s.number for s in ctl.supervisors] == [0, 1] and ctl.supervisor(1) is b
+
+
+def test_drain_events_empties_the_queue(ctl, ms, params):
+    # DESIGN.md /mpi/events: each event is delivered once
+    ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0)))
+    assert ctl.drain_events()
+    assert ctl.drain_events() == []
+
+
+def test_motion_snapshot(ctl, ms, params, run_to):
+    # spec 000:722 mpiMotionStatus "gets a Motion's status"
+    ms.start(T.S_CURVE, params=params((1000.0, 0.0), jerk_percent=20.0))
+    ctl.step(1000)
+    snap = ms.snapshot()
+    assert snap.state is MPIState.MOVING and snap.axis_numbers == (0, 1) and snap.motion_type == "S_CURVE"
+    assert not snap.done and 0.0 < snap.progress < 1.0 and snap.feedrate == 1.0
+    run_to(ctl, ms, MPIState.IDLE, 10_000, chunk=100)
+    snap = ms.snapshot()
+    assert snap.done and snap.at_target and snap.progress == 1.0

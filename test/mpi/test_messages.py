@@ -1,0 +1,85 @@
+"""Message codes (mpi_ros/mpi/messages.py): every name of the spec, stable codes."""
+
+from __future__ import annotations
+
+import pytest
+
+from mpi_ros.mpi.messages import OK, STATE_MESSAGES, Message
+from mpi_ros.mpi.types import MPIState
+
+# spec 000:2124-2145, the MPIMotionMessage enum listing, in order (DESIGN.md: the listing's
+# "Type_INVALID" / "Attribute_INVALID" are typos for the upper-case names of the descriptions).
+MOTION_MESSAGES = [
+    "MOTION_INVALID", "AXIS_NOT_FOUND", "AXIS_COUNT", "AXIS_FRAME_COUNT", "TYPE_INVALID",
+    "ATTRIBUTE_INVALID", "IDLE", "MOVING", "STOPPING", "STOPPED", "STOPPING_ERROR", "ERROR",
+    "AUTO_START", "ILLEGAL_DELAY", "PROFILE_ERROR", "PROFILE_NOT_SUPPORTED", "PATH_ERROR",
+    "FRAMES_LOW", "FRAMES_EMPTY", "FRAME_BUFFER_TOO_SMALL",
+]
+# spec 000:2241-2247, MEIMotionMessage.
+MEI_MOTION_MESSAGES = ["RESERVED0", "RESERVED1", "RESERVED2", "NO_AXES_MAPPED", "BAD_PATH_DATA"]
+# spec 002:588-592, MPIAxisMessage.
+AXIS_MESSAGES = ["AXIS_INVALID", "COMMAND_NOT_SET", "NOT_MAPPED_TO_MS"]
+
+
+@pytest.mark.parametrize("name", MOTION_MESSAGES)
+def test_every_motion_message_of_the_spec_exists(name):
+    # spec 000:2124-2145 MPIMotionMessage enum
+    assert Message[f"MPIMotionMessage{name}"].name == f"MPIMotionMessage{name}"
+
+
+def test_motion_messages_keep_the_order_of_the_spec_listing():
+    # spec 000:2124-2145: codes follow the enum listing (one module base plus the position)
+    codes = [Message[f"MPIMotionMessage{name}"].code for name in MOTION_MESSAGES]
+    assert codes == list(range(codes[0], codes[0] + len(codes)))
+
+
+def test_the_typo_spellings_of_the_enum_listing_are_not_names():
+    # DESIGN.md: "MPIMotionMessageTYPE_INVALID and MPIMotionMessageATTRIBUTE_INVALID (the enum
+    # listing's Type_INVALID/Attribute_INVALID is a typo)"
+    for typo in ("MPIMotionMessageType_INVALID", "MPIMotionMessageAttribute_INVALID"):
+        with pytest.raises(KeyError):
+            Message.from_name(typo)
+
+
+@pytest.mark.parametrize("name", MEI_MOTION_MESSAGES)
+def test_every_mei_motion_message_exists(name):
+    # spec 000:2241-2247 MEIMotionMessage enum
+    assert Message[f"MEIMotionMessage{name}"].name == f"MEIMotionMessage{name}"
+
+
+@pytest.mark.parametrize("name", AXIS_MESSAGES)
+def test_every_axis_message_exists(name):
+    # spec 002:588-592 MPIAxisMessage enum
+    assert Message[f"MPIAxisMessage{name}"].name == f"MPIAxisMessage{name}"
+
+
+def test_list_message_element_not_found_exists():
+    # spec 000:1141 mpiMotionAxis returns MEIListMessageELEMENT_NOT_FOUND
+    assert Message.MEIListMessageELEMENT_NOT_FOUND.name == "MEIListMessageELEMENT_NOT_FOUND"
+
+
+def test_ok_is_code_zero_and_the_only_ok():
+    # DESIGN.md: "code is 0 for MPIMessageOK and a stable number per message otherwise"
+    assert OK is Message.MPIMessageOK
+    assert Message.MPIMessageOK.code == 0
+    assert Message.MPIMessageOK.ok
+    assert [m for m in Message if m.ok] == [Message.MPIMessageOK]
+    assert all(m.code != 0 for m in Message if m is not Message.MPIMessageOK)
+
+
+def test_codes_are_unique():
+    # DESIGN.md: "a stable number per message" (an IntEnum alias would hide a name)
+    assert len({m.code for m in Message}) == len(Message.__members__)
+
+
+def test_from_name_round_trips_every_message():
+    # DESIGN.md: "string message is the spec's name exactly" and tools read the names
+    for message in Message:
+        assert Message.from_name(message.name) is message
+
+
+@pytest.mark.parametrize("state", ["IDLE", "MOVING", "STOPPING", "STOPPED", "STOPPING_ERROR", "ERROR"])
+def test_each_state_has_its_refusal_message(state):
+    # spec 000:2184-2204: a refused start/modify/action answers the message named after the state
+    assert STATE_MESSAGES[state] is Message[f"MPIMotionMessage{state}"]
+    assert MPIState[state].name == state

@@ -1,0 +1,218 @@
+"""compile_move (mpi_ros/mpi/planner.py): a validated request becomes per-axis frames."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from mpi_ros.mpi import Hold, HoldType, MotionAttr, MotionParams, MPIMotionType, Output, OutputType, Trajectory
+from mpi_ros.mpi.events import MPIEventType
+from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.planner import AxisStart, PlanError, compile_move
+
+A = MotionAttr
+T = MPIMotionType
+E = MPIEventType
+TRAJ = Trajectory(1000.0, 10_000.0, 5_000.0, 0.0)
+RATE = 2000.0
+
+
+def compile_(attrs=A.NONE, position=(3000.0, 4000.0), kind=T.TRAPEZOIDAL, starts=None, moving=False,
+             trajectory=(TRAJ,), rate=RATE, **fields):
+    params = MotionParams(trajectory=list(trajectory), position=list(position), **fields)
+    starts = starts or [AxisStart(i, 0.0) for i in range(len(position))]
+    return compile_move(0, kind, attrs, params, starts, rate, moving)
+
+
+def end(plan):
+    return plan.segments[-1].end_state()
+
+
+def test_vector_move_is_one_profile_along_the_line():
+    # spec 000:2550 "only the first trajectory structure will be applied as the vector trajectory
+    # for all the axes"
+    move, notes = compile_()
+    x, y = move.plans
+    assert x.duration == y.duration == pytest.approx(5000.0 / 1000.0 + 0.5 * (0.1 + 0.2))
+    for sx, sy in zip(x.segments, y.segments):
+        assert sx.duration == sy.duration
+        assert (sx.v * 4.0, sx.a * 4.0, sx.j * 4.0) == pytest.approx((sy.v * 3.0, sy.a * 3.0, sy.j * 3.0))
+    assert max(math.hypot(sx.v, sy.v) for sx, sy in zip(x.segments, y.segments)) == pytest.approx(1000.0)
+    assert (x.target, y.target) == (3000.0, 4000.0) and end(x)[0] == pytest.approx(3000.0)
+    assert notes.events == []
+
+
+def test_absolute_targets_include_the_origin():
+    # axis.py: "Positions seen by users are raw positions minus the origin"
+    move, _ = compile_(position=(10.0,), starts=[AxisStart(0, 500.0, 0.0, 500.0)])
+    assert move.plans[0].target == 510.0
+
+
+def test_sync_end_pads_the_start_of_shorter_profiles():
+    # spec 000:2850 "For all but the longest motion profile, wait frames will be added to the
+    # beginning of the moves"
+    trajectories = (TRAJ, Trajectory(50.0, 1000.0, 1000.0))  # 1.15 s and 2.0 s
+    move, _ = compile_(A.SYNC_END, position=(1000.0, 100.0), trajectory=trajectories)
+    fast, slow = move.plans
+    assert fast.duration == pytest.approx(slow.duration)
+    wait = fast.segments[0]
+    assert (wait.v, wait.a, wait.j) == (0.0, 0.0, 0.0) and wait.duration > 0.0
+    assert slow.segments[0].a > 0.0
+
+
+def test_sync_start_pads_the_end_of_shorter_profiles():
+    # spec 000:2856 "For those axes that finish first, a delay frame will be added to the end"
+    trajectories = (TRAJ, Trajectory(50.0, 1000.0, 1000.0))  # 1.15 s and 2.0 s
+    move, _ = compile_(A.SYNC_START, position=(1000.0, 100.0), trajectory=trajectories)
+    fast, slow = move.plans
+    assert fast.duration == pytest.approx(slow.duration)
+    assert fast.segments[0].a > 0.0 and fast.segments[-1].v == 0.0 and fast.segments[-1].p == 1000.0
+
+
+def test_delay_prepends_a_wait_frame_per_axis():
+    # spec 000:2822 delay "assign delay times for each Axis"
+    move, _ = compile_(A.DELAY, delay=[0.5, 0.0])
+    x, y = move.plans
+    assert x.segments[0].duration == 0.5 and x.segments[0].v == 0.0
+    assert x.duration == pytest.approx(y.duration + 0.5)
+
+
+def test_illegal_delay_only_while_moving():
+    # spec 000:2212 ILLEGAL_DELAY "non-zero delay value ... while in motion"
+    with pytest.raises(PlanError) as refused:
+        compile_(A.DELAY, moving=True, delay=[0.0, 0.1])
+    assert refused.value.message is Message.MPIMotionMessageILLEGAL_DELAY
+    compile_(A.DELAY, moving=True, delay=[0.0, 0.0])
+    compile_(A.DELAY, moving=False, delay=[0.0, 0.1])
+
+
+def test_relative_targets_and_truncation():
+    # spec 000:2844 relative distances from the start; 000:626 "the fractional portion is truncated
+    # and discarded"
+    starts = [AxisStart(0, 1000.0), AxisStart(1, -5.0)]
+    move, notes = compile_(A.RELATIVE, position=(2000.0, -3.9), starts=starts)
+    assert [p.target for p in move.plans] == [3000.0, -8.0]
+    assert [kind for kind, _ in notes.events] == [E.RELATIVE_TRUNCATED]
+    assert "-3.9" in notes.events[0][1] and "axis 1" in notes.events[0][1]
+
+
+@pytest.mark.parametrize("given,stored", [(32767, 32767), (32768, -32768), (-32769, 32767), (1 << 20, 0)])
+def test_id_truncated_to_16_bits(given, stored):
+    # spec 000:1876 "The id is limited to 16-bit resolution by the controller firmware"
+    move, notes = compile_(A.ID, id=given)
+    assert move.id == stored
+    assert [kind for kind, _ in notes.events] == ([] if given == stored else [E.ID_TRUNCATED])
+
+
+def test_id_without_the_attribute_is_zero():
+    # spec 000:1557 ID "enables an identification tag" (only with the attribute)
+    move, _ = compile_(id=77)
+    assert move.id == 0
+
+
+def test_element_id_and_event_mask_only_with_their_attributes():
+    # spec 000:1558 ELEMENT_ID; 000:1588 EVENT
+    move, _ = compile_(A.ELEMENT_ID | A.EVENT, element_id=[5, 6], event_mask=E.MOTION_DONE)
+    assert (move.element_id, move.event_mask) == (5, E.MOTION_DONE)
+    move, _ = compile_(element_id=[5], event_mask=E.MOTION_DONE)
+    assert (move.element_id, move.event_mask) == (0, E.NONE)
+
+
+def test_frame_longer_than_16384000_samples_is_cut():
+    # spec 000:628 "If the commanded motion exceeds the maximum frame time, the axes will stop
+    # abruptly after 16,384,000 samples"
+    move, notes = compile_(position=(1e6,), trajectory=(Trajectory(1.0, 1e4, 1e4),), rate=100.0)
+    plan = move.plans[0]
+    assert plan.truncated and plan.final_velocity == 0.0
+    assert max(s.duration for s in plan.segments) == 16_384_000 / 100.0
+    assert plan.target == pytest.approx(163_840.0, abs=1e-3)
+    assert [kind for kind, _ in notes.events] == [E.FRAME_TIME_LIMIT]
+
+
+def test_long_move_within_the_limit_is_not_cut():
+    # spec 000:628 the limit is 16,384,000 samples (2.27 hours at 2000 Hz)
+    move, notes = compile_(position=(8_000_000.0,), trajectory=(Trajectory(1000.0, 1e4, 1e4),))
+    assert not move.plans[0].truncated and notes.events == []
+
+
+def test_velocity_move_cruises_for_the_frame_limit():
+    # spec 000:628 "the maximum velocity time is 2.27 hours" (16,384,000 samples at 2000 Hz)
+    move, _ = compile_(kind=T.VELOCITY, position=(), starts=[AxisStart(0, 0.0)],
+                       trajectory=(Trajectory(500.0, 5000.0),))
+    plan = move.plans[0]
+    assert plan.is_velocity and plan.velocity_target == 500.0 and plan.ramp_end == pytest.approx(0.1)
+    assert plan.segments[-1].duration == pytest.approx(16_384_000 / RATE) and plan.truncated
+
+
+def test_velocity_move_per_axis_trajectories():
+    # DESIGN.md array lengths: a VELOCITY move may give one trajectory per axis
+    trajectories = (Trajectory(100.0, 1000.0), Trajectory(-50.0, 1000.0))
+    move, _ = compile_(kind=T.VELOCITY, position=(), starts=[AxisStart(0, 0.0), AxisStart(1, 0.0)],
+                       trajectory=trajectories)
+    assert [p.velocity_target for p in move.plans] == [100.0, -50.0]
+
+
+def test_final_velocity_plans_end_moving():
+    # spec 000:1898 finalVelocity "the target velocity for each axis"
+    move, _ = compile_(A.FINAL_VEL, position=(1000.0,), final_velocity=[250.0])
+    plan = move.plans[0]
+    assert plan.final_velocity == 250.0
+    p, v, _ = end(plan)
+    assert p == pytest.approx(1000.0) and v == pytest.approx(250.0)
+
+
+def test_final_velocity_off_the_vector_line():
+    # planner.py: "final velocities of a vector move must lie along the move"
+    with pytest.raises(PlanError) as refused:
+        compile_(A.FINAL_VEL, final_velocity=[100.0, 0.0])
+    assert refused.value.message is Message.MPIMessagePARAM_INVALID
+    move, _ = compile_(A.FINAL_VEL, final_velocity=[60.0, 80.0])
+    assert [p.final_velocity for p in move.plans] == [60.0, 80.0]
+
+
+def test_no_reversal():
+    # spec 000:2216 PROFILE_ERROR "when the NO_REVERSAL attribute mask is specified, but the
+    # specified target position is in the reverse direction"
+    moving = [AxisStart(0, 0.0, 1000.0)]
+    with pytest.raises(PlanError) as refused:
+        compile_(A.NO_REVERSAL, position=(-10.0,), starts=moving, moving=True)
+    assert refused.value.message is Message.MPIMotionMessagePROFILE_ERROR
+    compile_(A.NO_REVERSAL, position=(1000.0,), starts=moving, moving=True)
+
+
+def test_reversal_profile_from_a_moving_start():
+    # issue 3: modify "including reversal": decelerate, turn, arrive
+    move, _ = compile_(position=(-100.0,), starts=[AxisStart(0, 0.0, 1000.0)], moving=True)
+    plan = move.plans[0]
+    velocities = [s.v for s in plan.segments] + [end(plan)[1]]
+    assert max(velocities) == 1000.0 and min(velocities) == pytest.approx(-1000.0)
+    assert end(plan)[0] == pytest.approx(-100.0)
+
+
+def test_zero_length_move():
+    # a target equal to the current position: no motion, the plan holds the position
+    move, _ = compile_(position=(0.0, 0.0))
+    assert all(p.duration == 0.0 and p.target == 0.0 for p in move.plans)
+
+
+def test_vector_modify_off_the_line_plans_each_axis():
+    # planner.py decision: "each axis is then planned from its own state with the vector's limits
+    # scaled by the axis' share of the new displacement (never less than its share of the current
+    # velocity)"
+    starts = [AxisStart(0, 0.0, 1000.0), AxisStart(1, 0.0, 0.0)]
+    move, _ = compile_(position=(0.0, 1000.0), starts=starts, moving=True)
+    x, y = move.plans
+    assert end(x)[0] == pytest.approx(0.0) and end(y)[0] == pytest.approx(1000.0)
+    assert max(abs(s.v) for s in x.segments) == pytest.approx(1000.0)  # share of the velocity: 1
+    assert max(abs(s.v) for s in y.segments) <= 1000.0 + 1e-9
+
+
+def test_hold_and_outputs_go_to_the_plans():
+    # spec 000:1899 hold "for each axis"; 000:2892 OUTPUT "configures a frame to toggle an output
+    # bit as a move begins" (on the first axis' frames)
+    holds = [Hold(type=HoldType.GATE, gate=1), Hold(type=HoldType.GATE, gate=2)]
+    output = Output(type=OutputType.OUTPUT, on_mask=1)
+    move, _ = compile_(A.HOLD | A.OUTPUT, hold=holds, output=[output])
+    assert [p.hold.gate for p in move.plans] == [1, 2]
+    assert move.plans[0].outputs == [output] and move.plans[1].outputs == []
