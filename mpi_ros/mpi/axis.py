@@ -125,7 +125,7 @@ class Axis:
     def can_set_command(self, moving: bool) -> bool:
         """spec 002 mpiAxisCommandPositionSet error check: not while MOVING, STOPPING or
         STOPPED, and not while the command follows the actual position."""
-        return not moving and self.plan is None and not self.holding and self.mode is CommandMode.SERVO
+        return not moving and self.plan is None and not self.holding and self.mode is not CommandMode.FOLLOW_ACTUAL
 
     def set_command_position(self, position: float, t: float) -> None:
         """Command steps to ``position``; the loop follows (check ``can_set_command``)."""

@@ -424,7 +424,7 @@ class MotionSupervisor:
                 if MotionAttr.AUTO_START not in attrs:
                     return Message.MPIMotionMessageIDLE, "no motion in progress to modify"
                 auto_start = True
-            elif state is not MPIState.MOVING and not (append and state is MPIState.STOPPED):
+            elif state is not MPIState.MOVING:
                 return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
         elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
             return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
@@ -437,7 +437,10 @@ class MotionSupervisor:
             self._ctl.config.motors, len(self._ctl.axes))
         if not verdict.ok:
             return verdict.message, verdict.detail
-        queued = append and (self.current is not None or bool(self.queue)) and state is not MPIState.IDLE
+        # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
+        # (DESIGN.md table), and behind a move already cruising at its final velocity there
+        # is nothing to wait for: the new move starts from where the axes are (a modify).
+        queued = append and state is MPIState.MOVING and (bool(self.queue) or not self._cruising())
         try:
             move, notes = compile_move(
                 self.number, motion_type, attrs, params, self._starts(queued, state, modify and not auto_start),
@@ -772,11 +775,15 @@ class MotionSupervisor:
             for axis_number, wait in self._holds.items():
                 conditions[("hold", axis_number)] = self._hold_trigger(wait, samples, traces)
         if state is MPIState.MOVING and self.current is not None and not self._holds:
-            complete = np.ones(len(samples), dtype=bool)
-            key = "trajectory_complete" if self._blends() else "done"
-            for plan in self.current.plans:
-                complete &= statuses[plan.axis].bits[key]
-            conditions["move_done"] = complete
+            # A move that ends moving (FINAL_VEL) is never DONE: the next appended move
+            # takes over at its trajectory's end; with none, the axes go on at the final
+            # velocity (MOVING) until a modify, an append or a stop.
+            key = "trajectory_complete" if self._ends_moving() else "done"
+            if key == "done" or self.queue:
+                complete = np.ones(len(samples), dtype=bool)
+                for plan in self.current.plans:
+                    complete &= statuses[plan.axis].bits[key]
+                conditions["move_done"] = complete
         elif state is MPIState.STOPPING:
             conditions["stopped"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_stop)
         elif state is MPIState.STOPPING_ERROR:
@@ -788,9 +795,14 @@ class MotionSupervisor:
             return None
         return np.logical_or.reduce(list(conditions.values()))
 
-    def _blends(self) -> bool:
-        """An appended move follows one that ends moving (FINAL_VEL): start it at TC."""
-        return bool(self.queue) and any(p.final_velocity != 0.0 for p in self.current.plans)
+    def _ends_moving(self) -> bool:
+        """The current move ends at its target with a velocity (FINAL_VEL)."""
+        return self.current is not None and any(p.final_velocity != 0.0 for p in self.current.plans)
+
+    def _cruising(self) -> bool:
+        """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
+        return self._ends_moving() and all(
+            self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in self.current.plans)
 
     def _stop_complete(self, t, statuses, settle) -> np.ndarray:
         ready = t >= self._stop_end - 1e-12

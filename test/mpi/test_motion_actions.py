@@ -236,14 +236,19 @@ def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
     assert ctl.axes[0].command_position == 0.0
 
 
-def test_start_after_a_final_velocity_move_keeps_the_velocity(params):
+def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(params):
     # spec 000:1589 FINAL_VEL "a non-zero target velocity": the axis leaves the move at that
-    # velocity, and the next start continues from it (limits never exceeded, DESIGN.md)
+    # velocity, so the supervisor stays MOVING (docs/decisions.md: never DONE, never IDLE while
+    # the axis moves) and the next command is a modify that continues from the velocity
+    # (limits never exceeded, DESIGN.md).
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
-    assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 10_000, chunk=10)
-    assert ctl.axes[0].cmd_v == 400.0
-    assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))).ok
+    assert ctl.run_until(lambda c: c.axes[0].command_position > 1000.0, 10_000, chunk=10)
+    ctl.step(2000)
+    assert ms.state is MPIState.MOVING and ctl.axes[0].cmd_v == 400.0
+    assert ctl.axes[0].status.trajectory_complete
+    assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is Message.MPIMotionMessageMOVING
+    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))).ok
     previous = ctl.axes[0].cmd_v
     while ms.state is MPIState.MOVING:
         ctl.step(1)
@@ -266,3 +271,42 @@ def test_stop_while_holding_then_resume(params):
     assert ms.action(MPIAction.RESUME) is Message.MPIMessageOK
     assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000, chunk=10)
     assert ctl.axes[0].command_position == 300.0
+
+
+def test_append_in_stopped_follows_the_table(params):
+    # DESIGN.md table: start in STOPPED is "OK, pending profile dropped" and modify in STOPPED
+    # answers MPIMotionMessageSTOPPED; APPEND does not change either.
+    ctl, ms = two_axes()
+    ms.start(T.TRAPEZOIDAL, params=params((5000.0, 0.0)))
+    ctl.step(400)
+    ms.action(MPIAction.STOP)
+    assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 5000)
+    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.APPEND, params((0.0, 0.0))) is Message.MPIMotionMessageSTOPPED
+    assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((100.0, 0.0))).ok
+    assert not ms.queue and ms.state is MPIState.MOVING
+    assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000, chunk=50)
+    assert ctl.axes[0].command_position == 100.0  # the stopped 5000-count profile was dropped
+
+
+def test_command_position_can_be_set_in_error_after_abort():
+    # spec 002:611 COMMAND_NOT_SET while STOPPING, STOPPED or MOVING; ERROR is not among them
+    ctl, ms = two_axes()
+    ms.action(MPIAction.ABORT)
+    ctl.step(5)
+    assert ms.state is MPIState.ERROR
+    assert ctl.axis_command_position_set(0, 42.0).ok
+    assert ctl.axes[0].command_position == 42.0
+
+
+def test_append_behind_a_cruising_final_velocity_move_continues_without_a_jump(params):
+    # docs/decisions.md: behind a move already going on at its final velocity, an appended
+    # move starts from where the axes are
+    ctl, ms = two_axes()
+    ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
+    assert ctl.run_until(lambda c: c.axes[0].command_position > 1200.0, 10_000, chunk=10)
+    before = ctl.axes[0].command_position
+    assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((0.0, 0.0))).ok
+    ctl.step(1)
+    assert abs(ctl.axes[0].command_position - before) < 1.0  # no jump back to the old target
+    assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000, chunk=10)
+    assert ctl.axes[0].command_position == 0.0

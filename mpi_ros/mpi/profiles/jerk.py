@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 
 from .ramps import ProfileError
-from .segment import Segment
+from .segment import Segment, chain, end_state, total_duration
 
 _ITERATIONS = 80
 
@@ -41,14 +41,9 @@ def velocity_change(v: float, a: float, v1: float, amax: float, jerk: float) -> 
 
 
 def _integrate(p: float, v: float, a: float, pieces) -> tuple[list[Segment], tuple[float, float, float], float]:
-    segments = []
-    elapsed = 0.0
-    for duration, jerk in pieces:
-        seg = Segment(duration, p, v, a, jerk)
-        segments.append(seg)
-        p, v, a = seg.end_state()
-        elapsed += duration
-    return segments, (p, v, a), elapsed
+    """Segments of (duration, jerk) pieces from (p, v, a), their end state and duration."""
+    segments = chain(p, v, a, pieces)
+    return segments, end_state(segments, (p, v, a)), total_duration(segments)
 
 
 def _limits_for(v_from: float, v_to: float, accel, decel):
