@@ -28,6 +28,8 @@ COMMANDS: dict[str, str] = {
     "record": "mpi_ros.cli.record",
     "replay": "mpi_ros.cli.replay",
     "play": "mpi_ros.cli.play",
+    "crosscheck": "mpi_ros.cli.crosscheck",
+    "plot": "mpi_ros.cli.plot",
     "version": "mpi_ros.cli.version",
 }
 

@@ -44,6 +44,7 @@ class AxisPlan:
     limits: Trajectory | None = None  # the limits this axis' profile was planned with
     start_velocity: float = 0.0  # velocity (profile time) the profile starts from
     start_acceleration: float = 0.0
+    composite: str = ""  # why the segments are more than one profile (e.g. stop, then a new line)
     table: SegmentTable = field(init=False)
     duration: float = field(init=False)
 

@@ -11,10 +11,9 @@ Quirks kept from the firmware (spec 000 mpiMotionStart): a frame may not last mo
 16,384,000 samples (the axis stops abruptly there), and the fraction of a RELATIVE
 distance is truncated. Both are reported through ``notes``.
 
-Decision (the spec is silent): a vector modify whose current velocity is not along the
-new line cannot stay on one line; each axis is then planned from its own state with the
-vector's limits scaled by the axis' share of the new displacement (never less than its
-share of the current velocity).
+Decision (the spec is silent): a vector modify whose current velocity is not along the new
+line cannot stay on one line; the vector first comes to rest along its current line, then
+moves on a straight line to the new targets (docs/decisions.md).
 """
 
 from __future__ import annotations
@@ -28,10 +27,11 @@ from .events import MPIEventType
 from .frames import AxisPlan, Move
 from .messages import Message
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, MotionParams, Trajectory
-from .profiles.jerk import point_to_point_jerk, velocity_jerk
+from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import point_to_point, reverses, velocity_move
-from .profiles.ramps import ProfileError
-from .profiles.segment import Segment
+from .profiles.ramps import ProfileError, ramps_between
+from .profiles.scurve import reshape
+from .profiles.segment import Segment, chain
 from .types import MotionAttr, MPIMotionType
 
 A = MotionAttr
@@ -100,9 +100,10 @@ def _check_finite(segments: list[Segment], axis: int) -> None:
 def _check_lands(segments: list[Segment], start: AxisStart, target: float) -> None:
     """The frames must end on the target: the executor snaps the command onto it when the
     trajectory completes, which must never be a jump (guards against overflow and any
-    planning fault)."""
+    planning fault). Rounding grows with the positions and the distance travelled."""
     end = segments[-1].end_state()[0] if segments else start.position
-    scale = max(1.0, abs(target), abs(start.position))
+    travel = sum(max(abs(s.v), abs(s.end_state()[1])) * s.duration for s in segments)
+    scale = max(1.0, abs(target), abs(start.position), travel)
     if not math.isfinite(end) or abs(end - target) > 1e-9 * scale:
         raise ProfileError(f"axis {start.axis}: the profile cannot be calculated with these values")
 
@@ -145,9 +146,10 @@ def _scaled(traj: Trajectory, share: float) -> Trajectory:
                       traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
 
 
-def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[list[Segment]], list[Trajectory]]:
-    """One profile along the straight line from the start to the targets, and each
-    axis' effective limits (the vector's scaled by the axis' share of the line)."""
+def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[list[Segment]], list[Trajectory], str]:
+    """One profile along the straight line from the start to the targets, each axis'
+    effective limits (the vector's scaled by the axis' share of the line), and why the
+    profiles are not one profile per axis ("" when they are)."""
     p0 = np.array([s.position for s in starts])
     v0 = np.array([s.velocity for s in starts])
     delta = np.array(targets) - p0
@@ -161,7 +163,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
     elif speed > 0.0:
         unit = v0 / speed
     else:
-        return [[] for _ in starts], [traj for _ in starts]
+        return [[] for _ in starts], [traj for _ in starts], ""
     along = float(v0 @ unit)
     final_along = float(final @ unit)
     parallel = np.allclose(v0, along * unit, rtol=1e-9, atol=1e-9 * (1.0 + speed))
@@ -173,14 +175,34 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
         line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, float(accel @ unit)), length,
                                final_along, traj)
         profiles = [[seg.scaled(float(u), float(p)) for seg in line] for u, p in zip(unit, p0)]
-        return profiles, [_scaled(traj, abs(float(u))) for u in unit]
-    # Not on one line: each axis with its share of the vector's limits.
-    profiles, limits = [], []
-    for i, start in enumerate(starts):
-        share = max(abs(float(unit[i])), abs(float(v0[i])) / speed if speed > 0.0 else 0.0, 1e-6)
-        limits.append(_scaled(traj, share))
-        profiles.append(_scalar_profile(motion_type, start, targets[i], float(final[i]), limits[-1]))
-    return profiles, limits
+        return profiles, [_scaled(traj, abs(float(u))) for u in unit], ""
+    return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
+
+
+STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
+
+
+def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
+    """A vector modify off the current line: the vector first comes to rest along the line it
+    is on (decelerating as the trajectory says), then moves on a straight line to the new
+    targets. Both parts are single vector profiles, so the vector's limits hold throughout
+    (docs/decisions.md)."""
+    heading = v0 / speed
+    stop = _stop_profile(motion_type, speed, traj)
+    rest = p0 + heading * (stop[-1].end_state()[0] if stop else 0.0)
+    go_starts = [AxisStart(s.axis, float(p), 0.0, s.origin) for s, p in zip(starts, rest)]
+    go, limits, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
+    profiles = [[seg.scaled(float(h), float(p)) for seg in stop] + tail for h, p, tail in zip(heading, p0, go)]
+    limits = [_scaled(traj, max(abs(float(h)), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits)]
+    return profiles, limits, STOP_THEN_LINE
+
+
+def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) -> list[Segment]:
+    """1-D: from ``speed`` to rest with the trajectory's deceleration (and its jerk)."""
+    if motion_type is MPIMotionType.S_CURVE_JERK:
+        return chain(0.0, speed, 0.0, velocity_change(speed, 0.0, 0.0, traj.deceleration, traj.deceleration_jerk))
+    jerk_percent = traj.jerk_percent if motion_type is MPIMotionType.S_CURVE else 0.0
+    return reshape(ramps_between(speed, 0.0, traj.acceleration, traj.deceleration), 0.0, jerk_percent)
 
 
 def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], attrs: MotionAttr):
@@ -242,6 +264,7 @@ def _holds_and_outputs(params: MotionParams, attrs: MotionAttr, index: int):
 def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
     targets = _targets(params, attrs, starts, notes)
     finals = list(params.final_velocity) if A.FINAL_VEL in attrs else [0.0] * len(starts)
+    composite = ""
     if attrs & (A.SYNC_START | A.SYNC_END):
         profiles = [
             _scalar_profile(motion_type, start, target, final, traj)
@@ -253,7 +276,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
         profiles = [_scalar_profile(motion_type, starts[0], targets[0], finals[0], params.trajectory[0])]
         limits = [params.trajectory[0]]
     else:
-        profiles, limits = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
+        profiles, limits, composite = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
     plans = []
     for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles)):
         if A.NO_REVERSAL in attrs and reverses(prof, start.velocity):
@@ -271,6 +294,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
             final_velocity=0.0 if truncated else final,
             hold=hold, outputs=outputs, truncated=truncated,
             limits=limits[i], start_velocity=start.velocity, start_acceleration=start.acceleration,
+            composite=composite,
         ))
     return plans
 

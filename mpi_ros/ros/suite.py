@@ -28,10 +28,24 @@ class Suite:
         self.supervisor_nodes = [
             SupervisorNode(self.runner, spec.number, config.ros, context=context) for spec in config.supervisors
         ]
+        self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
         self.executor = MultiThreadedExecutor(num_threads=config.ros.executor_threads, context=context)
         for node in self.nodes:
             self.executor.add_node(node)
         self._spin_thread: threading.Thread | None = None
+
+    def _crosscheck(self):
+        """ros.crosscheck: every started/modified move is checked against ruckig; a
+        disagreement is logged, published as a CROSSCHECK event and in /diagnostics."""
+        from ..crosscheck.monitor import CrosscheckMonitor
+
+        log = self.controller_node.get_logger()
+        monitor = CrosscheckMonitor(
+            self.controller, on_disagreement=lambda found: log.warning(f"crosscheck: {found.result.detail}"))
+        self.runner.on_command(monitor)
+        name = f"{self.config.ros.namespace.strip('/')}/crosscheck"
+        self.controller_node.add_diagnostic(lambda ctl: [_crosscheck_status(name, monitor.summary())])
+        return monitor
 
     @property
     def nodes(self):
@@ -62,3 +76,19 @@ class Suite:
             self._spin_thread.join(timeout=5.0)
         for node in self.nodes:
             node.destroy_node()
+
+
+def _crosscheck_status(name: str, summary: dict):
+    from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+
+    status = DiagnosticStatus()
+    status.name = name
+    status.hardware_id = "mpi_ros simulated controller"
+    bad = summary["disagree"] or summary["errors"]
+    level = DiagnosticStatus.WARN if bad else DiagnosticStatus.OK
+    status.level = bytes([level]) if isinstance(level, int) else level
+    status.message = (f"{summary['checked']} profile(s) checked against ruckig: {summary['agree']} agree, "
+                      f"{summary['differ_explained']} differ (explained), {summary['disagree']} disagree"
+                      + (f", {summary['errors']} check error(s)" if summary["errors"] else ""))
+    status.values = [KeyValue(key=k, value=str(v)) for k, v in summary.items()]
+    return status

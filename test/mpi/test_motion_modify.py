@@ -190,17 +190,23 @@ def test_vector_modify_along_the_line(params):
     assert [a.command_position for a in ms.axes] == [-300.0, -400.0]
 
 
-def test_vector_modify_off_the_line_reaches_every_target(params):
-    # planner.py decision: "a vector modify whose current velocity is not along the new line cannot
-    # stay on one line; each axis is then planned from its own state"
+def test_vector_modify_off_the_line_stops_then_goes_straight_within_the_vector_limits(params):
+    # docs/decisions.md: a vector modify off its line first brings the vector to rest along the
+    # line it is on, then moves on a straight line; the vector's limits hold throughout
     ctl, ms = rig(axes=2)
     ms.start(T.TRAPEZOIDAL, params=params((5000.0, 0.0)))
     ctl.step(1000)
-    ms.modify(T.TRAPEZOIDAL, params=params((0.0, 3000.0)))
+    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 3000.0))).ok
     log = finish(ctl, ms)
     assert [a.command_position for a in ms.axes] == [0.0, 3000.0]
     assert_smooth(log[:, 2], 10_000.0)
     assert_smooth(log[:, 5], 10_000.0)
+    speed = np.hypot(log[:, 2], log[:, 5])
+    assert speed.max() <= 1000.0 * (1 + 1e-9)
+    stopped = int(np.flatnonzero(speed < 1e-9)[0])  # at rest once, between the two lines
+    assert abs(log[stopped, 3]) < 1e-9 and log[stopped, 0] > 0.0  # axis 1 waited for the stop
+    plan = ms.current.plans[0] if ms.current else ms.last_move.plans[0]
+    assert "stops along its line" in plan.composite
 
 
 def test_modify_during_the_resume_ramp(params):
