@@ -21,8 +21,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from .events import MPIEventType
 from .frames import AxisPlan, Move
 from .messages import Message
@@ -92,8 +90,7 @@ def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], n
 def _check_finite(segments: list[Segment], axis: int) -> None:
     """A profile that overflowed (absurd distances or limits) cannot be calculated."""
     for seg in segments:
-        values = (seg.duration, seg.p, seg.v, seg.a, seg.j)
-        if not all(math.isfinite(v) for v in values) or not seg.duration >= 0.0:
+        if not (seg.duration >= 0.0 and all(map(math.isfinite, (seg.duration, seg.p, seg.v, seg.a, seg.j)))):
             raise ProfileError(f"axis {axis}: the profile cannot be calculated with these values (overflow)")
 
 
@@ -146,37 +143,45 @@ def _scaled(traj: Trajectory, share: float) -> Trajectory:
                       traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
 
 
+def _dot(a, b) -> float:
+    return math.fsum(x * y for x, y in zip(a, b))
+
+
+def _along(vector, unit, scale: float) -> tuple[float, bool]:
+    """The component of ``vector`` along ``unit``, and whether ``vector`` lies on that line."""
+    along = _dot(vector, unit)
+    tolerance = 1e-9 * (1.0 + scale)
+    return along, all(abs(x - along * u) <= tolerance + 1e-9 * abs(x) for x, u in zip(vector, unit))
+
+
 def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[list[Segment]], list[Trajectory], str]:
     """One profile along the straight line from the start to the targets, each axis'
     effective limits (the vector's scaled by the axis' share of the line), and why the
-    profiles are not one profile per axis ("" when they are)."""
-    p0 = np.array([s.position for s in starts])
-    v0 = np.array([s.velocity for s in starts])
-    delta = np.array(targets) - p0
-    length = math.hypot(*delta)  # no overflow for large components, unlike norm()
+    profiles are not one profile per axis ("" when they are). Plain floats: a vector has at
+    most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
+    p0 = [s.position for s in starts]
+    v0 = [s.velocity for s in starts]
+    delta = [t - p for t, p in zip(targets, p0)]
+    length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
     if not (math.isfinite(length) and math.isfinite(speed)):
         raise ProfileError("the move's length cannot be calculated (overflow)")
-    final = np.array(finals)
     if length > 0.0:
-        unit = delta / length
+        unit = [d / length for d in delta]
     elif speed > 0.0:
-        unit = v0 / speed
+        unit = [v / speed for v in v0]
     else:
         return [[] for _ in starts], [traj for _ in starts], ""
-    along = float(v0 @ unit)
-    final_along = float(final @ unit)
-    parallel = np.allclose(v0, along * unit, rtol=1e-9, atol=1e-9 * (1.0 + speed))
-    final_parallel = np.allclose(final, final_along * unit, rtol=1e-9, atol=1e-9 * (1.0 + abs(final_along)))
+    along, parallel = _along(v0, unit, speed)
+    final_along, final_parallel = _along(finals, unit, math.hypot(*finals))
     if not final_parallel:
         raise PlanError(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
-    if parallel:
-        accel = np.array([s.acceleration for s in starts])
-        line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, float(accel @ unit)), length,
-                               final_along, traj)
-        profiles = [[seg.scaled(float(u), float(p)) for seg in line] for u, p in zip(unit, p0)]
-        return profiles, [_scaled(traj, abs(float(u))) for u in unit], ""
-    return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
+    if not parallel:
+        return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
+    accel = _dot([s.acceleration for s in starts], unit)
+    line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, accel), length, final_along, traj)
+    profiles = [[seg.scaled(u, p) for seg in line] for u, p in zip(unit, p0)]
+    return profiles, [_scaled(traj, abs(u)) for u in unit], ""
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
@@ -187,13 +192,14 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     is on (decelerating as the trajectory says), then moves on a straight line to the new
     targets. Both parts are single vector profiles, so the vector's limits hold throughout
     (docs/decisions.md)."""
-    heading = v0 / speed
+    heading = [v / speed for v in v0]
     stop = _stop_profile(motion_type, speed, traj)
-    rest = p0 + heading * (stop[-1].end_state()[0] if stop else 0.0)
-    go_starts = [AxisStart(s.axis, float(p), 0.0, s.origin) for s, p in zip(starts, rest)]
+    stopped_after = stop[-1].end_state()[0] if stop else 0.0
+    rest = [p + h * stopped_after for p, h in zip(p0, heading)]
+    go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest)]
     go, limits, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
-    profiles = [[seg.scaled(float(h), float(p)) for seg in stop] + tail for h, p, tail in zip(heading, p0, go)]
-    limits = [_scaled(traj, max(abs(float(h)), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits)]
+    profiles = [[seg.scaled(h, p) for seg in stop] + tail for h, p, tail in zip(heading, p0, go)]
+    limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits)]
     return profiles, limits, STOP_THEN_LINE
 
 
