@@ -14,6 +14,15 @@ T = MPIMotionType
 RATE = 2000.0
 
 
+def run_smoothly_to_idle(ctl, ms, accel_limit=10_000.0):
+    """Step until IDLE, checking no command velocity step exceeds the acceleration limit."""
+    previous = ctl.axes[0].cmd_v
+    while ms.state is MPIState.MOVING:
+        ctl.step(1)
+        assert abs(ctl.axes[0].cmd_v - previous) <= accel_limit / RATE * (1 + 1e-9)
+        previous = ctl.axes[0].cmd_v
+
+
 def two_axes():
     ctl = Controller(ControllerConfig(axis_count=2, supervisor_count=1))
     _, ms = ctl.create_motion(0)
@@ -228,11 +237,7 @@ def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
     assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 2000)
     assert ctl.axes[0].cmd_v == pytest.approx(500.0)
     assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))).ok
-    previous = ctl.axes[0].cmd_v
-    while ms.state is MPIState.MOVING:
-        ctl.step(1)
-        assert abs(ctl.axes[0].cmd_v - previous) <= 10_000.0 / RATE * (1 + 1e-9)
-        previous = ctl.axes[0].cmd_v
+    run_smoothly_to_idle(ctl, ms)
     assert ctl.axes[0].command_position == 0.0
 
 
@@ -249,11 +254,7 @@ def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(par
     assert ctl.axes[0].status.trajectory_complete
     assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is Message.MPIMotionMessageMOVING
     assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))).ok
-    previous = ctl.axes[0].cmd_v
-    while ms.state is MPIState.MOVING:
-        ctl.step(1)
-        assert abs(ctl.axes[0].cmd_v - previous) <= 10_000.0 / RATE * (1 + 1e-9)
-        previous = ctl.axes[0].cmd_v
+    run_smoothly_to_idle(ctl, ms)
     assert ctl.axes[0].command_position == 0.0
 
 

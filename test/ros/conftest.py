@@ -75,28 +75,28 @@ def drive(suite):
     return run
 
 
-@pytest.fixture
-def client(suite, ros_context):
+def _client(suite, ros_context, number: int):
     from mpi_ros.client import MotionClient
 
-    ms0 = MotionClient(0, context=ros_context, timeout=WAIT, node_name="test_client_ms0")
-    assert ms0.wait_for_server(WAIT)
-    try:
-        yield ms0
-    finally:
-        ms0.close()
+    client = MotionClient(number, context=ros_context, timeout=WAIT, node_name=f"test_client_ms{number}")
+    assert client.wait_for_server(WAIT)
+    return client
+
+
+@pytest.fixture
+def client(suite, ros_context):
+    """The Python client of supervisor 0."""
+    ms0 = _client(suite, ros_context, 0)
+    yield ms0
+    ms0.close()
 
 
 @pytest.fixture
 def client1(suite, ros_context):
-    from mpi_ros.client import MotionClient
-
-    ms1 = MotionClient(1, context=ros_context, timeout=WAIT, node_name="test_client_ms1")
-    assert ms1.wait_for_server(WAIT)
-    try:
-        yield ms1
-    finally:
-        ms1.close()
+    """The Python client of supervisor 1."""
+    ms1 = _client(suite, ros_context, 1)
+    yield ms1
+    ms1.close()
 
 
 def call(node, srv_type, name: str, request, timeout: float = WAIT):
