@@ -107,6 +107,10 @@ def test_live_run_recorded_with_mpi_ros_run_replays_exactly(tmp_path, ros_contex
     report = replay(bag)
     assert report.identical, report.summary()
     assert report.commands == 6 and report.statuses > 50
+    from rosbags.highlevel import AnyReader
+
+    with AnyReader([bag]) as reader:  # an independent reader reads all of it
+        assert sum(1 for _ in reader.messages()) == sum(BagReader(bag).counts().values())
 
 
 def test_playback_publishes_every_recorded_event(ros_context, probe):
