@@ -12,7 +12,8 @@ A scenario file (YAML):
         request: {type: S_CURVE, position: [2000.0, 0.0], trajectory: [{velocity: 1000.0, ...}]}
 
 This is how the regression fixtures in test/fixtures/bags are made
-(``mpi-ros record --scenario FILE OUTPUT``); a fixed epoch makes the bag reproducible.
+(``mpi-ros record --scenario FILE OUTPUT``); with a fixed epoch, recording a scenario again
+gives the same messages (not the same bytes: CDR leaves alignment padding uninitialised).
 """
 
 from __future__ import annotations
