@@ -23,9 +23,12 @@ Where each spec concept lives (spec = ../shared/spec; 000 motion objects, 002 ax
 | status bits IN_FINE/IN_COARSE/AT_TARGET/DONE/SETTLED/...  | status.py (002 tables, NOTE 1-3) |
 | HOLD triggers and timeouts                                | holds.py |
 | I/O image, control gates (meiControlGateSet)              | io.py |
-| Motion object: create/delete/validate, axis list, config, | motion.py |
-|   params, position, trajectory, status, events, actions,  |   |
-|   state machine IDLE/MOVING/STOPPING/STOPPED/...          |   |
+| Motion object: create/delete/validate, config, params,    | motion.py |
+|   position, trajectory, status, events, start/modify      |   |
+| its axis list (append/insert/remove/...) and MAP          | supervisor_axis_list.py |
+| its actions STOP/E_STOP/ABORT/RESET/RESUME/MAP            | supervisor_actions.py |
+| its state machine as the controller steps (DONE, stop     | supervisor_stepping.py |
+|   complete, ERROR, hold release at the exact sample)      |   |
 | motion log (meiMotionLogOpen/Print/Close)                 | log.py |
 | mpiMotionStatus / mpiAxisStatus / frame buffer status     | snapshot.py |
 | Controller: sample clock, step/run_until, objects, events | control.py |

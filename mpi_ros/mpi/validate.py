@@ -20,7 +20,6 @@ from .types import (
     HOLD_ATTRS,
     JERK_TYPES,
     MODIFIABLE_TYPES,
-    PATH_TYPES,
     POINT_TO_POINT_TYPES,
     VELOCITY_TYPES,
     HoldType,

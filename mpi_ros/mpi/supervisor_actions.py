@@ -1,0 +1,188 @@
+"""mpiMotionAction: STOP, RESUME, E_STOP, ABORT, E_STOP_ABORT, RESET and MEIActionMAP.
+
+Each action answers per the DESIGN.md table; safety actions are never refused. Stops ramp
+the supervisor's feedrate (clock.py); ABORT turns the amplifiers off.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .axis import CommandMode
+from .events import MPIEventType
+from .messages import STATE_MESSAGES, Message
+from .status import StatusMode
+from .types import ActionSource, MPIAction, MPIMotionType, MPIState
+
+OK = Message.MPIMessageOK
+
+
+class ActionsMixin:
+    """The actions of MotionSupervisor."""
+
+    def action(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Message:
+        """mpiMotionAction."""
+        message, _ = self.action_detail(action, source)
+        return message
+
+    def action_detail(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> tuple[Message, str]:
+        """mpiMotionAction, with why in words."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, "invalid motion handle"
+        handler = self._handlers.get(action)
+        if handler is None:
+            return Message.MPIMessagePARAM_INVALID, f"unknown action {action!r}"
+        self._notify_action(self.current.type if self.current else MPIMotionType.INVALID, MPIAction(action).name)
+        if not self.axis_list and not self.mapped:
+            return Message.MEIMotionMessageNO_AXES_MAPPED, "no axes mapped to the motion supervisor"
+        return handler(source)
+
+    @property
+    def _handlers(self):
+        return {
+            MPIAction.STOP: self._stop,
+            MPIAction.RESUME: self._resume,
+            MPIAction.E_STOP: self._e_stop,
+            MPIAction.ABORT: self._abort,
+            MPIAction.E_STOP_ABORT: self._e_stop_abort,
+            MPIAction.RESET: self._reset,
+            MPIAction.MAP: self._map_action,
+        }
+
+    def _refuse(self, allowed: tuple[MPIState, ...]) -> tuple[Message, str] | None:
+        state = self.state
+        if state in allowed:
+            return None
+        return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
+
+    def _stop(self, source: ActionSource) -> tuple[Message, str]:
+        refused = self._refuse((MPIState.MOVING,))
+        if refused:
+            return refused
+        t = self._ctl.time
+        self._rebase(t)
+        self.clock = self.clock.ramp_to(t, self.config.pause_feedrate, self.config.decel_time.stop)
+        self._stop_end = t + self.config.decel_time.stop
+        self._set_status_mode(StatusMode.STOP)
+        self._set_state(MPIState.STOPPING, "STOP", source)
+        self._emit(MPIEventType.STOP)
+        return OK, ""
+
+    def _resume(self, source: ActionSource) -> tuple[Message, str]:
+        refused = self._refuse((MPIState.STOPPED,))
+        if refused:
+            return refused
+        t = self._ctl.time
+        self._rebase(t)
+        self.clock = self.clock.ramp_to(t, self.config.normal_feedrate, self.config.decel_time.stop)
+        self._stop_end = math.inf
+        for axis in self.axes:
+            if axis.owner == self.number:
+                plan = axis.plan
+                axis.status_mode = StatusMode.VELOCITY if plan is not None and plan.is_velocity else StatusMode.POINT_TO_POINT
+        self._set_state(MPIState.MOVING, "RESUME", source)
+        self._emit(MPIEventType.RESUME)
+        return OK, ""
+
+    def _e_stop(self, source: ActionSource, then_abort: bool = False) -> tuple[Message, str]:
+        self._map_if_unmapped()
+        t = self._ctl.time
+        if self.own_state is MPIState.ERROR:
+            if then_abort and not self._aborted:
+                self._disable_amps(t)
+            return OK, "already in ERROR"
+        if self.own_state is MPIState.STOPPING_ERROR:
+            self._abort_after_stop |= then_abort
+            return OK, "already stopping on error"
+        self._rebase(t)
+        e_stop = self.config.decel_time.e_stop
+        self.clock = self.clock.ramp_to(t, 0.0, e_stop)
+        self._stop_end = t + e_stop
+        self._abort_after_stop = then_abort
+        self._claim_axes()
+        for axis in self.axes:
+            axis.status_mode = StatusMode.E_STOP
+            if axis.in_position.settle_on_estop_cmd_eq_act and axis.amp_enabled:
+                axis.follow_actual(t, self.clock)
+        self._set_state(MPIState.STOPPING_ERROR, "E_STOP_ABORT" if then_abort else "E_STOP", source)
+        self._emit(MPIEventType.E_STOP)
+        return OK, ""
+
+    def _e_stop_abort(self, source: ActionSource) -> tuple[Message, str]:
+        return self._e_stop(source, then_abort=True)
+
+    def _abort(self, source: ActionSource) -> tuple[Message, str]:
+        self._map_if_unmapped()
+        t = self._ctl.time
+        self._claim_axes()
+        self._rebase(t)
+        self._disable_amps(t)
+        if self.own_state is not MPIState.ERROR:
+            self._set_state(MPIState.STOPPING_ERROR, "ABORT", source)
+            self._error_at = self._ctl.sample + 1
+        self._emit(MPIEventType.ABORT)
+        return OK, ""
+
+    def _disable_amps(self, t: float) -> None:
+        self._aborted = True
+        for axis in self.axes:
+            axis.disable(t, self._clock_of(axis))
+            axis.status_mode = StatusMode.ABORT
+
+    def _claim_axes(self) -> None:
+        """Safety actions act on every mapped axis, whoever commanded it last."""
+        t = self._ctl.time
+        for axis in self.axes:
+            if axis.owner != self.number:
+                axis.rebase(t, self._clock_of(axis))
+                if axis.owner >= 0 and axis.plan is not None:
+                    # keep the motion going on this supervisor's clock from the same state
+                    axis.unload(t, self._clock_of(axis))
+                axis.owner = self.number
+
+    def _reset(self, source: ActionSource) -> tuple[Message, str]:
+        state = self.state
+        if state is MPIState.IDLE:
+            self._map()
+            return OK, "already IDLE"
+        refused = self._refuse((MPIState.STOPPED, MPIState.ERROR))
+        if refused:
+            return refused
+        t = self._ctl.time
+        self._rebase(t)
+        self._drop_pending(STATE_MESSAGES[state.name], f"dropped by RESET in {state.name}")
+        for axis in self.axes:
+            if axis.owner == self.number or axis.owner == -1:
+                axis.unload(t, self._clock_of(axis))
+                if not axis.amp_enabled or axis.mode is CommandMode.FOLLOW_ACTUAL:
+                    axis.enable(t, command_equals_actual=self._aborted or axis.mode is CommandMode.FOLLOW_ACTUAL)
+                axis.status_mode = StatusMode.POINT_TO_POINT
+                axis.target = axis.rest
+        self.clock = self.clock.ramp_to(t, self.config.normal_feedrate, 0.0)
+        self._stop_end = math.inf
+        self._aborted = False
+        self._error_at = None
+        self._abort_after_stop = False
+        self._map()
+        self._set_state(MPIState.IDLE, "RESET", source)
+        self._emit(MPIEventType.RESET)
+        return OK, ""
+
+    def _map_action(self, source: ActionSource) -> tuple[Message, str]:
+        refused = self._refuse((MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR))
+        if refused:
+            return refused
+        if not self.axis_list:
+            return Message.MEIMotionMessageNO_AXES_MAPPED, "the axis list is empty"
+        self._map()
+        return OK, ""
+
+    def _map_if_unmapped(self) -> None:
+        if not self.mapped:
+            self._map()
+
+    def _set_status_mode(self, mode: StatusMode) -> None:
+        for axis in self.axes:
+            if axis.owner == self.number:
+                axis.status_mode = mode
+

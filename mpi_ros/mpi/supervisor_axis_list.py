@@ -1,0 +1,129 @@
+"""The axis list of a motion supervisor (spec 000 mpiMotionAxis*): the coordinate system as
+the host holds it, and the mapping written to the controller (MEIActionMAP)."""
+
+from __future__ import annotations
+
+from .messages import Message
+from .params import MAX_COORD_AXES
+from .types import MPIState
+
+OK = Message.MPIMessageOK
+
+
+class AxisListMixin:
+    """mpiMotionAxisAppend/Insert/Remove/ListSet/ListGet/Count/Index/First/Next/... of
+    MotionSupervisor (which provides ``axis_list``, ``mapped``, ``config``, ``valid``,
+    ``own_state``, ``_axis`` and ``_state_message``)."""
+
+    def _check_axis(self, number: int) -> Message:
+        if not 0 <= number < len(self._ctl.axes):
+            return Message.MPIMessageHANDLE_INVALID
+        if not self._axis(number).enabled:
+            return Message.MPIMessageOBJECT_NOT_ENABLED
+        return OK
+
+    def axis_append(self, number: int) -> Message:
+        """mpiMotionAxisAppend."""
+        return self.axis_insert(self.axis_list[-1] if self.axis_list else None, number)
+
+    def axis_insert(self, after: int | None, number: int) -> Message:
+        """mpiMotionAxisInsert: insert ``number`` just after axis ``after`` (None: first)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        message = self._check_axis(number)
+        if not message.ok:
+            return message
+        if number in self.axis_list:
+            return Message.MPIMessageOBJECT_ON_LIST
+        if len(self.axis_list) >= MAX_COORD_AXES:
+            return Message.MPIMessageUNSUPPORTED
+        if after is None:
+            self.axis_list.insert(0, number)
+            return OK
+        if after not in self.axis_list:
+            return Message.MPIMotionMessageAXIS_NOT_FOUND
+        self.axis_list.insert(self.axis_list.index(after) + 1, number)
+        return OK
+
+    def axis_remove(self, number: int) -> Message:
+        """mpiMotionAxisRemove."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        message = self._check_axis(number)
+        if not message.ok:
+            return message
+        if number not in self.axis_list:
+            return Message.MPIMotionMessageAXIS_NOT_FOUND
+        if number not in self.mapped:
+            # spec 002 MPIAxisMessageNOT_MAPPED_TO_MS: on the list but not mapped.
+            return Message.MPIAxisMessageNOT_MAPPED_TO_MS
+        if self.own_state not in (MPIState.IDLE, MPIState.ERROR):
+            return self._state_message()
+        self.axis_list.remove(number)
+        return OK
+
+    def axis_list_set(self, numbers: list[int]) -> Message:
+        """mpiMotionAxisListSet: the coordinate system is completely replaced."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        if len(numbers) > MAX_COORD_AXES:
+            return Message.MPIMessageUNSUPPORTED
+        if len(set(numbers)) != len(numbers):
+            return Message.MPIMessageOBJECT_ON_LIST
+        for number in numbers:
+            message = self._check_axis(number)
+            if not message.ok:
+                return message
+        if self.own_state not in (MPIState.IDLE, MPIState.ERROR, MPIState.STOPPED):
+            return self._state_message()
+        self.axis_list = list(numbers)
+        return OK
+
+    def axis_list_get(self) -> tuple[Message, list[int]]:
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, []
+        return OK, list(self.axis_list)
+
+    def axis_count(self) -> int:
+        """mpiMotionAxisCount: -1 if the handle is invalid."""
+        return len(self.axis_list) if self.valid else -1
+
+    def axis_index(self, number: int) -> int:
+        """mpiMotionAxisIndex: -1 if invalid or not on the list."""
+        if not self.valid or number not in self.axis_list:
+            return -1
+        return self.axis_list.index(number)
+
+    def axis_at(self, index: int) -> tuple[Message, int | None]:
+        """mpiMotionAxis: the axis at ``index`` (None = MPIHandleVOID)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, None
+        if not 0 <= index < len(self.axis_list):
+            return Message.MEIListMessageELEMENT_NOT_FOUND, None
+        return OK, self.axis_list[index]
+
+    def axis_first(self) -> tuple[Message, int | None]:
+        return self.axis_at(0) if self.axis_list or not self.valid else (OK, None)
+
+    def axis_last(self) -> tuple[Message, int | None]:
+        return self.axis_at(len(self.axis_list) - 1) if self.axis_list or not self.valid else (OK, None)
+
+    def axis_next(self, number: int) -> tuple[Message, int | None]:
+        return self._neighbour(number, +1)
+
+    def axis_previous(self, number: int) -> tuple[Message, int | None]:
+        return self._neighbour(number, -1)
+
+    def _neighbour(self, number: int, step: int) -> tuple[Message, int | None]:
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, None
+        if number not in self.axis_list:
+            return Message.MPIMessageHANDLE_INVALID, None
+        index = self.axis_list.index(number) + step
+        return OK, self.axis_list[index] if 0 <= index < len(self.axis_list) else None
+
+    def _map(self) -> None:
+        """Write the axis list to the controller (MEIActionMAP)."""
+        self.mapped = list(self.axis_list)
+        self.config.axis_numbers = list(self.mapped)
+

@@ -1,0 +1,146 @@
+"""What happens to a motion supervisor while the controller steps: moves done, stops
+complete, errors entered, holds released, each at the exact sample its condition holds.
+
+The controller asks :meth:`scan` for the samples of a stretch at which a transition
+happens, stops there, and calls :meth:`transition`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .axis import CommandMode
+from .events import MPIEventType
+from .holds import HoldWait
+from .messages import Message
+from .status import StatusMode
+from .types import HoldType, MPIState
+
+OK = Message.MPIMessageOK
+
+
+class SteppingMixin:
+    """The transitions of MotionSupervisor."""
+
+    def scan(self, samples: np.ndarray, t: np.ndarray, traces, statuses) -> np.ndarray | None:
+        """Per sample of a stretch: does a transition of this supervisor happen there?
+
+        The conditions are kept until :meth:`transition` applies them.
+        """
+        self._conditions = conditions = {}
+        state = self.own_state
+        if self._holds and state in (MPIState.MOVING, MPIState.STOPPED):
+            for axis_number, wait in self._holds.items():
+                conditions[("hold", axis_number)] = self._hold_trigger(wait, samples, traces)
+        if state is MPIState.MOVING and self.current is not None and not self._holds:
+            # A move that ends moving (FINAL_VEL) is never DONE: the next appended move
+            # takes over at its trajectory's end; with none, the axes go on at the final
+            # velocity (MOVING) until a modify, an append or a stop.
+            key = "trajectory_complete" if self._ends_moving() else "done"
+            if key == "done" or self.queue:
+                complete = np.ones(len(samples), dtype=bool)
+                for plan in self.current.plans:
+                    complete &= statuses[plan.axis].bits[key]
+                conditions["move_done"] = complete
+        elif state is MPIState.STOPPING:
+            conditions["stopped"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_stop)
+        elif state is MPIState.STOPPING_ERROR:
+            if self._error_at is not None:
+                conditions["error"] = samples >= self._error_at
+            else:
+                conditions["error"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_estop)
+        if not conditions:
+            return None
+        return np.logical_or.reduce(list(conditions.values()))
+
+    def _ends_moving(self) -> bool:
+        """The current move ends at its target with a velocity (FINAL_VEL)."""
+        return self.current is not None and any(p.final_velocity != 0.0 for p in self.current.plans)
+
+    def _cruising(self) -> bool:
+        """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
+        return self._ends_moving() and all(
+            self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in self.current.plans)
+
+    def _stop_complete(self, t, statuses, settle) -> np.ndarray:
+        ready = t >= self._stop_end - 1e-12
+        for axis in self.axes:
+            if settle(axis) and axis.number in statuses:
+                ready = ready & statuses[axis.number].bits["done"]
+        return ready
+
+    def _hold_trigger(self, wait: HoldWait, samples, traces) -> np.ndarray:
+        if wait.watches_position:
+            trace = traces[wait.hold.number]
+            raw = trace.act_p if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else trace.cmd_p
+            fired = wait.position_trigger(raw - self._axis(wait.hold.number).origin)
+        else:
+            fired = np.full(len(samples), wait.static_trigger(self._ctl.io))
+        return fired | wait.timed_out(samples)
+
+    def transition(self, index: int, samples: np.ndarray) -> None:
+        """Apply what :meth:`scan` found at stretch sample ``index`` (the controller is there)."""
+        conditions, self._conditions = self._conditions, {}
+        for key, fired in conditions.items():
+            if not fired[index]:
+                continue
+            if key[0] == "hold":
+                wait = self._holds.get(key[1])
+                if wait is not None:
+                    self._release(key[1], wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
+            elif key == "move_done":
+                self._move_done()
+            elif key == "stopped":
+                self._set_state(MPIState.STOPPED, self.last_action, self.action_source)
+            elif key == "error":
+                self._stop_on_error_complete()
+
+    def _stop_on_error_complete(self) -> None:
+        """E_STOP (or ABORT) has run its course: disable what must be, enter ERROR."""
+        t = self._ctl.time
+        if self._error_at is None:
+            if self._abort_after_stop:
+                self._disable_amps(t)
+            for axis in self.axes:
+                if axis.mode is CommandMode.FOLLOW_ACTUAL:
+                    # settleOnEstopCmdEqAct: "After the Estop time elapses, the axis'
+                    # motors will disable the amplifiers."
+                    axis.disable(t, None)
+                    axis.status_mode = StatusMode.ABORT
+        self._error_at = None
+        self._rebase(t)
+        self._drop_pending(Message.MPIMotionMessageERROR, f"{self.last_action} by {self.action_source.value}")
+        for axis in self.axes:
+            if axis.owner == self.number and axis.plan is not None:
+                axis.unload(t, self.clock)
+        self._set_state(MPIState.ERROR, self.last_action, self.action_source)
+
+    def _move_done(self) -> None:
+        move = self.current
+        self._emit(MPIEventType.MOTION_DONE, move=move)
+        self._end_move(move, OK, "motion done")
+        self.current = None
+        if self.queue:
+            self._load(self.queue.popleft())
+        else:
+            self._set_state(MPIState.IDLE, self.last_action, self.action_source)
+
+    def release_holds(self, io) -> None:
+        """Release holds whose trigger is true now (after a gate or I/O change, a load)."""
+        for axis_number, wait in list(self._holds.items()):
+            if wait.watches_position:
+                fired = bool(wait.position_trigger(np.array([self._position_of(wait.hold)]))[0])
+            else:
+                fired = wait.static_trigger(io)
+            if fired:
+                self._release(axis_number, wait, timed_out=False)
+
+    def _release(self, axis_number: int, wait: HoldWait, timed_out: bool) -> None:
+        del self._holds[axis_number]
+        t = self._ctl.time
+        axis = self._axis(axis_number)
+        axis.load(wait.plan, self.clock.tau_at(t), t, self.clock)
+        self._fire_outputs(wait.plan)
+        kind = MPIEventType.HOLD_TIMEOUT if timed_out else MPIEventType.HOLD_RELEASED
+        self._emit(kind, axis=axis_number, move=self.current, detail=wait.hold.type.name)
+
