@@ -24,7 +24,7 @@ def timings(motion_type: MPIMotionType, axes: int, count: int = 3000) -> list[fl
         params = MotionParams(trajectory=[traj], position=[rng.uniform(-1e5, 1e5) for _ in range(axes)])
         starts = [AxisStart(n, 0.0) for n in range(axes)]
         t0 = time.perf_counter()
-        compile_move(0, motion_type, MotionAttr.NONE, params, starts, 2000.0, False)
+        compile_move(0, motion_type, MotionAttr.NONE, params, starts, 2000.0)
         out.append(time.perf_counter() - t0)
     return out
 

@@ -155,9 +155,8 @@ class ProfileRequest:
         if not verdict.ok:
             raise RequestInvalid(f"{verdict.message.name}: {verdict.detail}")
         start = AxisStart(0, self.start_position, self.start_velocity, 0.0, self.start_acceleration)
-        moving = self.start_velocity != 0.0 or self.start_acceleration != 0.0
         try:
-            move, _ = compile_move(0, self.type, attrs, params, [start], sample_rate, moving)
+            move, _ = compile_move(0, self.type, attrs, params, [start], sample_rate)
         except PlanError as exc:
             raise RequestInvalid(f"{exc.message.name}: {exc.detail}") from exc
         return move.plans[0]

@@ -329,10 +329,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         # (DESIGN.md table), and behind a move already cruising at its final velocity there
         # is nothing to wait for: the new move starts from where the axes are (a modify).
         queued = append and state is MPIState.MOVING and (bool(self.queue) or not self._cruising())
+        starts = self._starts(queued, state, modify and not auto_start)
         try:
-            move, notes = compile_move(
-                self.number, motion_type, attrs, params, self._starts(queued, state, modify and not auto_start),
-                self._ctl.rate, moving=modify and not auto_start and not queued)
+            move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate)
         except PlanError as exc:
             return exc.message, exc.detail
         if queued:

@@ -232,16 +232,21 @@ def compile_move(
     params: MotionParams,
     starts: list[AxisStart],
     sample_rate: float,
-    moving: bool,
 ) -> tuple[Move, PlanNotes]:
     """The frames of a request for the axes ``starts`` (in the supervisor's order).
 
-    ``moving``: the axes are in motion (a modify), so a non-zero DELAY is illegal.
-    Raises PlanError with the spec's message when the profile cannot be made.
+    Raises PlanError with the spec's message when the profile cannot be made. A profile
+    that starts while its axes move cannot wait first: a non-zero DELAY is
+    MPIMotionMessageILLEGAL_DELAY (spec 000, for a modify in motion) and a HOLD
+    MPIMotionMessageATTRIBUTE_INVALID (spec 000: HOLD is not permitted in modifies); either
+    would stop the axes dead.
     """
     notes = PlanNotes()
+    moving = any(s.velocity != 0.0 for s in starts)
     if A.DELAY in attrs and moving and any(d != 0.0 for d in params.delay):
-        raise PlanError(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
+        raise PlanError(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
+    if attrs & (A.HOLD | A.HOLD_LESS | A.HOLD_GREATER) and moving:
+        raise PlanError(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
     try:
         if motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)

@@ -68,9 +68,9 @@ def test_a_disagreement_is_exit_status_1(monkeypatch, capsys):
 
     real = request_module.compile_move
 
-    def wrong(supervisor, motion_type, attrs, params, starts, rate, moving):
+    def wrong(supervisor, motion_type, attrs, params, starts, rate):
         fast = replace(params, trajectory=[replace(t, velocity=2 * t.velocity) for t in params.trajectory])
-        move, notes = real(supervisor, motion_type, attrs, fast, starts, rate, moving)
+        move, notes = real(supervisor, motion_type, attrs, fast, starts, rate)
         move.plans[0].limits = params.trajectory[0]
         return move, notes
 

@@ -87,7 +87,7 @@ def test_delay_and_sync_waits_are_left_out():
     params = MotionParams(trajectory=[traj, replace(traj, velocity=250.0)], position=[1000.0, 400.0],
                           delay=[0.3, 0.0])
     starts = [AxisStart(0, 0.0), AxisStart(1, 0.0)]
-    move, _ = compile_move(0, S, MotionAttr.DELAY | MotionAttr.SYNC_START, params, starts, 2000.0, False)
+    move, _ = compile_move(0, S, MotionAttr.DELAY | MotionAttr.SYNC_START, params, starts, 2000.0)
     assert move.plans[0].segments[0].duration == 0.3  # the DELAY wait frame
     assert move.plans[1].segments[-1].v == 0.0  # SYNC_START pads the shorter profile at its end
     for plan in move.plans:
@@ -99,7 +99,7 @@ def test_vector_move_axes_are_checked_with_their_share_of_the_limits():
     # scaled by the axis' share), an axis that does not move has no profile at all
     params = MotionParams(trajectory=[Trajectory(500.0, 5000.0, 5000.0, 70.0)], position=[300.0, -400.0, 0.0])
     starts = [AxisStart(0, 0.0), AxisStart(1, 0.0), AxisStart(2, 0.0)]
-    move, _ = compile_move(0, S, MotionAttr.NONE, params, starts, 2000.0, False)
+    move, _ = compile_move(0, S, MotionAttr.NONE, params, starts, 2000.0)
     results = [check_plan(plan, S) for plan in move.plans]
     assert [r.verdict for r in results] == [Verdict.AGREE] * 3
     assert results[0].controller_duration == pytest.approx(results[1].controller_duration)

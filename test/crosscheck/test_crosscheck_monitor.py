@@ -66,12 +66,12 @@ def _plan_with_twice_the_acceleration(monkeypatch):
     """A planner bug: frames planned with twice the acceleration, the limits recorded as asked."""
     real = motion_module.compile_move
 
-    def wrong(supervisor, motion_type, attrs, params, starts, rate, moving):
+    def wrong(supervisor, motion_type, attrs, params, starts, rate):
         from dataclasses import replace
 
         asked = list(params.trajectory)
         fast = replace(params, trajectory=[replace(t, acceleration=2 * t.acceleration) for t in asked])
-        move, notes = real(supervisor, motion_type, attrs, fast, starts, rate, moving)
+        move, notes = real(supervisor, motion_type, attrs, fast, starts, rate)
         for plan in move.plans:
             plan.limits = replace(plan.limits, acceleration=plan.limits.acceleration / 2)
         return move, notes

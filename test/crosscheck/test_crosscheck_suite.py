@@ -88,9 +88,9 @@ def test_a_disagreement_is_an_event_and_a_diagnostic(crosscheck_suite, probe, mo
 
     real = motion_module.compile_move
 
-    def wrong(supervisor, motion_type, attrs, params, starts, rate, moving):  # a planner bug
+    def wrong(supervisor, motion_type, attrs, params, starts, rate):  # a planner bug
         fast = replace(params, trajectory=[replace(t, acceleration=2 * t.acceleration) for t in params.trajectory])
-        move, notes = real(supervisor, motion_type, attrs, fast, starts, rate, moving)
+        move, notes = real(supervisor, motion_type, attrs, fast, starts, rate)
         for plan in move.plans:
             plan.limits = replace(plan.limits, acceleration=plan.limits.acceleration / 2)
         return move, notes

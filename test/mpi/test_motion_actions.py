@@ -311,3 +311,18 @@ def test_append_behind_a_cruising_final_velocity_move_continues_without_a_jump(p
     assert abs(ctl.axes[0].command_position - before) < 1.0  # no jump back to the old target
     assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000, chunk=10)
     assert ctl.axes[0].command_position == 0.0
+
+
+def test_a_move_that_starts_in_motion_cannot_wait(params):
+    # spec 000:2212 ILLEGAL_DELAY "non-zero delay value ... while in motion" and 000:971 "It is
+    # impossible to use the HOLD attributes with mpiMotionModify": a move appended behind one that
+    # ends moving (FINAL_VEL) starts in motion too, and a wait would stop the axes dead.
+    ctl, ms = two_axes()
+    ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
+    delayed = params((2000.0, 0.0), delay=[0.1, 0.1])
+    assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.DELAY, delayed) is Message.MPIMotionMessageILLEGAL_DELAY
+    hold = Hold(type=HoldType.GATE, gate=1)
+    held = params((2000.0, 0.0), hold=[hold, hold])
+    assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.HOLD, held) is Message.MPIMotionMessageATTRIBUTE_INVALID
+    assert not ms.queue  # nothing changed
+    assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((2000.0, 0.0))).ok

@@ -20,9 +20,10 @@ RATE = 2000.0
 
 def compile_(attrs=A.NONE, position=(3000.0, 4000.0), kind=T.TRAPEZOIDAL, starts=None, moving=False,
              trajectory=(TRAJ,), rate=RATE, **fields):
+    """``moving``: the axes start at 100 counts/s (as a modify in motion does)."""
     params = MotionParams(trajectory=list(trajectory), position=list(position), **fields)
-    starts = starts or [AxisStart(i, 0.0) for i in range(len(position))]
-    return compile_move(0, kind, attrs, params, starts, rate, moving)
+    starts = starts or [AxisStart(i, 0.0, 100.0 if moving else 0.0) for i in range(len(position))]
+    return compile_move(0, kind, attrs, params, starts, rate)
 
 
 def end(plan):
