@@ -167,8 +167,8 @@ class Controller:
             count += axis.plan.frames_left(axis.rel if np.isfinite(axis.rel) else 0.0)
         owner = self.supervisor(axis.owner)
         if owner is not None:
-            if axis.holding and owner.current is not None and owner.current.plan_for(number) is not None:
-                count += owner.current.plan_for(number).frame_count
+            held = owner.current.plan_for(number) if axis.holding and owner.current is not None else None
+            count += held.frame_count if held is not None else 0
             count += sum(m.frame_counts.get(number, 0) for m in owner.queue)
         return count
 

@@ -328,7 +328,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
         # (DESIGN.md table), and behind a move already cruising at its final velocity there
         # is nothing to wait for: the new move starts from where the axes are (a modify).
-        queued = append and state is MPIState.MOVING and (bool(self.queue) or not self._cruising())
+        queued = append and state is MPIState.MOVING and (bool(self.queue) or not self.cruising())
         starts = self._starts(queued, state, modify and not auto_start)
         try:
             move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate)

@@ -57,7 +57,7 @@ class SteppingMixin:
         """The current move ends at its target with a velocity (FINAL_VEL)."""
         return self.current is not None and any(p.final_velocity != 0.0 for p in self.current.plans)
 
-    def _cruising(self) -> bool:
+    def cruising(self) -> bool:
         """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
         return self._ends_moving() and all(
             self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in self.current.plans)

@@ -67,7 +67,7 @@ class GoalTracker:
                            f"stopped by {ms.last_action} ({ms.action_source.value})", ctl.sample)
         if move is ms.current and move.is_velocity and self._at_velocity(ctl, move):
             return GoalEnd(Message.MPIMessageOK, "at velocity", ctl.sample)
-        if move is ms.current and not ms.queue and ms._cruising():
+        if move is ms.current and not ms.queue and ms.cruising():
             return GoalEnd(Message.MPIMessageOK, "at target, going on at the final velocity", ctl.sample)
         return None
 

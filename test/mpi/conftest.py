@@ -67,24 +67,40 @@ def ms1(ctl, ms):
     return _supervisor(ctl, 1, [2, 3])
 
 
+def drive_to(ctl: Controller, ms, state: MPIState) -> None:
+    """Drive ``ms`` into ``state`` through the public API, mid-way through a long move
+    (IDLE: untouched; STOPPING/STOPPING_ERROR: a few samples into the ramp)."""
+    if state is MPIState.IDLE:
+        return
+    assert ms.start(MPIMotionType.TRAPEZOIDAL, params=make_params(LONG_MOVE)).ok
+    ctl.step(400)  # at speed (the ramp takes 200 samples)
+    if state in (MPIState.STOPPING, MPIState.STOPPED):
+        assert ms.action(MPIAction.STOP).ok
+    elif state in (MPIState.STOPPING_ERROR, MPIState.ERROR):
+        assert ms.action(MPIAction.E_STOP).ok
+    if state in (MPIState.STOPPING, MPIState.STOPPING_ERROR):
+        ctl.step(10)
+    elif state in (MPIState.STOPPED, MPIState.ERROR):
+        run_to_state(ctl, ms, state, chunk=50)
+    assert ms.state is state
+
+
 @pytest.fixture
 def bring(ctl, ms):
-    """bring(state): drive ``ms`` into ``state`` through the public API, mid-way through a
-    long move (IDLE: untouched; STOPPING/STOPPING_ERROR: a few samples into the ramp)."""
+    """bring(state): drive the fixture's ``ms`` into ``state`` (see drive_to)."""
+    return lambda state: drive_to(ctl, ms, state)
 
-    def bring_to(state: MPIState) -> None:
-        if state is MPIState.IDLE:
-            return
-        assert ms.start(MPIMotionType.TRAPEZOIDAL, params=make_params(LONG_MOVE)).ok
-        ctl.step(400)  # at speed (the ramp takes 200 samples)
-        if state in (MPIState.STOPPING, MPIState.STOPPED):
-            assert ms.action(MPIAction.STOP).ok
-        elif state in (MPIState.STOPPING_ERROR, MPIState.ERROR):
-            assert ms.action(MPIAction.E_STOP).ok
-        if state in (MPIState.STOPPING, MPIState.STOPPING_ERROR):
-            ctl.step(10)
-        elif state in (MPIState.STOPPED, MPIState.ERROR):
-            run_to_state(ctl, ms, state, chunk=50)
-        assert ms.state is state
 
-    return bring_to
+@pytest.fixture
+def prepared():
+    """prepared(state) -> (ctl, ms): a new controller whose supervisor 0 (axes 0, 1) is in
+    ``state`` (see drive_to); call it twice for two identical controllers."""
+
+    def prepare(state: MPIState):
+        ctl = Controller()
+        ms = _supervisor(ctl, 0, [0, 1])
+        drive_to(ctl, ms, state)
+        ctl.drain_events()
+        return ctl, ms
+
+    return prepare

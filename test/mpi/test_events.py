@@ -11,6 +11,16 @@ E = MPIEventType
 T = MPIMotionType
 
 
+def sharing_axis_1(ctl):
+    """Supervisor 0 on axes [0, 1] and supervisor 1 on [1, 2], both mapped."""
+    _, a = ctl.create_motion(0)
+    _, b = ctl.create_motion(1)
+    for ms, axes in ((a, [0, 1]), (b, [1, 2])):
+        ms.axis_list_set(axes)
+        ms.action(MPIAction.MAP)
+    return a, b
+
+
 def of(events, kind):
     return [e for e in events if e.type is kind]
 
@@ -138,12 +148,7 @@ def test_shared_axes_send_motion_events_to_both_supervisors(ctl, params):
     # spec 000:1161 "When using multiple Motion Supervisors that share axes, Motion events (Done,
     # AtVelocity) are sent to both Motion objects, no matter which Motion Supervisor commanded the
     # motion"
-    _, a = ctl.create_motion(0)
-    _, b = ctl.create_motion(1)
-    a.axis_list_set([0, 1])
-    b.axis_list_set([1, 2])
-    a.action(MPIAction.MAP)
-    b.action(MPIAction.MAP)
+    a, b = sharing_axis_1(ctl)
     a.start(T.TRAPEZOIDAL, params=params((300.0, 300.0)))
     assert ctl.run_until(lambda c: a.state is MPIState.IDLE, 20_000, chunk=100)
     events = ctl.drain_events()
@@ -155,12 +160,7 @@ def test_shared_axes_send_motion_events_to_both_supervisors(ctl, params):
 def test_shared_axis_state_and_only_one_commander(ctl, params):
     # spec 000:9 "only one Motion Supervisor can command motion to an axis at a time"; 000:1161 the
     # status "is derived from each axis' status"
-    _, a = ctl.create_motion(0)
-    _, b = ctl.create_motion(1)
-    a.axis_list_set([0, 1])
-    b.axis_list_set([1, 2])
-    a.action(MPIAction.MAP)
-    b.action(MPIAction.MAP)
+    a, b = sharing_axis_1(ctl)
     assert a.start(T.TRAPEZOIDAL, params=params((3000.0, 3000.0))).ok
     assert b.state is MPIState.MOVING
     assert b.start(T.TRAPEZOIDAL, params=params((10.0, 10.0))) is Message.MPIMotionMessageMOVING
@@ -174,12 +174,7 @@ def test_shared_axis_state_and_only_one_commander(ctl, params):
 
 def test_safety_action_on_a_shared_axis_stops_it(ctl, params):
     # spec 000:917 E_STOP "on all axes" of the supervisor, whichever supervisor commanded them
-    _, a = ctl.create_motion(0)
-    _, b = ctl.create_motion(1)
-    a.axis_list_set([0, 1])
-    b.axis_list_set([1, 2])
-    a.action(MPIAction.MAP)
-    b.action(MPIAction.MAP)
+    a, b = sharing_axis_1(ctl)
     a.start(T.TRAPEZOIDAL, params=params((50_000.0, 50_000.0)))
     ctl.step(1000)
     assert b.action(MPIAction.E_STOP).ok

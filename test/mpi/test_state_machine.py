@@ -28,27 +28,6 @@ def p2p(position) -> MotionParams:
     return MotionParams(trajectory=[Trajectory(1000.0, 10_000.0, 10_000.0, 0.0)], position=list(position))
 
 
-def prepared(state: MPIState):
-    """A controller whose supervisor 0 (axes 0, 1) is in ``state``, mid-way through a long move."""
-    ctl = Controller()
-    _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set([0, 1]).ok and ms.action(MPIAction.MAP).ok
-    if state is not S.IDLE:
-        assert ms.start(T.TRAPEZOIDAL, params=p2p(TARGET)).ok
-        ctl.step(400)
-    if state in (S.STOPPING, S.STOPPED):
-        assert ms.action(MPIAction.STOP).ok
-    if state in (S.STOPPING_ERROR, S.ERROR):
-        assert ms.action(MPIAction.E_STOP).ok
-    if state in (S.STOPPING, S.STOPPING_ERROR):
-        ctl.step(10)
-    if state in (S.STOPPED, S.ERROR):
-        assert ctl.run_until(lambda c: ms.state is state, 5000, chunk=10)
-    assert ms.state is state
-    ctl.drain_events()
-    return ctl, ms
-
-
 def command(ms, name: str) -> Message:
     if name == "start":
         return ms.start(T.TRAPEZOIDAL, params=p2p(OTHER))
@@ -130,7 +109,7 @@ def test_the_table_has_every_cell():
 
 
 @pytest.mark.parametrize("state,name,message,after", CELLS, ids=[f"{c[0].name}-{c[1]}" for c in CELLS])
-def test_cell(state, name, message, after):
+def test_cell(state, name, message, after, prepared):
     ctl, ms = prepared(state)
     assert command(ms, name) is message
     assert ms.state is after
@@ -149,7 +128,7 @@ REFUSALS = [c for c in CELLS if c[2] is not OK]
 
 
 @pytest.mark.parametrize("state,name,message,after", REFUSALS, ids=[f"{c[0].name}-{c[1]}" for c in REFUSALS])
-def test_refused_cell_changes_nothing(state, name, message, after):
+def test_refused_cell_changes_nothing(state, name, message, after, prepared):
     # DESIGN.md table: '"msg X" = refused with MPIMotionMessageX, nothing changes'
     ctl_a, ms_a = prepared(state)
     ctl_b, ms_b = prepared(state)
@@ -159,7 +138,7 @@ def test_refused_cell_changes_nothing(state, name, message, after):
 
 @pytest.mark.parametrize("state", [S.IDLE, S.MOVING, S.STOPPING, S.STOPPED, S.STOPPING_ERROR])
 @pytest.mark.parametrize("action", ["E_STOP", "ABORT", "E_STOP_ABORT"])
-def test_safety_actions_end_in_error(state, action):
+def test_safety_actions_end_in_error(state, action, prepared):
     # spec 000:917 "the Motion will perform an emergency stop and/or abort on all axes, and then
     # change to the error state (MPIStateSTOPPING_ERROR to MPIStateERROR)"
     ctl, ms = prepared(state)
@@ -169,7 +148,7 @@ def test_safety_actions_end_in_error(state, action):
     assert ms.state is S.ERROR  # spec 000:917 "you must first make a call to ... RESET"
 
 
-def test_modify_auto_start_in_idle_starts_and_answers_auto_start():
+def test_modify_auto_start_in_idle_starts_and_answers_auto_start(prepared):
     # spec 000:2208 AUTO_START "returned from mpiMotionModify when the AUTO_START attribute mask was
     # specified and the motion was commanded while the motion supervisor is in the IDLE state";
     # 000:1554 "converts a mpiMotionModify(...) call to a mpiMotionStart(...)"
@@ -182,20 +161,20 @@ def test_modify_auto_start_in_idle_starts_and_answers_auto_start():
 
 @pytest.mark.parametrize("state,message", [(S.STOPPING, STOPPING), (S.STOPPED, STOPPED),
                                            (S.STOPPING_ERROR, STOPPING_ERROR), (S.ERROR, ERROR)])
-def test_auto_start_does_not_start_outside_idle(state, message):
+def test_auto_start_does_not_start_outside_idle(state, message, prepared):
     # spec 000:2208 AUTO_START converts a modify to a start only in the IDLE state
     ctl, ms = prepared(state)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is message
 
 
-def test_modify_auto_start_while_moving_is_a_plain_modify():
+def test_modify_auto_start_while_moving_is_a_plain_modify(prepared):
     # spec 000:1554 AUTO_START acts "if the modify occurs after the previous motion profile has
     # completed"; while moving the modify answers OK
     ctl, ms = prepared(S.MOVING)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is OK
 
 
-def test_start_from_stopped_drops_the_pending_profile():
+def test_start_from_stopped_drops_the_pending_profile(prepared):
     # DESIGN.md: "A new start from STOPPED discards the pending profile"
     ctl, ms = prepared(S.STOPPED)
     serial = ms.current.serial
@@ -207,7 +186,7 @@ def test_start_from_stopped_drops_the_pending_profile():
     assert ms.action(MPIAction.RESUME) is IDLE  # nothing pending any more
 
 
-def test_reset_from_stopped_drops_the_pending_profile():
+def test_reset_from_stopped_drops_the_pending_profile(prepared):
     # DESIGN.md table: RESET in STOPPED "OK, to IDLE, pending dropped"
     ctl, ms = prepared(S.STOPPED)
     where = [a.command_position for a in ms.axes]
@@ -232,7 +211,7 @@ def test_resume_from_stopped_finishes_the_move():
     assert [a.command_position for a in ms.axes] == [2000.0, 1000.0]
 
 
-def test_stop_completes_to_stopped_after_the_stop_time():
+def test_stop_completes_to_stopped_after_the_stop_time(prepared):
     # spec 000:924 STOP "decelerates the axis (or axes) to a stop in the time specified by the
     # stop time"; DESIGN.md: MOVING -> STOPPING (decelerate over decelTime.stop) -> STOPPED
     ctl, ms = prepared(S.MOVING)
@@ -244,7 +223,7 @@ def test_stop_completes_to_stopped_after_the_stop_time():
     assert ms.state is S.STOPPED and ctl.sample == k + 1000  # 0.5 s at 2000 Hz
 
 
-def test_e_stop_completes_to_error_after_the_e_stop_time():
+def test_e_stop_completes_to_error_after_the_e_stop_time(prepared):
     # spec 000:920 E_STOP "will decelerate the axis (or axes) to a stop in the time specified by
     # the eStop time. After the Motion stops, the Motion will be set to the ERROR state."
     ctl, ms = prepared(S.MOVING)
@@ -256,7 +235,7 @@ def test_e_stop_completes_to_error_after_the_e_stop_time():
     assert ms.state is S.ERROR and ctl.sample == k + 100  # 0.05 s
 
 
-def test_abort_reaches_error_at_the_next_sample():
+def test_abort_reaches_error_at_the_next_sample(prepared):
     # spec 000:918 ABORT "After the abort completes, the Motion will be set to the ERROR state";
     # DESIGN.md "ABORT disables the servo at once"
     ctl, ms = prepared(S.MOVING)
@@ -266,7 +245,7 @@ def test_abort_reaches_error_at_the_next_sample():
     assert ms.state is S.ERROR
 
 
-def test_e_stop_while_stopping_error_keeps_the_first_ramp():
+def test_e_stop_while_stopping_error_keeps_the_first_ramp(prepared):
     # DESIGN.md table: E_STOP in STOPPING_ERROR is "OK" and does not restart the ramp
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
@@ -277,7 +256,7 @@ def test_e_stop_while_stopping_error_keeps_the_first_ramp():
     assert ms.state is S.ERROR and ctl.sample == k + 100
 
 
-def test_e_stop_abort_while_e_stopping_disables_at_the_end():
+def test_e_stop_abort_while_e_stopping_disables_at_the_end(prepared):
     # spec 000:921 E_STOP_ABORT "first performs an E_STOP, and then performs an ABORT"
     ctl, ms = prepared(S.MOVING)
     assert ms.action(MPIAction.E_STOP).ok
@@ -288,7 +267,7 @@ def test_e_stop_abort_while_e_stopping_disables_at_the_end():
     assert not any(a.amp_enabled for a in ms.axes)
 
 
-def test_reset_in_error_returns_to_idle_and_allows_a_start():
+def test_reset_in_error_returns_to_idle_and_allows_a_start(prepared):
     # spec 000:922 RESET "change to the idle state (MPIStateIDLE), so that motion supervisor can
     # be restarted"
     ctl, ms = prepared(S.ERROR)
@@ -308,7 +287,7 @@ def test_actions_without_axes_answer_no_axes_mapped(action):
     assert ms.state is S.IDLE
 
 
-def test_the_action_source_is_recorded():
+def test_the_action_source_is_recorded(prepared):
     # issue 3: "Whether the user or the controller caused a state (action source) is recorded"
     ctl, ms = prepared(S.MOVING)
     assert ms.action(MPIAction.E_STOP, ActionSource.CONTROLLER).ok
@@ -320,7 +299,7 @@ def test_the_action_source_is_recorded():
     assert (snap.last_action, snap.action_source) == ("RESET", "USER")
 
 
-def test_stop_records_stop_until_stopped():
+def test_stop_records_stop_until_stopped(prepared):
     # issue 3: the action behind a state is recorded (STOPPING and STOPPED after a user STOP)
     ctl, ms = prepared(S.MOVING)
     ms.action(MPIAction.STOP)
@@ -331,7 +310,7 @@ def test_stop_records_stop_until_stopped():
 
 @pytest.mark.parametrize("action,event", [("STOP", MPIEventType.STOP), ("E_STOP", MPIEventType.E_STOP),
                                           ("ABORT", MPIEventType.ABORT)])
-def test_actions_emit_their_event_at_the_command_sample(action, event):
+def test_actions_emit_their_event_at_the_command_sample(action, event, prepared):
     # spec 000:927 "How STOP Events Work"; DESIGN.md: every command is recorded with its sample
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
