@@ -10,3 +10,11 @@ source tree). Importing this package must stay cheap: it does not import rclpy.
 """
 
 __version__ = "0.1.0"
+
+# The generated interfaces (mpi_ros.msg/.srv/.action and their typesupport libraries) exist
+# only in an installed package. When this source tree is first on sys.path (pytest or python
+# run from the repository root), let the package span both folders: the source's modules win,
+# the installed package supplies the generated ones.
+from pkgutil import extend_path
+
+__path__ = extend_path(__path__, __name__)

@@ -2,8 +2,8 @@
 # Run the tests: set-up first (scripts/setup.sh: venv, pinned wheels, build, install), then
 # pytest over test/ with the venv's interpreter. Extra arguments go to pytest, e.g.
 #   scripts/test.sh -k roundtrip -x
-# Tests import the INSTALLED mpi_ros (it has the generated interfaces; the source folder has
-# not): `python -P` keeps the repo root off sys.path, pyproject.toml sets --import-mode=importlib.
+# Tests run the source tree (pyproject: pythonpath = ["."]); mpi_ros/__init__.py extends the
+# package to the installed copy for the generated interfaces. `-P`: nothing else from cwd.
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$repo/scripts/setup.sh"

@@ -24,6 +24,9 @@ os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
 # Generated messages type-check field assignments only with this set (read at import time);
 # without it an int assigned to a float64 field silently serialises garbage.
 os.environ.setdefault("ROS_PYTHON_CHECK_FIELDS", "1")
+# Processes the tests start (mpi-ros run, peers) run this source tree too, not a stale install.
+_REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (_REPO, os.environ.get("PYTHONPATH", "")) if p)
 
 import sys  # noqa: E402
 import threading  # noqa: E402
