@@ -255,10 +255,10 @@ class Axis:
             cmd_v = np.zeros_like(t)
             cmd_a = np.zeros_like(t)
         else:
-            y, dy, anchors = self._trace_plant(t, clock)
+            y, dy, anchors = self._trace_plant(samples, t, clock)
         return AxisTrace(samples, t, cmd_p, cmd_v, cmd_a, self.plant.read(y), dy, rel, anchors)
 
-    def _trace_plant(self, t: np.ndarray, clock: ProfileClock | None):
+    def _trace_plant(self, samples: np.ndarray, t: np.ndarray, clock: ProfileClock | None):
         y = np.empty_like(t)
         dy = np.empty_like(t)
         state = self.state
@@ -267,11 +267,10 @@ class Axis:
             lo = int(np.searchsorted(t, start, side="left"))
             hi = int(np.searchsorted(t, end, side="left"))
             if hi > lo:
-                s = t[lo:hi] - start
                 if self.mode is CommandMode.COAST:
-                    y[lo:hi], dy[lo:hi] = self.plant.coast(state, s)
+                    y[lo:hi], dy[lo:hi] = self.plant.coast(state, samples[lo:hi], self.rate)
                 else:
-                    y[lo:hi], dy[lo:hi] = self.plant.response(state, forced, s)
+                    y[lo:hi], dy[lo:hi] = self.plant.response(state, forced, samples[lo:hi], self.rate)
             if end > t[-1] or not math.isfinite(end):
                 break
             state = self._advance_piece(state, forced, end)

@@ -65,6 +65,8 @@ class Plant:
         )
         self._resolution = config.encoder_resolution
         self._coast = config.coast_time_constant
+        # M^2 = kappa I (Cayley-Hamilton: A's eigenvalues are sigma +- i q, sigma +- q, or sigma twice)
+        self._kappa = {"under": -self._q * self._q, "over": self._q * self._q}.get(self._kind, 0.0)
 
     @staticmethod
     def _modes(z: float, w: float) -> tuple[str, float]:
@@ -96,27 +98,56 @@ class Plant:
             deriv = poly_der(deriv)
         return out
 
-    def _homogeneous(self, e0: float, e1: float, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Free response from error state (e0, e1) after time(s) s."""
-        # (A - sigma I) e for A = [[0, 1], [-w^2, -c]]
-        b0 = -self._sigma * e0 + e1
-        b1 = -self._w2 * e0 + (-self._c - self._sigma) * e1
-        decay = np.exp(self._sigma * s)
+    def _free(self, s: float) -> tuple[float, float]:
+        """Free response over ``s`` seconds as Phi(s) = p I + q M (M = A - sigma I): (p, q)."""
+        decay = math.exp(self._sigma * s)
         if self._kind == "under":
-            c, sn = np.cos(self._q * s), np.sin(self._q * s) / self._q
-        elif self._kind == "over":
-            c, sn = np.cosh(self._q * s), np.sinh(self._q * s) / self._q
-        else:
-            c, sn = np.ones_like(s), s
-        return decay * (c * e0 + sn * b0), decay * (c * e1 + sn * b1)
+            return decay * math.cos(self._q * s), decay * math.sin(self._q * s) / self._q
+        if self._kind == "over":
+            return decay * math.cosh(self._q * s), decay * math.sinh(self._q * s) / self._q
+        return decay, decay * s
+
+    def _apply_m(self, e0: float, e1: float) -> tuple[float, float]:
+        """M e for M = A - sigma I, A = [[0, 1], [-w^2, -c]]."""
+        return -self._sigma * e0 + e1, -self._w2 * e0 + (-self._c - self._sigma) * e1
+
+    def _homogeneous_at(self, e0: float, e1: float, s: float) -> tuple[float, float]:
+        """Free response from error state (e0, e1) after ``s`` seconds (scalar)."""
+        p, q = self._free(s)
+        m0, m1 = self._apply_m(e0, e1)
+        return p * e0 + q * m0, p * e1 + q * m1
+
+    def _grid(self, rate: float) -> "_FreeTable":
+        key = (self.config.bandwidth_hz, self.config.damping, self._coast, rate)
+        table = _TABLES.get(key)
+        if table is None:
+            table = _TABLES[key] = _FreeTable.build(self, rate)
+        return table
+
+    def _homogeneous(self, e0: float, e1: float, t0: float, samples: np.ndarray,
+                     rate: float) -> tuple[np.ndarray, np.ndarray]:
+        """Free response from error state (e0, e1) at time ``t0``, at whole samples.
+
+        Only + and x per sample, with tables built once by the C library's scalar
+        functions: numpy's vectorised exp/sin/cos differ in the last bit between CPUs
+        (AVX-512 or not), and replay must be exact on any machine. The sample grid is
+        reached from the anchor in a way that depends only on the anchor: a first step
+        to the first sample at or after ``t0`` (scalar), then whole samples (tables)."""
+        k0 = _first_sample(t0, rate)
+        v0, v1 = self._homogeneous_at(e0, e1, k0 / rate - t0)
+        m0, m1 = self._apply_m(v0, v1)
+        p, q = self._grid(rate).at(samples - k0)
+        return p * v0 + q * m0, p * v1 + q * m1
 
     def prepare(self, u: list[float]) -> "Forced":
         """The loop's steady response to a polynomial input (reusable for a piece)."""
         yp = self.particular(u)
         return Forced(yp, poly_der(yp))
 
-    def response(self, state: PlantState, forced: "Forced", s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Position and velocity at local times ``s`` (from ``state.t``)."""
+    def response(self, state: PlantState, forced: "Forced", samples: np.ndarray,
+                 rate: float) -> tuple[np.ndarray, np.ndarray]:
+        """Position and velocity at whole ``samples`` (at ``rate``) from ``state``."""
+        s = samples / rate - state.t
         y = poly_eval(forced.y, s)
         dy = poly_eval(forced.dy, s)
         e0 = state.y - forced.y[0]
@@ -124,7 +155,7 @@ class Plant:
         size = abs(e0) + abs(e1) / (-self._sigma)
         if size <= _QUIET:
             return y, dy
-        h0, h1 = self._homogeneous(e0, e1, s)
+        h0, h1 = self._homogeneous(e0, e1, state.t, samples, rate)
         if len(forced.y) == 1:
             # At rest on a constant command the loop counts as settled exactly once its
             # transient has decayed below the quiet level. Where that is depends only on
@@ -145,18 +176,30 @@ class Plant:
         return after >= self._settle_after(size)
 
     def advance(self, state: PlantState, forced: "Forced", t: float) -> PlantState:
-        """State at time ``t`` (within the piece that starts at ``state.t``)."""
-        y, dy = self.response(state, forced, np.array([t - state.t]))
-        return PlantState(t, float(y[0]), float(dy[0]))
+        """State at time ``t`` (within the piece that starts at ``state.t``); scalar math."""
+        s = t - state.t
+        y = _poly_eval_scalar(forced.y, s)
+        dy = _poly_eval_scalar(forced.dy, s)
+        e0 = state.y - forced.y[0]
+        e1 = state.dy - forced.dy[0]
+        size = abs(e0) + abs(e1) / (-self._sigma)
+        if size <= _QUIET or (len(forced.y) == 1 and s >= self._settle_after(size)):
+            return PlantState(t, y, dy)
+        h0, h1 = self._homogeneous_at(e0, e1, s)
+        return PlantState(t, y + h0, dy + h1)
 
     # -- servo off (ABORT) ---------------------------------------------------------
-    def coast(self, state: PlantState, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        k = np.exp(-s / self._coast)
+    def coast(self, state: PlantState, samples: np.ndarray, rate: float) -> tuple[np.ndarray, np.ndarray]:
+        """Position and velocity of the coasting motor at whole ``samples`` (y'' = -y'/tau_c),
+        reached from the anchor like :meth:`_homogeneous` (tables, no vectorised exp)."""
+        k0 = _first_sample(state.t, rate)
+        first = math.exp(-(k0 / rate - state.t) / self._coast)
+        k = first * self._grid(rate).coast_at(samples - k0)
         return state.y + state.dy * self._coast * (1.0 - k), state.dy * k
 
     def coast_to(self, state: PlantState, t: float) -> PlantState:
-        y, dy = self.coast(state, np.array([t - state.t]))
-        return PlantState(t, float(y[0]), float(dy[0]))
+        k = math.exp(-(t - state.t) / self._coast)
+        return PlantState(t, state.y + state.dy * self._coast * (1.0 - k), state.dy * k)
 
     # -- encoder ---------------------------------------------------------------------
     def read(self, y: np.ndarray) -> np.ndarray:
@@ -164,6 +207,74 @@ class Plant:
         if self._resolution <= 0.0:
             return y
         return np.floor(y / self._resolution + 0.5) * self._resolution
+
+
+def _first_sample(t: float, rate: float) -> int:
+    """The first whole sample at or after time ``t``."""
+    k = math.ceil(t * rate)
+    while k / rate < t:
+        k += 1
+    while (k - 1) / rate >= t:
+        k -= 1
+    return k
+
+
+_TABLES: dict[tuple[float, float, float, float], "_FreeTable"] = {}  # shared by identical loops
+_TABLE = 4096  # samples of free response tabulated; further ones are products of two
+
+
+class _FreeTable:
+    """Phi(m dt) = p_m I + q_m M and the coast decay exp(-m dt / tau_c) for m < _TABLE,
+    from the C library's scalar functions (the same on every CPU); beyond, products
+    Phi((a + b) dt) = Phi(a dt) Phi(b dt), using M^2 = kappa I."""
+
+    __slots__ = ("p", "q", "k", "kappa", "block_p", "block_q", "block_k")
+
+    def __init__(self, p, q, k, kappa: float):
+        self.p, self.q, self.k, self.kappa = p, q, k, kappa
+        self.block_p: list[float] = [1.0]  # Phi(n _TABLE dt) for n = 0, 1, ... (grown on demand)
+        self.block_q: list[float] = [0.0]
+        self.block_k: list[float] = [1.0]
+
+    @classmethod
+    def build(cls, plant: "Plant", rate: float) -> "_FreeTable":
+        pq = [plant._free(m / rate) for m in range(_TABLE + 1)]
+        p = np.array([x for x, _ in pq])
+        q = np.array([y for _, y in pq])
+        k = np.array([math.exp(-(m / rate) / plant._coast) for m in range(_TABLE + 1)])
+        return cls(p, q, k, plant._kappa)
+
+    def _blocks(self, n: int) -> None:
+        while len(self.block_p) <= n:
+            a, b = self.block_p[-1], self.block_q[-1]
+            c, d = float(self.p[_TABLE]), float(self.q[_TABLE])
+            self.block_p.append(a * c + self.kappa * b * d)
+            self.block_q.append(a * d + b * c)
+            self.block_k.append(self.block_k[-1] * float(self.k[_TABLE]))
+
+    def at(self, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(p, q) of Phi(m dt) for sample counts m >= 0."""
+        if len(m) == 0 or m[-1] < _TABLE:
+            return self.p[m], self.q[m]
+        n, r = np.divmod(m, _TABLE)
+        self._blocks(int(n[-1]))
+        bp, bq = np.array(self.block_p)[n], np.array(self.block_q)[n]
+        pr, qr = self.p[r], self.q[r]
+        return bp * pr + self.kappa * bq * qr, bp * qr + bq * pr
+
+    def coast_at(self, m: np.ndarray) -> np.ndarray:
+        if len(m) == 0 or m[-1] < _TABLE:
+            return self.k[m]
+        n, r = np.divmod(m, _TABLE)
+        self._blocks(int(n[-1]))
+        return np.array(self.block_k)[n] * self.k[r]
+
+
+def _poly_eval_scalar(c: list[float], s: float) -> float:
+    out = c[-1]
+    for coefficient in reversed(c[:-1]):
+        out = out * s + coefficient
+    return out
 
 
 def poly_der(c: list[float]) -> list[float]:
