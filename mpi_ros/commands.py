@@ -4,23 +4,37 @@ A :class:`Command` names an operation, its target and its request (a JSON-able d
 with the ROS interfaces' field names). :func:`apply` carries it out on a controller and
 answers a :class:`Reply`. The ROS nodes, the Python client and replay all go through
 here, so a recording of commands with the samples they took effect at reproduces a run.
+
+Errors: a request that cannot be read (:class:`mpi_ros.requests.RequestError`) is the
+user's and answers its message (MPIMessagePARAM_INVALID unless named). Any other
+exception is a bug of this package, not of the request: it is logged with its traceback
+and answered with :data:`INTERNAL_ERROR`, so it never passes for the user's fault, and
+the node that asked stays up (docs/decisions.md, "Validation and ranges").
 """
 
 from __future__ import annotations
 
 import json
+import logging
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from . import requests as rq
 from .mpi.control import Controller
-from .mpi.events import MPIEventType
 from .mpi.messages import Message
+from .mpi.params import Verdict, check_position, first_refusal
 from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
 
 MOTION_START = "motion_start"
 MOTION_MODIFY = "motion_modify"
 ACTION = "action"
+# The reference has no "internal error" message; of its generic messages, NO_MEMORY ("not
+# enough memory was available") is the one that says the library failed, not the call.
+# Nothing else in the controller answers it, so it tells a bug apart from every refusal.
+INTERNAL_ERROR = Message.MPIMessageNO_MEMORY
+INTERNAL_DETAIL = "internal error in mpi_ros (logged with its traceback; please report it)"
+
+_log = logging.getLogger("mpi_ros.commands")
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,6 +65,12 @@ class Reply:
         return self.message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
 
 
+def _refusal_detail(message: Message, verdict: Verdict) -> str:
+    """The validator's words for a refusal the controller answered (a call that returns a
+    bare Message, like the C API): the same validator, so the same verdict."""
+    return verdict.detail if message is verdict.message else ""
+
+
 def _supervisor(ctl: Controller, command: Command):
     ms = ctl.supervisor(command.supervisor)
     if ms is None:
@@ -68,7 +88,7 @@ def _motion(ctl: Controller, command: Command, modify: bool) -> Reply:
 
 def _action(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    name = str(command.request.get("action", "")).strip().upper()
+    name = rq.text(command.request.get("action", ""), "action").strip().upper()
     action = MPIAction.__members__.get(name)
     if action is None or action is MPIAction.NONE:
         return Reply(Message.MPIMessagePARAM_INVALID,
@@ -80,30 +100,37 @@ def _action(ctl: Controller, command: Command) -> Reply:
 
 def _config_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    return Reply(ms.config_set(rq.motion_config(command.request.get("config", {}))), state=ms.state)
+    config = rq.motion_config(command.request.get("config", {}))
+    message = ms.config_set(config)  # validates with MotionConfig.validate
+    return Reply(message, _refusal_detail(message, config.validate()), state=ms.state)
 
 
 def _params_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    return Reply(ms.params_set(rq.motion_params(command.request.get("params", {}))), state=ms.state)
+    params = rq.motion_params(command.request.get("params", {}))
+    # mpiMotionParamsSet stores them for any later start: every value must be one it can hold
+    verdict = params.validate()
+    if not verdict.ok:
+        return Reply(verdict.message, verdict.detail, state=ms.state)
+    return Reply(ms.params_set(params), state=ms.state)
 
 
 def _axis_list_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    message = ms.axis_list_set([int(a) for a in command.request.get("axis_numbers", [])])
-    if message.ok and command.request.get("map", True):
+    message = ms.axis_list_set(rq.integers(command.request.get("axis_numbers", []), "axis_numbers"))
+    if message.ok and rq.boolean(command.request.get("map", True), "map"):
         message = ms.action(MPIAction.MAP)
     return Reply(message, state=ms.state, value=list(ms.axis_list))
 
 
 def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    operation = str(command.request.get("operation", "")).upper()
-    axis = int(command.request.get("axis", -1))
+    operation = rq.text(command.request.get("operation", ""), "operation").upper()
+    axis = rq.integer(command.request.get("axis", -1), "axis")
     if operation == "APPEND":
         message = ms.axis_append(axis)
     elif operation == "INSERT":
-        message = ms.axis_insert(int(command.request.get("after_axis", -1)), axis)
+        message = ms.axis_insert(rq.integer(command.request.get("after_axis", -1), "after_axis"), axis)
     elif operation == "REMOVE":
         message = ms.axis_remove(axis)
     else:
@@ -114,31 +141,29 @@ def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
 
 def _position_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    actual = [float(x) for x in command.request.get("actual", [])]
-    commanded = [float(x) for x in command.request.get("command", [])]
-    return Reply(ms.position_set(actual, commanded), state=ms.state)
-
-
-def _event_mask(names) -> MPIEventType:
-    mask = MPIEventType.parse(names or [])
-    if mask is None:
-        raise rq.RequestError(Message.MPIMessagePARAM_INVALID, f"unknown event type in {list(names or [])}")
-    return mask
+    actual = rq.numbers(command.request.get("actual", []), "actual")
+    commanded = rq.numbers(command.request.get("command", []), "command")
+    message = ms.position_set(actual, commanded)  # checks each with params.check_position
+    ranges = first_refusal(check_position(f"{name}[{i}]", x)
+                           for name, values in (("actual", actual), ("command", commanded))
+                           for i, x in enumerate(values))
+    return Reply(message, _refusal_detail(message, ranges), state=ms.state)
 
 
 def _event_notify_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    return Reply(ms.event_notify_set(_event_mask(command.request.get("event_types"))))
+    return Reply(ms.event_notify_set(rq.event_mask(command.request.get("event_types"), "event_types")))
 
 
 def _event_reset(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    message = ms.event_reset(_event_mask(command.request.get("event_types")))
+    message = ms.event_reset(rq.event_mask(command.request.get("event_types"), "event_types"))
     return Reply(message, value=ms.latched.names())
 
 
 def _gate_set(ctl: Controller, command: Command) -> Reply:
-    return Reply(ctl.gate_set(int(command.request.get("gate", -1)), bool(command.request.get("closed", False))))
+    r = command.request
+    return Reply(ctl.gate_set(rq.integer(r.get("gate", -1), "gate"), rq.boolean(r.get("closed", False), "closed")))
 
 
 def io_space(name) -> IoSpace:
@@ -151,17 +176,19 @@ def io_space(name) -> IoSpace:
 
 def _io_set(ctl: Controller, command: Command) -> Reply:
     r = command.request
-    return Reply(ctl.io_set(io_space(r.get("space")), int(r.get("index", -1)), int(r.get("value", 0)),
-                            int(r.get("mask", -1))))
+    return Reply(ctl.io_set(io_space(r.get("space")), rq.integer(r.get("index", -1), "index"),
+                            rq.integer(r.get("value", 0), "value"), rq.integer(r.get("mask", -1), "mask")))
 
 
 def _axis_config_set(ctl: Controller, command: Command) -> Reply:
-    return Reply(ctl.axis_in_position_set(command.axis, rq.in_position(command.request.get("in_position", {}))))
+    in_position = rq.in_position(command.request.get("in_position", {}))
+    message = ctl.axis_in_position_set(command.axis, in_position)  # validates with AxisInPosition.validate
+    return Reply(message, _refusal_detail(message, in_position.validate()))
 
 
 def _axis_position_set(ctl: Controller, command: Command) -> Reply:
-    which = str(command.request.get("which", "")).upper()
-    value = float(command.request.get("value", 0.0))
+    which = rq.text(command.request.get("which", ""), "which").upper()
+    value = rq.number(command.request.get("value", 0.0), "value")
     setter = {
         "COMMAND": ctl.axis_command_position_set,
         "ACTUAL": ctl.axis_actual_position_set,
@@ -169,7 +196,8 @@ def _axis_position_set(ctl: Controller, command: Command) -> Reply:
     }.get(which)
     if setter is None:
         return Reply(Message.MPIMessagePARAM_INVALID, f"unknown position {which!r} (COMMAND, ACTUAL, ORIGIN)")
-    return Reply(setter(command.axis, value))
+    message = setter(command.axis, value)  # the axis checks the range with params.check_position
+    return Reply(message, _refusal_detail(message, check_position("value", value)))
 
 
 OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
@@ -196,9 +224,16 @@ def apply(ctl: Controller, command: Command) -> Reply:
     if handler is None:
         return Reply(Message.MPIMessageUNSUPPORTED, f"unknown operation {command.operation!r}")
     try:
+        rq.mapping(command.request, "request")
         return handler(ctl, command)
     except rq.RequestError as exc:
-        ms = ctl.supervisor(command.supervisor)
-        return Reply(exc.message, exc.detail, state=ms.state if ms is not None else MPIState.INVALID)
-    except (TypeError, ValueError) as exc:
-        return Reply(Message.MPIMessagePARAM_INVALID, str(exc))
+        return Reply(exc.message, exc.detail, state=_state(ctl, command))
+    except Exception as exc:  # noqa: BLE001 - a bug, not the request: logged in full, answered, the node stays up
+        _log.exception("internal error applying %s (supervisor %s, axis %s, request %r)",
+                       command.operation, command.supervisor, command.axis, command.request)
+        return Reply(INTERNAL_ERROR, f"{INTERNAL_DETAIL}: {type(exc).__name__}: {exc}", state=_state(ctl, command))
+
+
+def _state(ctl: Controller, command: Command) -> MPIState:
+    ms = ctl.supervisor(command.supervisor)
+    return ms.state if ms is not None else MPIState.INVALID

@@ -2,6 +2,9 @@
 
 Validated when loaded: every error names its key (``supervisors[1].axes[0]: axis 7
 does not exist (4 axes)``) so a wrong file never starts a half-configured suite. The
+ranges are the structs' own validators (mpi_ros/mpi/params.py), the ones the controller
+and the services use, and building the controller checks every call's answer: a value
+the controller refuses stops the suite with its key named, it is never dropped. The
 same configuration builds the controller for the ROS suite, the CLI tools and replay.
 """
 
@@ -18,10 +21,21 @@ import yaml
 
 from .mpi.control import Controller
 from .mpi.events import MPIEventType
-from .mpi.params import MAX_COORD_AXES, AxisInPosition, ControllerConfig, DecelTime, MotionConfig, PlantConfig
+from .mpi.messages import Message
+from .mpi.params import (
+    MAX_COORD_AXES,
+    MAX_OBJECTS,
+    VALID,
+    AxisInPosition,
+    ControllerConfig,
+    DecelTime,
+    MotionConfig,
+    PlantConfig,
+    Verdict,
+    check_settling_reachable,
+)
 from .mpi.plant import Plant
 from .mpi.types import MPIAction
-
 
 
 def default_config_path() -> Path:
@@ -79,18 +93,46 @@ class SuiteConfig:
         return self.controller.axis_count
 
     def build_controller(self) -> Controller:
-        """A controller with the configured axes and supervisors (axis lists mapped)."""
+        """A controller with the configured axes and supervisors (axis lists mapped). Every
+        call must succeed: a refused value raises ConfigError naming its key."""
+        _require(self.controller.validate(), "controller.")
+        if not len(self.in_position) == len(self.plant) == self.controller.axis_count:
+            raise ConfigError(f"axes: {self.controller.axis_count} axes need as many in_position and plant "
+                              f"settings, got {len(self.in_position)} and {len(self.plant)}")
         ctl = Controller(self.controller)
-        for axis, in_position, plant in zip(ctl.axes, self.in_position, self.plant):
-            axis.in_position = in_position.copy()
-            axis.plant = Plant(plant)
-        for spec in self.supervisors:
-            _, ms = ctl.create_motion(spec.number)
-            ms.config_set(spec.config)
-            ms.axis_list_set(spec.axes)
-            ms.event_notify_set(spec.event_notify)
-            ms.action(MPIAction.MAP)
+        for n, (in_position, plant) in enumerate(zip(self.in_position, self.plant)):
+            _require(plant.validate(), f"axes[{n}].plant.")
+            ctl.axes[n].plant = Plant(plant)  # before the tolerances: they are checked against its encoder
+            _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position", in_position.validate())
+        for i, spec in enumerate(self.supervisors):
+            self._build_supervisor(ctl, spec, f"supervisors[{i}]")
         return ctl
+
+    @staticmethod
+    def _build_supervisor(ctl: Controller, spec: SupervisorSpec, where: str) -> None:
+        message, ms = ctl.create_motion(spec.number)
+        _accepted(message, f"{where}.number")
+        # the axes first: mpiMotionConfigSet answers AXIS_COUNT without them (spec 000)
+        _accepted(ms.axis_list_set(spec.axes), f"{where}.axes")
+        _accepted(ms.config_set(spec.config), f"{where}.config", spec.config.validate())
+        _accepted(ms.event_notify_set(spec.event_notify), f"{where}.event_notify")
+        _accepted(ms.action(MPIAction.MAP), f"{where}.axes")
+
+
+def _require(verdict: Verdict, where: str) -> None:
+    """Stop on a refusal; ``where`` ends where the field the verdict names is appended."""
+    if not verdict.ok:
+        raise ConfigError(f"{where}{verdict.detail}")
+
+
+def _accepted(message: Message, where: str, verdict: Verdict = VALID) -> None:
+    """Stop unless the controller accepted a call; the validator that refused it (if it was
+    one) names the field."""
+    if message.ok:
+        return
+    if message is verdict.message:
+        raise ConfigError(f"{where}.{verdict.detail} (the controller answered {message.name})")
+    raise ConfigError(f"{where}: the controller answered {message.name}")
 
 
 def merge(base: dict, override: dict) -> dict:
@@ -158,11 +200,7 @@ def _controller(raw: dict, axis_count: int, supervisor_count: int) -> Controller
     raw = dict(raw or {})
     cfg = _dataclass(ControllerConfig, {**raw, "axis_count": axis_count, "supervisor_count": supervisor_count},
                      "controller")
-    _positive(cfg.sample_rate, "controller.sample_rate")
-    if cfg.frame_buffer_size < 16:
-        raise ConfigError(f"controller.frame_buffer_size: must be >= 16, got {cfg.frame_buffer_size}")
-    if cfg.io_words < 1:
-        raise ConfigError("controller.io_words: must be >= 1")
+    _require(cfg.validate(), "controller.")
     return cfg
 
 
@@ -172,8 +210,8 @@ def _axes(raw: dict) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
     if unknown:
         raise ConfigError(f"axes.{sorted(unknown)[0]}: unknown key (known: count, defaults, overrides)")
     count = raw.get("count", 4)
-    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-        raise ConfigError(f"axes.count: expected an integer >= 1, got {count!r}")
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_OBJECTS:
+        raise ConfigError(f"axes.count: expected an integer from 1 to {MAX_OBJECTS}, got {count!r}")
     defaults = raw.get("defaults") or {}
     overrides = raw.get("overrides") or {}
     if not isinstance(overrides, dict):
@@ -186,14 +224,9 @@ def _axes(raw: dict) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
             raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: in_position, plant)")
         ip = _dataclass(AxisInPosition, merged.get("in_position"), f"axes[{n}].in_position")
         plant = _dataclass(PlantConfig, merged.get("plant"), f"axes[{n}].plant")
-        for key in ("position_fine", "velocity", "settling_time"):
-            if getattr(ip, key) < 0.0:
-                raise ConfigError(f"axes[{n}].in_position.{key}: must be >= 0")
-        _positive(plant.bandwidth_hz, f"axes[{n}].plant.bandwidth_hz")
-        _positive(plant.damping, f"axes[{n}].plant.damping")
-        _positive(plant.coast_time_constant, f"axes[{n}].plant.coast_time_constant")
-        if plant.encoder_resolution < 0.0:
-            raise ConfigError(f"axes[{n}].plant.encoder_resolution: must be >= 0")
+        _require(ip.validate(), f"axes[{n}].in_position.")
+        _require(plant.validate(), f"axes[{n}].plant.")
+        _require(check_settling_reachable(ip, plant), f"axes[{n}].in_position.")
         in_position.append(ip)
         plants.append(plant)
     return count, in_position, plants
@@ -207,11 +240,7 @@ def _motion_config(raw: dict, where: str) -> MotionConfig:
     )
     cfg = _dataclass(MotionConfig, raw, where)
     cfg.decel_time = decel
-    _positive(decel.stop, f"{where}.decel_time_stop")
-    _positive(decel.e_stop, f"{where}.decel_time_e_stop")
-    _positive(cfg.normal_feedrate, f"{where}.normal_feedrate")
-    if cfg.pause_feedrate < 0.0:
-        raise ConfigError(f"{where}.pause_feedrate: must be >= 0")
+    _require(cfg.validate(), f"{where}.")
     return cfg
 
 
@@ -228,8 +257,8 @@ def _supervisors(raw: list, defaults: dict, axis_count: int) -> list[SupervisorS
         if extra:
             raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: axes, config, event_notify, number)")
         number = entry.get("number", i)
-        if isinstance(number, bool) or not isinstance(number, int) or number < 0:
-            raise ConfigError(f"{where}.number: expected an integer >= 0, got {number!r}")
+        if isinstance(number, bool) or not isinstance(number, int) or not 0 <= number < MAX_OBJECTS:
+            raise ConfigError(f"{where}.number: expected an integer from 0 to {MAX_OBJECTS - 1}, got {number!r}")
         if number in seen:
             raise ConfigError(f"{where}.number: supervisor {number} is configured twice")
         seen.add(number)

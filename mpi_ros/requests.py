@@ -3,12 +3,16 @@
 The ROS layer turns messages into these dicts at the edge; recordings store them as
 JSON; replay and the Python client build them directly. Names are the spec's without
 prefix (type "S_CURVE", attribute "APPEND", hold type "GATE", event "MOTION_DONE").
+
+Parsing only checks that a request can be read (a mapping where one is expected, a
+number where a number is): anything else raises :class:`RequestError`, the only error
+the command layer answers as the user's (MPIMessagePARAM_INVALID unless named). Ranges
+are the structs' validators' business (mpi_ros/mpi/params.py), run by the controller.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
 from .mpi.events import MPIEventType
@@ -33,7 +37,70 @@ class MotionRequest:
     params: MotionParams | None  # None: the parameters stored with params_set
 
 
-def _enum_by_name(enum, name: str, what: str, message: Message):
+def _unreadable(what: str, expected: str, value: Any) -> RequestError:
+    return RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: {expected} expected, got {value!r}")
+
+
+def mapping(data: Any, what: str) -> Mapping[str, Any]:
+    """A mapping (None: an empty one)."""
+    if data is None:
+        return {}
+    if not isinstance(data, Mapping):
+        raise _unreadable(what, "a mapping", data)
+    return data
+
+
+def sequence(values: Any, what: str) -> list:
+    """A list (None: an empty one); a string is not a list of its characters."""
+    if values is None:
+        return []
+    if not isinstance(values, (list, tuple)):
+        raise _unreadable(what, "a list", values)
+    return list(values)
+
+
+def number(value: Any, what: str) -> float:
+    """A number as a float (its range is the validators' business: nan passes here)."""
+    if isinstance(value, bool):
+        raise _unreadable(what, "a number", value)
+    try:
+        return float(value)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise _unreadable(what, "a number", value) from exc
+
+
+def integer(value: Any, what: str) -> int:
+    """An integer (an integral float such as 3.0 reads as 3)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise _unreadable(what, "an integer", value)
+    if isinstance(value, float) and not value.is_integer():  # nan and inf are not integers either
+        raise _unreadable(what, "an integer", value)
+    return int(value)
+
+
+def boolean(value: Any, what: str) -> bool:
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, int) and value in (0, 1):
+        return bool(value)
+    raise _unreadable(what, "true or false", value)
+
+
+def text(value: Any, what: str) -> str:
+    if not isinstance(value, str):
+        raise _unreadable(what, "a string", value)
+    return value
+
+
+def numbers(values: Any, what: str) -> list[float]:
+    return [number(v, f"{what}[{i}]") for i, v in enumerate(sequence(values, what))]
+
+
+def integers(values: Any, what: str) -> list[int]:
+    return [integer(v, f"{what}[{i}]") for i, v in enumerate(sequence(values, what))]
+
+
+def enum_by_name(enum, name: Any, what: str, message: Message = Message.MPIMessagePARAM_INVALID):
     key = str(name).strip().upper()
     member = enum.__members__.get(key)
     if member is None:
@@ -41,82 +108,80 @@ def _enum_by_name(enum, name: str, what: str, message: Message):
     return member
 
 
-def _floats(values, what: str) -> list[float]:
-    try:
-        return [float(v) for v in (values or [])]
-    except (TypeError, ValueError) as exc:
-        raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: numbers expected") from exc
+def event_mask(names: Any, what: str) -> MPIEventType:
+    values = sequence(names, what)
+    mask = MPIEventType.parse(values)
+    if mask is None:
+        raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown event type in {values}")
+    return mask
 
 
-def _ints(values, what: str) -> list[int]:
-    try:
-        return [int(v) for v in (values or [])]
-    except (TypeError, ValueError) as exc:
-        raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: integers expected") from exc
+_READERS = {bool: boolean, int: integer, float: number, str: text}
 
 
-def _struct(cls, data: Mapping[str, Any] | None, what: str, enum_fields: dict | None = None):
-    data = dict(data or {})
+def _struct(cls, data: Any, what: str, enum_fields: dict | None = None):
+    """Dataclass ``cls`` from a mapping of its fields (each read as its default's type)."""
     enum_fields = enum_fields or {}
     kwargs = {}
     defaults = cls()
-    for key, value in data.items():
-        if not hasattr(defaults, key):
+    known = {f.name for f in fields(cls)}
+    for key, value in mapping(data, what).items():
+        if key not in known:
             raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown field {key!r}")
         if key in enum_fields:
             enum, message = enum_fields[key]
-            kwargs[key] = enum.NONE if value in ("", None) else _enum_by_name(enum, value, f"{what} type", message)
+            kwargs[key] = enum.NONE if value in ("", None) else enum_by_name(enum, value, f"{what} type", message)
             continue
-        default = getattr(defaults, key)
-        try:
-            kwargs[key] = type(default)(value) if not isinstance(default, bool) else bool(value)
-        except (TypeError, ValueError) as exc:
-            raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}.{key}: bad value {value!r}") from exc
+        kwargs[key] = _READERS[type(getattr(defaults, key))](value, f"{what}.{key}")
     return cls(**kwargs)
 
 
-def motion_request(data: Mapping[str, Any]) -> MotionRequest:
+def _structs(cls, values: Any, what: str, enum_fields: dict | None = None) -> list:
+    return [_struct(cls, v, f"{what}[{i}]", enum_fields) for i, v in enumerate(sequence(values, what))]
+
+
+def motion_request(data: Any) -> MotionRequest:
     """A MotionStart/MotionModify goal (as a dict) to the MPI's type, attributes, params."""
-    motion_type = _enum_by_name(MPIMotionType, data.get("type", ""), "motion type",
-                                Message.MPIMotionMessageTYPE_INVALID)
-    attributes = MotionAttr.parse(data.get("attributes") or [])
+    data = mapping(data, "goal")
+    motion_type = enum_by_name(MPIMotionType, data.get("type", ""), "motion type",
+                               Message.MPIMotionMessageTYPE_INVALID)
+    names = sequence(data.get("attributes"), "attributes")
+    attributes = MotionAttr.parse(names)
     if attributes is None:
-        raise RequestError(Message.MPIMotionMessageTYPE_INVALID,
-                           f"unknown attribute in {list(data.get('attributes') or [])}")
-    if data.get("use_stored_params"):
+        raise RequestError(Message.MPIMotionMessageTYPE_INVALID, f"unknown attribute in {names}")
+    if boolean(data.get("use_stored_params", False), "use_stored_params"):
         return MotionRequest(motion_type, attributes, None)
     return MotionRequest(motion_type, attributes, motion_params(data))
 
 
-def motion_params(data: Mapping[str, Any]) -> MotionParams:
-    event_names = data.get("event_mask") or []
-    event_mask = MPIEventType.parse(event_names)
-    if event_mask is None:
-        raise RequestError(Message.MPIMessagePARAM_INVALID, f"unknown event type in {list(event_names)}")
+_HOLD_TYPED = {"type": (HoldType, Message.MPIMessagePARAM_INVALID)}
+_OUTPUT_TYPED = {"type": (OutputType, Message.MPIMessagePARAM_INVALID)}
+
+
+def motion_params(data: Any) -> MotionParams:
+    data = mapping(data, "params")
     return MotionParams(
-        trajectory=[_struct(Trajectory, t, "trajectory") for t in data.get("trajectory") or []],
-        position=_floats(data.get("position"), "position"),
-        point_velocity=_floats(data.get("point_velocity"), "point_velocity"),
-        time=_floats(data.get("time"), "time"),
-        feedforward=_floats(data.get("feedforward"), "feedforward"),
-        final=bool(data.get("final", True)),
-        retain=bool(data.get("retain", False)),
-        empty_count=int(data.get("empty_count", 5)),
-        delay=_floats(data.get("delay"), "delay"),
-        id=int(data.get("id", 0)),
-        element_id=_ints(data.get("element_id"), "element_id"),
-        final_velocity=_floats(data.get("final_velocity"), "final_velocity"),
-        hold=[_struct(Hold, h, "hold", {"type": (HoldType, Message.MPIMessagePARAM_INVALID)})
-              for h in data.get("hold") or []],
-        output=[_struct(Output, o, "output", {"type": (OutputType, Message.MPIMessagePARAM_INVALID)})
-                for o in data.get("output") or []],
-        event_mask=event_mask,
-        master_start=int(data.get("master_start", 0)),
-        repeat_from=int(data.get("repeat_from", 0)),
-        master_distance=_floats(data.get("master_distance"), "master_distance"),
-        slave_position=_floats(data.get("slave_position"), "slave_position"),
-        gear_ratio=_floats(data.get("gear_ratio"), "gear_ratio"),
-        frames=[_struct(UserFrame, f, "frames") for f in data.get("frames") or []],
+        trajectory=_structs(Trajectory, data.get("trajectory"), "trajectory"),
+        position=numbers(data.get("position"), "position"),
+        point_velocity=numbers(data.get("point_velocity"), "point_velocity"),
+        time=numbers(data.get("time"), "time"),
+        feedforward=numbers(data.get("feedforward"), "feedforward"),
+        final=boolean(data.get("final", True), "final"),
+        retain=boolean(data.get("retain", False), "retain"),
+        empty_count=integer(data.get("empty_count", 5), "empty_count"),
+        delay=numbers(data.get("delay"), "delay"),
+        id=integer(data.get("id", 0), "id"),
+        element_id=integers(data.get("element_id"), "element_id"),
+        final_velocity=numbers(data.get("final_velocity"), "final_velocity"),
+        hold=_structs(Hold, data.get("hold"), "hold", _HOLD_TYPED),
+        output=_structs(Output, data.get("output"), "output", _OUTPUT_TYPED),
+        event_mask=event_mask(data.get("event_mask"), "event_mask"),
+        master_start=integer(data.get("master_start", 0), "master_start"),
+        repeat_from=integer(data.get("repeat_from", 0), "repeat_from"),
+        master_distance=numbers(data.get("master_distance"), "master_distance"),
+        slave_position=numbers(data.get("slave_position"), "slave_position"),
+        gear_ratio=numbers(data.get("gear_ratio"), "gear_ratio"),
+        frames=_structs(UserFrame, data.get("frames"), "frames"),
     )
 
 
@@ -154,20 +219,17 @@ def params_to_dict(params: MotionParams) -> dict[str, Any]:
     }
 
 
-def motion_config(data: Mapping[str, Any]) -> MotionConfig:
+def motion_config(data: Any) -> MotionConfig:
     """A MotionConfig message (as a dict) to MPIMotionConfig; axis_numbers is ignored."""
-    numbers = {}
-    for key in ("decel_time_stop", "decel_time_e_stop", "normal_feedrate", "pause_feedrate", "blend_limit"):
-        try:
-            numbers[key] = float(data.get(key, 0.0))
-        except (TypeError, ValueError) as exc:
-            raise RequestError(Message.MPIMessagePARAM_INVALID, f"{key}: a number expected") from exc
+    data = mapping(data, "config")
+    value = {key: number(data.get(key, 0.0), key)
+             for key in ("decel_time_stop", "decel_time_e_stop", "normal_feedrate", "pause_feedrate", "blend_limit")}
     return MotionConfig(
-        decel_time=DecelTime(numbers["decel_time_stop"], numbers["decel_time_e_stop"]),
-        normal_feedrate=numbers["normal_feedrate"],
-        pause_feedrate=numbers["pause_feedrate"],
-        user_label=str(data.get("user_label", "")),
-        blend_limit=numbers["blend_limit"],
+        decel_time=DecelTime(value["decel_time_stop"], value["decel_time_e_stop"]),
+        normal_feedrate=value["normal_feedrate"],
+        pause_feedrate=value["pause_feedrate"],
+        user_label=text(data.get("user_label", ""), "user_label"),
+        blend_limit=value["blend_limit"],
     )
 
 
@@ -183,12 +245,9 @@ def motion_config_to_dict(config: MotionConfig) -> dict[str, Any]:
     }
 
 
-def in_position(data: Mapping[str, Any]) -> AxisInPosition:
-    cfg = _struct(AxisInPosition, data, "in_position")
-    numbers = [cfg.position_fine, cfg.velocity, cfg.settling_time]
-    if not all(math.isfinite(x) for x in numbers):
-        raise RequestError(Message.MPIMessagePARAM_INVALID, "in_position values must be finite")
-    return cfg
+def in_position(data: Any) -> AxisInPosition:
+    """An AxisInPosition message (as a dict); its ranges are checked by the controller."""
+    return _struct(AxisInPosition, data, "in_position")
 
 
 def in_position_to_dict(cfg: AxisInPosition) -> dict[str, Any]:

@@ -99,7 +99,7 @@ def _compare(report: ReplayReport, sample: int, topic: str, recorded, replayed, 
         other = new.get(name)
         report.values += 1
         if isinstance(value, float) and isinstance(other, float):
-            same = value == other or abs(value - other) <= tolerance
+            same = value == other or abs(value - other) <= tolerance or (math.isnan(value) and math.isnan(other))
         else:
             same = value == other
         if not same:

@@ -22,9 +22,10 @@ import numpy as np
 from .clock import ProfileClock
 from .frames import AxisPlan
 from .messages import Message
-from .params import AxisInPosition, PlantConfig
+from .params import AxisInPosition, PlantConfig, check_position
 from .plant import Forced, Plant, PlantState, compose
 from .status import AxisStatusBits, SettleCounters, StatusMode
+from .types import MPIState
 
 
 @dataclass(slots=True)
@@ -106,29 +107,39 @@ class Axis:
 
     def set_origin(self, origin: float) -> Message:
         """mpiAxisOriginSet: reported positions are raw positions minus the origin."""
-        if not math.isfinite(origin):
-            return Message.MPIMessagePARAM_INVALID
+        verdict = check_position("origin", origin)
+        if not verdict.ok:
+            return verdict.message
         self.origin = float(origin)
         return Message.MPIMessageOK
 
     def set_actual_position(self, position: float, t: float) -> Message:
         """mpiAxisActualPositionSet: the encoder now reads ``position``. The command is
         untouched, so the loop sees the new error and moves to remove it."""
-        if not math.isfinite(position):
-            return Message.MPIMessagePARAM_INVALID
-        delta = (position + self.origin) - self.act_p
+        verdict = check_position("position", position)
+        if not verdict.ok:
+            return verdict.message
+        delta = (float(position) + self.origin) - self.act_p
         self.rebase(t)
         self.state = PlantState(self.state.t, self.state.y + delta, self.state.dy)
         self.act_p += delta
         return Message.MPIMessageOK
 
-    def can_set_command(self, moving: bool) -> bool:
-        """spec 002 mpiAxisCommandPositionSet error check: not while MOVING, STOPPING or
-        STOPPED, and not while the command follows the actual position."""
-        return not moving and self.plan is None and not self.holding and self.mode is not CommandMode.FOLLOW_ACTUAL
+    def can_set_command(self, state: MPIState) -> bool:
+        """The one rule of mpiAxisCommandPositionSet (spec 002, "mpiAxisCommandPositionSet(...)
+        Error Check"), for the axis service and mpiMotionPositionSet alike; ``state`` is the
+        axis' state (its supervisor's). Refused while the controller computes a new command
+        every sample: in a MOVING, STOPPING or STOPPED state (STOPPING_ERROR is a stopping
+        state too), while the command follows the actual position (settleOnEstopCmdEqAct,
+        the simulator's "CMD_EQ_ACT with the amp disabled"), or while a move is loaded or
+        held. ERROR and IDLE are not on the list: there the command rests and can be set."""
+        if state in (MPIState.MOVING, MPIState.STOPPING, MPIState.STOPPED, MPIState.STOPPING_ERROR):
+            return False
+        return self.plan is None and not self.holding and self.mode is not CommandMode.FOLLOW_ACTUAL
 
     def set_command_position(self, position: float, t: float) -> None:
-        """Command steps to ``position``; the loop follows (check ``can_set_command``)."""
+        """Command steps to ``position``; the loop follows (check ``can_set_command`` and the
+        range, params.check_position, first)."""
         self.rebase(t)
         self.rest = position + self.origin
         self.cmd_p = self.rest

@@ -11,6 +11,7 @@ not depend on how the samples are batched.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from typing import Callable
 
@@ -21,7 +22,14 @@ from .events import Event, MPIEventType
 from .io import IoImage
 from .messages import STATE_MESSAGES, Message
 from .motion import MotionSupervisor
-from .params import AxisInPosition, ControllerConfig, MotionConfig, PlantConfig
+from .params import (
+    AxisInPosition,
+    ControllerConfig,
+    MotionConfig,
+    PlantConfig,
+    check_position,
+    check_settling_reachable,
+)
 from .snapshot import AxisSnapshot
 from .status import StatusContext, compute, rising_edges
 from .types import IoSpace, MPIState
@@ -126,37 +134,44 @@ class Controller:
         return owner is not None and owner.own_state not in (MPIState.IDLE, MPIState.ERROR)
 
     def axis_command_position_set(self, number: int, position: float) -> Message:
-        """mpiAxisCommandPositionSet (MPIAxisMessageCOMMAND_NOT_SET while it moves)."""
+        """mpiAxisCommandPositionSet under the rule of spec 002 (Axis.can_set_command, which
+        mpiMotionPositionSet applies too): MPIAxisMessageCOMMAND_NOT_SET while it moves."""
         if not 0 <= number < len(self.axes):
             return Message.MPIAxisMessageAXIS_INVALID
         axis = self.axes[number]
-        if not np.isfinite(position):
-            return Message.MPIMessagePARAM_INVALID
-        if not axis.can_set_command(self._axis_moving(axis)):
+        verdict = check_position("position", position)
+        if not verdict.ok:
+            return verdict.message
+        owner = self.supervisor(axis.owner)  # an axis is in its owner's state (IDLE without one)
+        if not axis.can_set_command(owner.own_state if owner is not None else MPIState.IDLE):
             return Message.MPIAxisMessageCOMMAND_NOT_SET
         axis.set_command_position(float(position), self.time)
         return Message.MPIMessageOK
 
     def axis_actual_position_set(self, number: int, position: float) -> Message:
-        """mpiAxisActualPositionSet."""
+        """mpiAxisActualPositionSet (the axis checks the range)."""
         if not 0 <= number < len(self.axes):
             return Message.MPIAxisMessageAXIS_INVALID
-        return self.axes[number].set_actual_position(float(position), self.time)
+        return self.axes[number].set_actual_position(position, self.time)
 
     def axis_origin_set(self, number: int, origin: float) -> Message:
-        """mpiAxisOriginSet."""
+        """mpiAxisOriginSet (the axis checks the range)."""
         if not 0 <= number < len(self.axes):
             return Message.MPIAxisMessageAXIS_INVALID
-        return self.axes[number].set_origin(float(origin))
+        return self.axes[number].set_origin(origin)
 
     def axis_in_position_set(self, number: int, in_position: AxisInPosition) -> Message:
-        """mpiAxisConfigSet (inPosition)."""
+        """mpiAxisConfigSet (inPosition), checked by the one AxisInPosition validator (the
+        YAML loader and the service use it too) and against the axis' encoder."""
         if not 0 <= number < len(self.axes):
             return Message.MPIAxisMessageAXIS_INVALID
-        values = [in_position.position_fine, in_position.velocity, in_position.settling_time]
-        if not all(np.isfinite(v) and v >= 0.0 for v in values) or in_position.position_coarse < 0:
-            return Message.MPIMessagePARAM_INVALID
-        self.axes[number].in_position = in_position.copy()
+        axis = self.axes[number]
+        verdict = in_position.validate()
+        if verdict.ok:
+            verdict = check_settling_reachable(in_position, axis.plant.config)
+        if not verdict.ok:
+            return verdict.message
+        axis.in_position = in_position.copy()
         return Message.MPIMessageOK
 
     def frame_count(self, number: int) -> int:
@@ -184,7 +199,8 @@ class Controller:
             command_position=axis.command_position,
             actual_position=axis.actual_position,
             position_error=axis.position_error,
-            target_position=axis.target_position,
+            # A velocity move has no target: NaN, rather than the end of its long frame.
+            target_position=math.nan if axis.plan is not None and axis.plan.is_velocity else axis.target_position,
             origin=axis.origin,
             command_velocity=axis.cmd_v,
             actual_velocity=axis.act_v,
@@ -298,6 +314,7 @@ class Controller:
             velocity_target=plan.velocity_target if plan is not None else None,
             ramp_end=plan.ramp_end if plan is not None else 0.0,
             has_plan=plan is not None,
+            ends_moving=plan is not None and plan.final_velocity != 0.0,
         )
 
     def _advance(self, k1: int) -> None:
@@ -350,11 +367,4 @@ class Controller:
             axis = self.axes[number]
             self.emit(kind, supervisor=axis.owner, axis=number, move_id=axis.move_id,
                       element_id=axis.element_id, detail=detail, sample=sample)
-        for ms in self.supervisors:
-            index = ms.at_velocity_index(statuses, stop)
-            if index is not None:
-                ms.at_velocity_reached(int(samples_of(traces)[index]))
 
-
-def samples_of(traces) -> np.ndarray:
-    return next(iter(traces.values())).samples

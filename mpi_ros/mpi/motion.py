@@ -24,7 +24,7 @@ from .frames import Move, frames_needed
 from .holds import HoldWait
 from .log import MotionLog
 from .messages import STATE_MESSAGES, Message
-from .params import USER_LABEL_MAX, MotionConfig, MotionParams
+from .params import MotionConfig, MotionParams, check_position
 from .planner import AxisStart, PlanError, compile_move
 from .snapshot import FrameBufferStatus, MotionSnapshot
 from .status import StatusMode
@@ -46,6 +46,9 @@ if TYPE_CHECKING:
     from .control import Controller
 
 OK = Message.MPIMessageOK
+# Attributes that belong to a start, not to the on-the-fly modify of mpiMotionParamsSet.
+_START_ONLY = (MotionAttr.APPEND | MotionAttr.AUTO_START | MotionAttr.DELAY | MotionAttr.HOLD
+               | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER)
 # meiMotionActionFunction: called with (motion, motion type, action name) on every
 # start ("START"), modify ("MODIFY") and action ("STOP", "E_STOP", ...).
 ActionCallback = Callable[["MotionSupervisor", MPIMotionType, str], object]
@@ -53,7 +56,9 @@ ActionCallback = Callable[["MotionSupervisor", MPIMotionType, str], object]
 
 @dataclass(frozen=True, slots=True)
 class MoveEnd:
-    """How a move ended, with the supervisor's axis positions at that sample."""
+    """An outcome of a move, with the supervisor's axis positions at its sample: how the move
+    ended, or (a VELOCITY move) that it reached its velocity, which is what its goals wait for.
+    A modify keeps the move's serial: an outcome before the modify's sample is not its own."""
 
     serial: int
     message: Message
@@ -139,16 +144,11 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         stop time while moving)."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
-        numbers = [config.decel_time.stop, config.decel_time.e_stop, config.normal_feedrate,
-                   config.pause_feedrate, config.blend_limit]
-        if not all(math.isfinite(x) for x in numbers):
-            return Message.MPIMessagePARAM_INVALID
-        if config.decel_time.stop <= 0.0 or config.decel_time.e_stop <= 0.0:
-            return Message.MPIMessagePARAM_INVALID
-        if config.normal_feedrate <= 0.0 or config.pause_feedrate < 0.0:
-            return Message.MPIMessagePARAM_INVALID
-        if not -1.0 <= config.blend_limit <= 1.0 or len(config.user_label) > USER_LABEL_MAX:
-            return Message.MPIMessagePARAM_INVALID
+        if not self.axis_list:  # spec 000 MPIMotionMessageAXIS_COUNT: "from mpiMotionConfigSet ... no axes"
+            return Message.MPIMotionMessageAXIS_COUNT
+        verdict = config.validate()  # the one MotionConfig validator (params.py): YAML and services too
+        if not verdict.ok:
+            return verdict.message
         old_normal = self.config.normal_feedrate
         kept_axes = self.config.axis_numbers
         self.config = config.copy()
@@ -169,9 +169,17 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.stored_params.copy()
 
     def params_set(self, params: MotionParams) -> Message:
-        """mpiMotionParamsSet."""
+        """mpiMotionParamsSet. While a motion runs the parameters apply "on-the-fly" (MPI 000,
+        mpiMotionParamsSet): a modify of the running move's type with its attributes (less
+        those that only make sense at a start), refused as that modify would be, in which
+        case nothing is stored either."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
+        if self.own_state is MPIState.MOVING and self.current is not None:
+            message, _ = self._command(self.current.type, self.current.attributes & ~_START_ONLY, params,
+                                       modify=True)
+            if not message.ok:
+                return message
         self.stored_params = params.copy()
         return OK
 
@@ -184,8 +192,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         return OK, [a.actual_position for a in axes], [a.command_position for a in axes]
 
     def position_set(self, actual: list[float], command: list[float]) -> Message:
-        """mpiMotionPositionSet: both arrays one value per axis; the command position can
-        only be set while the axes rest (MPIAxisMessageCOMMAND_NOT_SET otherwise)."""
+        """mpiMotionPositionSet: both arrays one value per axis; each command position is set
+        under the rule of mpiAxisCommandPositionSet (Axis.can_set_command), all or none."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
         axes = self._list_axes()
@@ -193,10 +201,12 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             return Message.MPIMotionMessageAXIS_COUNT
         if len(actual) != len(axes) or len(command) != len(axes):
             return Message.MPIMessagePARAM_INVALID
-        if not all(math.isfinite(x) for x in list(actual) + list(command)):
+        if not all(check_position("position", x).ok for x in list(actual) + list(command)):
             return Message.MPIMessagePARAM_INVALID
-        moving = self.state is not MPIState.IDLE
-        if any(not a.can_set_command(moving) for a in axes):
+        # an axis is in the state of the supervisor commanding it (IDLE without one)
+        owners = [self._ctl.supervisor(a.owner) for a in axes]
+        states = [o.own_state if o is not None else MPIState.IDLE for o in owners]
+        if not all(a.can_set_command(state) for a, state in zip(axes, states)):
             return Message.MPIAxisMessageCOMMAND_NOT_SET
         t = self._ctl.time
         for axis, act, cmd in zip(axes, actual, command):
@@ -222,9 +232,11 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         """mpiMotionEventNotifySet (also maps the axes, spec 002 NOT_MAPPED_TO_MS)."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
-        self.notify_mask = MPIEventType(mask)
         if self.own_state in (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR):
-            self._map()
+            message = self._map()
+            if not message.ok:
+                return message
+        self.notify_mask = MPIEventType(mask)
         return OK
 
     def event_reset(self, mask: MPIEventType) -> Message:
@@ -305,6 +317,14 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         if not verdict.ok:
             return verdict.message, verdict.detail
         state = self._state_for(self.axis_list)
+        held = self._held_by_others(self.axis_list)
+        if held:
+            # A start or modify would take the axis out of the other supervisor's vector (its
+            # motion, running or stopped, keeps it until it ends or is RESET): answered with the
+            # state the axes show (DESIGN: a supervisor's state includes its axes' commanders).
+            axis, other = held[0]
+            return STATE_MESSAGES[state.name], (f"axis {axis} is in the {other.own_state.name} motion of "
+                                                f"supervisor {other.number}: command it there, or RESET it")
         append = MotionAttr.APPEND in attrs
         auto_start = False
         if modify:
@@ -325,6 +345,10 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             self._ctl.config.motors, len(self._ctl.axes))
         if not verdict.ok:
             return verdict.message, verdict.detail
+        if modify and not auto_start and MotionAttr.DELAY in attrs and any(d != 0.0 for d in params.delay):
+            # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
+            # motion" (the supervisor's motion, even while its axes wait out a DELAY).
+            return Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed"
         # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
         # (DESIGN.md table), and behind a move already cruising at its final velocity there
         # is nothing to wait for: the new move starts from where the axes are (a modify).
@@ -340,7 +364,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             message = self._check_frames([move])
         if not message.ok:
             return message, "the move does not fit in the frame buffer"
-        self._map()
+        message = self._map()
+        if not message.ok:
+            return message, "an axis that leaves the mapping still moves (pauseFeedrate); RESET first"
         for kind, detail in notes.events:
             self._emit(kind, detail=detail, move=move)
         if queued:
@@ -349,20 +375,29 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             self._replace(move)
         else:
             self._begin(move)
+        if auto_start or not modify:
+            # MPI 000, mpiMotionParamsGet: the parameters are set by mpiMotionParamsSet "or
+            # mpiMotionStart", so a start's parameters are the ones a later get returns.
+            self.stored_params = params.copy()
         if auto_start:
             return Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)"
         return OK, ""
 
     def _state_for(self, numbers: list[int]) -> MPIState:
         """State as a command on ``numbers`` sees it (other supervisors' axes included)."""
-        states = [self.own_state]
+        states = [self.own_state] + [other.own_state for _, other in self._held_by_others(numbers)]
+        return max(states, key=STATE_SEVERITY.__getitem__)
+
+    def _held_by_others(self, numbers: list[int]) -> list[tuple[int, "MotionSupervisor"]]:
+        """(axis, supervisor) for each axis of ``numbers`` in another supervisor's motion."""
+        held = []
         for n in numbers:
             owner = self._axis(n).owner
             if owner not in (-1, self.number):
                 other = self._ctl.supervisor(owner)
                 if other is not None and other.own_state is not MPIState.IDLE:
-                    states.append(other.own_state)
-        return max(states, key=STATE_SEVERITY.__getitem__)
+                    held.append((n, other))
+        return held
 
     def _starts(self, queued: bool, state: MPIState, moving: bool) -> list[AxisStart]:
         """Where the new profile of each axis starts."""
@@ -404,14 +439,25 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                                       tuple(a.actual_position for a in axes)))
 
     def _drop_pending(self, message: Message, detail: str) -> None:
+        """End the move in progress and the queued ones. Every axis that runs (or waits to
+        run) a plan of the dropped move is released where its command is now, whether or
+        not it is still mapped: no axis keeps motion that no supervisor owns."""
         for move in list(self.queue):
             self._end_move(move, message, detail)
         self.queue.clear()
         if self.current is not None:
+            self._release_axes(self.current)
             self._end_move(self.current, message, detail)
             self.last_move = self.current
             self.current = None
         self._holds.clear()
+
+    def _release_axes(self, move: Move) -> None:
+        t = self._ctl.time
+        for plan in move.plans:
+            axis = self._axis(plan.axis)
+            if axis.owner == self.number and (axis.plan is plan or axis.holding):
+                axis.unload(t, self.clock)
 
     def _begin(self, move: Move) -> None:
         """A start: whatever is pending is dropped and ``move`` runs from now."""
@@ -484,20 +530,12 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 self._ctl.io.apply_masks(IoSpace.IO, output.address, output.on_mask, output.off_mask)
 
     # ================================================================= status ====
-    def at_velocity_index(self, statuses, upto: int) -> int | None:
-        move = self.current
-        if move is None or self._at_velocity_sent or not move.is_velocity or self.own_state is not MPIState.MOVING:
-            return None
-        together = None
-        for plan in move.plans:
-            bits = statuses[plan.axis].bits["at_velocity"][: upto + 1]
-            together = bits if together is None else together & bits
-        hits = np.flatnonzero(together) if together is not None else []
-        return int(hits[0]) if len(hits) else None
-
-    def at_velocity_reached(self, sample: int) -> None:
+    def _at_velocity_reached(self) -> None:
+        """The velocity move is at velocity (the controller is at that sample): the event,
+        and the outcome a goal on this move waits for."""
         self._at_velocity_sent = True
-        self._emit(MPIEventType.MOTION_AT_VELOCITY, sample=sample)
+        self._emit(MPIEventType.MOTION_AT_VELOCITY)
+        self._end_move(self.current, OK, "at velocity")
 
     def snapshot(self) -> MotionSnapshot:
         """mpiMotionStatus."""

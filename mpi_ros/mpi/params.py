@@ -2,20 +2,135 @@
 
 C pointers become data (DESIGN.md): a NULL array is an empty list here, a hold or
 output is a value, an I/O address is the index of a word in the simulated I/O image.
+
+Each struct has one validator, ``validate() -> Verdict``: the ranges a controller can
+hold (docs/decisions.md, "Validation and ranges"). The YAML loader, the services and
+the controller all call it, so a value is accepted or refused the same way whatever
+way it comes in, and a value the controller accepted can never break its clock.
 """
 
 from __future__ import annotations
 
 import copy
+import math
+import numbers
 from dataclasses import dataclass, field
+from typing import Iterable
 
 from .events import MASK_ALL, MPIEventType
-from .types import HoldType, OutputType
+from .messages import Message
+from .types import HOLD_ATTRS, POINT_TO_POINT_TYPES, VELOCITY_TYPES, HoldType, MotionAttr, MPIMotionType, OutputType
 
 MAX_COORD_AXES = 8  # MEIXmpMAX_COORD_AXES
 MAX_GATES = 32  # gate numbers 0..31 (spec 000 MEIMotionAttrHoldSource)
 VELOCITY_FRAME_LIMIT_SAMPLES = 16_384_000  # spec 000 mpiMotionStart
 ID_BITS = 16  # spec 000 MPIMotionAttributes: "limited to 16-bit resolution"
+USER_LABEL_MAX = 16  # MEIObjectLabelCharMAX
+
+# -- ranges (docs/decisions.md "Validation and ranges") -------------------------------------
+LONG_MIN, LONG_MAX = -(2**31), 2**31 - 1  # the MPI's C long (32 bits)
+FLOAT_MAX = 3.4028234663852886e38  # the MPI's C float (MPIAxisInPosition, MPIMotionConfig)
+SAMPLE_RATE_MIN, SAMPLE_RATE_MAX = 1.0, 100_000.0  # Hz
+# The sample counter is a C long: a duration must fit in 2^31 - 1 samples. Bounding it at the
+# highest allowed rate makes it fit at every rate (5.96 h).
+MAX_DURATION = LONG_MAX / SAMPLE_RATE_MAX  # seconds
+# Positions are doubles. A raw position is a user position plus the origin, and a relative
+# move adds a distance: below 2^47 each, their sums stay below 2^49, where a double still
+# resolves 1/16 count (far finer than any settling tolerance).
+MAX_POSITION = 2.0**47  # counts
+MAX_VELOCITY = 1e12  # counts/s
+MAX_ACCELERATION = 1e15  # counts/s^2
+MAX_JERK = 1e18  # counts/s^3
+MAX_RATIO = 1e6  # a cam's gear ratio (slave counts per master count)
+FEEDRATE_MIN, FEEDRATE_MAX = 1e-3, 1e3  # 0.1 % .. 100,000 % of the programmed speed
+# The simulated servo: the closed-form response of an over-damped loop overflows after a
+# few seconds of one command piece, so the loop is at most critically damped.
+BANDWIDTH_MIN_HZ, BANDWIDTH_MAX_HZ = 0.01, SAMPLE_RATE_MAX / 2.0
+DAMPING_MAX = 1.0
+FEEDFORWARD_MAX = 10.0
+MAX_OBJECTS = 1024  # axes, supervisors and motors of one controller
+FRAME_BUFFER_MIN, FRAME_BUFFER_MAX = 16, 65_536  # frames per axis
+IO_WORDS_MAX = 65_536
+
+
+# -- the outcome of a check -------------------------------------------------------------------
+@dataclass(frozen=True, slots=True)
+class Verdict:
+    """OK, or the spec's message and why (``detail`` names the field first: "field: why")."""
+
+    message: Message
+    detail: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.message is Message.MPIMessageOK
+
+    def prefixed(self, prefix: str) -> "Verdict":
+        """The same verdict with ``prefix`` before the field it names (for nested structs)."""
+        return self if self.ok else Verdict(self.message, prefix + self.detail)
+
+
+VALID = Verdict(Message.MPIMessageOK)
+
+
+def refuse(detail: str, message: Message = Message.MPIMessagePARAM_INVALID) -> Verdict:
+    return Verdict(message, detail)
+
+
+def first_refusal(verdicts: Iterable[Verdict]) -> Verdict:
+    """The first verdict that refuses, else VALID."""
+    return next((v for v in verdicts if not v.ok), VALID)
+
+
+def _finite_number(value: object) -> bool:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an int beyond every double: not a finite number here
+        return False
+
+
+def check_range(name: str, value: object, low: float, high: float, above_low: bool = False) -> Verdict:
+    """``value`` is a finite number within [low, high] ((low, high] with ``above_low``)."""
+    if _finite_number(value) and low <= value <= high and not (above_low and value == low):
+        return VALID
+    lower = f"> {low:g}" if above_low else f">= {low:g}"
+    return refuse(f"{name}: must be a finite number {lower} and <= {high:g}, got {value!r}")
+
+
+def check_integer(name: str, value: object, low: int, high: int) -> Verdict:
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= value <= high:
+        return VALID
+    return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {value!r}")
+
+
+def check_bool(name: str, value: object) -> Verdict:
+    return VALID if isinstance(value, bool) else refuse(f"{name}: must be true or false, got {value!r}")
+
+
+def check_magnitude(name: str, value: object, limit: float) -> Verdict:
+    if _finite_number(value) and abs(value) <= limit:
+        return VALID
+    return refuse(f"{name}: must be a finite number of magnitude <= {limit:g}, got {value!r}")
+
+
+def check_position(name: str, value: object) -> Verdict:
+    """A position, origin or distance (counts)."""
+    return check_magnitude(name, value, MAX_POSITION)
+
+
+def check_duration(name: str, value: object, positive: bool = False) -> Verdict:
+    """A time in seconds that fits the sample counter (> 0 with ``positive``)."""
+    return check_range(name, value, 0.0, MAX_DURATION, above_low=positive)
+
+
+def _each(name: str, values: Iterable[object], check) -> Iterable[Verdict]:
+    return (check(f"{name}[{i}]", v) for i, v in enumerate(values))
+
+
+def _each_struct(name: str, structs: Iterable) -> Iterable[Verdict]:
+    return (s.validate().prefixed(f"{name}[{i}].") for i, s in enumerate(structs))
 
 
 @dataclass(slots=True)
@@ -28,6 +143,19 @@ class Trajectory:
     jerk_percent: float = 0.0
     acceleration_jerk: float = 0.0
     deceleration_jerk: float = 0.0
+
+    def validate(self) -> Verdict:
+        """Magnitudes a controller can hold. Which must be positive depends on the motion
+        type and is checked with the move (validate.check_params): VELOCITY ignores the
+        deceleration, the jerk types the jerk percentage (spec 000, MPITrajectory)."""
+        return first_refusal((
+            check_magnitude("velocity", self.velocity, MAX_VELOCITY),
+            check_magnitude("acceleration", self.acceleration, MAX_ACCELERATION),
+            check_magnitude("deceleration", self.deceleration, MAX_ACCELERATION),
+            check_magnitude("jerk_percent", self.jerk_percent, 100.0),
+            check_magnitude("acceleration_jerk", self.acceleration_jerk, MAX_JERK),
+            check_magnitude("deceleration_jerk", self.deceleration_jerk, MAX_JERK),
+        ))
 
 
 @dataclass(slots=True)
@@ -42,6 +170,11 @@ class Hold:
     pattern: int = 0
     position: float = 0.0
     timeout: float = 0.0
+
+    def validate(self) -> Verdict:
+        """The trigger position and the timeout; the source (gate, word, motor, axis) is
+        checked against the controller's objects with the move (validate.check_params)."""
+        return first_refusal((check_position("position", self.position), check_duration("timeout", self.timeout)))
 
 
 @dataclass(slots=True)
@@ -65,6 +198,15 @@ class UserFrame:
     acceleration: float = 0.0
     jerk: float = 0.0
     time: float = 0.0
+
+    def validate(self) -> Verdict:
+        return first_refusal((
+            check_position("position", self.position),
+            check_magnitude("velocity", self.velocity, MAX_VELOCITY),
+            check_magnitude("acceleration", self.acceleration, MAX_ACCELERATION),
+            check_magnitude("jerk", self.jerk, MAX_JERK),
+            check_duration("time", self.time),
+        ))
 
 
 @dataclass(slots=True)
@@ -96,6 +238,54 @@ class MotionParams:
     def copy(self) -> "MotionParams":
         return copy.deepcopy(self)
 
+    @property
+    def empty_count_disabled(self) -> bool:
+        """spec 000 MPIMotionPathAttributes: emptyCount -1 disables the E_STOP on a starving
+        buffer; spec 001 EMPTY_COUNT: "set the value to zero". Both do: any value <= 0."""
+        return self.empty_count <= 0
+
+    def validate(self, motion_type: MPIMotionType | None = None, attributes: MotionAttr | None = None) -> Verdict:
+        """The values a move of ``motion_type`` with ``attributes`` uses (None: every value,
+        as mpiMotionParamsSet stores them for any later start). Values a move ignores are
+        not read (spec 000: VELOCITY "will ignore" the positions; an attribute's array is
+        read only with the attribute). Lengths are checked with the move."""
+        every = motion_type is None
+
+        def uses(attr: MotionAttr) -> bool:
+            return attributes is None or bool(attributes & attr)
+
+        checks: list[Iterable[Verdict]] = [
+            _each("position", self.position if every or motion_type not in VELOCITY_TYPES else (), check_position),
+            _each_struct("trajectory", self.trajectory),
+            (check_integer("empty_count", self.empty_count, LONG_MIN, LONG_MAX),
+             check_integer("id", self.id, LONG_MIN, LONG_MAX),
+             check_integer("master_start", self.master_start, LONG_MIN, LONG_MAX),
+             check_integer("repeat_from", self.repeat_from, LONG_MIN, LONG_MAX)),
+            _each("element_id", self.element_id, lambda n, v: check_integer(n, v, LONG_MIN, LONG_MAX)),
+        ]
+        if uses(MotionAttr.DELAY):
+            checks.append(_each("delay", self.delay, check_duration))
+        if uses(MotionAttr.FINAL_VEL):
+            checks.append(_each("final_velocity", self.final_velocity,
+                                lambda n, v: check_magnitude(n, v, MAX_VELOCITY)))
+        if uses(HOLD_ATTRS):
+            checks.append(_each_struct("hold", self.hold))
+        if every or motion_type not in POINT_TO_POINT_TYPES | VELOCITY_TYPES:
+            checks += self._path_checks()
+        return first_refusal(v for group in checks for v in group)
+
+    def _path_checks(self) -> list[Iterable[Verdict]]:
+        """Path, cam and frame data (read only by those types)."""
+        return [
+            _each("point_velocity", self.point_velocity, lambda n, v: check_magnitude(n, v, MAX_VELOCITY)),
+            _each("time", self.time, check_duration),
+            _each("feedforward", self.feedforward, lambda n, v: check_magnitude(n, v, MAX_VELOCITY)),
+            _each("master_distance", self.master_distance, check_position),
+            _each("slave_position", self.slave_position, check_position),
+            _each("gear_ratio", self.gear_ratio, lambda n, v: check_magnitude(n, v, MAX_RATIO)),
+            _each_struct("frames", self.frames),
+        ]
+
 
 @dataclass(slots=True)
 class DecelTime:
@@ -103,6 +293,11 @@ class DecelTime:
 
     stop: float = 0.5
     e_stop: float = 0.05
+
+    def validate(self) -> Verdict:
+        """Durations (spec 000 MPIMotionDecelTime, seconds); a stop takes some time."""
+        return first_refusal((check_duration("stop", self.stop, positive=True),
+                              check_duration("e_stop", self.e_stop, positive=True)))
 
 
 @dataclass(slots=True)
@@ -123,8 +318,29 @@ class MotionConfig:
     def copy(self) -> "MotionConfig":
         return copy.deepcopy(self)
 
+    def validate(self) -> Verdict:
+        """spec 000 MPIMotionConfig/MEIMotionConfig. The decel times are named as the ROS
+        interface and the YAML name them (decel_time_stop); axis_numbers is read only."""
+        return first_refusal((
+            self.decel_time.validate().prefixed("decel_time_"),
+            check_range("normal_feedrate", self.normal_feedrate, FEEDRATE_MIN, FEEDRATE_MAX),
+            self._pause_feedrate(),
+            check_range("blend_limit", self.blend_limit, -1.0, 1.0),  # a cosine (MEIMotionConfig)
+            self._user_label(),
+        ))
 
-USER_LABEL_MAX = 16  # MEIObjectLabelCharMAX
+    def _pause_feedrate(self) -> Verdict:
+        # 0 (the default) stops; a pause feedrate above 0 keeps the axes crawling and is held
+        # to the range of the normal one.
+        if self.pause_feedrate == 0.0 and _finite_number(self.pause_feedrate):
+            return VALID
+        return check_range("pause_feedrate", self.pause_feedrate, FEEDRATE_MIN, FEEDRATE_MAX)
+
+    def _user_label(self) -> Verdict:
+        if isinstance(self.user_label, str) and len(self.user_label) <= USER_LABEL_MAX:
+            return VALID
+        return refuse(f"user_label: at most {USER_LABEL_MAX} characters (MEIObjectLabelCharMAX), "
+                      f"got {self.user_label!r}")
 
 
 @dataclass(slots=True)
@@ -143,6 +359,19 @@ class AxisInPosition:
     def copy(self) -> "AxisInPosition":
         return copy.deepcopy(self)
 
+    def validate(self) -> Verdict:
+        """spec 002 MPIAxisInPosition. The tolerances are compared with a strict "<" (the
+        NOTEs under the status tables), so a zero tolerance could never be met."""
+        return first_refusal((
+            check_range("position_fine", self.position_fine, 0.0, MAX_POSITION, above_low=True),
+            check_integer("position_coarse", self.position_coarse, 0, LONG_MAX),
+            check_range("velocity", self.velocity, 0.0, FLOAT_MAX, above_low=True),
+            check_duration("settling_time", self.settling_time),
+            check_bool("settle_on_stop", self.settle_on_stop),
+            check_bool("settle_on_estop", self.settle_on_estop),
+            check_bool("settle_on_estop_cmd_eq_act", self.settle_on_estop_cmd_eq_act),
+        ))
+
 
 @dataclass(slots=True)
 class PlantConfig:
@@ -156,6 +385,32 @@ class PlantConfig:
     acceleration_feedforward: float = 0.0
     encoder_resolution: float = 1.0
     coast_time_constant: float = 0.2
+
+    def validate(self) -> Verdict:
+        return first_refusal((
+            check_range("bandwidth_hz", self.bandwidth_hz, BANDWIDTH_MIN_HZ, BANDWIDTH_MAX_HZ),
+            check_range("damping", self.damping, 0.0, DAMPING_MAX, above_low=True),
+            check_magnitude("velocity_feedforward", self.velocity_feedforward, FEEDFORWARD_MAX),
+            check_magnitude("acceleration_feedforward", self.acceleration_feedforward, FEEDFORWARD_MAX),
+            self._encoder_resolution(),
+            check_duration("coast_time_constant", self.coast_time_constant, positive=True),
+        ))
+
+    def _encoder_resolution(self) -> Verdict:
+        # 0 reads the exact position; a step finer than 1e-6 count would overflow the reading
+        # of a large position (y / resolution).
+        if self.encoder_resolution == 0.0 and _finite_number(self.encoder_resolution):
+            return VALID
+        return check_range("encoder_resolution", self.encoder_resolution, 1e-6, MAX_POSITION)
+
+
+def check_settling_reachable(in_position: AxisInPosition, plant: PlantConfig) -> Verdict:
+    """The encoder rounds to its resolution, so a reading can be resolution/2 from any
+    target: a fine tolerance below that would never be met and no move would end."""
+    if plant.encoder_resolution / 2.0 < in_position.position_fine:
+        return VALID
+    return refuse(f"position_fine: must be above half the encoder resolution "
+                  f"({plant.encoder_resolution:g} counts), got {in_position.position_fine!r}")
 
 
 @dataclass(slots=True)
@@ -174,3 +429,14 @@ class ControllerConfig:
     @property
     def motors(self) -> int:
         return self.axis_count if self.motor_count < 0 else self.motor_count
+
+    def validate(self) -> Verdict:
+        return first_refusal((
+            check_range("sample_rate", self.sample_rate, SAMPLE_RATE_MIN, SAMPLE_RATE_MAX),
+            check_integer("axis_count", self.axis_count, 1, MAX_OBJECTS),
+            check_integer("supervisor_count", self.supervisor_count, 1, MAX_OBJECTS),
+            check_integer("frame_buffer_size", self.frame_buffer_size, FRAME_BUFFER_MIN, FRAME_BUFFER_MAX),
+            check_bool("firmware_option_21", self.firmware_option_21),
+            check_integer("io_words", self.io_words, 1, IO_WORDS_MAX),
+            check_integer("motor_count", self.motor_count, -1, MAX_OBJECTS),  # -1: one per axis
+        ))

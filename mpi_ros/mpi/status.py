@@ -81,6 +81,7 @@ class StatusContext:
     velocity_target: float | None = None  # VELOCITY moves
     ramp_end: float = 0.0  # VELOCITY moves: profile time the ramp is done
     has_plan: bool = False
+    ends_moving: bool = False  # a FINAL_VEL plan: its last frame goes on at the final velocity
 
 
 @dataclass(slots=True)
@@ -116,6 +117,9 @@ def _trajectory_complete(trace, ctx: StatusContext, stopped: np.ndarray) -> np.n
     if ctx.mode in (StatusMode.STOP, StatusMode.E_STOP):
         return stopped
     if ctx.holding:
+        return np.zeros(len(trace), dtype=bool)
+    if ctx.ends_moving:
+        # The last frame of a FINAL_VEL move runs on at the final velocity: it never completes.
         return np.zeros(len(trace), dtype=bool)
     if ctx.has_plan:
         return trace.rel >= ctx.plan_duration
@@ -163,7 +167,13 @@ def compute(trace, ctx: StatusContext, counters: SettleCounters) -> StatusTrace:
             ramp_done = ~tc & (trace.rel >= ctx.ramp_end)
             vel_runs = run_lengths(ramp_done & velocity_ok, counters.velocity)
             at_velocity = vel_runs >= need
-        bits = dict(in_fine_position=in_fine, in_coarse_position=in_coarse, at_target=tc, done=tc & in_fine)
+        # AT_TARGET: "TRUE when command = target" (002's table), at rest there; an axis of a
+        # SYNC_START move that arrives early is at its target while the others still move.
+        at_target = (trace.cmd_p == ctx.target) & stopped & (not ctx.holding)
+        if ctx.velocity_target is not None:
+            at_target = false
+        bits = dict(in_fine_position=in_fine, in_coarse_position=in_coarse, at_target=at_target,
+                    done=tc & in_fine)
 
     bits.update(settled=settled, at_velocity=at_velocity, trajectory_complete=tc)
     runs = {"fine": fine_runs, "settled": settled_runs, "velocity": vel_runs}

@@ -15,6 +15,12 @@ from .status import StatusMode
 from .types import ActionSource, MPIAction, MPIMotionType, MPIState
 
 OK = Message.MPIMessageOK
+# Actions that act on another supervisor's motion on shared axes (all but MAP).
+_SHARED = (MPIAction.STOP, MPIAction.RESUME, MPIAction.E_STOP, MPIAction.ABORT, MPIAction.E_STOP_ABORT,
+           MPIAction.RESET)
+# The own states in which these act on this supervisor's own motion (None: always).
+_OWN_STATES = {MPIAction.STOP: (MPIState.MOVING,), MPIAction.RESUME: (MPIState.STOPPED,),
+               MPIAction.RESET: (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR)}
 
 
 class ActionsMixin:
@@ -35,7 +41,35 @@ class ActionsMixin:
         self._notify_action(self.current.type if self.current else MPIMotionType.INVALID, MPIAction(action).name)
         if not self.axis_list and not self.mapped:
             return Message.MEIMotionMessageNO_AXES_MAPPED, "no axes mapped to the motion supervisor"
+        if action in _SHARED:
+            return self._on_shared_axes(action, handler, source)
         return handler(source)
+
+    def _sharing(self) -> list:
+        """Other supervisors whose motion runs on one of this supervisor's mapped axes."""
+        others = []
+        for axis in self.axes:
+            other = self._ctl.supervisor(axis.owner) if axis.owner not in (-1, self.number) else None
+            if other is not None and other not in others and other.own_state is not MPIState.IDLE:
+                others.append(other)
+        return others
+
+    def _on_shared_axes(self, action: MPIAction, handler, source: ActionSource) -> tuple[Message, str]:
+        """STOP, RESUME, E_STOP, ABORT, E_STOP_ABORT and RESET act on the whole motion that
+        holds this supervisor's axes (docs/decisions.md, "Supervisors and axes"), with that
+        motion's own decel times, so a vector another supervisor runs stays on its path: the
+        action goes to that supervisor as well. The answer is OK if the action did something
+        anywhere, else the message of the state that refused it."""
+        others = self._sharing()
+        if not others:
+            return handler(source)
+        forwarded = [other.action_detail(action, source)[0].ok for other in others]
+        allowed = _OWN_STATES.get(action)
+        if allowed is None or (self.own_state in allowed and self.own_state is not MPIState.IDLE):
+            return handler(source)
+        if any(forwarded):
+            return OK, "acted on the motion of the supervisor sharing its axes"
+        return self._refuse(())
 
     @property
     def _handlers(self):
@@ -49,14 +83,17 @@ class ActionsMixin:
             MPIAction.MAP: self._map_action,
         }
 
-    def _refuse(self, allowed: tuple[MPIState, ...]) -> tuple[Message, str] | None:
+    def _refuse(self, allowed: tuple[MPIState, ...], own: bool = False) -> tuple[Message, str] | None:
+        """None if the action may go on, else the message of the state that refuses it.
+        ``own``: decide by this supervisor's own state (its own motion), not the state it
+        shows (which includes the motions of supervisors sharing its axes)."""
         state = self.state
-        if state in allowed:
+        if (self.own_state if own else state) in allowed:
             return None
         return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
 
     def _stop(self, source: ActionSource) -> tuple[Message, str]:
-        refused = self._refuse((MPIState.MOVING,))
+        refused = self._refuse(_OWN_STATES[MPIAction.STOP], own=True)
         if refused:
             return refused
         t = self._ctl.time
@@ -69,7 +106,7 @@ class ActionsMixin:
         return OK, ""
 
     def _resume(self, source: ActionSource) -> tuple[Message, str]:
-        refused = self._refuse((MPIState.STOPPED,))
+        refused = self._refuse(_OWN_STATES[MPIAction.RESUME], own=True)
         if refused:
             return refused
         t = self._ctl.time
@@ -100,7 +137,7 @@ class ActionsMixin:
         self._stop_end = t + e_stop
         self._abort_after_stop = then_abort
         self._claim_axes()
-        for axis in self.axes:
+        for axis in self._own_axes():
             axis.status_mode = StatusMode.E_STOP
             if axis.in_position.settle_on_estop_cmd_eq_act and axis.amp_enabled:
                 axis.follow_actual(t, self.clock)
@@ -125,20 +162,25 @@ class ActionsMixin:
 
     def _disable_amps(self, t: float) -> None:
         self._aborted = True
-        for axis in self.axes:
+        for axis in self._own_axes():
             axis.disable(t, self._clock_of(axis))
             axis.status_mode = StatusMode.ABORT
 
     def _claim_axes(self) -> None:
-        """Safety actions act on every mapped axis, whoever commanded it last."""
+        """A safety action takes over the mapped axes that no motion runs (their last
+        commander is IDLE or in ERROR, or none). An axis another supervisor's motion runs
+        stays with it: the action went to that supervisor (:meth:`_on_shared_axes`)."""
         t = self._ctl.time
         for axis in self.axes:
-            if axis.owner != self.number:
-                axis.rebase(t, self._clock_of(axis))
-                if axis.owner >= 0 and axis.plan is not None:
-                    # keep the motion going on this supervisor's clock from the same state
-                    axis.unload(t, self._clock_of(axis))
-                axis.owner = self.number
+            if axis.owner != self.number and axis.plan is None and not axis.holding:
+                other = self._ctl.supervisor(axis.owner) if axis.owner >= 0 else None
+                if other is None or other.own_state in (MPIState.IDLE, MPIState.ERROR):
+                    axis.rebase(t, self._clock_of(axis))
+                    axis.owner = self.number
+
+    def _own_axes(self) -> list:
+        """The mapped axes this supervisor commands (or that no one commands)."""
+        return [axis for axis in self.axes if axis.owner in (self.number, -1)]
 
     def _reset(self, source: ActionSource) -> tuple[Message, str]:
         state = self.state
@@ -174,7 +216,9 @@ class ActionsMixin:
             return refused
         if not self.axis_list:
             return Message.MEIMotionMessageNO_AXES_MAPPED, "the axis list is empty"
-        self._map()
+        message = self._map()
+        if not message.ok:
+            return message, "an axis that leaves the mapping still moves (pauseFeedrate); RESET first"
         return OK, ""
 
     def _map_if_unmapped(self) -> None:

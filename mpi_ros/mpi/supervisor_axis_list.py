@@ -122,8 +122,24 @@ class AxisListMixin:
         index = self.axis_list.index(number) + step
         return OK, self.axis_list[index] if 0 <= index < len(self.axis_list) else None
 
-    def _map(self) -> None:
-        """Write the axis list to the controller (MEIActionMAP)."""
+    def _map(self) -> Message:
+        """Write the axis list to the controller (MEIActionMAP).
+
+        A stopped motion's pending profile belongs to the axes it was started on. Mapping a
+        list that leaves out one of them drops that profile (the supervisor goes IDLE, as a
+        RESET would take it): RESUME could not continue it, and the axes it leaves must not
+        keep a plan no supervisor runs. Refused while such an axis still moves (a non-zero
+        pauseFeedrate): it would stop dead."""
+        move = self.current
+        leaving = [p.axis for p in move.plans if p.axis not in self.axis_list] if move is not None else []
+        if leaving and self.own_state is MPIState.STOPPED:
+            moving = [n for n in leaving if self._axis(n).cmd_v != 0.0]
+            if moving:
+                return Message.MPIMotionMessageSTOPPED
+            self._rebase(self._ctl.time)
+            self._drop_pending(Message.MPIMotionMessageSTOPPED, "dropped: its axes were remapped")
+            self._set_state(MPIState.IDLE, "MAP", self.action_source)
         self.mapped = list(self.axis_list)
         self.config.axis_numbers = list(self.mapped)
+        return OK
 

@@ -36,13 +36,23 @@ class SteppingMixin:
             # A move that ends moving (FINAL_VEL) is never DONE: the next appended move
             # takes over at its trajectory's end; with none, the axes go on at the final
             # velocity (MOVING) until a modify, an append or a stop.
-            key = "trajectory_complete" if self._ends_moving() else "done"
-            if key == "done" or self.queue:
+            ends_moving = self._ends_moving()
+            if not ends_moving or self.queue:
                 complete = np.ones(len(samples), dtype=bool)
                 for plan in self.current.plans:
-                    complete &= statuses[plan.axis].bits[key]
+                    if ends_moving:
+                        complete &= traces[plan.axis].rel >= plan.duration
+                    else:
+                        complete &= statuses[plan.axis].bits["done"]
                 conditions["move_done"] = complete
-        elif state is MPIState.STOPPING:
+        if state is MPIState.MOVING and self.current is not None and self.current.is_velocity \
+                and not self._at_velocity_sent and not self._holds:
+            # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
+            together = np.ones(len(samples), dtype=bool)
+            for plan in self.current.plans:
+                together &= statuses[plan.axis].bits["at_velocity"]
+            conditions["at_velocity"] = together
+        if state is MPIState.STOPPING:
             conditions["stopped"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_stop)
         elif state is MPIState.STOPPING_ERROR:
             if self._error_at is not None:
@@ -90,6 +100,8 @@ class SteppingMixin:
                     self._release(key[1], wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
             elif key == "move_done":
                 self._move_done()
+            elif key == "at_velocity":
+                self._at_velocity_reached()
             elif key == "stopped":
                 self._set_state(MPIState.STOPPED, self.last_action, self.action_source)
             elif key == "error":

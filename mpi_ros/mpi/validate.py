@@ -8,12 +8,8 @@ failing check wins and nothing is changed.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
-from typing import Iterable
-
 from .messages import Message
-from .params import MAX_COORD_AXES, MAX_GATES, Hold, MotionParams, Output
+from .params import MAX_COORD_AXES, MAX_GATES, Hold, MotionParams, Output, Verdict
 from .types import (
     CAM_ATTRS,
     CAM_TYPES,
@@ -51,16 +47,6 @@ FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
 SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID} - CAM_TYPES
 # Types this simulator executes today; the rest of SUPPORTED_TYPES answer UNSUPPORTED.
 EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES
-
-
-@dataclass(frozen=True, slots=True)
-class Verdict:
-    message: Message
-    detail: str = ""
-
-    @property
-    def ok(self) -> bool:
-        return self.message is Message.MPIMessageOK
 
 
 OK = Verdict(Message.MPIMessageOK)
@@ -119,10 +105,6 @@ def check_attributes(
     return OK
 
 
-def _finite(values: Iterable[float]) -> bool:
-    return all(math.isfinite(float(v)) for v in values)
-
-
 def check_params(
     motion_type: MPIMotionType,
     attrs: MotionAttr,
@@ -143,12 +125,10 @@ def check_params(
         return _bad(bad, f"trajectory needs {want} element(s), got {len(params.trajectory)}")
     if not velocity_type and len(params.position) != axis_count:
         return _bad(bad, f"position needs {axis_count} value(s) (one per axis), got {len(params.position)}")
-    numbers = list(params.position if not velocity_type else [])
-    for traj in params.trajectory:
-        numbers += [traj.velocity, traj.acceleration, traj.deceleration, traj.jerk_percent,
-                    traj.acceleration_jerk, traj.deceleration_jerk]
-    if not _finite(numbers):
-        return _bad(bad, "positions and trajectory values must be finite")
+    # Ranges of every value the move reads (emptyCount <= 0 included: it disables, 000/001).
+    verdict = params.validate(motion_type, attrs)
+    if not verdict.ok:
+        return verdict
     for traj in params.trajectory:
         verdict = _check_trajectory(motion_type, traj)
         if not verdict.ok:
@@ -160,11 +140,6 @@ def check_params(
     ):
         if attrs & attr and len(values) != axis_count:
             return _bad(bad, f"{name} needs {axis_count} value(s) (one per axis), got {len(values)}")
-    if A.DELAY in attrs and not all(math.isfinite(d) and d >= 0.0 for d in params.delay):
-        return _bad(bad, "delays must be finite and >= 0")
-    if A.FINAL_VEL in attrs:
-        if not _finite(params.final_velocity):
-            return _bad(bad, "final velocities must be finite")
     if attrs & HOLD_ATTRS:
         for hold in params.hold:
             verdict = _check_hold(hold, attrs, io_words, motors, axes)
@@ -200,8 +175,6 @@ def _check_trajectory(motion_type: MPIMotionType, traj) -> Verdict:
 
 def _check_hold(hold: Hold, attrs: MotionAttr, io_words: int, motors: int, axes: int) -> Verdict:
     bad = Message.MPIMessagePARAM_INVALID
-    if not (math.isfinite(hold.timeout) and hold.timeout >= 0.0 and math.isfinite(hold.position)):
-        return _bad(bad, "hold timeout must be >= 0 and position finite")
     kind = hold.type
     if kind is HoldType.INVALID:
         return _bad(bad, "hold type INVALID")

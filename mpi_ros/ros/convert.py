@@ -92,7 +92,7 @@ def axis_status(snap: AxisSnapshot, rate: float) -> AxisStatus:
     msg.command_position = _finite(snap.command_position)
     msg.actual_position = _finite(snap.actual_position)
     msg.position_error = _finite(snap.position_error)
-    msg.target_position = _finite(snap.target_position)
+    msg.target_position = float(snap.target_position)  # NaN: no target (a velocity move)
     msg.origin = _finite(snap.origin)
     msg.command_velocity = _finite(snap.command_velocity)
     msg.actual_velocity = _finite(snap.actual_velocity)

@@ -172,18 +172,6 @@ def test_shared_axis_state_and_only_one_commander(ctl, params):
     assert [ctl.axes[n].command_position for n in (0, 1, 2)] == [3000.0, 10.0, 10.0]
 
 
-def test_safety_action_on_a_shared_axis_stops_it(ctl, params):
-    # spec 000:917 E_STOP "on all axes" of the supervisor, whichever supervisor commanded them
-    a, b = sharing_axis_1(ctl)
-    a.start(T.TRAPEZOIDAL, params=params((50_000.0, 50_000.0)))
-    ctl.step(1000)
-    assert b.action(MPIAction.E_STOP).ok
-    assert ctl.run_until(lambda c: b.state is MPIState.ERROR, 500)
-    ctl.step(10)
-    assert ctl.axes[1].cmd_v == 0.0
-    assert ctl.axes[0].cmd_v != 0.0  # not shared: still moving under supervisor 0
-
-
 def test_events_reach_listeners_in_order(ctl, ms, params, run_to):
     # DESIGN.md /mpi/events topic: listeners receive each event as it is delivered
     heard = []

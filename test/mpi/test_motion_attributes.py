@@ -114,6 +114,18 @@ def test_illegal_delay_on_modify_in_motion(ctl, ms, params, bring):
     assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.0, 0.0])).ok  # zero is legal
 
 
+def test_illegal_delay_while_the_axes_wait_out_a_delay(ctl, ms, params):
+    # spec 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in motion".
+    # In motion is the supervisor's state (MOVING), not the axes' velocity: during a start's
+    # DELAY the axes stand still, yet the motion is under way.
+    assert ms.start(T.TRAPEZOIDAL, A.DELAY, params((100.0, 0.0), delay=[0.5, 0.5])).ok
+    ctl.step(10)
+    assert ms.state is MPIState.MOVING and ctl.axes[0].cmd_v == 0.0
+    assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.1, 0.1])) is M.MPIMotionMessageILLEGAL_DELAY
+    ctl.step(1)
+    assert ctl.axes[0].cmd_v == 0.0 and ms.current.plans[0].target == 100.0  # nothing changed
+
+
 def test_delay_with_velocity_move(ctl, ms, params):
     # spec 000:2824 DELAY move types: S-Curve, Trapezoidal, Velocity
     ms.start(T.VELOCITY, A.DELAY, params((), velocity=100.0, delay=[0.01, 0.0]))

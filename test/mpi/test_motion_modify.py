@@ -134,6 +134,30 @@ def test_velocity_modify_changes_speed_and_direction(params):
     assert ms.state is MPIState.MOVING
 
 
+def test_a_velocity_modify_reaches_its_velocity_at_the_end_of_its_own_ramp(params):
+    # spec 000, MPIEventTypeMOTION_AT_VELOCITY and mpiMotionModify: the outcome a goal on a
+    # velocity move waits for is decided from the move the command made, at the sample its
+    # axes reach the new velocity, never from the earlier velocity the modify replaced.
+    ctl, ms = rig()
+    ms.start(T.VELOCITY, params=params((), velocity=200.0, acceleration=5000.0))
+    ctl.step(200)
+    first = [end for end in ms.move_ends]
+    assert [(e.message, e.detail) for e in first] == [(Message.MPIMessageOK, "at velocity")]
+    ms.move_ends.clear()
+    modified = ctl.effective_sample
+    assert ms.modify(T.VELOCITY, params=params((), velocity=-300.0, acceleration=5000.0)).ok
+    ramp = 500.0 / 5000.0 * RATE  # samples from +200 to -300 counts/s
+    ctl.step(int(ramp) - 2)
+    assert ms.move_ends == [] and ctl.axes[0].cmd_v > -300.0  # still ramping through zero
+    ctl.step(200)
+    (end,) = ms.move_ends
+    assert end.message is Message.MPIMessageOK and end.serial == first[0].serial
+    assert end.sample >= modified + ramp - 1
+    assert ctl.axes[0].cmd_v == pytest.approx(-300.0)
+    events = [e for e in ctl.drain_events() if e.type is MPIEventType.MOTION_AT_VELOCITY]
+    assert [e.sample for e in events] == [first[0].sample, end.sample]
+
+
 def test_velocity_modify_to_zero_ends_the_move(params):
     # spec 002:631 DONE after the velocity move is over; a velocity of zero ends the motion
     ctl, ms = rig()

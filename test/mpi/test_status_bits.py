@@ -14,7 +14,7 @@ import math
 
 import pytest
 
-from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, MotionParams, MPIAction, MPIMotionType,
+from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, MotionAttr, MotionParams, MPIAction, MPIMotionType,
                          MPIState, PlantConfig, Trajectory)
 from mpi_ros.mpi.events import MPIEventType
 
@@ -275,3 +275,47 @@ def test_coarse_tolerance_does_not_affect_done():
         return ctl.sample
 
     assert done_sample(0) == done_sample(10**6)
+
+
+def test_final_velocity_move_never_sets_at_target_done_or_in_fine_while_it_runs_on():
+    # MPI 002, the status tables: AT_TARGET is "TRUE when command = target", DONE is TC and
+    # IN_FINE_POSITION. A FINAL_VEL move leaves its target at the final velocity: its last frame
+    # runs on, so TC, AT_TARGET, IN_FINE_POSITION and DONE stay FALSE while the axis moves.
+    ctl, ms, axis = rig(AxisInPosition())
+    params = trapezoid(1000.0)
+    params.final_velocity = [500.0]
+    assert ms.start(MPIMotionType.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params).ok
+    for _ in range(600):
+        ctl.step(10)
+        bits = axis.status
+        assert not (bits.at_target or bits.done or bits.in_fine_position or bits.trajectory_complete)
+    assert axis.command_position > 1500.0 and axis.cmd_v == 500.0
+    assert ms.state is MPIState.MOVING
+
+
+def test_sync_start_sets_at_target_on_each_axis_when_its_command_arrives():
+    # MPI 002, the status tables: AT_TARGET is "TRUE when command = target". With SYNC_START the
+    # axes start together and the shorter one arrives first; it is at its target from then on.
+    ctl = Controller(ControllerConfig(axis_count=2, supervisor_count=1))
+    _, ms = ctl.create_motion(0)
+    assert ms.axis_list_set([0, 1]).ok and ms.action(MPIAction.MAP).ok
+    params = MotionParams(trajectory=[Trajectory(V, ACC, ACC, 0.0)] * 2, position=[500.0, 3000.0])
+    assert ms.start(MPIMotionType.TRAPEZOIDAL, MotionAttr.SYNC_START, params).ok
+    short, long_ = ctl.axes
+    assert ctl.run_until(lambda c: short.command_position == 500.0 and short.cmd_v == 0.0, 20_000)
+    ctl.step(1)
+    assert short.status.at_target and not long_.status.at_target
+    assert long_.cmd_v != 0.0
+
+
+def test_a_velocity_move_reports_no_target_position():
+    # MPI 002, the status-bit tables: AT_TARGET is "TRUE when command = target" after a point-to-
+    # point move and FALSE "During Velocity Move"; a velocity move has no target at all, so the
+    # axis status says so (NaN) instead of the far end of the velocity move's long frame.
+    ctl, ms, axis = rig(AxisInPosition())
+    ms.start(MPIMotionType.VELOCITY, params=MotionParams(trajectory=[Trajectory(500.0, 5000.0)]))
+    ctl.step(400)
+    assert math.isnan(ctl.axis_snapshot(0).target_position)
+    assert ms.modify(MPIMotionType.TRAPEZOIDAL, params=trapezoid(1000.0)).ok  # a target again
+    ctl.step(1)
+    assert ctl.axis_snapshot(0).target_position == 1000.0
