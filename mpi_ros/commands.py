@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import json
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
 from . import requests as rq
 from .mpi.control import Controller
 from .mpi.messages import Message
-from .mpi.params import Verdict, check_position, first_refusal
+from .mpi.params import Verdict, check_position, check_settling_reachable, first_refusal
 from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
 
 MOTION_START = "motion_start"
@@ -102,6 +102,8 @@ def _config_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
     config = rq.motion_config(command.request.get("config", {}))
     message = ms.config_set(config)  # validates with MotionConfig.validate
+    if message is Message.MPIMotionMessageAXIS_COUNT:  # spec 000 MPIMotionMessageAXIS_COUNT
+        return Reply(message, "the motion supervisor has no axes", state=ms.state)
     return Reply(message, _refusal_detail(message, config.validate()), state=ms.state)
 
 
@@ -183,7 +185,10 @@ def _io_set(ctl: Controller, command: Command) -> Reply:
 def _axis_config_set(ctl: Controller, command: Command) -> Reply:
     in_position = rq.in_position(command.request.get("in_position", {}))
     message = ctl.axis_in_position_set(command.axis, in_position)  # validates with AxisInPosition.validate
-    return Reply(message, _refusal_detail(message, in_position.validate()))
+    checks = [in_position.validate()]
+    if 0 <= command.axis < len(ctl.axes):  # and against the axis' encoder
+        checks.append(check_settling_reachable(in_position, ctl.axes[command.axis].plant.config))
+    return Reply(message, _refusal_detail(message, first_refusal(checks)))
 
 
 def _axis_position_set(ctl: Controller, command: Command) -> Reply:
@@ -224,6 +229,8 @@ def apply(ctl: Controller, command: Command) -> Reply:
     if handler is None:
         return Reply(Message.MPIMessageUNSUPPORTED, f"unknown operation {command.operation!r}")
     try:
+        if command.request is None:  # no request: every field takes its default
+            command = replace(command, request={})
         rq.mapping(command.request, "request")
         return handler(ctl, command)
     except rq.RequestError as exc:

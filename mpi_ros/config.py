@@ -33,6 +33,7 @@ from .mpi.params import (
     PlantConfig,
     Verdict,
     check_settling_reachable,
+    first_refusal,
 )
 from .mpi.plant import Plant
 from .mpi.types import MPIAction
@@ -103,7 +104,8 @@ class SuiteConfig:
         for n, (in_position, plant) in enumerate(zip(self.in_position, self.plant)):
             _require(plant.validate(), f"axes[{n}].plant.")
             ctl.axes[n].plant = Plant(plant)  # before the tolerances: they are checked against its encoder
-            _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position", in_position.validate())
+            _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position",
+                      first_refusal((in_position.validate(), check_settling_reachable(in_position, plant))))
         for i, spec in enumerate(self.supervisors):
             self._build_supervisor(ctl, spec, f"supervisors[{i}]")
         return ctl

@@ -12,6 +12,7 @@ are the structs' validators' business (mpi_ros/mpi/params.py), run by the contro
 
 from __future__ import annotations
 
+import numbers as _numbers
 from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
@@ -60,28 +61,36 @@ def sequence(values: Any, what: str) -> list:
 
 
 def number(value: Any, what: str) -> float:
-    """A number as a float (its range is the validators' business: nan passes here)."""
-    if isinstance(value, bool):
+    """A number as a float (its range is the validators' business: nan passes here). A
+    string that spells a number reads as one, as in the YAML loader (PyYAML reads 1e9,
+    without an exponent sign, as a string)."""
+    if isinstance(value, bool) or not isinstance(value, (_numbers.Real, str)):
         raise _unreadable(what, "a number", value)
     try:
         return float(value)
-    except (TypeError, ValueError, OverflowError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:  # an int beyond every double, a word
         raise _unreadable(what, "a number", value) from exc
 
 
 def integer(value: Any, what: str) -> int:
-    """An integer (an integral float such as 3.0 reads as 3)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    """An integer (an integral float such as 3.0 reads as 3; its range is the validators')."""
+    if isinstance(value, bool) or not isinstance(value, _numbers.Real):
         raise _unreadable(what, "an integer", value)
-    if isinstance(value, float) and not value.is_integer():  # nan and inf are not integers either
-        raise _unreadable(what, "an integer", value)
-    return int(value)
+    if isinstance(value, _numbers.Integral):
+        return int(value)
+    try:
+        if float(value).is_integer():  # nan and inf are not integers either
+            return int(value)
+    except (TypeError, ValueError, OverflowError):
+        pass
+    raise _unreadable(what, "an integer", value)
 
 
 def boolean(value: Any, what: str) -> bool:
+    """true or false (1 and 0 too, as C's long flags)."""
     if isinstance(value, bool):
         return value
-    if isinstance(value, int) and value in (0, 1):
+    if isinstance(value, _numbers.Integral) and value in (0, 1):
         return bool(value)
     raise _unreadable(what, "true or false", value)
 
@@ -219,11 +228,18 @@ def params_to_dict(params: MotionParams) -> dict[str, Any]:
     }
 
 
+_CONFIG_NUMBERS = ("decel_time_stop", "decel_time_e_stop", "normal_feedrate", "pause_feedrate", "blend_limit")
+_CONFIG_FIELDS = frozenset(_CONFIG_NUMBERS) | {"user_label", "axis_numbers"}
+
+
 def motion_config(data: Any) -> MotionConfig:
-    """A MotionConfig message (as a dict) to MPIMotionConfig; axis_numbers is ignored."""
+    """A MotionConfig message (as a dict) to MPIMotionConfig; axis_numbers (read only) is
+    ignored, an unknown field refused (a misspelt one would otherwise set its field to 0)."""
     data = mapping(data, "config")
-    value = {key: number(data.get(key, 0.0), key)
-             for key in ("decel_time_stop", "decel_time_e_stop", "normal_feedrate", "pause_feedrate", "blend_limit")}
+    unknown = sorted(str(key) for key in data if key not in _CONFIG_FIELDS)
+    if unknown:
+        raise RequestError(Message.MPIMessagePARAM_INVALID, f"config: unknown field {unknown[0]!r}")
+    value = {key: number(data.get(key, 0.0), key) for key in _CONFIG_NUMBERS}
     return MotionConfig(
         decel_time=DecelTime(value["decel_time_stop"], value["decel_time_e_stop"]),
         normal_feedrate=value["normal_feedrate"],

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from mpi_ros import config
+from mpi_ros import config, requests
+from mpi_ros.commands import Command, apply
 from mpi_ros.mpi.types import MPIState
 
 
@@ -62,3 +63,104 @@ def test_per_axis_overrides(tmp_path):
                     "supervisors:\n  - {number: 0, axes: [0, 1]}\n")
     cfg = config.load(path)
     assert [ip.settling_time for ip in cfg.in_position] == [0.01, 0.2]
+
+
+# ------------------------------------------------------------------ ranges: one validator per struct ----
+@pytest.mark.parametrize(
+    "data, where",
+    [
+        # issue 9: "blend_limit: 5.0 with decel_time_stop: 2.0 starts with the defaults"
+        ({"supervisor_defaults": {"config": {"blend_limit": 5.0, "decel_time_stop": 2.0}}},
+         "supervisors[0].config.blend_limit"),
+        ({"supervisor_defaults": {"config": {"normal_feedrate": 1e308}}}, "supervisors[0].config.normal_feedrate"),
+        ({"supervisor_defaults": {"config": {"normal_feedrate": 1e-300}}}, "supervisors[0].config.normal_feedrate"),
+        ({"supervisor_defaults": {"config": {"user_label": "x" * 17}}}, "supervisors[0].config.user_label"),
+        ({"axes": {"defaults": {"in_position": {"settling_time": 1e308}}}}, "axes[0].in_position.settling_time"),
+        ({"axes": {"overrides": {2: {"in_position": {"position_fine": 0.0}}}}}, "axes[2].in_position.position_fine"),
+        ({"axes": {"defaults": {"in_position": {"position_fine": 0.5}}}}, "axes[0].in_position.position_fine"),
+        ({"axes": {"defaults": {"plant": {"damping": 1.5}}}}, "axes[0].plant.damping"),
+        ({"axes": {"count": 100_000}}, "axes.count"),
+        ({"controller": {"sample_rate": 1e9}}, "controller.sample_rate"),
+        ({"controller": {"frame_buffer_size": 10**9}}, "controller.frame_buffer_size"),
+    ],
+)
+def test_values_the_controller_cannot_hold_name_the_key(data, where):
+    # the struct validators (spec 000 MPIMotionConfig/MEIMotionConfig, 002 MPIAxisInPosition, ...):
+    # the file is refused with the key named, never started with some other value
+    with pytest.raises(config.ConfigError) as error:
+        config.parse(data)
+    assert str(error.value).startswith(where + ":")
+
+
+def test_configured_values_reach_the_controller():
+    cfg = config.parse({"supervisor_defaults": {"config": {"blend_limit": 0.5, "decel_time_stop": 2.0,
+                                                           "normal_feedrate": 0.25}},
+                        "axes": {"overrides": {1: {"in_position": {"settling_time": 0.2}}}}})
+    ctl = cfg.build_controller()
+    ms = ctl.supervisor(0)
+    assert (ms.config.blend_limit, ms.config.decel_time.stop, ms.config.normal_feedrate) == (0.5, 2.0, 0.25)
+    assert [a.in_position.settling_time for a in ctl.axes] == [0.01, 0.2, 0.01, 0.01]
+
+
+@pytest.mark.parametrize(
+    "spoil, where",
+    [
+        (lambda c: setattr(c.supervisors[1].config, "blend_limit", 5.0), "supervisors[1].config.blend_limit"),
+        (lambda c: setattr(c.supervisors[0].config, "normal_feedrate", 1e308), "supervisors[0].config.normal_feedrate"),
+        (lambda c: setattr(c.in_position[3], "settling_time", 1e308), "axes[3].in_position.settling_time"),
+        (lambda c: setattr(c.plant[0], "encoder_resolution", 40.0), "axes[0].in_position.position_fine"),
+        (lambda c: setattr(c.plant[1], "damping", 3.0), "axes[1].plant.damping"),
+        (lambda c: setattr(c.controller, "io_words", 0), "controller.io_words"),
+        (lambda c: setattr(c.supervisors[0], "axes", [0, 9]), "supervisors[0].axes"),
+        (lambda c: setattr(c.supervisors[1], "number", 0), "supervisors[1].number"),
+    ],
+)
+def test_build_controller_never_drops_a_refused_value(spoil, where):
+    # issue 9: build_controller ignored the Message of config_set. Every call that builds the
+    # controller must succeed, or the suite stops with the key named.
+    cfg = config.load()
+    spoil(cfg)
+    with pytest.raises(config.ConfigError) as error:
+        cfg.build_controller()
+    assert str(error.value).startswith(where)
+
+
+@pytest.mark.parametrize("key, values", [
+    ("normal_feedrate", [1.0, 1e-3, 1e3, 9.9e-4, 1000.1, 0.0, 1e308]),
+    ("blend_limit", [-1.0, 1.0, 1.0001, -2.0]),
+    ("decel_time_stop", [1e-6, 21474.0, 0.0, 1e9]),
+    ("pause_feedrate", [0.0, 0.5, 1e-300, -1.0]),
+])
+def test_yaml_service_and_controller_agree_on_motion_config(key, values):
+    # one MotionConfig validator: the YAML loader, /mpi/ms<n>/config_set (commands.apply) and
+    # mpiMotionConfigSet accept and refuse the same values
+    for value in values:
+        try:
+            config.parse({"supervisor_defaults": {"config": {key: value}}})
+            by_yaml = True
+        except config.ConfigError:
+            by_yaml = False
+        ctl = config.load().build_controller()
+        request = {**requests.motion_config_to_dict(ctl.supervisor(0).config_get()[1]), key: value}
+        by_service = apply(ctl, Command("config_set", 0, request={"config": request})).accepted
+        assert by_yaml is by_service, (key, value)
+
+
+@pytest.mark.parametrize("key, values", [
+    ("settling_time", [0.0, 21474.0, 1e308, -1.0]),
+    ("position_fine", [0.51, 1e14, 0.5, 0.0]),
+    ("velocity", [1e-3, 3e38, 0.0, 1e39]),
+    ("position_coarse", [0, 2**31 - 1, -1, 2**31]),
+])
+def test_yaml_service_and_controller_agree_on_in_position(key, values):
+    # one AxisInPosition validator (spec 002 MPIAxisInPosition): YAML, /mpi/axis<k>/config_set
+    for value in values:
+        try:
+            config.parse({"axes": {"defaults": {"in_position": {key: value}}}})
+            by_yaml = True
+        except config.ConfigError:
+            by_yaml = False
+        ctl = config.load().build_controller()
+        by_service = apply(ctl, Command("axis_config_set", axis=0, request={"in_position": {key: value}})).accepted
+        assert by_yaml is by_service, (key, value)
+

@@ -113,14 +113,17 @@ class Axis:
         self.origin = float(origin)
         return Message.MPIMessageOK
 
-    def set_actual_position(self, position: float, t: float) -> Message:
+    def set_actual_position(self, position: float, t: float, clock: ProfileClock | None = None) -> Message:
         """mpiAxisActualPositionSet: the encoder now reads ``position``. The command is
-        untouched, so the loop sees the new error and moves to remove it."""
+        untouched, so the loop sees the new error and moves to remove it. ``clock`` is the
+        owning supervisor's: the plant is re-anchored along the plan the axis follows."""
         verdict = check_position("position", position)
         if not verdict.ok:
             return verdict.message
         delta = (float(position) + self.origin) - self.act_p
-        self.rebase(t)
+        if clock is None:  # without the clock only a resting command can be followed
+            self._retire_finished_plan(t, None)
+        self.rebase(t, clock)
         self.state = PlantState(self.state.t, self.state.y + delta, self.state.dy)
         self.act_p += delta
         return Message.MPIMessageOK
@@ -131,16 +134,38 @@ class Axis:
         axis' state (its supervisor's). Refused while the controller computes a new command
         every sample: in a MOVING, STOPPING or STOPPED state (STOPPING_ERROR is a stopping
         state too), while the command follows the actual position (settleOnEstopCmdEqAct,
-        the simulator's "CMD_EQ_ACT with the amp disabled"), or while a move is loaded or
-        held. ERROR and IDLE are not on the list: there the command rests and can be set."""
+        the simulator's "CMD_EQ_ACT with the amp disabled"), while a loaded move still
+        changes the command, or while a hold waits. ERROR and IDLE are not on the list: there
+        the command rests and can be set, also at the end of a finished move (002: "set the
+        command position when the motion is in an IDLE state")."""
         if state in (MPIState.MOVING, MPIState.STOPPING, MPIState.STOPPED, MPIState.STOPPING_ERROR):
             return False
-        return self.plan is None and not self.holding and self.mode is not CommandMode.FOLLOW_ACTUAL
+        return self.command_at_rest and not self.holding and self.mode is not CommandMode.FOLLOW_ACTUAL
 
-    def set_command_position(self, position: float, t: float) -> None:
+    @property
+    def command_at_rest(self) -> bool:
+        """The command no longer changes: no plan, or a point-to-point plan whose last frame
+        holds its end position (the plan stays loaded after its move is done)."""
+        plan = self.plan
+        return plan is None or (not plan.is_velocity and plan.final_velocity == 0.0 and self.rel >= plan.duration)
+
+    def _retire_finished_plan(self, t: float, clock: ProfileClock | None) -> None:
+        """Before a setter re-anchors the plant: a finished plan is dropped and the command
+        rests where it ended. Without the supervisor's clock the plant then follows the
+        resting command, exactly as the plan's last frame would (its anchor is at or after
+        the plan's end: anchors sit at command breakpoints)."""
+        if self.plan is not None and self.command_at_rest:
+            if clock is not None:
+                self.rebase(t, clock)
+            self.plan = None
+            self.rest = self.cmd_p
+
+    def set_command_position(self, position: float, t: float, clock: ProfileClock | None = None) -> None:
         """Command steps to ``position``; the loop follows (check ``can_set_command`` and the
-        range, params.check_position, first)."""
-        self.rebase(t)
+        range, params.check_position, first). A finished plan is dropped: the command now
+        rests at ``position``."""
+        self._retire_finished_plan(t, clock)
+        self.rebase(t, clock)
         self.rest = position + self.origin
         self.cmd_p = self.rest
         self.cmd_v = self.cmd_a = 0.0

@@ -56,8 +56,12 @@ class Controller:
         motion_config: MotionConfig | None = None,
     ):
         self.config = config or ControllerConfig()
-        if self.config.sample_rate <= 0.0:
-            raise ValueError("sample_rate must be positive")
+        # The one validator of each struct (params.py), as the YAML loader and the services.
+        for what, struct in (("config", self.config), ("in_position", in_position), ("plant", plant),
+                             ("motion_config", motion_config)):
+            verdict = struct.validate() if struct is not None else None
+            if verdict is not None and not verdict.ok:
+                raise ValueError(f"{what}.{verdict.detail}")
         self.rate = float(self.config.sample_rate)
         self.sample = 0
         self.axes = [
@@ -145,14 +149,17 @@ class Controller:
         owner = self.supervisor(axis.owner)  # an axis is in its owner's state (IDLE without one)
         if not axis.can_set_command(owner.own_state if owner is not None else MPIState.IDLE):
             return Message.MPIAxisMessageCOMMAND_NOT_SET
-        axis.set_command_position(float(position), self.time)
+        axis.set_command_position(float(position), self.time, owner.clock if owner is not None else None)
         return Message.MPIMessageOK
 
     def axis_actual_position_set(self, number: int, position: float) -> Message:
-        """mpiAxisActualPositionSet (the axis checks the range)."""
+        """mpiAxisActualPositionSet (the axis checks the range), at any time: the plant is
+        re-anchored along the move the axis follows (its owner's clock)."""
         if not 0 <= number < len(self.axes):
             return Message.MPIAxisMessageAXIS_INVALID
-        return self.axes[number].set_actual_position(position, self.time)
+        axis = self.axes[number]
+        owner = self.supervisor(axis.owner)
+        return axis.set_actual_position(position, self.time, owner.clock if owner is not None else None)
 
     def axis_origin_set(self, number: int, origin: float) -> Message:
         """mpiAxisOriginSet (the axis checks the range)."""

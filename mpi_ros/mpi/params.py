@@ -105,6 +105,11 @@ def check_integer(name: str, value: object, low: int, high: int) -> Verdict:
     return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {value!r}")
 
 
+def check_long(name: str, value: object) -> Verdict:
+    """An integer a C long (the MPI's 32 bits) holds."""
+    return check_integer(name, value, LONG_MIN, LONG_MAX)
+
+
 def check_bool(name: str, value: object) -> Verdict:
     return VALID if isinstance(value, bool) else refuse(f"{name}: must be true or false, got {value!r}")
 
@@ -147,7 +152,8 @@ class Trajectory:
     def validate(self) -> Verdict:
         """Magnitudes a controller can hold. Which must be positive depends on the motion
         type and is checked with the move (validate.check_params): VELOCITY ignores the
-        deceleration, the jerk types the jerk percentage (spec 000, MPITrajectory)."""
+        deceleration, the jerk types the jerk percentage (spec 000, MPIMotionSCurve and
+        MPIMotionVelocity: the trajectory parameters each type reads)."""
         return first_refusal((
             check_magnitude("velocity", self.velocity, MAX_VELOCITY),
             check_magnitude("acceleration", self.acceleration, MAX_ACCELERATION),
@@ -172,9 +178,14 @@ class Hold:
     timeout: float = 0.0
 
     def validate(self) -> Verdict:
-        """The trigger position and the timeout; the source (gate, word, motor, axis) is
-        checked against the controller's objects with the move (validate.check_params)."""
-        return first_refusal((check_position("position", self.position), check_duration("timeout", self.timeout)))
+        """The trigger position, the timeout, and C longs (the MPI's 32 bits) elsewhere; the
+        source (gate, word, motor, axis) is checked against the controller's objects with
+        the move (validate.check_params)."""
+        return first_refusal((
+            *(check_long(name, getattr(self, name)) for name in ("gate", "number", "address", "mask", "pattern")),
+            check_position("position", self.position),
+            check_duration("timeout", self.timeout),
+        ))
 
 
 @dataclass(slots=True)
@@ -187,6 +198,12 @@ class Output:
     on_mask: int = 0
     off_mask: int = 0
     point_index: int = 0
+
+    def validate(self) -> Verdict:
+        """C longs (32 bits, as the ROS interface's int32); the motor or I/O word is checked
+        against the controller's objects with the move (validate.check_params)."""
+        return first_refusal(check_long(name, getattr(self, name))
+                             for name in ("motor", "address", "on_mask", "off_mask", "point_index"))
 
 
 @dataclass(slots=True)
@@ -240,15 +257,18 @@ class MotionParams:
 
     @property
     def empty_count_disabled(self) -> bool:
-        """spec 000 MPIMotionPathAttributes: emptyCount -1 disables the E_STOP on a starving
-        buffer; spec 001 EMPTY_COUNT: "set the value to zero". Both do: any value <= 0."""
+        """spec 000 MPIMotionPoint: emptyCount (-1) disables the E_STOP on a starving buffer;
+        spec 001 MPIMotionPathAttrMask EMPTY_COUNT: "To disable path-based deceleration, set
+        the value to zero". Both do, and so does any value below: emptyCount <= 0 (no buffer
+        holds fewer than 0 points, so the trigger could never fire anyway)."""
         return self.empty_count <= 0
 
     def validate(self, motion_type: MPIMotionType | None = None, attributes: MotionAttr | None = None) -> Verdict:
         """The values a move of ``motion_type`` with ``attributes`` uses (None: every value,
         as mpiMotionParamsSet stores them for any later start). Values a move ignores are
-        not read (spec 000: VELOCITY "will ignore" the positions; an attribute's array is
-        read only with the attribute). Lengths are checked with the move."""
+        not read (spec 000 MPIMotionSCurve, position: VELOCITY "will ignore these values";
+        an attribute's array is read only with the attribute). Lengths are checked with
+        the move."""
         every = motion_type is None
 
         def uses(attr: MotionAttr) -> bool:
@@ -257,11 +277,13 @@ class MotionParams:
         checks: list[Iterable[Verdict]] = [
             _each("position", self.position if every or motion_type not in VELOCITY_TYPES else (), check_position),
             _each_struct("trajectory", self.trajectory),
-            (check_integer("empty_count", self.empty_count, LONG_MIN, LONG_MAX),
-             check_integer("id", self.id, LONG_MIN, LONG_MAX),
-             check_integer("master_start", self.master_start, LONG_MIN, LONG_MAX),
-             check_integer("repeat_from", self.repeat_from, LONG_MIN, LONG_MAX)),
-            _each("element_id", self.element_id, lambda n, v: check_integer(n, v, LONG_MIN, LONG_MAX)),
+            (check_bool("final", self.final),
+             check_bool("retain", self.retain),
+             check_long("empty_count", self.empty_count),  # any value: <= 0 disables (empty_count_disabled)
+             check_long("id", self.id),
+             check_long("master_start", self.master_start),
+             check_long("repeat_from", self.repeat_from)),
+            _each("element_id", self.element_id, check_long),
         ]
         if uses(MotionAttr.DELAY):
             checks.append(_each("delay", self.delay, check_duration))
@@ -270,6 +292,8 @@ class MotionParams:
                                 lambda n, v: check_magnitude(n, v, MAX_VELOCITY)))
         if uses(HOLD_ATTRS):
             checks.append(_each_struct("hold", self.hold))
+        if uses(MotionAttr.OUTPUT):
+            checks.append(_each_struct("output", self.output))
         if every or motion_type not in POINT_TO_POINT_TYPES | VELOCITY_TYPES:
             checks += self._path_checks()
         return first_refusal(v for group in checks for v in group)

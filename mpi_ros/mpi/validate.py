@@ -43,9 +43,12 @@ FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
     MPIMotionType.VELOCITY: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,
     MPIMotionType.VELOCITY_JERK: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,
 }
-# spec 000 mpiMotionStart: the supported list (cams are not on it).
-SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID} - CAM_TYPES
-# Types this simulator executes today; the rest of SUPPORTED_TYPES answer UNSUPPORTED.
+# Every documented type is supported by the controller. (The list under MPI 000,
+# mpiMotionStart is visibly incomplete: it leaves out VELOCITY and FRAME, which the same
+# reference documents as supported, so it does not exclude the cams either.)
+SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID}
+# Types this simulator executes today; the rest answer UNSUPPORTED "not simulated yet" (the
+# path types, FRAME and the cams are built in their own issues).
 EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES
 
 
@@ -150,6 +153,11 @@ def check_params(
             verdict = _check_output(output, io_words, motors)
             if not verdict.ok:
                 return verdict
+            if motion_type in EXECUTED_TYPES and output.point_index != 0:
+                # MEIMotionAttrOutput.pointIndex picks a point "when multiple point motion is
+                # used"; a point-to-point or velocity move has one, index 0.
+                return _bad(bad, f"output point_index {output.point_index}: a {motion_type.name} move has "
+                                 "one point (index 0)")
     if A.ELEMENT_ID in attrs and not params.element_id:
         return _bad(bad, "ELEMENT_ID attribute specified and element_id is empty")
     return OK

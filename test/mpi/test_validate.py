@@ -10,6 +10,7 @@ import pytest
 
 from mpi_ros.mpi import (Controller, Hold, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState, Output,
                          Trajectory)
+from mpi_ros.mpi.params import MotionConfig
 from mpi_ros.mpi.messages import Message
 from mpi_ros.mpi.types import HoldType, OutputType
 from mpi_ros.mpi.validate import check_attributes, check_params, check_type
@@ -51,10 +52,11 @@ def test_jerk_types_without_firmware_option_21_are_not_supported(kind, modify):
 
 
 @pytest.mark.parametrize("kind", [T.CAM_LINEAR, T.CAM_CUBIC])
-def test_cams_are_not_on_the_supported_list(kind):
-    # spec 000:3031 MPIMessageUNSUPPORTED "if the motion type is not supported"; the list of
-    # supported types has no cam
-    assert check_type(kind, False, False).message is M.MPIMessageUNSUPPORTED
+def test_cams_answer_unsupported_because_they_are_not_simulated_yet(kind):
+    # MPI 000 documents the cams in full (MPIMotionCam, REPEAT, MASTER_START): they are supported
+    # by the controller. Until this twin simulates them, MPIMessageUNSUPPORTED says so.
+    verdict = check_type(kind, False, False)
+    assert verdict.message is M.MPIMessageUNSUPPORTED and "not simulated yet" in verdict.detail
 
 
 @pytest.mark.parametrize("kind", [T.PTF, T.PVTF, T.SPLINE, T.BESSEL, T.BSPLINE, T.BSPLINE2, T.FRAME])
@@ -278,6 +280,9 @@ def test_hold_sources(hold, ok):
     (Output(type=OutputType.MOTOR, motor=3), True),  # spec 000:1827 motor number
     (Output(type=OutputType.MOTOR, motor=4), False),
     (Output(type=OutputType.INVALID), False),
+    # MEIMotionAttrOutput.pointIndex "when multiple point motion is used": a point-to-point move
+    # has one point, index 0; another index would never be reached
+    (Output(type=OutputType.OUTPUT, address=0, on_mask=1, point_index=1), False),
 ])
 def test_output_targets(output, ok):
     # spec 000:1825-1830 MEIMotionAttrOutput
@@ -290,6 +295,38 @@ def test_element_id_needs_values():
     assert params_verdict(p2p(element_id=[7]), attrs=A.ELEMENT_ID).ok
 
 
+# ------------------------------------------------------------------ ranges ----
+# docs/decisions.md "Validation and ranges": every value a move reads is one a controller can
+# hold (MotionParams.validate, the validator the services and the YAML loader use too).
+@pytest.mark.parametrize("attrs,params", [
+    (A.NONE, p2p([1e300, 0.0])),  # finite, but past any position a controller holds
+    (A.NONE, p2p(trajectory=[Trajectory(1e300, 1e4, 1e4)])),
+    (A.DELAY, p2p(delay=[0.0, 1e9])),  # more samples than the counter holds
+    (A.FINAL_VEL, p2p(final_velocity=[0.0, 1e300])),
+    (A.HOLD, p2p(hold=[Hold(type=HoldType.GATE, gate=1, timeout=1e9)] * 2)),
+    (A.OUTPUT, p2p(output=[Output(type=OutputType.OUTPUT, address=0, on_mask=2**32)])),
+    (A.ID, p2p(id=2**40)),
+])
+def test_values_no_controller_holds_are_param_invalid(attrs, params):
+    # spec 000 "Returns for mpiMotionStart and mpiMotionModify": MPIMessagePARAM_INVALID "if the
+    # specified motion parameters are not valid"; C longs and doubles (MPIMotionParams,
+    # MPIMotionAttributes, MEIMotionAttrHold/Output), durations that fit the sample counter
+    verdict = params_verdict(params, attrs=attrs)
+    assert verdict.message is M.MPIMessagePARAM_INVALID and ":" in verdict.detail
+
+
+@pytest.mark.parametrize("empty_count", [-1, 0, -100, 1, 5])
+def test_every_empty_count_is_accepted(empty_count):
+    # spec 000 MPIMotionPoint: -1 disables; spec 001 EMPTY_COUNT: zero disables; DESIGN.md: both
+    # do (<= 0), so neither is refused
+    assert params_verdict(p2p(empty_count=empty_count)).ok
+
+
+def test_empty_count_past_a_c_long_is_param_invalid():
+    # spec 000 MPIMotionPoint: long emptyCount
+    assert params_verdict(p2p(empty_count=2**40)).message is M.MPIMessagePARAM_INVALID
+
+
 # ------------------------------------------------------------------ through the supervisor ----
 def test_start_with_no_axes_answers_axis_count(ctl):
     # spec 000:3026 MPIMotionMessageAXIS_COUNT "if the motion object has no axes"; 000:2166;
@@ -298,6 +335,16 @@ def test_start_with_no_axes_answers_axis_count(ctl):
     assert ms.start(T.TRAPEZOIDAL, params=p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT
     assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT
     assert ms.state is MPIState.IDLE
+
+
+def test_config_set_with_no_axes_answers_axis_count(ctl):
+    # spec 000 MPIMotionMessageAXIS_COUNT: "returned from mpiMotionConfigSet(...), mpiMotionStart(...),
+    # or mpiMotionModify(...) if there are no axes associated with the motion object"
+    _, ms = ctl.create_motion(0)
+    before = ms.config.copy()
+    assert ms.config_set(MotionConfig(normal_feedrate=0.5)) is M.MPIMotionMessageAXIS_COUNT
+    assert ms.config == before
+    assert ms.axis_list_set([0]).ok and ms.config_set(MotionConfig(normal_feedrate=0.5)).ok
 
 
 def test_start_in_error_answers_error(ms, bring, params):
