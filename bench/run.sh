@@ -30,6 +30,10 @@ cd "$repo/bench"
     echo "## The ROS suite in real time (bench/bench_ros.py)"
     echo
     "$py" -P bench_ros.py
+    echo
+    echo "## E_STOP with hundreds of goals in flight (bench/goal_storm.py)"
+    echo
+    "$py" -P goal_storm.py
 } > "$out.tmp"
 mv "$out.tmp" "$out"
 cat "$out"

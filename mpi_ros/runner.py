@@ -4,7 +4,11 @@ Python cannot sleep 500 us reliably, so the thread wakes every few milliseconds 
 steps, in one batch, the samples that wall time x scale says are due (DESIGN.md). A
 command first catches the controller up to the sample that is due now and is then
 applied, so it takes effect within one sample of arriving. One lock guards the
-controller; work that talks to ROS (publishing) runs after the lock is released.
+controller; work that talks to ROS (publishing) runs after the lock is released, in
+order: on the clock thread while it runs (a command wakes it), else by the caller.
+Change hooks (``on_change``) run under the lock after every step batch and every
+command, so whoever follows the controller (the goals of the nodes) is told without
+a thread of its own waiting on it.
 
 Modes: ``time_scale`` 1 = real time, >1 faster, 0 = as fast as possible, None = manual
 (nothing runs by itself; ``step`` advances, as tests and replay do).
@@ -47,12 +51,16 @@ class ControllerRunner:
         self.wake_period = wake_period
         self.lock = threading.RLock()
         self.changed = threading.Condition(self.lock)
-        self.outcomes: OrderedDict[int, MoveEnd] = OrderedDict()  # serial -> how the move ended
+        # serial -> the move's outcomes (MoveEnd: how it ended, or that it reached its velocity),
+        # in the order the controller recorded them; a modified move can have several
+        self.outcomes: OrderedDict[int, list[MoveEnd]] = OrderedDict()
         self._periodic: list[_Periodic] = []
         self._command_listeners: list[Callable[[int, Command, Reply], None]] = []
+        self._change_hooks: list[Callable[[Controller], Output | None]] = []
         self._event_listeners: list[Callable[[Event], None]] = []
         self._outputs: deque[Output] = deque()
         self._flush_lock = threading.Lock()
+        self._wake = threading.Event()  # the clock thread: flush now
         self._thread: threading.Thread | None = None
         self._running = threading.Event()
         self._anchor_wall = 0.0
@@ -72,6 +80,12 @@ class ControllerRunner:
         """``listener(sample, command, reply)`` for every command applied (under the lock)."""
         self._command_listeners.append(listener)
 
+    def on_change(self, hook: Callable[[Controller], Output | None]) -> None:
+        """Call ``hook(controller)`` (under the lock) after every step batch and every command,
+        once the moves that ended are in ``outcomes``; what it returns is run after the lock
+        is released, in order with the other deferred work."""
+        self._change_hooks.append(hook)
+
     def on_event(self, listener: Callable[[Event], None]) -> None:
         """``listener(event)`` for every notified event (outside the lock, in order)."""
         self._event_listeners.append(listener)
@@ -89,6 +103,7 @@ class ControllerRunner:
 
     def stop(self) -> None:
         self._running.clear()
+        self._wake.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
             self._thread = None
@@ -109,7 +124,8 @@ class ControllerRunner:
             except Exception:  # noqa: BLE001 - the clock must keep running; the error is logged
                 _log.exception("controller clock: a step or its output failed")
             if self.time_scale:
-                time.sleep(period)
+                self._wake.wait(period)
+                self._wake.clear()
 
     def due_sample(self) -> int:
         """The sample the controller should be at now."""
@@ -133,23 +149,39 @@ class ControllerRunner:
 
     def _advance_to(self, target: int) -> None:
         ctl = self.ctl
+        if ctl.sample >= target:
+            return
         while ctl.sample < target:
             stop = min([target] + [p.next_sample for p in self._periodic])
             if stop > ctl.sample:
                 ctl.step(stop - ctl.sample)
+                self._collect_outcomes()  # periodic callbacks see the moves that have ended
             for periodic in self._periodic:
                 if periodic.next_sample <= ctl.sample:
                     periodic.next_sample += periodic.every * max(1, (ctl.sample - periodic.next_sample) // periodic.every + 1)
                     output = periodic.callback(ctl)
                     if output is not None:
                         self._outputs.append(output)
+        self._changed()
+
+    def _changed(self) -> None:
+        """After a step batch or a command (under the lock): outcomes, hooks, waiters."""
         self._collect_outcomes()
+        for hook in self._change_hooks:
+            try:
+                output = hook(self.ctl)
+            except Exception:  # noqa: BLE001 - the step or command is done; a hook must not undo
+                # that for its caller (an E_STOP service, the clock thread): log it and go on
+                _log.exception("controller runner: a change hook failed")
+                continue
+            if output is not None:
+                self._outputs.append(output)
         self.changed.notify_all()
 
     def _collect_outcomes(self) -> None:
         for ms in self.ctl.supervisors:
             for end in ms.move_ends:
-                self.outcomes[end.serial] = end
+                self.outcomes.setdefault(end.serial, []).append(end)
             ms.move_ends.clear()
         while len(self.outcomes) > _OUTCOMES_KEPT:
             self.outcomes.popitem(last=False)
@@ -163,10 +195,19 @@ class ControllerRunner:
             reply = apply(self.ctl, command)
             for listener in self._command_listeners:
                 listener(sample, command, reply)
-            self._collect_outcomes()
-            self.changed.notify_all()
-        self._flush()
+            self._changed()
+        self._deferred()
         return reply, sample
+
+    def update(self, change: Callable[[Controller], Output | None]) -> None:
+        """Run ``change(controller)`` under the lock (bookkeeping around the controller, not
+        motion: commands go through ``submit``); what it returns is run after the lock is
+        released, in order with the other deferred work."""
+        with self.lock:
+            output = change(self.ctl)
+            if output is not None:
+                self._outputs.append(output)
+        self._deferred()
 
     def read(self, reader: Callable[[Controller], object]):
         """Run ``reader(controller)`` under the lock (queries; must not change anything)."""
@@ -182,6 +223,15 @@ class ControllerRunner:
     def _on_event(self, event: Event) -> None:
         if self._event_listeners:
             self._outputs.append(lambda e=event: [listener(e) for listener in self._event_listeners])
+
+    def _deferred(self) -> None:
+        """After a command or an update, the lock released: its deferred work runs now, on
+        the clock thread if it runs. A caller (an E_STOP service) thus answers at once, and
+        never first publishes what others left (feedback of hundreds of goals, say)."""
+        if self.running:
+            self._wake.set()
+        else:
+            self._flush()
 
     def _flush(self) -> None:
         with self._flush_lock:

@@ -1,7 +1,7 @@
 """Shared pytest set-up for mpi_ros.
 
 Runs before any test module imports rclpy:
-- every test run gets its own DDS domain (ROS_DOMAIN_ID from the pid, unless already set), so
+- every test run gets its own DDS domain (ROS_DOMAIN_ID claimed with a lock file, unless set), so
   concurrent runs on one machine do not see each other's nodes;
 - discovery stays on this machine (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST);
 - the RMW is rmw_fastrtps_cpp (the one the wheels ship), unless set;
@@ -17,8 +17,32 @@ from __future__ import annotations
 
 import os
 
-# Domain IDs 1..100: valid for every RMW on Linux (0 is the default everyone uses).
-os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+
+
+def _claim_domain() -> str:
+    """A DDS domain no other test run on this machine holds: ids 1..100 (valid for every RMW on
+    Linux; 0 is the default everyone uses), each claimed with an exclusive lock on a file in
+    the temp directory, held until this process exits (the pid alone collided)."""
+    import fcntl
+    import tempfile
+
+    start = os.getpid() % 100
+    for i in range(100):
+        domain = 1 + (start + i) % 100
+        lock = open(os.path.join(tempfile.gettempdir(), f"mpi_ros-test-domain-{domain}.lock"), "w")  # noqa: SIM115
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            lock.close()
+            continue
+        _DOMAIN_LOCKS.append(lock)  # kept open: the lock lasts as long as the run
+        return str(domain)
+    return str(1 + start)  # every id held: share one, as before
+
+
+_DOMAIN_LOCKS: list = []
+if "ROS_DOMAIN_ID" not in os.environ:
+    os.environ["ROS_DOMAIN_ID"] = _claim_domain()
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
 # Generated messages type-check field assignments only with this set (read at import time);
@@ -40,9 +64,7 @@ def pytest_report_header(config):
             f"RMW_IMPLEMENTATION={os.environ['RMW_IMPLEMENTATION']}")
 
 
-@pytest.fixture
-def ros_context():
-    """A fresh rclpy context, initialised for this test and shut down after it."""
+def _fresh_context():
     import rclpy
 
     context = rclpy.Context()
@@ -51,6 +73,18 @@ def ros_context():
         yield context
     finally:
         context.try_shutdown()
+
+
+@pytest.fixture
+def ros_context():
+    """A fresh rclpy context, initialised for this test and shut down after it."""
+    yield from _fresh_context()
+
+
+@pytest.fixture(scope="module")
+def module_context():
+    """A fresh rclpy context shared by one test module (clients of a suite started once)."""
+    yield from _fresh_context()
 
 
 @pytest.fixture(autouse=True)

@@ -40,7 +40,7 @@ def test_a_command_takes_effect_at_the_next_sample_and_listeners_see_it():
     # DESIGN.md: "a command is applied at the first sample after the controller's current one"
     assert sample == 38 and log == [(38, "motion_start", "MPIMessageOK")]
     runner.step(2000)
-    assert runner.outcomes[reply.serial].message.name == "MPIMessageOK"
+    assert [end.message.name for end in runner.outcomes[reply.serial]] == ["MPIMessageOK"]
 
 
 def test_wait_wakes_when_the_controller_changes():
@@ -63,3 +63,60 @@ def test_real_time_mode_keeps_up_with_wall_time():
     finally:
         runner.stop()
     assert not runner.running
+
+
+def test_change_hooks_see_every_batch_and_command_with_the_outcomes_collected():
+    runner = manual()
+    seen = []
+
+    def hook(ctl):
+        assert runner.lock._is_owned()
+        seen.append((ctl.sample, {serial: [e.message.name for e in ends] for serial, ends in runner.outcomes.items()}))
+        return lambda: seen.append(("output", runner.lock._is_owned()))
+
+    runner.on_change(hook)
+    reply, _ = runner.submit(Command("motion_start", 0, request=GOAL))
+    assert seen == [(0, {}), ("output", False)]
+    runner.step(2000)  # the move ends within this batch: the hook sees its outcome
+    assert seen[2:] == [(2000, {reply.serial: ["MPIMessageOK"]}), ("output", False)]
+
+
+def test_a_modified_move_keeps_each_of_its_outcomes_in_order():
+    # MPI 000, mpiMotionModify: a modify keeps the move (its serial); a VELOCITY move reaches
+    # its velocity once per command, and a goal needs the outcome of its own command.
+    runner = manual()
+    velocity = {"type": "VELOCITY", "trajectory": [{"velocity": 200.0, "acceleration": 5000.0}]}
+    reply, _ = runner.submit(Command("motion_start", 0, request=velocity))
+    runner.step(400)
+    modified, modify_sample = runner.submit(Command("motion_modify", 0, request={
+        **velocity, "trajectory": [{"velocity": -300.0, "acceleration": 5000.0}]}))
+    runner.step(400)
+    assert modified.serial == reply.serial
+    ends = runner.outcomes[reply.serial]
+    assert [(e.message.name, e.detail) for e in ends] == [("MPIMessageOK", "at velocity")] * 2
+    assert ends[0].sample < modify_sample <= ends[1].sample
+
+
+def test_deferred_work_of_a_command_runs_on_the_clock_thread_while_it_runs():
+    # An E_STOP service answers at once: the output a command leaves (publishing) is not the
+    # caller's to run while the clock thread runs; without it (manual mode) the caller runs it.
+    runner = ControllerRunner(config.load().build_controller(), time_scale=1.0)
+    commands, ran = [], []
+    done = threading.Event()
+    runner.on_command(lambda sample, command, reply: commands.append(command.request["action"]))
+
+    def hook(ctl):
+        if commands:  # right after the command, under the lock
+            action = commands.pop()
+            return lambda: (ran.append((action, threading.current_thread().name)), done.set())
+        return None
+
+    runner.on_change(hook)
+    runner.start()
+    try:
+        runner.submit(Command("action", 0, request={"action": "E_STOP"}))
+        assert done.wait(10.0)
+    finally:
+        runner.stop()
+    runner.submit(Command("action", 0, request={"action": "RESET"}))
+    assert ran == [("E_STOP", "mpi-controller-clock"), ("RESET", threading.current_thread().name)]

@@ -3,14 +3,33 @@
 Goals are always accepted; the controller's answer comes back in the result (a refused
 command ends the goal ABORTED with the spec's message). Services live in their own
 reentrant callback group, apart from the goals, so E_STOP is served while goals run.
+
+A goal holds no executor thread while its move runs (with more goals than threads nothing
+else would be served, E_STOP included). Deferred execution: the goal callback applies the
+goal's command (so the client's goal response comes after it took effect), the
+handle_accepted callback files the goal in a GoalBook, and the runner reviews the book
+after every step batch and command, under its lock. A goal whose move has become current
+is marked EXECUTING; a goal whose move has ended is handed back to rclpy, whose execute
+callback (scheduled then) sets the terminal state and returns the result at once.
+Feedback for every running goal comes from one periodic hook at the feedback rate.
+Goal and cancel requests are handled in the order they arrived (_GoalServer).
 """
 
 from __future__ import annotations
 
+import threading
+import traceback
+from collections import deque
+from dataclasses import dataclass
+from functools import partial
+
+from action_msgs.msg import GoalStatus
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.action.server import GoalEvent, RCLError, ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.serialization import serialize_message
 from std_srvs.srv import Trigger
 
 from mpi_ros.action import MotionModify, MotionStart
@@ -37,18 +56,111 @@ from mpi_ros.srv import (
 from .. import requests as rq
 from ..commands import ACTION, MOTION_MODIFY, MOTION_START, Command, Reply
 from ..config import RosSettings
+from ..mpi.control import Controller
 from ..mpi.messages import Message
-from ..runner import ControllerRunner
+from ..runner import ControllerRunner, Output
 from . import convert
-from .goal_tracker import GoalEnd, GoalTracker
+from .goal_tracker import GoalBook, GoalEnd, TrackedGoal
 
 STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feedback publisher
 # The action's services default to a history of 10: an E_STOP that ends more goals than
 # that at once would drop results. Deep enough for every goal a frame buffer can queue.
 ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 ACTION_QOS = dict(goal_service_qos_profile=ACTION_SERVICE_QOS, result_service_qos_profile=ACTION_SERVICE_QOS,
                   cancel_service_qos_profile=ACTION_SERVICE_QOS)
 TRIGGER_ACTIONS = {"stop": "STOP", "e_stop": "E_STOP", "abort": "ABORT", "reset": "RESET", "resume": "RESUME"}
+# A goal whose cancel was accepted is still in one of these until rclpy has moved it to
+# CANCELING (right after our cancel callback returns); only then may it end CANCELED.
+_NOT_YET_CANCELING = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING)
+
+
+@dataclass(eq=False, slots=True)
+class _RosGoal:
+    """What finishing a goal needs from ROS (the payload of its TrackedGoal)."""
+
+    handle: ServerGoalHandle
+    action_type: type
+    server: ActionServer
+    executing: bool = False  # we moved it to EXECUTING (changed under the node's _transitions)
+
+
+@dataclass(frozen=True, slots=True)
+class _Facts:
+    """The supervisor when goals end, read once under the lock for their results."""
+
+    state: int
+    state_name: str
+    actual_position: list[float]
+    command_position: list[float]
+    move_id: int
+
+
+class _GoalServer(ActionServer):
+    """An ActionServer that handles goal and cancel requests in the order it took them.
+
+    rclpy takes one request per executor round and handles each in a task of its own, so
+    with a reentrant group two goals sent back to back could be applied out of order (an
+    APPEND before the start it follows, an older modify last) and a cancel could be handled
+    before its goal is filed. Here the requests join a queue as they are taken (takes of
+    one waitable never overlap), and whichever task holds the queue's lock handles all of
+    them, oldest first; the others return at once, so no executor thread waits here. The
+    callbacks are synchronous: nothing awaits while the lock is held.
+    """
+
+    def __init__(self, *args, after_cancel, **kwargs):
+        self._taken: deque[dict] = deque()
+        self._in_order = threading.Lock()
+        self._after_cancel = after_cancel
+        self.goal_id: bytes | None = None  # the goal request being handled (for the goal callback)
+        self.applied: dict[bytes, object] = {}  # goal id -> its command's (reply, sample), or the error
+        super().__init__(*args, **kwargs)
+
+    def take_data(self):
+        data = super().take_data()
+        requests = {key: data.pop(key) for key in ("goal", "cancel") if key in data}
+        if requests:
+            self._taken.append(requests)
+        return data
+
+    async def execute(self, taken_data):
+        # Try again after releasing: a request taken while another task held the lock
+        # (and so returned at once) is handled by the holder.
+        while self._taken and self._in_order.acquire(blocking=False):
+            try:
+                while self._taken:
+                    await self._serve(self._taken.popleft())
+            finally:
+                self._in_order.release()
+        if taken_data:
+            await super().execute(taken_data)  # result requests, expired goals
+
+    async def _serve(self, requests: dict) -> None:
+        goal = requests.get("goal")
+        self.goal_id = bytes(goal[1].goal_id.uuid) if goal is not None else None
+        try:
+            await super().execute(requests)
+            if "cancel" in requests:
+                self._after_cancel()  # the goals whose cancel was accepted are CANCELING now
+        except Exception:  # noqa: BLE001 - one bad request must neither strand the queue nor stop the executor
+            self._node.get_logger().error(f"a goal or cancel request failed:\n{traceback.format_exc()}")
+        finally:
+            if self.goal_id is not None and self.applied.pop(self.goal_id, None) is not None:
+                # rclpy did not hand the accepted goal over (its response could not be sent)
+                self._node.get_logger().warning("a goal's command was applied, but the goal did not reach "
+                                                "its client (gone?): its move runs without a goal")
+            self.goal_id = None
+
+
+def _never_executed(_handle) -> None:
+    """The action servers' registered execute callback. Goals are finished with a callback
+    of their own (``SupervisorNode._close``), so rclpy never calls this one; if it ever did,
+    the goal would fail loudly (rclpy logs the error and aborts it) instead of hanging."""
+    raise RuntimeError("a goal was executed without going through the goal book")
+
+
+def _reraise(exc: BaseException, _handle) -> None:
+    raise exc
 
 
 class SupervisorNode(Node):
@@ -60,14 +172,18 @@ class SupervisorNode(Node):
         self._shutting_down = False
         self._goal_group = ReentrantCallbackGroup()
         self._service_group = ReentrantCallbackGroup()
-        self._actions = [
-            ActionServer(self, MotionStart, "~/motion_start", lambda h: self._execute(h, MotionStart, MOTION_START),
-                         goal_callback=self._on_goal, cancel_callback=self._on_cancel, callback_group=self._goal_group,
-                         **ACTION_QOS),
-            ActionServer(self, MotionModify, "~/motion_modify", lambda h: self._execute(h, MotionModify, MOTION_MODIFY),
-                         goal_callback=self._on_goal, cancel_callback=self._on_cancel, callback_group=self._goal_group,
-                         **ACTION_QOS),
-        ]
+        self._book = GoalBook(runner, number)
+        # Orders our own goal-state changes against an accepted cancel (see _mark_executing).
+        self._transitions = threading.Lock()
+        self._closing = threading.Condition()
+        self._unfinished = 0  # goals handed to rclpy whose execute callback has not run yet
+        actions = ((MotionStart, "motion_start", MOTION_START), (MotionModify, "motion_modify", MOTION_MODIFY))
+        self._servers = {action_type: self._action_server(action_type, name, operation)
+                         for action_type, name, operation in actions}
+        # Feedback goes out pre-serialized on the actions' own feedback topics (see _collect_feedback).
+        self._feedback_pubs = {action_type: self.create_publisher(action_type.Impl.FeedbackMessage,
+                                                                  f"~/{name}/_action/feedback", FEEDBACK_QOS)
+                               for action_type, name, _ in actions}
         self._service(MotionAction, "action", self._on_action)
         for name, action in TRIGGER_ACTIONS.items():
             self._service(Trigger, name, lambda req, resp, a=action: self._on_trigger(a, resp))
@@ -86,100 +202,222 @@ class SupervisorNode(Node):
         self._service(EventReset, "event_reset", self._on_event_reset)
         self._pub_status = self.create_publisher(MotionStatus, "~/status", STATUS_QOS)
         runner.add_periodic(settings.status_rate, self._collect_status)
+        runner.add_periodic(settings.feedback_rate, self._collect_feedback)
+        runner.on_change(self._review)
+
+    def _action_server(self, action_type, name: str, operation: str) -> ActionServer:
+        return _GoalServer(self, action_type, f"~/{name}", _never_executed,
+                           goal_callback=lambda goal: self._on_goal(goal, action_type, operation),
+                           handle_accepted_callback=lambda handle: self._accept(handle, action_type),
+                           cancel_callback=self._on_cancel,
+                           after_cancel=lambda: self.runner.update(self._review),
+                           callback_group=self._goal_group, **ACTION_QOS)
 
     def _service(self, srv_type, name, callback):
         """A service of this supervisor: /<ns>/ms<n>/<name>."""
         self.create_service(srv_type, f"~/{name}", callback, callback_group=self._service_group)
 
-    def shutdown(self) -> None:
+    def shutdown(self, timeout: float = 2.0) -> None:
+        """Reject new goals and end the pending ones with MPIMotionMessageSTOPPED ("the suite
+        is shutting down"); waits (up to ``timeout`` s, while ROS runs) until rclpy has them."""
         self._shutting_down = True
-        for server in self._actions:
+        self.runner.update(self._end_all)
+        if self.context.ok():
+            with self._closing:
+                self._closing.wait_for(lambda: self._unfinished == 0, timeout)
+
+    def destroy_node(self):
+        """The action servers go first (after the executor has stopped: see Suite.shutdown)."""
+        for server in self._servers.values():
             server.destroy()
+        return super().destroy_node()
 
     # -- status -----------------------------------------------------------------------
     def _collect_status(self, ctl):
         ms = ctl.supervisor(self.number)
         if ms is None:
             return None
-        msg = convert.motion_status(ms.snapshot(), ctl.rate)
+        msg = convert.motion_status(ms.snapshot(), ctl.rate, convert.epoch_of(ctl))
         return lambda: convert.publish(self, self._pub_status, msg)
 
-    # -- goals ------------------------------------------------------------------------
-    def _on_goal(self, _goal) -> GoalResponse:
-        return GoalResponse.REJECT if self._shutting_down else GoalResponse.ACCEPT
+    # -- goals: acceptance and cancel (executor threads) -------------------------------
+    def _on_goal(self, goal_msg, action_type, operation: str) -> GoalResponse:
+        """goal_callback: apply the goal's command now, before rclpy answers the client, so
+        that a client that sends a modify on receiving its start's answer finds the move.
+        Every goal is accepted (but while shutting down); a refused command ends it ABORTED."""
+        if self._shutting_down:
+            return GoalResponse.REJECT
+        server = self._servers[action_type]
+        try:
+            command = Command(operation, self.number, request=convert.to_dict(goal_msg))
+            server.applied[server.goal_id] = self.runner.submit(command)
+        except Exception as exc:  # noqa: BLE001 - not swallowed: the goal is aborted with it (_accept)
+            server.applied[server.goal_id] = exc
+        return GoalResponse.ACCEPT
 
-    def _on_cancel(self, _handle) -> CancelResponse:
+    def _accept(self, handle: ServerGoalHandle, action_type) -> None:
+        """handle_accepted_callback: file the goal (its command has been applied) and review
+        the book at once. Returns at once. Goal and cancel requests are handled in order
+        (_GoalServer), so a cancel of this goal comes after this."""
+        server = self._servers[action_type]
+        key = bytes(handle.goal_id.uuid)
+        applied = server.applied.pop(key, None)
+        if not isinstance(applied, tuple):  # the command raised: rclpy logs it and aborts the goal
+            handle.execute(partial(_reraise, applied or RuntimeError("the goal's command was not applied")))
+            return
+        reply, sample = applied
+        goal = TrackedGoal(key, _RosGoal(handle, action_type, server), sample=sample)
+        if reply.accepted:
+            goal.serial = reply.serial
+        else:
+            goal.end = GoalEnd(reply.message, reply.detail, sample)
+        self.runner.update(partial(self._file, goal))
+
+    def _file(self, goal: TrackedGoal, ctl: Controller) -> Output | None:
+        """Runner lock held: file the goal and review the book. What its move did since its
+        command is in the runner's outcomes, so the review decides it as if it had been
+        filed with the command; a refused command ends it here."""
+        if self._shutting_down and goal.end is None:
+            goal.end = self._shutdown_end(ctl)  # accepted just before shutdown began
+        self._book.add(goal)
+        return self._review(ctl)
+
+    def _on_cancel(self, handle: ServerGoalHandle) -> CancelResponse:
+        """Cancel = STOP: the axes decelerate over decelTime.stop and the goal ends CANCELED
+        once stopped. A goal whose end is already known cannot be cancelled any more."""
+        with self.runner.lock:
+            goal = self._book.get(bytes(handle.goal_id.uuid))
+            if goal is None or goal.end is not None or goal.cancel:
+                return CancelResponse.REJECT
+            with self._transitions:
+                goal.cancel = True
+        self._stop()
         return CancelResponse.ACCEPT
 
-    def _execute(self, handle, action_type, operation: str):
-        command = Command(operation, self.number, request=convert.to_dict(handle.request))
-        reply, sample = self.runner.submit(command)
-        if not reply.accepted:
-            handle.abort()
-            return self._result(action_type, GoalEnd(reply.message, reply.detail, sample), sample)
-        tracker = GoalTracker(self.runner, self.number, reply.serial)
-        period = 1.0 / self.settings.feedback_rate
-        stop_sent = False
-        while True:
-            if handle.is_cancel_requested and not stop_sent:
-                # Cancel = STOP: decelerate over decelTime.stop, then end the goal.
-                self.runner.submit(Command(ACTION, self.number, request={"action": "STOP"}))
-                stop_sent = True
-            end = tracker.wait(period)
-            if end is not None:
-                break
-            if self._shutting_down or not self.context.ok():
-                end = GoalEnd(Message.MPIMotionMessageSTOPPED, "the suite is shutting down", sample)
-                break
-            handle.publish_feedback(self._feedback(action_type, reply.serial))
-        result = self._result(action_type, end, sample)
-        if handle.is_cancel_requested:
-            handle.canceled()
-        elif end.succeeded:
-            handle.succeed()
-        else:
-            handle.abort()
+    def _stop(self) -> None:
+        self.runner.submit(Command(ACTION, self.number, request={"action": "STOP"}))
+
+    # -- goals: the runner's hooks (runner lock held) ---------------------------------
+    def _review(self, ctl: Controller) -> Output | None:
+        """After every step batch and command: which goals started, which ended."""
+        if not self._book:
+            return None
+        review = self._book.review(ctl, self._may_end)
+        if not review.started and not review.ended:
+            return None
+        close = self._ended(review.ended, ctl) if review.ended else None
+
+        def output() -> None:
+            for goal in review.started:
+                self._mark_executing(goal)
+            if close is not None:
+                close()
+
+        return output
+
+    @staticmethod
+    def _may_end(goal: TrackedGoal) -> bool:
+        # A cancelled goal ends CANCELED, which rclpy allows only from CANCELING.
+        return not goal.cancel or goal.payload.handle.status not in _NOT_YET_CANCELING
+
+    def _end_all(self, ctl: Controller) -> Output | None:
+        goals = self._book.end_all(self._shutdown_end(ctl))
+        return self._ended(goals, ctl) if goals else None
+
+    @staticmethod
+    def _shutdown_end(ctl: Controller) -> GoalEnd:
+        return GoalEnd(Message.MPIMotionMessageSTOPPED, "the suite is shutting down", ctl.sample)
+
+    def _ended(self, goals: list[TrackedGoal], ctl: Controller) -> Output:
+        """Reads what the results need now; the goals are closed after the lock."""
+        facts = _result_facts(ctl, self.number)
+        with self._closing:
+            self._unfinished += len(goals)
+
+        def close() -> None:
+            for goal in goals:
+                self._close(goal, facts)
+
+        return close
+
+    def _collect_feedback(self, ctl: Controller) -> Output | None:
+        """At the feedback rate: first the review (a goal that has ended gets no more
+        feedback), then one reading of the supervisor gives the feedback of every running
+        goal; all of it published after the lock.
+
+        Hundreds of goals may be in flight, and the feedback of one goal differs from its
+        neighbour's only in the goal id: each message is serialized once (per action type
+        and "is the goal's move current") and published raw, with each goal's id in place,
+        on the action's feedback topic (``<action>/_action/feedback``, where rcl_action
+        publishes it; the goal id is the FeedbackMessage's first field, 16 bytes after the
+        4-byte CDR header). ServerGoalHandle.publish_feedback would build and convert a
+        message per goal: four times the work, all of it holding the GIL that an E_STOP
+        service needs."""
+        review = self._review(ctl)
+        running = list(self._book.running())
+        ms = ctl.supervisor(self.number)
+        if not running or ms is None:
+            return review
+        current = ms.current.serial if ms.current is not None else None
+        templates = {}
+        sends = []
+        for goal in running:
+            kind = (goal.payload.action_type, goal.serial == current)
+            if kind not in templates:
+                templates[kind] = _feedback_template(ctl, ms, *kind)
+            head, tail = templates[kind]
+            sends.append((self._feedback_pubs[kind[0]], head + goal.key + tail))
+        return partial(_publish_feedback, review, sends)
+
+    # -- goals: state changes (after the lock) ----------------------------------------
+    def _mark_executing(self, goal: TrackedGoal) -> None:
+        """The goal's move is now the supervisor's current one: status EXECUTING.
+
+        rclpy has no public call for a deferred goal that starts executing (rclcpp has
+        ServerGoalHandle::set_executing): ServerGoalHandle.execute() also schedules the
+        execute callback, which would end the goal at once. ServerGoalHandle._update_state
+        is what execute() itself uses, unchanged since rclpy's first ActionServer; it keeps
+        the status honest for clients (ACCEPTED while an appended move waits its turn,
+        EXECUTING while it runs).
+        """
+        with self._transitions:
+            if goal.cancel or goal.payload.executing:
+                return  # cancelled while waiting: rclpy moves it from ACCEPTED to CANCELING
+            goal.payload.handle._update_state(GoalEvent.EXECUTE)
+            goal.payload.executing = True
+
+    def _close(self, goal: TrackedGoal, facts: _Facts | None) -> None:
+        """Hand an ended goal back to rclpy: its execute callback, scheduled now on the
+        executor, sets the terminal state and returns the result without waiting."""
+        ros = goal.payload
+        finish = partial(self._finish, goal, _result(ros.action_type, goal.end, goal.sample, facts))
+        with self._transitions:
+            if ros.executing:
+                ros.server.notify_execute(ros.handle, finish)
+                return
+            try:
+                ros.handle.execute(finish)  # ACCEPTED -> EXECUTING (not if CANCELING), then `finish`
+            except RCLError:
+                # A cancel moved it to CANCELING between rclpy's check and its EXECUTE (only
+                # at shutdown, which does not wait for the cancel): just schedule `finish`.
+                if not ros.handle.is_cancel_requested:
+                    raise
+                ros.server.notify_execute(ros.handle, finish)
+
+    def _finish(self, goal: TrackedGoal, result, handle: ServerGoalHandle):
+        """The goal's execute callback (executor thread): terminal state and result."""
+        try:
+            if goal.end.succeeded:
+                handle.succeed()  # done (or at velocity) before a cancel's STOP took effect
+            elif goal.serial is not None and handle.is_cancel_requested:
+                handle.canceled()
+            else:
+                handle.abort()  # refused, stopped, E_STOP/ABORT, dropped, shut down
+        finally:
+            with self._closing:
+                self._unfinished -= 1
+                self._closing.notify_all()
         return result
-
-    def _feedback(self, action_type, serial: int):
-        def read(ctl):
-            ms = ctl.supervisor(self.number)
-            axes = [ctl.axes[n] for n in ms.mapped]
-            fb = action_type.Feedback()
-            fb.sample = ctl.sample
-            fb.state = int(ms.state)
-            fb.state_name = ms.state.name
-            fb.command_position = [a.command_position for a in axes]
-            fb.actual_position = [a.actual_position for a in axes]
-            fb.command_velocity = [a.cmd_v for a in axes]
-            fb.progress = float(ms.progress()) if ms.current is not None and ms.current.serial == serial else 0.0
-            move = ms.current or ms.last_move
-            fb.move_id = move.id if move else 0
-            fb.element_id = move.element_id if move else 0
-            return fb
-
-        return self.runner.read(read)
-
-    def _result(self, action_type, end: GoalEnd, sample: int):
-        def read(ctl):
-            ms = ctl.supervisor(self.number)
-            result = action_type.Result()
-            result.message = end.message.name
-            result.code = end.message.code
-            result.sample = sample
-            result.end_sample = end.sample
-            result.detail = end.detail
-            if ms is not None:
-                axes = [ctl.axes[n] for n in ms.mapped]
-                result.state = int(ms.state)
-                result.state_name = ms.state.name
-                result.actual_position = list(end.actual_position or [a.actual_position for a in axes])
-                result.command_position = list(end.command_position or [a.command_position for a in axes])
-                move = ms.current or ms.last_move
-                result.move_id = move.id if move else 0
-            return result
-
-        return self.runner.read(read)
 
     # -- services ---------------------------------------------------------------------
     def _submit(self, operation: str, request: dict) -> Reply:
@@ -262,3 +500,64 @@ class SupervisorNode(Node):
         response.latched_event_types = list(reply.value or [])
         return convert.answer(response, reply)
 
+
+def _result(action_type, end: GoalEnd, sample: int, facts: _Facts | None):
+    """The result: the end's message and positions, the supervisor's state when it ended."""
+    result = action_type.Result()
+    result.message = end.message.name
+    result.code = end.message.code
+    result.sample = sample
+    result.end_sample = end.sample
+    result.detail = end.detail
+    if facts is not None:
+        result.state = facts.state
+        result.state_name = facts.state_name
+        result.actual_position = list(end.actual_position or facts.actual_position)
+        result.command_position = list(end.command_position or facts.command_position)
+        result.move_id = facts.move_id
+    return result
+
+
+def _result_facts(ctl: Controller, number: int) -> _Facts | None:
+    ms = ctl.supervisor(number)
+    if ms is None:
+        return None
+    axes = [ctl.axes[n] for n in ms.mapped]
+    move = ms.current or ms.last_move
+    return _Facts(int(ms.state), ms.state.name, [a.actual_position for a in axes],
+                  [a.command_position for a in axes], move.id if move else 0)
+
+
+def _feedback(ctl: Controller, ms, action_type, current: bool):
+    """A goal's feedback; ``current``: the goal's move is the supervisor's current one."""
+    axes = [ctl.axes[n] for n in ms.mapped]
+    fb = action_type.Feedback()
+    fb.sample = ctl.sample
+    fb.state = int(ms.state)
+    fb.state_name = ms.state.name
+    fb.command_position = [a.command_position for a in axes]
+    fb.actual_position = [a.actual_position for a in axes]
+    fb.command_velocity = [a.cmd_v for a in axes]
+    fb.progress = float(ms.progress()) if current and ms.current is not None else 0.0
+    move = ms.current or ms.last_move
+    fb.move_id = move.id if move else 0
+    fb.element_id = move.element_id if move else 0
+    return fb
+
+
+def _feedback_template(ctl: Controller, ms, action_type, current: bool) -> tuple[bytes, bytes]:
+    """A FeedbackMessage serialized, split around its goal id: (CDR header, the rest)."""
+    message = action_type.Impl.FeedbackMessage()
+    message.feedback = _feedback(ctl, ms, action_type, current)
+    data = serialize_message(message)
+    return data[:4], data[4 + _GOAL_ID_SIZE:]
+
+
+_GOAL_ID_SIZE = 16  # unique_identifier_msgs/UUID: uint8[16], no length, alignment 1
+
+
+def _publish_feedback(review: Output | None, sends: list) -> None:
+    if review is not None:
+        review()
+    for publisher, data in sends:
+        publisher.publish(data)

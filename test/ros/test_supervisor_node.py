@@ -9,6 +9,8 @@ from action_msgs.msg import GoalStatus
 
 from mpi_ros import errors
 
+from .conftest import WAIT
+
 S_CURVE = {"type": "S_CURVE", "trajectory": [{"velocity": 2000.0, "acceleration": 20000.0,
                                                "deceleration": 20000.0, "jerk_percent": 50.0}]}
 
@@ -77,8 +79,9 @@ def test_e_stop_mid_move_ends_goal_with_error_then_reset_returns_idle(suite, cli
 def test_stop_ends_goal_stopped_and_resume_completes_the_move(suite, client, applied, drive, probe):
     from mpi_ros.msg import MotionEvent
 
-    events = []
-    probe.create_subscription(MotionEvent, "/mpi/events", events.append, 1000)
+    motion_done = threading.Event()
+    probe.create_subscription(MotionEvent, "/mpi/events",
+                              lambda e: e.type == "MOTION_DONE" and e.supervisor == 0 and motion_done.set(), 1000)
     goal = client.start(move([8000.0, 0.0]))
     applied.wait(1)
     drive(lambda: suite.runner.ctl.axes[0].command_position > 1000.0)
@@ -92,7 +95,8 @@ def test_stop_ends_goal_stopped_and_resume_completes_the_move(suite, client, app
     assert client.resume().state_name == "MOVING"
     drive(lambda: state_of(suite) == "IDLE")
     assert suite.runner.ctl.axes[0].command_position == 8000.0
-    drive(lambda: any(e.type == "MOTION_DONE" and e.supervisor == 0 for e in events), samples=1000)
+    # the move that reached IDLE emitted MOTION_DONE (nothing more to step: wait for its delivery)
+    assert motion_done.wait(WAIT)
 
 
 def test_modify_retargets_a_running_move(suite, client, applied, drive):
@@ -105,6 +109,49 @@ def test_modify_retargets_a_running_move(suite, client, applied, drive):
     assert modify.wait().message == "MPIMessageOK"
     result = goal.wait()  # the start goal follows the modified move to its end
     assert list(result.command_position) == [-1500.0, 300.0]
+
+
+def test_a_goal_is_applied_before_it_is_answered(suite, client, applied, drive):
+    # A client that modifies the move as soon as its start is answered finds the move: the
+    # command is applied before rclpy sends the goal's answer (no applied.wait in between).
+    start = client.start(move([10000.0, 0.0]))
+    assert [command.operation for _, command, _ in applied.commands] == ["motion_start"]
+    modify = client.modify(move([-1500.0, 300.0]))
+    assert [reply.message.name for _, _, reply in applied.commands] == ["MPIMessageOK", "MPIMessageOK"]
+    drive(lambda: start.done and modify.done)
+    assert modify.wait().message == "MPIMessageOK"
+    assert list(start.wait().command_position) == [-1500.0, 300.0]
+
+
+def test_a_velocity_modify_goal_succeeds_only_once_its_own_velocity_is_reached(suite, client, applied, drive):
+    # MPI 000, mpiMotionModify: a VELOCITY move can be modified while MOVING (here from +200 to
+    # -300 counts/s). The modify keeps the move, so the move's +200 "at velocity"
+    # (MPIEventTypeMOTION_AT_VELOCITY) belongs to the start's goal; the modify's goal succeeds
+    # only when the commanded velocity has ramped to -300 through zero.
+    def velocity(v):
+        return {"type": "VELOCITY", "trajectory": [{"velocity": v, "acceleration": 5000.0, "deceleration": 5000.0}]}
+
+    def command_velocity():
+        return suite.runner.read(lambda ctl: [ctl.axes[n].cmd_v for n in (0, 1)])
+
+    start = client.start(velocity(200.0))
+    applied.wait(1)
+    drive(lambda: start.done)
+    first = start.wait()
+    assert (first.message, first.detail) == ("MPIMessageOK", "at velocity")
+    assert command_velocity() == [200.0, 200.0]
+    modify = client.modify(velocity(-300.0))
+    sample, command, reply = applied.wait(2)
+    assert command.operation == "motion_modify" and reply.message.name == "MPIMessageOK"
+    ramped = []  # the first sample at which the commanded velocity is -300 on both axes
+    drive(lambda: ramped or (command_velocity() == [-300.0, -300.0] and ramped.append(suite.runner.ctl.sample)),
+          chunk=1)
+    assert ramped[0] > sample  # it did ramp: +200 -> -300 at 5000 counts/s^2 takes 0.1 s
+    drive(lambda: modify.done)
+    result = modify.wait()
+    assert (result.message, result.detail) == ("MPIMessageOK", "at velocity")
+    assert result.sample == sample <= ramped[0] <= result.end_sample
+    assert command_velocity() == [-300.0, -300.0]
 
 
 def test_cancel_is_a_stop(suite, client, applied, drive):
