@@ -1,64 +1,438 @@
-"""A small Python API over the suite's ROS interface, hiding the action plumbing.
+"""The Python client of the suite: commands, status and events over ROS, nothing else.
 
-    from mpi_ros.client import MotionClient
+    from mpi_ros.client import MotionClient, MotionType, Outcome
     with MotionClient(supervisor=0) as ms0:
-        ms0.move([1000.0, 0.0], velocity=500.0, acceleration=5000.0)   # waits until DONE
+        result = ms0.move([1000.0, 0.0], velocity=500.0, acceleration=5000.0, jerk_percent=50.0)
+        print(result.outcome, result.message, result.actual_position)   # waits until DONE
         goal = ms0.start({"type": "VELOCITY", "trajectory": [{"velocity": 200.0, "acceleration": 1000.0}]})
         ms0.stop()
+        goal.wait(raise_on_error=False).outcome                        # Outcome.ENDED
         ms0.reset()
         print(ms0.status().state_name)
 
+It imports rclpy and the generated interfaces (``mpi_ros.msg/.srv/.action``) and nothing of
+the simulated controller, so it runs wherever the suite is reachable over DDS.
+
 Refusals raise the exception of the spec's message (``mpi_ros.errors.MPIMotionMessageMOVING``
-...); a missing answer raises ``mpi_ros.errors.NoResponse``. The client spins its own node
-in a background thread; action goals are sent from that thread (rclpy's ActionClient is
-not safe to send from another thread while spinning).
+...); a missing answer raises ``mpi_ros.errors.NoResponse``. Every client spins its own node
+in a background thread; action goals are sent from that thread (rclpy's ActionClient is not
+safe to send from another thread while spinning). :class:`Watcher` follows the whole suite
+(every supervisor's and axis' status, the events, any topic), as ``mpi-ros status`` does.
 """
 
 from __future__ import annotations
 
+import importlib
+import re
 import threading
-from dataclasses import dataclass
-from typing import Any, Callable, Iterable
+import time
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import Any, Self
 
 import rclpy
+from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
 from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
 from mpi_ros.action import MotionModify, MotionStart
-from mpi_ros.msg import MotionStatus
+from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 from mpi_ros.srv import MotionAction
 
-from .errors import NoResponse, raise_for
-from .ros import convert
-from .ros.supervisor_node import ACTION_QOS
+from . import errors
+from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
+
+# The suite serves actions with deep service queues (an E_STOP can end many goals at once);
+# a client asks for the same so no result is dropped on its side either.
+ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+ACTION_QOS = {"goal_service_qos_profile": ACTION_SERVICE_QOS, "result_service_qos_profile": ACTION_SERVICE_QOS,
+              "cancel_service_qos_profile": ACTION_SERVICE_QOS}
+STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+# Events come in bursts (6-7 in one sample at the end of a move): deep and reliable.
+EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+
+_SUPERVISOR_NODE = re.compile(r"ms(\d+)")
+_POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
+# Every node of a process is announced together (one DDS participant per context), but give
+# a late announcement a moment before saying a supervisor is not there.
+_GRACE = 0.5
+
+
+# -- typed arguments and answers --------------------------------------------------------------
+class MotionType(StrEnum):
+    """MPIMotionType names without the prefix (a goal's ``type``)."""
+
+    TRAPEZOIDAL = "TRAPEZOIDAL"
+    S_CURVE = "S_CURVE"
+    S_CURVE_JERK = "S_CURVE_JERK"
+    VELOCITY = "VELOCITY"
+    VELOCITY_JERK = "VELOCITY_JERK"
+    PT = "PT"
+    PTF = "PTF"
+    PVT = "PVT"
+    PVTF = "PVTF"
+    SPLINE = "SPLINE"
+    BESSEL = "BESSEL"
+    BSPLINE = "BSPLINE"
+    BSPLINE2 = "BSPLINE2"
+    CAM_LINEAR = "CAM_LINEAR"
+    CAM_CUBIC = "CAM_CUBIC"
+    FRAME = "FRAME"
+
+
+class Attribute(StrEnum):
+    """MPIMotionAttrMask names without the prefix (a goal's ``attributes``)."""
+
+    APPEND = "APPEND"
+    AUTO_START = "AUTO_START"
+    DELAY = "DELAY"
+    ID = "ID"
+    ELEMENT_ID = "ELEMENT_ID"
+    RELATIVE = "RELATIVE"
+    SYNC_START = "SYNC_START"
+    SYNC_END = "SYNC_END"
+    REPEAT = "REPEAT"
+    MASTER_START = "MASTER_START"
+    NO_BACKTRACK = "NO_BACKTRACK"
+    NO_BACKTRACK_HOLD = "NO_BACKTRACK_HOLD"
+    EVENT = "EVENT"
+    FINAL_VEL = "FINAL_VEL"
+    NO_REVERSAL = "NO_REVERSAL"
+    HOLD = "HOLD"
+    HOLD_LESS = "HOLD_LESS"
+    HOLD_GREATER = "HOLD_GREATER"
+    OUTPUT = "OUTPUT"
+
+
+class Action(StrEnum):
+    """mpiMotionAction's actions (MotionAction ``action``)."""
+
+    STOP = "STOP"
+    E_STOP = "E_STOP"
+    ABORT = "ABORT"
+    E_STOP_ABORT = "E_STOP_ABORT"
+    RESET = "RESET"
+    RESUME = "RESUME"
+    MAP = "MAP"
+
+
+class State(StrEnum):
+    """A supervisor's or axis' state (``state_name``)."""
+
+    INVALID = "INVALID"
+    IDLE = "IDLE"
+    MOVING = "MOVING"
+    STOPPING = "STOPPING"
+    STOPPED = "STOPPED"
+    STOPPING_ERROR = "STOPPING_ERROR"
+    ERROR = "ERROR"
+
+
+class EventType(StrEnum):
+    """MPIEventType names without the prefix (MotionEvent ``type``)."""
+
+    MOTION_DONE = "MOTION_DONE"
+    MOTION_AT_VELOCITY = "MOTION_AT_VELOCITY"
+    MOTION_START = "MOTION_START"
+    STOP = "STOP"
+    E_STOP = "E_STOP"
+    ABORT = "ABORT"
+    RESET = "RESET"
+    RESUME = "RESUME"
+    FRAMES_LOW = "FRAMES_LOW"
+    FRAMES_EMPTY = "FRAMES_EMPTY"
+    HOLD_RELEASED = "HOLD_RELEASED"
+    HOLD_TIMEOUT = "HOLD_TIMEOUT"
+    FRAME_TIME_LIMIT = "FRAME_TIME_LIMIT"
+    RELATIVE_TRUNCATED = "RELATIVE_TRUNCATED"
+    ID_TRUNCATED = "ID_TRUNCATED"
+    CROSSCHECK = "CROSSCHECK"
+    SETTLED = "SETTLED"
+    IN_FINE_POSITION = "IN_FINE_POSITION"
+    IN_COARSE_POSITION = "IN_COARSE_POSITION"
+    AT_TARGET = "AT_TARGET"
+    AT_VELOCITY = "AT_VELOCITY"
+    DONE = "DONE"
+
+
+class Outcome(StrEnum):
+    """How a MotionStart/MotionModify goal ended."""
+
+    DONE = "DONE"          # MPIMessageOK: the move is done (a VELOCITY move: at velocity)
+    REFUSED = "REFUSED"    # the controller refused the command; nothing moved
+    ENDED = "ENDED"        # it moved, then ended early: STOP, E_STOP, ABORT, a new start, RESET
+    CANCELED = "CANCELED"  # the goal was cancelled (a cancel is a STOP)
+
 
 @dataclass(frozen=True)
 class ActionReply:
+    """The answer of mpiMotionAction (a MotionAction service call)."""
+
     message: str
     code: int
     state_name: str
-    sample: int
+    sample: int  # the sample at which the action took effect
+
+    @property
+    def ok(self) -> bool:
+        return self.message == errors.OK
+
+    @property
+    def state(self) -> State:
+        return State(self.state_name)
 
 
+@dataclass(frozen=True)
+class MotionResult:
+    """How a goal ended: the controller's message, the state and where the axes are."""
+
+    message: str
+    code: int
+    state_name: str
+    actual_position: tuple[float, ...]
+    command_position: tuple[float, ...]
+    move_id: int
+    sample: int      # the sample at which the command took effect
+    end_sample: int  # the sample at which the goal ended
+    detail: str
+    outcome: Outcome
+    raw: Any = field(default=None, repr=False, compare=False)  # the action's Result message
+
+    @property
+    def ok(self) -> bool:
+        return self.message == errors.OK
+
+    @property
+    def state(self) -> State:
+        return State(self.state_name)
+
+    @classmethod
+    def from_ros(cls, result: Any, status: int) -> MotionResult:
+        return cls(result.message, result.code, result.state_name, tuple(result.actual_position),
+                   tuple(result.command_position), result.move_id, result.sample, result.end_sample,
+                   result.detail, _outcome(result, status), result)
+
+
+def _outcome(result: Any, status: int) -> Outcome:
+    if status == GoalStatus.STATUS_CANCELED:
+        return Outcome.CANCELED
+    if result.message == errors.OK:
+        return Outcome.DONE
+    # A refused command is answered at the sample it arrived; a move that ran ends later.
+    if result.end_sample == result.sample:
+        return Outcome.REFUSED
+    return Outcome.ENDED
+
+
+# -- messages <-> plain data ------------------------------------------------------------------------
+def message_to_dict(msg: Any) -> dict[str, Any]:
+    """A ROS message as plain Python data (nested messages as dicts), in field order."""
+    return {name: _plain(getattr(msg, name)) for name in msg.get_fields_and_field_types()}
+
+
+def _plain(value: Any) -> Any:
+    if hasattr(value, "get_fields_and_field_types"):
+        return message_to_dict(value)
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, bytes):  # octet/byte fields (DiagnosticStatus.level)
+        return value[0] if len(value) == 1 else list(value)
+    if hasattr(value, "tolist"):  # array.array for sequences, numpy arrays for fixed arrays
+        return value.tolist()
+    return value
+
+
+def message_class(type_name: str) -> type:
+    """The generated class of ``pkg/msg/Type`` (or ``pkg/Type``)."""
+    parts = type_name.split("/")
+    if len(parts) == 2:
+        parts.insert(1, "msg")
+    if len(parts) != 3:
+        raise ValueError(f"{type_name!r}: not a message type name (pkg/msg/Type)")
+    return getattr(importlib.import_module(f"{parts[0]}.{parts[1]}"), parts[2])
+
+
+def fill(msg: Any, data: Mapping[str, Any], where: str = "") -> Any:
+    """Set a message's fields from a mapping (as ``ros2 action send_goal`` reads its YAML).
+
+    Names and types are checked (ValueError naming the field); numbers become float64 at
+    the edge, as the generated messages want.
+    """
+    if not isinstance(data, Mapping):
+        raise ValueError(f"{where or type(msg).__name__}: expected a mapping of fields, got {data!r}")  # noqa: TRY004 - bad user data, reported as such
+    types = msg.get_fields_and_field_types()
+    for name, value in data.items():
+        path = f"{where}.{name}" if where else str(name)
+        if name not in types:
+            raise ValueError(f"{path}: no such field in {type(msg).__name__} (fields: {', '.join(types)})")
+        setattr(msg, name, _convert(types[name], value, path))
+    return msg
+
+
+_INTEGERS = {"int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "char", "octet"}
+
+
+def _convert(kind: str, value: Any, where: str) -> Any:
+    element = _element_kind(kind)
+    if element is not None:
+        if not isinstance(value, (list, tuple)):
+            raise ValueError(f"{where}: expected a list, got {value!r}")
+        return [_convert(element, v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if "/" in kind:
+        return fill(message_class(kind)(), value, where)
+    if kind in ("double", "float"):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f"{where}: expected a number, got {value!r}")
+        return float(value)
+    if kind in _INTEGERS:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
+            raise ValueError(f"{where}: expected an integer, got {value!r}")
+        return int(value)
+    if kind == "boolean":
+        if not isinstance(value, bool):
+            raise ValueError(f"{where}: expected true or false, got {value!r}")
+        return value
+    if kind.startswith(("string", "wstring")):
+        if not isinstance(value, str):
+            raise ValueError(f"{where}: expected a string, got {value!r}")
+        return str(value)  # a StrEnum member becomes its plain name
+    raise ValueError(f"{where}: fields of type {kind} cannot be set here")
+
+
+def _element_kind(kind: str) -> str | None:
+    """``double`` for ``sequence<double>``, ``sequence<double, 5>`` or ``double[3]``; None for scalars."""
+    if kind.startswith("sequence<"):
+        return kind[len("sequence<"):-1].split(",")[0].strip()
+    if kind.endswith("]") and "[" in kind:
+        return kind[:kind.index("[")]
+    return None
+
+
+def _name(value: Any) -> str:
+    return str(value)  # StrEnum members print as their value
+
+
+# -- a node that spins itself ------------------------------------------------------------------------------
+class _Endpoint:
+    """A node of its own, spun by an executor in a background thread; finds the suite."""
+
+    def __init__(self, namespace: str, context: Context | None, timeout: float, node_name: str):
+        self.namespace = "/" + namespace.strip("/")
+        self.timeout = timeout
+        self._own_context = context is None and not rclpy.ok()
+        if self._own_context:
+            rclpy.init()
+        self._context = context
+        self.node = Node(node_name, context=context)
+        self._executor = SingleThreadedExecutor(context=context)
+        self._executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, name=f"mpi-ros-{node_name}", daemon=True)
+
+    def _start_spinning(self) -> None:
+        self._thread.start()
+
+    def _spin(self) -> None:
+        try:
+            self._executor.spin()
+        except ExternalShutdownException:
+            pass  # the context was shut down under us (Ctrl-C in the owner): nothing left to serve
+
+    def close(self) -> None:
+        self._executor.shutdown(timeout_sec=2.0)
+        self._thread.join(timeout=2.0)
+        self.node.destroy_node()
+        if self._own_context:
+            rclpy.try_shutdown()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- the graph -------------------------------------------------------------------------
+    @property
+    def domain_id(self) -> int:
+        return self.node.context.get_domain_id()
+
+    def supervisors_on_graph(self, namespace: str | None = None) -> list[int]:
+        """Numbers of the supervisor nodes (``<namespace>/ms<n>``) on the graph now."""
+        namespace = self.namespace if namespace is None else namespace
+        return sorted(int(match.group(1)) for name, ns in self.node.get_node_names_and_namespaces()
+                      if ns == namespace and (match := _SUPERVISOR_NODE.fullmatch(name)))
+
+    def wait_for_suite(self, timeout: float | None = None, supervisor: int | None = None) -> list[int]:
+        """Wait until the suite (and ``supervisor``, if given) is on the graph.
+
+        Returns the supervisor numbers; raises SuiteNotFound or NoSuchSupervisor with a
+        message an operator can act on.
+        """
+        timeout = self.timeout if timeout is None else timeout
+        deadline = time.monotonic() + timeout
+        first_seen: float | None = None
+        pause = threading.Event()  # never set: a wait that a debugger can interrupt, unlike sleep
+        while True:
+            found = self.supervisors_on_graph()
+            now = time.monotonic()
+            if found and (supervisor is None or supervisor in found):
+                return found
+            if found and first_seen is None:
+                first_seen = now
+            if now >= deadline or (first_seen is not None and now - first_seen >= _GRACE):
+                break
+            pause.wait(_POLL)
+        if found:
+            runs = ", ".join(f"ms{n}" for n in found)
+            raise NoSuchSupervisor(f"no supervisor {self.namespace}/ms{supervisor}: the suite runs {runs}")
+        raise SuiteNotFound(self._not_found(timeout))
+
+    def _not_found(self, timeout: float) -> str:
+        where = "" if self.namespace == "/mpi" else f" under {self.namespace}"
+        elsewhere = sorted({ns for name, ns in self.node.get_node_names_and_namespaces()
+                            if _SUPERVISOR_NODE.fullmatch(name) and ns != self.namespace})
+        hint = f" (supervisors found under {', '.join(elsewhere)})" if elsewhere else ""
+        return (f"no suite found{where} on ROS_DOMAIN_ID {self.domain_id} within {timeout:g} s{hint}: "
+                f"is `mpi-ros run` running, on the same domain?")
+
+
+# -- goals and the motion client ---------------------------------------------------------------------------
 class Goal:
     """A running MotionStart/MotionModify goal."""
 
-    def __init__(self, client: "MotionClient", handle, result_future):
+    def __init__(self, client: MotionClient, handle: Any, result_future: Any, progress: threading.Event):
         self._client = client
         self.handle = handle
         self._result_future = result_future
-        self.feedback = None  # the latest feedback message
+        self._progress = progress  # set by the first feedback or the result
+        self._finished = threading.Event()
+        result_future.add_done_callback(lambda _f: (self._finished.set(), progress.set()))
+        self.feedback = None  # the latest feedback message (MotionStart.Feedback)
 
     @property
     def done(self) -> bool:
         return self._result_future.done()
 
-    def wait(self, timeout: float | None = None, raise_on_error: bool = True):
-        """Wait for the result (the action's Result message)."""
+    def result_ready(self, timeout: float | None = None) -> bool:
+        """Wait up to ``timeout`` s (None: forever) for the result; whether it has arrived."""
+        return self._finished.wait(timeout)
+
+    def wait_started(self, timeout: float | None = None) -> bool:
+        """Wait for the first feedback (the move runs: True) or the result (False)."""
+        if not self._progress.wait(self._client.timeout if timeout is None else timeout):
+            raise NoResponse("neither feedback nor a result for the goal within the timeout")
+        return not self.done
+
+    def wait(self, timeout: float | None = None, raise_on_error: bool = True) -> MotionResult:
+        """Wait for the result; raises the message's exception unless it is MPIMessageOK.
+
+        ``timeout``: seconds (None: the client's timeout); NoResponse when it passes.
+        """
         response = self._client._wait_future(self._result_future, timeout, "the goal's result")
-        result = response.result
+        result = MotionResult.from_ros(response.result, response.status)
         if raise_on_error:
             raise_for(result.message, result.detail, result)
         return result
@@ -69,61 +443,37 @@ class Goal:
         self._client._wait_future(future, timeout, "the cancel answer")
 
 
-class MotionClient:
+class MotionClient(_Endpoint):
+    """One motion supervisor (``<namespace>/ms<supervisor>``): goals, actions and status."""
+
     def __init__(self, supervisor: int = 0, namespace: str = "/mpi", context: Context | None = None,
                  timeout: float = 10.0, node_name: str | None = None):
+        super().__init__(namespace, context, timeout, node_name or f"mpi_ros_client_ms{supervisor}")
         self.supervisor = supervisor
-        self.namespace = namespace.rstrip("/")
-        self.timeout = timeout
-        self._own_context = context is None and not rclpy.ok()
-        if self._own_context:
-            rclpy.init()
-        self._context = context
         prefix = f"{self.namespace}/ms{supervisor}"
-        self.node = Node(node_name or f"mpi_ros_client_ms{supervisor}", context=context)
+        self.prefix = prefix
         self._start = ActionClient(self.node, MotionStart, f"{prefix}/motion_start", **ACTION_QOS)
         self._modify = ActionClient(self.node, MotionModify, f"{prefix}/motion_modify", **ACTION_QOS)
         self._action = self.node.create_client(MotionAction, f"{prefix}/action")
         self._status: MotionStatus | None = None
         self._status_event = threading.Condition()
-        qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-        self.node.create_subscription(MotionStatus, f"{prefix}/status", self._on_status, qos)
-        self._executor = SingleThreadedExecutor(context=context)
-        self._executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, name="mpi-ros-client", daemon=True)
-        self._thread.start()
-
-    # -- lifecycle -------------------------------------------------------------------------
-    def _spin(self) -> None:
-        try:
-            self._executor.spin()
-        except Exception:  # noqa: BLE001 - the context shut down under us: stop spinning
-            pass
-
-    def close(self) -> None:
-        self._executor.shutdown(timeout_sec=2.0)
-        self._thread.join(timeout=2.0)
-        self.node.destroy_node()
-        if self._own_context:
-            rclpy.try_shutdown()
-
-    def __enter__(self) -> "MotionClient":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
+        self.node.create_subscription(MotionStatus, f"{prefix}/status", self._on_status, STATUS_QOS)
+        self._start_spinning()
 
     def wait_for_server(self, timeout: float | None = None) -> bool:
+        """Wait for the supervisor's actions and services (False if they did not appear)."""
         timeout = self.timeout if timeout is None else timeout
-        return self._start.wait_for_server(timeout_sec=timeout) and self._action.wait_for_service(timeout_sec=timeout)
+        return all(wait(timeout_sec=timeout) for wait in (self._start.wait_for_server,
+                                                            self._modify.wait_for_server,
+                                                            self._action.wait_for_service))
 
     # -- plumbing ------------------------------------------------------------------------
-    def _on_executor(self, call: Callable[[], Any]):
-        """Run ``call`` on the spinning thread; returns the future it returns."""
+    def _on_executor(self, call: Callable[[], Any]) -> Any:
+        """Run ``call`` on the spinning thread; returns what it returns (a future)."""
         box: dict[str, Any] = {}
         ready = threading.Event()
 
-        def run():
+        def run() -> None:
             try:
                 box["future"] = call()
             finally:
@@ -132,9 +482,11 @@ class MotionClient:
         self._executor.create_task(run)
         if not ready.wait(self.timeout):
             raise NoResponse("the client's executor did not run the request")
+        if "future" not in box:
+            raise NoResponse("the request failed on the client's executor (see its log)")
         return box["future"]
 
-    def _wait_future(self, future, timeout: float | None, what: str):
+    def _wait_future(self, future: Any, timeout: float | None, what: str) -> Any:
         done = threading.Event()
         future.add_done_callback(lambda _f: done.set())
         if not done.wait(self.timeout if timeout is None else timeout):
@@ -142,21 +494,27 @@ class MotionClient:
         return future.result()
 
     # -- goals ---------------------------------------------------------------------------
-    def start(self, goal: dict[str, Any], feedback: Callable[[Any], None] | None = None) -> Goal:
-        """Send a MotionStart goal given as a dict of its fields; returns the running Goal."""
-        return self._send(self._start, MotionStart.Goal(), goal, feedback)
+    def start(self, goal: Mapping[str, Any] | Any, feedback: Callable[[Any], None] | None = None) -> Goal:
+        """Send a MotionStart goal (a mapping of its fields, or a MotionStart.Goal); returns the running Goal.
 
-    def modify(self, goal: dict[str, Any], feedback: Callable[[Any], None] | None = None) -> Goal:
-        """Send a MotionModify goal given as a dict of its fields."""
-        return self._send(self._modify, MotionModify.Goal(), goal, feedback)
+        ``feedback`` is called on the client's thread with each MotionStart.Feedback.
+        """
+        return self._send(self._start, goal if isinstance(goal, MotionStart.Goal) else fill(MotionStart.Goal(), goal),
+                          feedback)
 
-    def _send(self, action_client, msg, goal: dict[str, Any], feedback) -> Goal:
-        convert.fill(msg, goal)
+    def modify(self, goal: Mapping[str, Any] | Any, feedback: Callable[[Any], None] | None = None) -> Goal:
+        """Send a MotionModify goal (a mapping of its fields, or a MotionModify.Goal)."""
+        return self._send(self._modify,
+                          goal if isinstance(goal, MotionModify.Goal) else fill(MotionModify.Goal(), goal), feedback)
+
+    def _send(self, action_client: ActionClient, msg: Any, feedback: Callable[[Any], None] | None) -> Goal:
+        progress = threading.Event()
         holder: dict[str, Goal] = {}
 
-        def on_feedback(message):
+        def on_feedback(message: Any) -> None:
             if "goal" in holder:
                 holder["goal"].feedback = message.feedback
+            progress.set()
             if feedback is not None:
                 feedback(message.feedback)
 
@@ -164,17 +522,24 @@ class MotionClient:
             raise NoResponse(f"action server {action_client._action_name} not available")
         send = self._on_executor(lambda: action_client.send_goal_async(msg, feedback_callback=on_feedback))
         handle = self._wait_future(send, None, "the goal request")
+        if not handle.accepted:
+            raise NoResponse(f"{action_client._action_name} rejected the goal (the suite is shutting down)")
         result = self._on_executor(handle.get_result_async)
-        holder["goal"] = Goal(self, handle, result)
+        holder["goal"] = Goal(self, handle, result, progress)
         return holder["goal"]
 
     def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float | None = None,
-             jerk_percent: float = 0.0, motion_type: str = "S_CURVE", attributes: Iterable[str] = (),
-             wait: bool = True, timeout: float | None = None, **fields):
-        """A point-to-point move; waits for DONE and returns the result (or the Goal)."""
+             jerk_percent: float = 0.0, motion_type: MotionType | str = MotionType.S_CURVE,
+             attributes: Iterable[Attribute | str] = (), wait: bool = True, timeout: float | None = None,
+             **fields: Any) -> MotionResult | Goal:
+        """A point-to-point move (one position per axis); waits for the result (or returns the Goal).
+
+        ``timeout``: seconds to wait for the result (None: the client's timeout; give a long
+        move a longer one). Refused or ended early: raises the message's exception.
+        """
         goal = {
-            "type": motion_type,
-            "attributes": list(attributes),
+            "type": _name(motion_type),
+            "attributes": [_name(a) for a in attributes],
             "position": [float(p) for p in position],
             "trajectory": [{"velocity": velocity, "acceleration": acceleration,
                             "deceleration": acceleration if deceleration is None else deceleration,
@@ -184,14 +549,16 @@ class MotionClient:
         running = self.start(goal)
         return running.wait(timeout) if wait else running
 
-    def wait_done(self, goal: Goal, timeout: float | None = None, raise_on_error: bool = True):
+    def wait_done(self, goal: Goal, timeout: float | None = None, raise_on_error: bool = True) -> MotionResult:
+        """``goal.wait(timeout, raise_on_error)``: the result of a goal this client sent."""
         return goal.wait(timeout, raise_on_error)
 
     # -- actions ----------------------------------------------------------------------------
-    def action(self, name: str, raise_on_error: bool = True) -> ActionReply:
+    def action(self, name: Action | str, raise_on_error: bool = True) -> ActionReply:
         """mpiMotionAction: STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME or MAP."""
+        name = _name(name)
         if not self._action.wait_for_service(timeout_sec=self.timeout):
-            raise NoResponse("the supervisor's action service is not available")
+            raise NoResponse(f"the supervisor's action service {self.prefix}/action is not available")
         response = self._wait_future(self._action.call_async(MotionAction.Request(action=name)), None,
                                      f"action {name}")
         reply = ActionReply(response.message, response.code, response.state_name, response.sample)
@@ -200,19 +567,22 @@ class MotionClient:
         return reply
 
     def stop(self) -> ActionReply:
-        return self.action("STOP")
+        return self.action(Action.STOP)
 
     def e_stop(self) -> ActionReply:
-        return self.action("E_STOP")
+        return self.action(Action.E_STOP)
 
     def abort(self) -> ActionReply:
-        return self.action("ABORT")
+        return self.action(Action.ABORT)
+
+    def e_stop_abort(self) -> ActionReply:
+        return self.action(Action.E_STOP_ABORT)
 
     def reset(self) -> ActionReply:
-        return self.action("RESET")
+        return self.action(Action.RESET)
 
     def resume(self) -> ActionReply:
-        return self.action("RESUME")
+        return self.action(Action.RESUME)
 
     # -- status ---------------------------------------------------------------------------------
     def _on_status(self, msg: MotionStatus) -> None:
@@ -220,23 +590,120 @@ class MotionClient:
             self._status = msg
             self._status_event.notify_all()
 
+    def wait_for(self, predicate: Callable[[MotionStatus], bool], timeout: float | None = None,
+                 what: str = "the awaited status") -> MotionStatus:
+        """Wait for a MotionStatus for which ``predicate`` holds; returns it."""
+        with self._status_event:
+            ok = self._status_event.wait_for(lambda: self._status is not None and predicate(self._status),
+                                             self.timeout if timeout is None else timeout)
+            if not ok:
+                raise NoResponse(f"{self.prefix}: no MotionStatus showed {what}")
+            return self._status
+
     def status(self, timeout: float | None = None, newer_than: int = -1) -> MotionStatus:
         """The latest MotionStatus (waits for one newer than sample ``newer_than``)."""
-        with self._status_event:
-            ok = self._status_event.wait_for(
-                lambda: self._status is not None and self._status.sample > newer_than,
-                self.timeout if timeout is None else timeout)
-            if not ok:
-                raise NoResponse("no MotionStatus received")
-            return self._status
+        return self.wait_for(lambda s: s.sample > newer_than, timeout, f"a sample after {newer_than}")
 
-    def wait_for_state(self, state_name: str, timeout: float | None = None) -> MotionStatus:
-        """Wait until the supervisor's status shows ``state_name``."""
-        with self._status_event:
-            ok = self._status_event.wait_for(
-                lambda: self._status is not None and self._status.state_name == state_name,
-                self.timeout if timeout is None else timeout)
-            if not ok:
-                raise NoResponse(f"the supervisor did not reach {state_name}")
-            return self._status
+    def wait_for_state(self, state_name: State | str, timeout: float | None = None,
+                       newer_than: int = -1) -> MotionStatus:
+        """Wait until the supervisor's status (after sample ``newer_than``) shows ``state_name``."""
+        wanted = _name(state_name)
+        return self.wait_for(lambda s: s.state_name == wanted and s.sample > newer_than, timeout,
+                             f"state {wanted}")
 
+
+# -- the whole suite ----------------------------------------------------------------------------------------
+class Watcher(_Endpoint):
+    """Follows the suite: every supervisor's and axis' latest status, the events, any topic.
+
+        with Watcher() as watch:
+            supervisors = watch.wait_for_suite(5.0)
+            watch.follow_status(supervisors, watch.axes_on_graph())
+            statuses, axes = watch.latest()
+    """
+
+    def __init__(self, namespace: str = "/mpi", context: Context | None = None, timeout: float = 10.0,
+                 node_name: str | None = None):
+        super().__init__(namespace, context, timeout, node_name or "mpi_ros_watcher")
+        self._changed = threading.Condition()
+        self._supervisors: dict[int, MotionStatus] = {}
+        self._axes: dict[int, AxisStatus] = {}
+        self._start_spinning()
+
+    def axes_on_graph(self) -> list[int]:
+        """Numbers of the axes whose status topic (``<namespace>/axis<k>/status``) is on the graph."""
+        pattern = re.compile(re.escape(self.namespace) + r"/axis(\d+)/status")
+        return sorted(int(m.group(1)) for name, _ in self.node.get_topic_names_and_types()
+                      if (m := pattern.fullmatch(name)))
+
+    def topics_on_graph(self) -> dict[str, str]:
+        """Topic name -> type (``pkg/msg/Type``) of every topic on the graph."""
+        return {name: types[0] for name, types in self.node.get_topic_names_and_types() if types}
+
+    # -- status ---------------------------------------------------------------------------------
+    def follow_status(self, supervisors: Iterable[int], axes: Iterable[int]) -> None:
+        """Keep the latest MotionStatus of ``supervisors`` and AxisStatus of ``axes``."""
+        for n in supervisors:
+            self.node.create_subscription(MotionStatus, f"{self.namespace}/ms{n}/status",
+                                          lambda msg, n=n: self._keep(self._supervisors, n, msg), STATUS_QOS)
+        for k in axes:
+            self.node.create_subscription(AxisStatus, f"{self.namespace}/axis{k}/status",
+                                          lambda msg, k=k: self._keep(self._axes, k, msg), STATUS_QOS)
+
+    def _keep(self, table: dict[int, Any], key: int, msg: Any) -> None:
+        with self._changed:
+            table[key] = msg
+            self._changed.notify_all()
+
+    def latest(self) -> tuple[dict[int, MotionStatus], dict[int, AxisStatus]]:
+        """Copies of the latest statuses: supervisor number -> MotionStatus, axis -> AxisStatus."""
+        with self._changed:
+            return dict(self._supervisors), dict(self._axes)
+
+    def wait_for_status(self, supervisors: Iterable[int], axes: Iterable[int], timeout: float | None = None,
+                        newer_than: int = -1) -> tuple[dict[int, MotionStatus], dict[int, AxisStatus]]:
+        """Wait until every one of ``supervisors`` and ``axes`` has a status after ``newer_than``."""
+        wanted_ms, wanted_axes = list(supervisors), list(axes)
+
+        def complete() -> bool:
+            return (all(n in self._supervisors and self._supervisors[n].sample > newer_than for n in wanted_ms)
+                    and all(k in self._axes and self._axes[k].sample > newer_than for k in wanted_axes))
+
+        with self._changed:
+            if not self._changed.wait_for(complete, self.timeout if timeout is None else timeout):
+                missing = [f"{self.namespace}/ms{n}/status" for n in wanted_ms if n not in self._supervisors]
+                missing += [f"{self.namespace}/axis{k}/status" for k in wanted_axes if k not in self._axes]
+                raise NoResponse(f"no status from {', '.join(missing) or 'the suite'} within the timeout")
+            return dict(self._supervisors), dict(self._axes)
+
+    # -- events and other topics ----------------------------------------------------------------------
+    def follow_events(self, callback: Callable[[MotionEvent], None]) -> Any:
+        """Call ``callback`` (on the watcher's thread) with every MotionEvent; returns the subscription."""
+        return self.node.create_subscription(MotionEvent, f"{self.namespace}/events", callback, EVENTS_QOS)
+
+    def follow_topic(self, topic: str, callback: Callable[[Any], None], depth: int = 100) -> tuple[Any, str]:
+        """Subscribe to any topic on the graph, with a QoS its publishers accept.
+
+        Returns (subscription, type name). Reliable unless a publisher is best effort (/clock
+        is); transient local when every publisher is (latched topics).
+        """
+        types = self.topics_on_graph()
+        if topic not in types:
+            raise LookupError(topic)
+        publishers = self.node.get_publishers_info_by_topic(topic)
+        best_effort = any(p.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT for p in publishers)
+        latched = bool(publishers) and all(
+            p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers)
+        qos = QoSProfile(depth=depth,
+                         reliability=ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+        return self.node.create_subscription(message_class(types[topic]), topic, callback, qos), types[topic]
+
+    def wait_matched(self, subscription: Any, timeout: float | None = None) -> None:
+        """Wait until ``subscription`` is connected to a publisher (what it gets from then on arrives)."""
+        deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
+        pause = threading.Event()
+        while subscription.get_publisher_count() == 0:
+            if time.monotonic() >= deadline:
+                raise NoResponse(f"no publisher of {subscription.topic_name} connected within the timeout")
+            pause.wait(_POLL)

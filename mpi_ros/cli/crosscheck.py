@@ -29,8 +29,8 @@ EXAMPLES = [
     "{type: S_CURVE, distance: 1000, velocity: 500, acceleration: 5000, deceleration: 2000, jerk_percent: 50}",
     "{type: S_CURVE, distance: 1000, velocity: 500, acceleration: 5000, jerk_percent: 100, start_velocity: 200}",
     "{type: TRAPEZOIDAL, distance: 100, velocity: 500, acceleration: 5000, deceleration: 2000, start_velocity: -300}",
-    "{type: TRAPEZOIDAL, distance: 1000, velocity: 500, acceleration: 5000, start_velocity: 200,"
-    " start_acceleration: 3000}",
+    ("{type: TRAPEZOIDAL, distance: 1000, velocity: 500, acceleration: 5000, start_velocity: 200,"
+     " start_acceleration: 3000}"),
     "{type: VELOCITY, velocity: -300, acceleration: 5000, jerk_percent: 40, start_velocity: 100}",
 ]
 

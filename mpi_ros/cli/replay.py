@@ -2,8 +2,12 @@
 
   mpi-ros replay BAG [--set KEY=VALUE ...] [--tolerance X]
 
-Exit status 0 when the replay reproduces every recorded status, event and answer, 1 when
-it diverges (the first divergence is printed: where, which field, by how much).
+BAG is a bag of `mpi-ros record` / `mpi-ros run --record`, or of any recorder of the graph
+(`ros2 bag record -a`): the suite publishes its commands (/mpi/commands) and configuration
+(/mpi/configuration, latched) for that. Exit status 0 when the replay reproduces every
+recorded status, event and answer, 1 when it diverges (the first divergence is printed:
+where, which field, by how much), 2 when the bag cannot be replayed (the message says what
+it lacks: the configuration, the commands, the statuses).
 --set changes the recorded configuration, e.g. --set axes.defaults.plant.bandwidth_hz=20.
 """
 

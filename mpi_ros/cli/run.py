@@ -1,9 +1,12 @@
 """Run the node suite on the built-in simulated controller.
 
-  mpi-ros run [--config FILE] [--time-scale X] [--ros-args ...]
+  mpi-ros run [--config FILE] [--time-scale X] [--record BAG] [--ros-args ...]
+  ros2 run mpi_ros suite [the same options]         (on a full ROS install; launch uses it too)
 
 X = 1 runs in real time (the default), larger is faster, 0 as fast as possible. Stop it
-with Ctrl-C: goals end, the nodes are destroyed and the controller stops.
+with Ctrl-C: goals end, the nodes are destroyed and the controller stops. Then, from
+another shell: `mpi-ros status`, `mpi-ros move ...` (see `mpi-ros --help`); or, instead
+of run, `mpi-ros demo` for a narrated, recorded tour.
 """
 
 from __future__ import annotations
@@ -22,8 +25,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     from mpi_ros import config as suite_config
 
+    # The name the user started: `mpi-ros run`, `mpi-ros record` or `mpi_ros suite` (ros2 run, launch).
+    prog = getattr(args, "_prog", "mpi-ros run")
     if args.time_scale < 0:
-        print("mpi-ros run: --time-scale must be >= 0", file=sys.stderr)
+        print(f"{prog}: --time-scale must be >= 0", file=sys.stderr)
         return 2
 
     import rclpy
@@ -36,7 +41,7 @@ def run(args) -> int:
     try:
         cfg, time_scale = parameters.resolve(None, args.config, args.time_scale)
     except suite_config.ConfigError as exc:
-        print(f"mpi-ros run: invalid configuration: {exc}", file=sys.stderr)
+        print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         rclpy.try_shutdown()
         return 2
     suite = Suite(cfg, time_scale=time_scale)
@@ -48,7 +53,7 @@ def run(args) -> int:
         try:
             recorder = Recorder(suite.runner, args.record, cfg)
         except OSError as exc:
-            print(f"mpi-ros run: cannot record: {exc}", file=sys.stderr)
+            print(f"{prog}: cannot record: {exc}", file=sys.stderr)
             suite.shutdown()
             rclpy.try_shutdown()
             return 2

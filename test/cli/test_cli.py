@@ -71,7 +71,7 @@ def test_ros_args_do_not_reach_the_parser(capsys):
 
 
 def _run_python(code: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-P", "-c", code], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-P", "-c", code], check=False, capture_output=True, text=True,
                           env=dict(os.environ), timeout=60, cwd=REPO)
 
 
@@ -86,7 +86,26 @@ def test_importing_the_package_and_cli_does_not_import_rclpy():
 def test_console_script_is_installed():
     script = Path(sys.prefix) / "bin" / "mpi-ros"
     assert script.is_file(), f"{script} missing: run scripts/setup.sh"
-    proc = subprocess.run([str(script), "version"], capture_output=True, text=True,
+    proc = subprocess.run([str(script), "version"], check=False, capture_output=True, text=True,
                           env=dict(os.environ), timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == f"mpi_ros {__version__}"
+
+
+def test_started_as_the_suite_executable_messages_name_it(monkeypatch, capsys):
+    # `ros2 run mpi_ros suite` and the launch file run scripts/ros/suite, which calls main(["run", ...])
+    monkeypatch.setattr(sys, "argv", ["/ws/install/lib/mpi_ros/suite", "--time-scale", "-1"])
+    assert main(["run", "--time-scale", "-1"]) == 2
+    assert capsys.readouterr().err.strip() == "mpi_ros suite: --time-scale must be >= 0"
+    with pytest.raises(SystemExit):
+        main(["run", "--bogus"])
+    assert capsys.readouterr().err.startswith("usage: mpi_ros suite ")
+    monkeypatch.setattr(sys, "argv", ["mpi-ros"])
+    assert main(["run", "--time-scale", "-1"]) == 2
+    assert capsys.readouterr().err.strip() == "mpi-ros run: --time-scale must be >= 0"
+
+
+def test_help_says_where_to_start_and_what_exit_statuses_mean():
+    text = build_parser().format_help()
+    assert "mpi-ros run " in text and "mpi-ros status" in text and "mpi-ros demo" in text
+    assert "Exit status: 0 OK; 1 refused by the controller" in text

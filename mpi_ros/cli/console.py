@@ -1,0 +1,153 @@
+"""What the operator-console verbs share: options, the ROS session, errors, result lines.
+
+Exit codes every verb keeps (scripts rely on them): 0 OK; 1 the controller refused or
+ended the command with a message other than MPIMessageOK (the message is printed); 2 a
+usage or connection problem (what was wrong and what to do is printed on stderr).
+
+rclpy and the client are imported inside functions: ``mpi-ros --help`` must stay fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import Any, Self, TextIO
+
+OK, REFUSED, USAGE = 0, 1, 2
+DEFAULT_NAMESPACE = "/mpi"
+DEFAULT_TIMEOUT = 5.0
+
+# What to do next when the supervisor's state refused a command.
+HINTS = {
+    "MPIMotionMessageERROR": "ms{n} is in ERROR (after an E_STOP or ABORT): `mpi-ros reset` leaves it",
+    "MPIMotionMessageSTOPPING_ERROR": "ms{n} is stopping after an E_STOP or ABORT: wait for ERROR, then `mpi-ros reset`",
+    "MPIMotionMessageMOVING": "ms{n} is moving: wait for it, `mpi-ros modify` it or `mpi-ros stop` it",
+    "MPIMotionMessageSTOPPING": "ms{n} is stopping: wait for STOPPED",
+    "MPIMotionMessageSTOPPED": "ms{n} is STOPPED: `mpi-ros resume` continues the move, `mpi-ros reset` drops it",
+    "MPIMotionMessageIDLE": "ms{n} is idle: there is no move to act on",
+}
+
+
+class UsageError(Exception):
+    """A usage or connection problem: printed as ``<prog>: <message>``, exit status 2."""
+
+
+def add_target_options(parser: argparse.ArgumentParser, supervisor_default: int | None = 0) -> None:
+    """--namespace, --supervisor and --timeout, as every console verb takes them."""
+    where = parser.add_argument_group("where")
+    where.add_argument("--namespace", default=DEFAULT_NAMESPACE, metavar="NS",
+                       help=f"the suite's namespace (default {DEFAULT_NAMESPACE})")
+    shown = "every supervisor" if supervisor_default is None else str(supervisor_default)
+    where.add_argument("--supervisor", "-s", type=int, default=supervisor_default, metavar="N",
+                       help=f"motion supervisor number: node <namespace>/ms<N> (default {shown})")
+    where.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT, metavar="S",
+                       help=f"seconds to wait for the suite to appear on the graph (default {DEFAULT_TIMEOUT:g})")
+
+
+def prog(args: argparse.Namespace) -> str:
+    return getattr(args, "_prog", "mpi-ros")
+
+
+def fail(args: argparse.Namespace, message: str, status: int = USAGE) -> int:
+    print(f"{prog(args)}: {message}", file=sys.stderr)
+    return status
+
+
+class Session:
+    """One verb's ROS side: its own context (ROS arguments applied), clean shutdown.
+
+    Its own context (not rclpy's default) so rclpy installs no SIGINT handler: Ctrl-C stays
+    a KeyboardInterrupt, and a running goal can still be cancelled over ROS after it.
+    """
+
+    def __init__(self, args: argparse.Namespace):
+        import rclpy
+
+        self.args = args
+        self.context = rclpy.Context()
+        try:
+            rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])], context=self.context)
+        except RuntimeError as exc:  # rclpy's RCLError: the ROS arguments did not parse
+            raise UsageError(f"invalid ROS arguments {' '.join(args.ros_args)!r}: "
+                             f"{str(exc).split(', at ')[0]}") from exc
+        self.node_name = f"mpi_ros_cli_{os.getpid()}"
+        self._endpoints: list[Any] = []
+
+    def client(self, supervisor: int):
+        """A MotionClient of ``supervisor``, once the suite and that supervisor are on the graph."""
+        from mpi_ros.client import MotionClient
+
+        client = self._keep(MotionClient(supervisor, self.args.namespace, context=self.context,
+                                         timeout=self.args.timeout, node_name=self.node_name))
+        client.wait_for_suite(self.args.timeout, supervisor)
+        if not client.wait_for_server(self.args.timeout):
+            raise UsageError(f"{client.prefix} is on the graph but its actions and services did not answer "
+                             f"within {self.args.timeout:g} s: is the suite shutting down?")
+        return client
+
+    def watcher(self):
+        """A Watcher of the suite, once the suite (and --supervisor, if given) is on the graph."""
+        from mpi_ros.client import Watcher
+
+        watcher = self._keep(Watcher(self.args.namespace, context=self.context, timeout=self.args.timeout,
+                                     node_name=f"{self.node_name}_watch"))
+        watcher.wait_for_suite(self.args.timeout, self.args.supervisor)
+        return watcher
+
+    def _keep(self, endpoint):
+        self._endpoints.append(endpoint)
+        return endpoint
+
+    def close(self) -> None:
+        for endpoint in reversed(self._endpoints):
+            endpoint.close()
+        self.context.try_shutdown()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def run_verb(args: argparse.Namespace, body) -> int:
+    """Run ``body(session)`` with the errors every verb reports the same way."""
+    from mpi_ros.errors import NoResponse, NoSuchSupervisor
+
+    try:
+        with Session(args) as session:
+            return body(session)
+    except (UsageError, NoResponse, NoSuchSupervisor) as exc:
+        return fail(args, str(exc))
+
+
+# -- printing answers --------------------------------------------------------------------------
+def positions(values) -> str:
+    return "[" + ", ".join(f"{v:.1f}" for v in values) + "]"
+
+
+def print_result(result, supervisor: int, out: TextIO | None = None) -> int:
+    """The final lines of a goal: message, code, outcome, state, positions; returns the exit status."""
+    out = out or sys.stdout  # looked up now: tests and callers may have replaced it
+    detail = f": {result.detail}" if result.detail else ""
+    print(f"{result.message} (code {result.code}) {result.outcome}, state {result.state_name}{detail}", file=out)
+    print(f"  command position {positions(result.command_position)}", file=out)
+    print(f"  actual position  {positions(result.actual_position)}", file=out)
+    print(f"  move {result.move_id}, samples {result.sample}..{result.end_sample}", file=out)
+    _hint(result.message, supervisor)
+    return OK if result.ok else REFUSED
+
+
+def print_reply(action: str, reply, supervisor: int, out: TextIO | None = None) -> int:
+    """An action's answer; returns the exit status."""
+    out = out or sys.stdout
+    print(f"{action}: {reply.message} (code {reply.code}), state {reply.state_name}, sample {reply.sample}",
+          file=out)
+    _hint(reply.message, supervisor)
+    return OK if reply.ok else REFUSED
+
+
+def _hint(message: str, supervisor: int) -> None:
+    if message in HINTS:
+        print(f"hint: {HINTS[message].format(n=supervisor)}", file=sys.stderr)
