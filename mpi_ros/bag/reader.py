@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import struct
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
 import yaml
+from mcap.exceptions import McapError
 from mcap.reader import make_reader
 
 from . import schema
@@ -47,7 +49,10 @@ class BagReader:
         self.path = mcap_path(path)
 
     def _reader(self, stream):
-        return make_reader(stream)
+        try:
+            return make_reader(stream)
+        except (McapError, struct.error, EOFError) as exc:  # not an MCAP file (or cut short)
+            raise ValueError(f"{self.path}: not a readable MCAP file ({exc or type(exc).__name__})") from exc
 
     def metadata(self, name: str) -> dict[str, str] | None:
         """An MCAP metadata record's data, by name."""

@@ -3,10 +3,16 @@
 The recorder hooks into the controller runner in-process, so the bag holds exactly what
 the controller did, sample for sample: commands with the sample at which they took effect
 (``/mpi/commands``, mpi_ros/msg/Command), MotionStatus and AxisStatus at the status rate,
-MotionEvent for every event, JointState. It also stores the configuration the run used
-(MCAP metadata ``mpi_ros``), which is what replay builds its fresh controller from.
-Log times are controller time after a fixed epoch (the wall time of sample 0), so a bag
-plays back with the controller's timing.
+MotionEvent for every event, JointState. It also stores the configuration the run used,
+which is what replay builds its fresh controller from, twice: as MCAP metadata ``mpi_ros``
+and as the message a suite latches on ``/mpi/configuration`` (mpi_ros/msg/SuiteConfiguration),
+so the bag looks like a recording of the graph too. (A bag of the graph made by any other
+recorder has the commands and the configuration from the suite's topics, and replays alike.)
+
+Time: the epoch is the wall-clock time of sample 0; every stamp and every log time is
+``epoch + sample / rate``. Recording a suite, the epoch is the suite's (its stamps on the
+graph are the same); a scenario uses a fixed epoch, so that recording it again gives the
+same bytes.
 """
 
 from __future__ import annotations
@@ -15,8 +21,6 @@ import time
 from pathlib import Path
 
 import yaml
-
-from mpi_ros.msg import Command
 
 from .. import __version__
 from ..commands import Command as ControllerCommand
@@ -27,8 +31,20 @@ from ..runner import ControllerRunner
 from ..ros import convert
 from .writer import BagWriter, TopicQos
 
-COMMANDS_TOPIC = "/mpi/commands"
+COMMANDS_TOPIC = "/mpi/commands"  # with the default namespace; in general <namespace>/commands
 METADATA_NAME = "mpi_ros"
+COMMAND_TYPE = "mpi_ros/msg/Command"
+CONFIGURATION_TYPE = "mpi_ros/msg/SuiteConfiguration"
+COMMANDS_QOS = TopicQos(depth=1000, transient_local=True)  # as the controller node offers them
+LATCHED_QOS = TopicQos(depth=1, transient_local=True)
+
+
+def commands_topic(namespace: str) -> str:
+    return f"{namespace.rstrip('/')}/commands"
+
+
+def configuration_topic(namespace: str) -> str:
+    return f"{namespace.rstrip('/')}/configuration"
 
 
 class Recorder:
@@ -39,10 +55,16 @@ class Recorder:
         self.rate = ctl.rate
         ns = config.ros.namespace.rstrip("/")
         self.ns = ns
-        self.epoch = time.time_ns() - round(ctl.sample * 1e9 / self.rate) if epoch_ns is None else epoch_ns
+        if epoch_ns is None:  # the suite's epoch when recording a suite (its stamps on the graph)
+            epoch_ns = convert.epoch_of(ctl)
+        if epoch_ns is None:
+            epoch_ns = time.time_ns() - convert.sample_ns(ctl.sample, self.rate)
+        self.epoch = int(epoch_ns)
         self.writer = BagWriter(directory, compress=compress)
         status, deep = TopicQos(depth=10), TopicQos(depth=1000)
-        self.writer.add_topic(COMMANDS_TOPIC, "mpi_ros/msg/Command", deep)
+        self.commands_topic = commands_topic(ns)
+        self.writer.add_topic(self.commands_topic, COMMAND_TYPE, COMMANDS_QOS)
+        self.writer.add_topic(configuration_topic(ns), CONFIGURATION_TYPE, LATCHED_QOS)
         self.writer.add_topic(f"{ns}/events", "mpi_ros/msg/MotionEvent", deep)
         for spec in config.supervisors:
             self.writer.add_topic(f"{ns}/ms{spec.number}/status", "mpi_ros/msg/MotionStatus", status)
@@ -54,44 +76,43 @@ class Recorder:
             "sample_rate": repr(self.rate),
             "start_sample": str(ctl.sample),
             "epoch_ns": str(self.epoch),
+            "stamp_epoch_ns": str(self.epoch),  # stamps are epoch + sample / rate (replay compares them)
+            "namespace": config.ros.namespace,
             "mpi_ros_version": __version__,
         })
+        self.writer.write(configuration_topic(ns), convert.configuration(config, self.rate, ctl.sample, self.epoch),
+                          self.log_time(ctl.sample))
         runner.add_periodic(config.ros.status_rate, self._collect_status)
         runner.add_periodic(config.ros.joint_states_rate, self._collect_joints)
         runner.on_event(self._on_event)
         runner.on_command(self._on_command)
 
     def log_time(self, sample: int) -> int:
-        return self.epoch + round(sample * 1e9 / self.rate)
+        return convert.stamp_ns(sample, self.rate, self.epoch)
 
     # -- hooks (periodic collection under the runner lock, writing after it) --------------------------
     def _collect_status(self, ctl):
         t = self.log_time(ctl.sample)
         messages: list[tuple[str, object]] = [
-            (f"{self.ns}/ms{ms.number}/status", convert.motion_status(ms.snapshot(), ctl.rate)) for ms in ctl.supervisors
+            (f"{self.ns}/ms{ms.number}/status", convert.motion_status(ms.snapshot(), ctl.rate, self.epoch))
+            for ms in ctl.supervisors
         ]
-        messages += [(f"{self.ns}/axis{a.number}/status", convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate))
-                     for a in ctl.axes]
+        messages += [(f"{self.ns}/axis{a.number}/status",
+                      convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate, self.epoch)) for a in ctl.axes]
         return lambda: [self.writer.write(topic, msg, t) for topic, msg in messages]
 
     def _collect_joints(self, ctl):
-        msg = convert.joint_state(ctl)
+        msg = convert.joint_state(ctl, self.epoch)
         t = self.log_time(ctl.sample)
         return lambda: self.writer.write("/joint_states", msg, t)
 
     def _on_event(self, event) -> None:
-        self.writer.write(f"{self.ns}/events", convert.motion_event(event, self.rate), self.log_time(event.sample))
+        self.writer.write(f"{self.ns}/events", convert.motion_event(event, self.rate, self.epoch),
+                          self.log_time(event.sample))
 
     def _on_command(self, sample: int, command: ControllerCommand, reply: Reply) -> None:
-        msg = Command()
-        msg.stamp = convert.stamp(sample, self.rate)
-        msg.sample = sample
-        msg.operation = command.operation
-        msg.supervisor = command.supervisor
-        msg.axis = command.axis
-        msg.request = command.to_json()
-        msg.message = reply.message.name
-        self.writer.write(COMMANDS_TOPIC, msg, self.log_time(sample))
+        msg = convert.command(sample, command, reply, self.rate, self.epoch)
+        self.writer.write(self.commands_topic, msg, self.log_time(sample))
 
     def close(self) -> None:
         self.writer.close()

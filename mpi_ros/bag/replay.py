@@ -2,7 +2,11 @@
 compare every recorded status, event and command answer with the new run.
 
 The fresh controller is built from the configuration stored in the bag (optionally with
-overrides, to see what a changed parameter does). Statuses recorded at sample k are
+overrides, to see what a changed parameter does): the MCAP metadata ``mpi_ros`` that
+``mpi-ros record`` writes, or else the suite's latched <ns>/configuration message, which
+any recorder of the graph (``ros2 bag record -a``) captures along with the commands on
+<ns>/commands. A bag without one of them is refused with what it lacks (MissingInput).
+Stamps are compared too when the bag knows the epoch they count from. Statuses recorded at sample k are
 compared once the new controller is at k; commands recorded with effective sample k are
 applied when it is at k-1 (DESIGN.md: a command is applied at the first sample after the
 controller's current one). Identical runs report zero differences; otherwise the report
@@ -16,14 +20,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
+from mcap.exceptions import McapError
 
 from .. import config as suite_config
 from ..commands import Command, apply
 from ..ros import convert
 from .reader import BagReader
-from .recorder import COMMANDS_TOPIC, METADATA_NAME, NOT_REPLAYED
+from .recorder import (COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED,
+                       commands_topic)
 
-_SKIPPED_FIELDS = {"stamp"}  # derived from the sample
+_SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
+STATUS_TYPES = ("mpi_ros/msg/MotionStatus", "mpi_ros/msg/AxisStatus")
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,22 +87,23 @@ class ReplayReport:
                 + (f"; largest: {worst}" if worst else ""))
 
 
-def _flatten(data, prefix: str = ""):
+def _flatten(data, prefix: str = "", skipped=_SKIPPED_FIELDS):
     if isinstance(data, dict):
         for key, value in data.items():
-            if key in _SKIPPED_FIELDS:
+            if key in skipped:
                 continue
-            yield from _flatten(value, f"{prefix}.{key}" if prefix else key)
+            yield from _flatten(value, f"{prefix}.{key}" if prefix else key, skipped)
     elif isinstance(data, list) and data and isinstance(data[0], dict):
         for i, value in enumerate(data):
-            yield from _flatten(value, f"{prefix}[{i}]")
+            yield from _flatten(value, f"{prefix}[{i}]", skipped)
     else:
         yield prefix, data
 
 
-def _compare(report: ReplayReport, sample: int, topic: str, recorded, replayed, tolerance: float) -> None:
-    new = dict(_flatten(convert.to_dict(replayed)))
-    for name, value in _flatten(convert.to_dict(recorded)):
+def _compare(report: ReplayReport, sample: int, topic: str, recorded, replayed, tolerance: float,
+             skipped=_SKIPPED_FIELDS) -> None:
+    new = dict(_flatten(convert.to_dict(replayed), skipped=skipped))
+    for name, value in _flatten(convert.to_dict(recorded), skipped=skipped):
         other = new.get(name)
         report.values += 1
         if isinstance(value, float) and isinstance(other, float):
@@ -106,38 +114,113 @@ def _compare(report: ReplayReport, sample: int, topic: str, recorded, replayed, 
             report.record(Divergence(sample, topic, name, value, other))
 
 
-def load_config(reader: BagReader, overrides: dict | None = None) -> suite_config.SuiteConfig:
+class MissingInput(ValueError):
+    """The bag lacks what replay needs (the configuration, the commands, any status)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Recording:
+    """What a bag says about the run it recorded: where the configuration came from and
+    which topics hold the commands, events and statuses."""
+
+    config: dict  # the configuration as recorded (YAML mapping)
+    source: str  # "metadata" (mpi-ros record) or the configuration topic's name
+    start_sample: int
+    epoch_ns: int | None  # stamps are epoch + sample / rate (None: older bags, stamps not compared)
+    namespace: str
+    commands: list[str]  # topics
+    events: str | None
+    statuses: list[str]
+    graph: bool  # a recording of the graph (any recorder): it may have started after the suite
+
+
+def inspect(reader: BagReader) -> Recording:
+    """The recording's configuration and topics; MissingInput names everything that is missing."""
+    topics = reader.topics()
     stored = reader.metadata(METADATA_NAME)
-    if stored is None:
-        raise ValueError(f"{reader.path}: no '{METADATA_NAME}' metadata: not recorded by mpi_ros")
-    if int(stored.get("start_sample", "0")) != 0:
-        raise ValueError(f"{reader.path}: recording did not start at sample 0; it cannot be replayed")
-    raw = yaml.safe_load(stored["config"]) or {}
-    return suite_config.parse(suite_config.merge(raw, overrides or {}), f"{reader.path} (recorded)")
+    config_topics = sorted(t for t, k in topics.items() if k == CONFIGURATION_TYPE)
+    missing = []
+    setup = None
+    if stored is not None:
+        epoch = stored.get("stamp_epoch_ns")
+        setup = (yaml.safe_load(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
+                 int(epoch) if epoch is not None else None, stored.get("namespace"))
+    elif config_topics:
+        found = next((msg for _, msg in reader.decoded(config_topics[:1])), None)
+        if found is not None:
+            setup = (yaml.safe_load(found.config) or {}, config_topics[0], int(found.start_sample),
+                     int(found.epoch_ns), found.ros_namespace or None)
+    if setup is None:
+        where = (f"the topic {config_topics[0]} is there but holds no message" if config_topics else
+                 "no MCAP metadata 'mpi_ros' (what `mpi-ros record` writes) and no topic of type "
+                 f"{CONFIGURATION_TYPE} (the suite latches it on /mpi/configuration)")
+        missing.append(f"the configuration ({where})")
+    raw, source, start, epoch, namespace = setup or ({}, "", 0, None, None)
+    if namespace is None:
+        namespace = ((raw.get("ros") or {}).get("namespace") if isinstance(raw, dict) else None) or "/mpi"
+    ns = namespace.rstrip("/")
+    commands = [t for t, k in topics.items() if k == COMMAND_TYPE and t in (commands_topic(ns), COMMANDS_TOPIC)]
+    if not commands:
+        others = sorted(t for t, k in topics.items() if k == COMMAND_TYPE)
+        missing.append(f"the commands (no topic {commands_topic(ns)} of type {COMMAND_TYPE}"
+                       + (f"; only {', '.join(others)}" if others else "") + ")")
+    statuses = sorted(t for t, k in topics.items() if k in STATUS_TYPES and t.startswith(ns + "/"))
+    if not statuses:
+        missing.append(f"the statuses to compare (no {ns}/ms<n>/status or {ns}/axis<k>/status topic)")
+    if missing:
+        raise MissingInput(f"{reader.path}: cannot replay, the bag lacks " + "; and ".join(missing))
+    if start != 0:
+        raise ValueError(f"{reader.path}: the suite did not start at sample 0 (it started at {start}); "
+                         "it cannot be replayed")
+    events = f"{ns}/events" if topics.get(f"{ns}/events") == "mpi_ros/msg/MotionEvent" else None
+    return Recording(raw, source, start, epoch, namespace, commands, events, statuses, source != "metadata")
+
+
+def load_config(reader: BagReader, overrides: dict | None = None) -> suite_config.SuiteConfig:
+    """The configuration the bag's run used (from its metadata or its configuration topic)."""
+    return _config(reader, inspect(reader), overrides)
+
+
+def _config(reader: BagReader, recording: Recording, overrides: dict | None) -> suite_config.SuiteConfig:
+    return suite_config.parse(suite_config.merge(recording.config, overrides or {}), f"{reader.path} (recorded)")
 
 
 def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0.0,
            stop_at_first: bool = False) -> ReplayReport:
-    """Replay a bag; ``overrides`` change the recorded configuration (e.g. a plant gain)."""
+    """Replay a bag; ``overrides`` change the recorded configuration (e.g. a plant gain).
+
+    The bag may come from ``mpi-ros record`` (configuration in its metadata) or from any
+    recorder of the graph (configuration from the latched <ns>/configuration topic).
+    Raises MissingInput (a ValueError) naming what the bag lacks."""
     reader = BagReader(path)
-    cfg = load_config(reader, overrides)
+    try:
+        recording = inspect(reader)
+    except McapError as exc:
+        raise ValueError(f"{path}: not a readable MCAP file: {exc}") from exc
+    cfg = _config(reader, recording, overrides)
     ctl = cfg.build_controller()
+    epoch = recording.epoch_ns
+    skipped = _SKIPPED_FIELDS if epoch is None else frozenset()
     replayed_events = []
     ctl.listeners.append(lambda e: replayed_events.append(e) if e.type_name not in NOT_REPLAYED else None)
     report = ReplayReport(str(path))
-    ns = cfg.ros.namespace.rstrip("/")
     recorded_events = []
     timeline = []  # (controller sample, 0 status / 1 command, order, topic, type, msg)
-    for item, msg in reader.decoded():
-        if item.topic == COMMANDS_TOPIC:
+    first_recorded = None  # the first sample the recording saw (a graph recording may start late)
+    wanted = [*recording.commands, *recording.statuses] + ([recording.events] if recording.events else [])
+    for order, (item, msg) in enumerate(reader.decoded(wanted)):
+        key = (item.sequence, order)
+        if item.topic in recording.commands:
             # applied while the controller was one sample before the one it took effect at
-            timeline.append((msg.sample - 1, 1, item.sequence, item.topic, item.type, msg))
-        elif item.topic == f"{ns}/events":
+            timeline.append((msg.sample - 1, 1, key, item.topic, item.type, msg))
+            continue
+        first_recorded = msg.sample if first_recorded is None else min(first_recorded, msg.sample)
+        if item.topic == recording.events:
             if msg.type not in NOT_REPLAYED:
-                recorded_events.append((item.sequence, msg))
-        elif item.type in ("mpi_ros/msg/MotionStatus", "mpi_ros/msg/AxisStatus"):
+                recorded_events.append((key, msg))
+        else:
             # statuses at a sample were taken before commands given at that sample
-            timeline.append((msg.sample, 0, item.sequence, item.topic, item.type, msg))
+            timeline.append((msg.sample, 0, key, item.topic, item.type, msg))
     timeline.sort(key=lambda entry: entry[:3])
     # the order they were written in, which ties in log time may not keep
     recorded_events = [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0])]
@@ -150,12 +233,14 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
                 report.record(Divergence(msg.sample, topic, f"{msg.operation}.message", msg.message,
                                          reply.message.name))
         else:
-            _compare(report, sample, topic, msg, _replayed_status(ctl, msg_type, msg.number), tolerance)
+            _compare(report, sample, topic, msg, _replayed_status(ctl, msg_type, msg.number, epoch), tolerance, skipped)
             report.statuses += 1
         if stop_at_first and report.first is not None:
             break
     report.last_sample = ctl.sample
-    _compare_events(report, recorded_events, replayed_events, ctl.rate, tolerance)
+    # a recording of the graph holds the events from when it started; mpi-ros record has them all
+    since = (first_recorded if first_recorded is not None else report.last_sample + 1) if recording.graph else 0
+    _compare_events(report, recorded_events, replayed_events, ctl.rate, tolerance, epoch, skipped, since)
     return report
 
 
@@ -164,19 +249,20 @@ def _step_to(ctl, sample: int) -> None:
         ctl.step(sample - ctl.sample)
 
 
-def _replayed_status(ctl, msg_type: str, number: int):
+def _replayed_status(ctl, msg_type: str, number: int, epoch: int | None):
     if msg_type == "mpi_ros/msg/MotionStatus":
-        return convert.motion_status(ctl.supervisor(number).snapshot(), ctl.rate)
-    return convert.axis_status(ctl.axis_snapshot(number), ctl.rate)
+        return convert.motion_status(ctl.supervisor(number).snapshot(), ctl.rate, epoch or 0)
+    return convert.axis_status(ctl.axis_snapshot(number), ctl.rate, epoch or 0)
 
 
-def _compare_events(report: ReplayReport, recorded, replayed, rate: float, tolerance: float) -> None:
-    """Events up to the last compared sample, in order."""
+def _compare_events(report: ReplayReport, recorded, replayed, rate: float, tolerance: float,
+                    epoch: int | None = None, skipped=_SKIPPED_FIELDS, since: int = 0) -> None:
+    """Events from ``since`` up to the last compared sample, in order."""
     horizon = report.last_sample
-    replayed = [convert.motion_event(e, rate) for e in replayed if e.sample <= horizon]
+    replayed = [convert.motion_event(e, rate, epoch or 0) for e in replayed if since <= e.sample <= horizon]
     recorded = [e for e in recorded if e.sample <= horizon]
     for i, (old, new) in enumerate(zip(recorded, replayed)):
         report.events += 1
-        _compare(report, old.sample, f"event[{i}]", old, new, tolerance)
+        _compare(report, old.sample, f"event[{i}]", old, new, tolerance, skipped)
     if len(recorded) != len(replayed):
         report.record(Divergence(horizon, "events", "count", len(recorded), len(replayed)))

@@ -13,7 +13,7 @@ A scenario file (YAML):
 
 This is how the regression fixtures in test/fixtures/bags are made
 (``mpi-ros record --scenario FILE OUTPUT``); with a fixed epoch, recording a scenario again
-gives the same messages (not the same bytes: CDR leaves alignment padding uninitialised).
+gives the same bytes (the writer stores canonical CDR, padding zeroed: bag/cdr.py).
 """
 
 from __future__ import annotations

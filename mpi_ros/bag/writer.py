@@ -6,6 +6,10 @@ encoding ``ros2msg``; channels with message encoding ``cdr`` and the metadata
 in nanoseconds; a ``rosbag2`` metadata record carrying the bag information. The mcap
 Writer keeps messages in memory until a chunk fills, so ``close`` must run on every exit
 path (use the writer as a context manager).
+
+Messages are stored as canonical CDR (cdr.py): exactly as long as their data, alignment
+padding zeroed. rclpy's serializer returns a longer buffer for messages with empty
+sequences of 8-byte elements, which strict readers (rosbags) refuse.
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from pathlib import Path
 import yaml
 from mcap.writer import CompressionType, Writer
 
-from . import schema
+from . import cdr, schema
 
 METADATA_VERSION = 9
 ROS_DISTRO = "jazzy"
@@ -104,10 +108,8 @@ class BagWriter:
         return topic
 
     def write(self, name: str, msg, log_time: int) -> None:
-        """Serialise a ROS message and store it (thread-safe)."""
-        from rclpy.serialization import serialize_message
-
-        data = serialize_message(msg)
+        """Serialise a ROS message (canonical CDR) and store it (thread-safe)."""
+        data = cdr.serialize(msg)
         self.write_raw(name, schema.full_name(type(msg)), data, log_time)
 
     def write_raw(self, name: str, msg_type: str, data: bytes, log_time: int) -> None:

@@ -19,8 +19,13 @@ def _series(reader: BagReader):
     axes: dict[int, dict[str, list]] = defaultdict(lambda: defaultdict(list))
     states: dict[int, list[tuple[float, str]]] = defaultdict(list)
     events: list[tuple[float, str, int]] = []
+    t0: int | None = None  # stamps are wall-clock anchored: plot the time since the first one
     for item, msg in reader.decoded():
-        t = msg.stamp.sec + msg.stamp.nanosec * 1e-9 if hasattr(msg, "stamp") else None
+        if not hasattr(msg, "stamp"):
+            continue
+        ns = msg.stamp.sec * 1_000_000_000 + msg.stamp.nanosec
+        t0 = ns if t0 is None else t0
+        t = (ns - t0) * 1e-9
         if item.type == "mpi_ros/msg/AxisStatus":
             series = axes[msg.number]
             series["t"].append(t)
@@ -76,7 +81,7 @@ def plot_bag(path: str | Path, output: str | Path, axes_wanted: list[int] | None
     handles = [Patch(color=c, label=s) for s, c in STATE_COLOURS.items()]
     if state_axes:
         state_axes[-1].legend(handles=handles, loc="lower right", fontsize=6, ncol=6)
-    rows[-1].set_xlabel("controller time [s]")
+    rows[-1].set_xlabel("time since the first message [s]")
     fig.suptitle(f"{Path(path).name}")
     fig.tight_layout()
     output = Path(output)

@@ -4,6 +4,16 @@ Publishes /<ns>/axis<k>/status, /<ns>/events, /joint_states, /diagnostics and /c
 (controller time, for use_sim_time consumers); serves the axis services
 (/<ns>/axis<k>/config_get|config_set|position_set) and the control's gates and I/O
 (/<ns>/gate_set|gate_get|io_get|io_set).
+
+For recordings any tool can make: every command the controller applied goes out on
+/<ns>/commands (mpi_ros/msg/Command, with the sample at which it took effect) and the
+configuration in effect on /<ns>/configuration (latched), so a bag of the graph made by any
+recorder (`ros2 bag record -a`) replays exactly with `mpi-ros replay`. Both are reliable and
+transient local: a recorder that joins late still gets the configuration and the last
+COMMAND_HISTORY commands.
+
+Stamps (and /clock) are controller time anchored to the wall clock: epoch + sample / rate
+(mpi_ros/ros/convert.py).
 """
 
 from __future__ import annotations
@@ -15,7 +25,8 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
-from mpi_ros.msg import AxisStatus, MotionEvent
+from mpi_ros.msg import AxisStatus, MotionEvent, SuiteConfiguration
+from mpi_ros.msg import Command as CommandMsg
 from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisPositionSet, GateGet, GateSet, IoGet, IoSet
 
 from .. import requests as rq
@@ -27,8 +38,17 @@ from ..runner import ControllerRunner
 from . import convert
 from .supervisor_node import STATUS_QOS
 
-# Events are never dropped in a burst: reliable and deep.
+# Events are never dropped in a burst by the publisher: reliable and deep. (A subscriber
+# keeps its own history: see the README's topic table for the QoS to echo them with.)
 EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
+COMMAND_HISTORY = 1000
+# Applied commands: reliable, deep, and kept for late joiners (a recorder started after the
+# first moves still gets them; a subscriber asking for volatile durability is matched too).
+COMMANDS_QOS = QoSProfile(depth=COMMAND_HISTORY, reliability=ReliabilityPolicy.RELIABLE,
+                          history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# The configuration: published once, latched.
+LATCHED_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
 CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE)
 _LEVELS = {
     MPIState.ERROR: DiagnosticStatus.ERROR,
@@ -47,6 +67,9 @@ class ControllerNode(Node):
         super().__init__("controller", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.settings = settings
+        # the wall-clock time of sample 0 (the suite anchors its controller before building nodes)
+        epoch = convert.epoch_of(runner.ctl)
+        self.epoch_ns = convert.anchor(runner.ctl) if epoch is None else epoch
         self._service_group = ReentrantCallbackGroup()
         count = len(runner.ctl.axes)
         self._pub_axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
@@ -63,32 +86,57 @@ class ControllerNode(Node):
         self._pub_joints = self.create_publisher(JointState, "/joint_states", 10)
         self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
+        self._pub_commands = self.create_publisher(CommandMsg, "commands", COMMANDS_QOS)
+        self._pub_configuration = self.create_publisher(SuiteConfiguration, "configuration", LATCHED_QOS)
+        self._applied: list = []  # commands applied since the last change hook, to publish after the lock
+        runner.on_command(self._on_command)
+        runner.on_change(self._collect_commands)
         runner.add_periodic(settings.status_rate, self._collect_axis_status)
         runner.add_periodic(settings.joint_states_rate, self._collect_joints)
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
         runner.add_periodic(settings.clock_rate, self._collect_clock)
-        runner.on_event(lambda event: convert.publish(self, self._pub_events, convert.motion_event(event, runner.ctl.rate)))
+        runner.on_event(lambda event: convert.publish(
+            self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns)))
 
     def _service(self, srv_type, name, callback):
         self.create_service(srv_type, name, callback, callback_group=self._service_group)
 
+    def publish_configuration(self, config, start_sample: int | None = None) -> SuiteConfiguration:
+        """Publish (latched) the configuration the suite runs: ``config`` (a SuiteConfig), the
+        sample rate, the sample the suite started at and the epoch of its stamps."""
+        start = self.runner.read(lambda ctl: ctl.sample) if start_sample is None else start_sample
+        msg = convert.configuration(config, self.runner.ctl.rate, start, self.epoch_ns)
+        convert.publish(self, self._pub_configuration, msg)
+        return msg
+
+    # -- applied commands -------------------------------------------------------------------
+    def _on_command(self, sample, command, reply) -> None:
+        # under the runner lock: keep it; it is published once the lock is released
+        self._applied.append(convert.command(sample, command, reply, self.runner.ctl.rate, self.epoch_ns))
+
+    def _collect_commands(self, ctl):
+        if not self._applied:
+            return None
+        messages, self._applied = self._applied, []
+        return lambda: [convert.publish(self, self._pub_commands, msg) for msg in messages]
+
     # -- periodic topics ------------------------------------------------------------------
     def _collect_axis_status(self, ctl):
-        messages = [convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate) for a in ctl.axes]
+        messages = [convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate, self.epoch_ns) for a in ctl.axes]
         return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._pub_axis_status, messages)]
 
     def _collect_joints(self, ctl):
-        msg = convert.joint_state(ctl)
+        msg = convert.joint_state(ctl, self.epoch_ns)
         return lambda: convert.publish(self, self._pub_joints, msg)
 
     def _collect_clock(self, ctl):
-        msg = Clock(clock=convert.stamp(ctl.sample, ctl.rate))
+        msg = Clock(clock=convert.stamp(ctl.sample, ctl.rate, self.epoch_ns))
         return lambda: convert.publish(self, self._pub_clock, msg)
 
     def _collect_diagnostics(self, ctl):
         array = DiagnosticArray()
-        array.header.stamp = convert.stamp(ctl.sample, ctl.rate)
+        array.header.stamp = convert.stamp(ctl.sample, ctl.rate, self.epoch_ns)
         for ms in ctl.supervisors:
             array.status.append(self._supervisor_diagnostic(ms))
         for axis in ctl.axes:

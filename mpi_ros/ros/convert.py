@@ -1,9 +1,21 @@
-"""Conversions at the ROS edge: messages <-> plain dicts, controller snapshots -> messages."""
+"""Conversions at the ROS edge: messages <-> plain dicts, controller snapshots -> messages.
+
+Time: every stamp is controller time anchored to the wall clock, ``epoch + sample / rate``,
+where the epoch is the wall-clock time of sample 0 (ns since the Unix epoch). The suite
+anchors its controller when it is built (:func:`anchor`), so a stamp is "now" for RViz, tf,
+Foxglove and every tool that does not use sim time, /clock carries the same time, and the
+epoch is published (latched, <ns>/configuration) and recorded in bags so replay reproduces
+every stamp. Functions that stamp take ``epoch_ns``; left out, they use the epoch of the
+suite anchored last in this process (one suite per process is the rule; pass it explicitly
+where two may coexist).
+"""
 
 from __future__ import annotations
 
 import array
 import math
+import time
+import weakref
 from typing import Any
 
 import numpy as np
@@ -12,6 +24,7 @@ from rclpy._rclpy_pybind11 import RCLError
 from sensor_msgs.msg import JointState
 
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
+from mpi_ros.msg import Command as CommandMsg
 
 from ..mpi.events import Event
 from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
@@ -72,19 +85,61 @@ def answer(response, reply):
     return response
 
 
-def stamp(sample: int, rate: float) -> Time:
-    """Controller time of a sample."""
-    nanoseconds = int(round(sample * 1e9 / rate))
+_default_epoch_ns = 0  # the epoch of the suite anchored last in this process
+_EPOCHS: "weakref.WeakKeyDictionary[Any, int]" = weakref.WeakKeyDictionary()
+
+
+def anchor(controller, epoch_ns: int | None = None) -> int:
+    """Anchor ``controller``'s time to the wall clock: sample k is stamped ``epoch + k / rate``.
+
+    ``epoch_ns`` defaults to now minus the controller's current time (so its current sample
+    is stamped now). The epoch also becomes this process's default for :func:`stamp`."""
+    global _default_epoch_ns
+    if epoch_ns is None:
+        epoch_ns = time.time_ns() - sample_ns(controller.sample, controller.rate)
+    _EPOCHS[controller] = int(epoch_ns)
+    _default_epoch_ns = int(epoch_ns)
+    return int(epoch_ns)
+
+
+def epoch_of(controller) -> int | None:
+    """The epoch ``controller`` was anchored with (None if it never was)."""
+    return _EPOCHS.get(controller)
+
+
+def default_epoch() -> int:
+    """The epoch stamps use when none is given: the suite anchored last (0 before any)."""
+    return _default_epoch_ns
+
+
+def sample_ns(sample: int, rate: float) -> int:
+    """Controller time of a sample since sample 0, in ns."""
+    return int(round(sample * 1e9 / rate))
+
+
+def stamp_ns(sample: int, rate: float, epoch_ns: int | None = None) -> int:
+    """Wall-anchored time of a sample in ns since the Unix epoch."""
+    return (_default_epoch_ns if epoch_ns is None else int(epoch_ns)) + sample_ns(sample, rate)
+
+
+def stamp(sample: int, rate: float, epoch_ns: int | None = None) -> Time:
+    """The stamp of a sample: ``epoch + sample / rate`` (see the module's docstring)."""
+    nanoseconds = stamp_ns(sample, rate, epoch_ns)
     return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+
+def time_ns(value: Time) -> int:
+    """A builtin_interfaces/Time in ns."""
+    return int(value.sec) * 1_000_000_000 + int(value.nanosec)
 
 
 def _finite(x: float) -> float:
     return float(x) if math.isfinite(x) else 0.0
 
 
-def axis_status(snap: AxisSnapshot, rate: float) -> AxisStatus:
+def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) -> AxisStatus:
     msg = AxisStatus()
-    msg.stamp = stamp(snap.sample, rate)
+    msg.stamp = stamp(snap.sample, rate, epoch_ns)
     msg.sample = snap.sample
     msg.number = snap.number
     msg.state = int(snap.state)
@@ -112,15 +167,15 @@ def axis_status(snap: AxisSnapshot, rate: float) -> AxisStatus:
     return msg
 
 
-def motion_status(snap: MotionSnapshot, rate: float) -> MotionStatus:
+def motion_status(snap: MotionSnapshot, rate: float, epoch_ns: int | None = None) -> MotionStatus:
     msg = MotionStatus()
-    msg.stamp = stamp(snap.sample, rate)
+    msg.stamp = stamp(snap.sample, rate, epoch_ns)
     msg.sample = snap.sample
     msg.number = snap.number
     msg.state = int(snap.state)
     msg.state_name = snap.state.name
     msg.axis_numbers = list(snap.axis_numbers)
-    msg.axes = [axis_status(a, rate) for a in snap.axes]
+    msg.axes = [axis_status(a, rate, epoch_ns) for a in snap.axes]
     msg.done = snap.done
     msg.at_target = snap.at_target
     msg.settled = snap.settled
@@ -134,19 +189,74 @@ def motion_status(snap: MotionSnapshot, rate: float) -> MotionStatus:
     return msg
 
 
-def joint_state(ctl) -> JointState:
-    """Every axis as a joint: actual position and velocity."""
+def servo_effort(axis) -> float:
+    """The simulated servo's control effort, in counts/s^2.
+
+    The position loop (mpi_ros/mpi/plant.py) drives the motor with
+    ``w^2 (u - y) + 2 zeta w (kv u' - y') + ka u''`` (u the command, y the motor; w, zeta,
+    kv, ka the plant's bandwidth, damping and feed-forwards): the acceleration it demands
+    of a motor of unit inertia, which is what the simulated motor then does. Here it is
+    computed as a real servo computes it, from the encoder's reading of the position (so
+    it carries the encoder's quantisation: up to w^2 x resolution / 2) and the actual
+    velocity. 0 while the amplifier is off (after ABORT the motor coasts)."""
+    if not axis.amp_enabled:
+        return 0.0
+    cfg = axis.plant.config
+    w = 2.0 * math.pi * cfg.bandwidth_hz
+    effort = (w * w * (axis.cmd_p - axis.act_p)
+              + 2.0 * cfg.damping * w * (cfg.velocity_feedforward * axis.cmd_v - axis.act_v)
+              + cfg.acceleration_feedforward * axis.cmd_a)
+    return _finite(effort)
+
+
+def joint_state(ctl, epoch_ns: int | None = None) -> JointState:
+    """Every axis as a joint: actual position (counts), actual velocity (counts/s) and the
+    servo's control effort (counts/s^2, see :func:`servo_effort`)."""
     msg = JointState()
-    msg.header.stamp = stamp(ctl.sample, ctl.rate)
+    msg.header.stamp = stamp(ctl.sample, ctl.rate, epoch_ns)
     msg.name = [f"axis{a.number}" for a in ctl.axes]
     msg.position = [float(a.actual_position) for a in ctl.axes]
     msg.velocity = [float(a.act_v) for a in ctl.axes]
+    msg.effort = [servo_effort(a) for a in ctl.axes]
     return msg
 
 
-def motion_event(event: Event, rate: float) -> MotionEvent:
+def command(sample: int, command, reply, rate: float, epoch_ns: int | None = None) -> CommandMsg:
+    """An applied command (mpi_ros.commands.Command) and the controller's reply, with the
+    sample at which it took effect, as published on <ns>/commands and recorded for replay."""
+    msg = CommandMsg()
+    msg.stamp = stamp(sample, rate, epoch_ns)
+    msg.sample = int(sample)
+    msg.operation = command.operation
+    msg.supervisor = int(command.supervisor)
+    msg.axis = int(command.axis)
+    msg.request = command.to_json()
+    msg.message = reply.message.name
+    return msg
+
+
+def configuration(config, rate: float, start_sample: int, epoch_ns: int):
+    """The latched <ns>/configuration message: what a replay builds its controller from."""
+    import yaml
+
+    from mpi_ros import __version__
+    from mpi_ros.msg import SuiteConfiguration
+
+    msg = SuiteConfiguration()
+    msg.stamp = stamp(start_sample, rate, epoch_ns)
+    msg.config = yaml.safe_dump(config.raw, sort_keys=False)
+    msg.source = str(config.source)
+    msg.sample_rate = float(rate)
+    msg.start_sample = int(start_sample)
+    msg.epoch_ns = int(epoch_ns)
+    msg.ros_namespace = config.ros.namespace
+    msg.mpi_ros_version = __version__
+    return msg
+
+
+def motion_event(event: Event, rate: float, epoch_ns: int | None = None) -> MotionEvent:
     msg = MotionEvent()
-    msg.stamp = stamp(event.sample, rate)
+    msg.stamp = stamp(event.sample, rate, epoch_ns)
     msg.sample = event.sample
     msg.type = event.type_name
     msg.supervisor = event.supervisor

@@ -9,6 +9,7 @@ from rclpy.executors import MultiThreadedExecutor
 
 from ..config import SuiteConfig
 from ..runner import ControllerRunner
+from . import convert
 from .controller_node import ControllerNode
 from .supervisor_node import SupervisorNode
 
@@ -18,16 +19,24 @@ class Suite:
 
     ``time_scale``: 1 real time, >1 faster, 0 as fast as possible, None manual (the
     caller steps ``suite.runner``; tests do this).
+
+    ``epoch_ns``: the wall-clock time of sample 0 (ns since the Unix epoch); every stamp and
+    /clock is ``epoch + sample / rate``. Default: now, when the suite is built (the controller
+    starts counting when ``start`` is called, a few milliseconds later). It is published with
+    the configuration (latched, <ns>/configuration) and recorded in bags.
     """
 
-    def __init__(self, config: SuiteConfig, time_scale: float | None = 1.0, context: Context | None = None):
+    def __init__(self, config: SuiteConfig, time_scale: float | None = 1.0, context: Context | None = None,
+                 epoch_ns: int | None = None):
         self.config = config
         self.controller = config.build_controller()
+        self.epoch_ns = convert.anchor(self.controller, epoch_ns)
         self.runner = ControllerRunner(self.controller, time_scale)
         self.controller_node = ControllerNode(self.runner, config.ros, context=context)
         self.supervisor_nodes = [
             SupervisorNode(self.runner, spec.number, config.ros, context=context) for spec in config.supervisors
         ]
+        self.configuration = self.controller_node.publish_configuration(config)
         self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
         self.executor = MultiThreadedExecutor(num_threads=config.ros.executor_threads, context=context)
         for node in self.nodes:

@@ -30,7 +30,7 @@ class Collector:
             return list(self.messages)
 
 
-def test_axis_status_is_stamped_with_controller_time_at_the_status_rate(suite, probe, drive):
+def test_axis_status_is_stamped_with_anchored_controller_time_at_the_status_rate(suite, probe, drive):
     status = Collector(probe, AxisStatus, "/mpi/axis2/status")
     drive(lambda: len(status.messages) >= 5, chunk=20)
     messages = status.messages[:5]
@@ -39,7 +39,8 @@ def test_axis_status_is_stamped_with_controller_time_at_the_status_rate(suite, p
     assert [m.sample for m in messages] == list(range(messages[0].sample, messages[0].sample + 5 * every, every))
     for msg in messages:
         assert msg.number == 2 and msg.state_name == "IDLE" and msg.state == AxisStatus.STATE_IDLE
-        assert msg.stamp.sec * 1_000_000_000 + msg.stamp.nanosec == round(msg.sample * 1e9 / rate)
+        # controller time anchored to the wall clock: epoch + sample / rate
+        assert msg.stamp.sec * 1_000_000_000 + msg.stamp.nanosec == suite.epoch_ns + round(msg.sample * 1e9 / rate)
         assert msg.done and msg.in_fine_position and msg.settled and msg.amp_enabled
         assert msg.supervisor in (-1, 1)
 
@@ -67,6 +68,7 @@ def test_joint_states_report_every_axis(suite, probe, drive):
     msg = joints.messages[0]
     assert list(msg.name) == ["axis0", "axis1", "axis2", "axis3"]
     assert len(msg.position) == 4 and len(msg.velocity) == 4
+    assert list(msg.effort) == [0.0] * 4  # the servo's effort: at rest, none
 
 
 def test_diagnostics_go_to_error_on_e_stop(suite, client, probe, applied, drive):
@@ -92,8 +94,11 @@ def test_clock_follows_the_controller(suite, probe, drive):
     ticks = []
     probe.create_subscription(Clock, "/clock", ticks.append, QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT))
     drive(lambda: len(ticks) >= 3, chunk=20)
-    stamps = [t.clock.sec + t.clock.nanosec * 1e-9 for t in ticks[:3]]
-    assert stamps == sorted(stamps) and stamps[1] - stamps[0] == 1.0 / suite.config.ros.clock_rate
+    stamps = [t.clock.sec * 1_000_000_000 + t.clock.nanosec for t in ticks[:3]]
+    period = round(1e9 / suite.config.ros.clock_rate)
+    assert stamps == sorted(stamps) and stamps[1] - stamps[0] == period
+    # the same time base as every stamp: epoch + sample / rate, at whole samples
+    assert all((t - suite.epoch_ns) % round(1e9 / suite.controller.rate) == 0 for t in stamps)
 
 
 def test_axis_services_config_and_positions(suite, client, probe, service, applied, drive):
