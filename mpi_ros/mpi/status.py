@@ -26,7 +26,7 @@ velocity| < velocity tolerance for the settling time.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from enum import Enum
 
 import numpy as np
@@ -59,43 +59,23 @@ class AxisStatusBits:
 BIT_NAMES = tuple(f.name for f in fields(AxisStatusBits))
 
 
-@dataclass(slots=True)
-class SettleCounters:
-    """Consecutive samples each settling criterion has held (carried between stretches)."""
-
-    fine: int = 0
-    settled: int = 0
-    velocity: int = 0
-
-
-@dataclass(slots=True)
-class StatusContext:
-    """What the status of an axis depends on besides its trace."""
-
-    mode: StatusMode
-    target: float
-    in_position: AxisInPosition
-    sample_rate: float
-    holding: bool = False
-    plan_duration: float = 0.0  # profile time at which the trajectory completes
-    velocity_target: float | None = None  # VELOCITY moves
-    ramp_end: float = 0.0  # VELOCITY moves: profile time the ramp is done
-    has_plan: bool = False
-    ends_moving: bool = False  # a FINAL_VEL plan: its last frame goes on at the final velocity
+# The order of the bits in arrays: the six that raise events first, in the order their
+# events of one sample are emitted (as the controller has always emitted them).
+BITS = ("done", "in_fine_position", "in_coarse_position", "at_target", "settled", "at_velocity",
+        "trajectory_complete")
+EVENT_BITS = 6
+DONE, IN_FINE, IN_COARSE, AT_TARGET, SETTLED, AT_VELOCITY, TC = range(len(BITS))
+# The settling counters in arrays: run lengths of the IN_FINE, SETTLED and AT_VELOCITY criteria.
+FINE_RUN, SETTLED_RUN, VELOCITY_RUN = range(3)
 
 
-@dataclass(slots=True)
-class StatusTrace:
-    bits: dict[str, np.ndarray]
-    runs: dict[str, np.ndarray]
+def bits_of(column: np.ndarray) -> AxisStatusBits:
+    """The bits of one axis from a column of an array in :data:`BITS` order."""
+    return AxisStatusBits(**dict(zip(BITS, (bool(b) for b in column))))
 
-    def at(self, index: int) -> AxisStatusBits:
-        return AxisStatusBits(**{name: bool(arr[index]) for name, arr in self.bits.items()})
 
-    def counters_at(self, index: int) -> SettleCounters:
-        return SettleCounters(
-            int(self.runs["fine"][index]), int(self.runs["settled"][index]), int(self.runs["velocity"][index])
-        )
+def column_of(bits: AxisStatusBits) -> list[bool]:
+    return [getattr(bits, name) for name in BITS]
 
 
 def settle_samples(in_position: AxisInPosition, sample_rate: float) -> int:
@@ -103,81 +83,183 @@ def settle_samples(in_position: AxisInPosition, sample_rate: float) -> int:
     return max(0, math.ceil(in_position.settling_time * sample_rate - 1e-9)) + 1
 
 
-def run_lengths(criterion: np.ndarray, carry: int) -> np.ndarray:
-    """Length of the run of True ending at each index (continuing ``carry``)."""
-    n = len(criterion)
+def run_lengths(criterion: np.ndarray, carry: np.ndarray | int) -> np.ndarray:
+    """Length of the run of True ending at each index along the last axis (continuing
+    ``carry``, one per row)."""
+    n = criterion.shape[-1]
     index = np.arange(1, n + 1)
-    last_false = np.maximum.accumulate(np.where(criterion, 0, index))
+    last_false = np.maximum.accumulate(np.where(criterion, 0, index), axis=-1)
     runs = index - last_false
-    return np.where(last_false == 0, runs + carry, runs)
+    return np.where(last_false == 0, runs + np.asarray(carry)[..., None], runs)
 
 
-def _trajectory_complete(trace, ctx: StatusContext, stopped: np.ndarray) -> np.ndarray:
-    """TC: every frame executed (after a stop: the command has stopped)."""
-    if ctx.mode in (StatusMode.STOP, StatusMode.E_STOP):
-        return stopped
-    if ctx.holding:
-        return np.zeros(len(trace), dtype=bool)
-    if ctx.ends_moving:
-        # The last frame of a FINAL_VEL move runs on at the final velocity: it never completes.
-        return np.zeros(len(trace), dtype=bool)
-    if ctx.has_plan:
-        return trace.rel >= ctx.plan_duration
-    return np.ones(len(trace), dtype=bool)
+@dataclass(slots=True)
+class Runs:
+    """Run lengths of one settling criterion over a stretch, one row per axis. A row the
+    criterion holds throughout counts on from its carry, one it never holds is 0: only
+    the rows that change are accumulated (the costly part)."""
+
+    carry: np.ndarray  # (axes,)
+    every: np.ndarray  # (axes,) rows that hold throughout
+    mixed: np.ndarray  # indices of the rows that change
+    mixed_runs: np.ndarray  # (len(mixed), samples)
+
+    def at(self, index: int) -> np.ndarray:
+        """Every row's run length at stretch sample ``index``."""
+        out = np.where(self.every, self.carry + (index + 1), 0)
+        if len(self.mixed):
+            out[self.mixed] = self.mixed_runs[:, index]
+        return out
 
 
-def compute(trace, ctx: StatusContext, counters: SettleCounters) -> StatusTrace:
-    """Status bits of every sample of an axis trace."""
-    n = len(trace)
-    tol = ctx.in_position
-    need = settle_samples(tol, ctx.sample_rate)
-    false = np.zeros(n, dtype=bool)
-    no_runs = np.zeros(n, dtype=np.int64)
-    velocity_ok = np.abs(trace.cmd_v - trace.act_v) < tol.velocity
+def settle(criterion: np.ndarray, carry: np.ndarray, need: np.ndarray, out: np.ndarray) -> Runs:
+    """``out`` = the criterion has held for ``need`` samples (per row), and its runs."""
+    n = criterion.shape[1]
+    every = criterion.all(axis=1)
+    some = criterion.any(axis=1)
+    # A row that holds throughout has run carry + i + 1 at sample i: on from i = need - 1 - carry.
+    first = np.where(every, need - 1 - carry, n)
+    np.greater_equal(np.arange(n), first[:, None], out=out)
+    mixed = np.flatnonzero(some & ~every)
+    runs = run_lengths(criterion[mixed], carry[mixed]) if len(mixed) else np.zeros((0, n), dtype=np.int64)
+    if len(mixed):
+        out[mixed] = runs >= need[mixed, None]
+    return Runs(carry, every, mixed, runs)
+
+
+@dataclass(slots=True)
+class StatusRows:
+    """Per axis, what its status bits depend on besides the trace (spec 002's two tables,
+    see the module docstring), as columns: rebuilt for an axis when its move, mode or
+    tolerances change."""
+
+    stop: np.ndarray  # STOP or E_STOP: TC is "command velocity = 0"
+    abort: np.ndarray
+    settle_on: np.ndarray  # stop rows: settleOnStop (STOP) or settleOnEstop (E_STOP)
+    moving: np.ndarray  # POINT_TO_POINT or VELOCITY
+    velocity: np.ndarray  # a VELOCITY move
+    tc_always: np.ndarray  # no plan: the trajectory is complete
+    tc_after: np.ndarray  # profile time from which TC holds (inf: never)
+    ramp_end: np.ndarray
+    target: np.ndarray
+    at_target_ok: np.ndarray  # AT_TARGET can hold: a point-to-point move, not held
+    fine: np.ndarray
+    coarse: np.ndarray
+    velocity_tol: np.ndarray
+    need: np.ndarray  # samples a criterion must hold
+
+    @classmethod
+    def empty(cls, count: int) -> "StatusRows":
+        flags = {"stop", "abort", "settle_on", "moving", "velocity", "tc_always", "at_target_ok"}
+        return cls(**{f.name: np.zeros(count, dtype=bool if f.name in flags else
+                                       (np.int64 if f.name == "need" else float))
+                      for f in fields(cls)})
+
+    def set(self, row: int, mode: StatusMode, in_position: AxisInPosition, sample_rate: float,
+            target: float, holding: bool, plan) -> None:
+        """Row ``row`` for an axis in ``mode`` running ``plan`` (an AxisPlan or None)."""
+        stop = mode in (StatusMode.STOP, StatusMode.E_STOP)
+        velocity = plan is not None and plan.velocity_target is not None
+        # A held move has not started; the last frame of a FINAL_VEL move runs on at the
+        # final velocity: neither completes.
+        never = holding or (plan is not None and plan.final_velocity != 0.0)
+        self.stop[row] = stop
+        self.abort[row] = mode is StatusMode.ABORT
+        self.settle_on[row] = in_position.settle_on_stop if mode is StatusMode.STOP else in_position.settle_on_estop
+        self.moving[row] = moving = mode in (StatusMode.POINT_TO_POINT, StatusMode.VELOCITY)
+        self.velocity[row] = moving and velocity
+        self.tc_always[row] = not never and plan is None
+        self.tc_after[row] = plan.duration if plan is not None and not never else math.inf
+        self.ramp_end[row] = plan.ramp_end if plan is not None else 0.0
+        self.target[row] = target
+        self.at_target_ok[row] = moving and not velocity and not holding
+        self.fine[row] = in_position.position_fine
+        self.coarse[row] = in_position.position_coarse
+        self.velocity_tol[row] = in_position.velocity
+        self.need[row] = settle_samples(in_position, sample_rate)
+
+
+@dataclass(slots=True)
+class StretchStatus:
+    """The status bits of every axis at every sample of a stretch: ``bits[b, axis, i]``
+    (b in :data:`BITS` order), and the settling runs to carry on from any sample."""
+
+    bits: np.ndarray
+    runs: tuple[Runs, Runs, Runs]  # FINE_RUN, SETTLED_RUN, VELOCITY_RUN
+    _ever: dict[int, list[bool]] = field(default_factory=dict)
+
+    def ever(self, bit: int) -> list[bool]:
+        """Per axis: is ``bit`` set anywhere in the stretch? (cheap tests before a scan)"""
+        found = self._ever.get(bit)
+        if found is None:
+            found = self._ever[bit] = self.bits[bit].any(axis=1).tolist()
+        return found
+
+    def counters_at(self, index: int) -> np.ndarray:
+        """(3, axes) settling counters at stretch sample ``index``."""
+        return np.stack([r.at(index) for r in self.runs])
+
+
+def compute(trace, rows: StatusRows, counters: np.ndarray) -> StretchStatus:
+    """Status bits of every axis at every sample of a stretch (``trace`` has (axes, samples)
+    arrays cmd_p, cmd_v, act_p, act_v, rel; ``counters`` the (3, axes) carried runs)."""
+    col = _columns(rows)
+    bits = np.empty((len(BITS),) + trace.cmd_p.shape, dtype=bool)
+    velocity_ok = np.abs(trace.cmd_v - trace.act_v) < col["velocity_tol"]
     stopped = np.abs(trace.cmd_v) < _STOPPED_VELOCITY
-    tc = _trajectory_complete(trace, ctx, stopped)
+    tc = _trajectory_complete(trace.rel, stopped, col, bits[TC])
+    # Note 1: at rest on the command (SETTLED; IN_FINE after a stop with settling on).
+    at_rest = tc & stopped & (np.abs(trace.cmd_p - trace.act_p) < col["fine"]) & velocity_ok & ~col["abort"]
+    settled_runs = settle(at_rest, counters[SETTLED_RUN], rows.need, bits[SETTLED])
+    # Note 3: after a point-to-point move, distance to the target.
+    distance = np.abs(col["target"] - trace.act_p)
+    fine_runs = settle(tc & (distance < col["fine"]) & velocity_ok & col["moving"], counters[FINE_RUN],
+                       rows.need, bits[IN_FINE])
+    stop_settling = col["stop"] & col["settle_on"]
+    np.copyto(bits[IN_FINE], bits[SETTLED], where=stop_settling)
+    fine_runs = _select(rows.stop & rows.settle_on, settled_runs, fine_runs)
+    # During a velocity move (until its frame ends) IN_COARSE is FALSE; IN_FINE and DONE need TC.
+    np.logical_and(col["moving"] & (distance < col["coarse"]), tc | ~col["velocity"], out=bits[IN_COARSE])
+    ramp_done = ~tc & (trace.rel >= col["ramp_end"]) & col["velocity"]
+    velocity_runs = settle(ramp_done & velocity_ok, counters[VELOCITY_RUN], rows.need, bits[AT_VELOCITY])
+    # AT_TARGET: "TRUE when command = target" (002's table), at rest there; an axis of a
+    # SYNC_START move that arrives early is at its target while the others still move.
+    np.logical_and(col["at_target_ok"] & (trace.cmd_p == col["target"]), stopped, out=bits[AT_TARGET])
+    done = col["moving"] & tc & bits[IN_FINE]
+    done |= col["stop"] & ~col["settle_on"] & stopped
+    done |= stop_settling & bits[IN_FINE]
+    np.logical_or(done, col["abort"], out=bits[DONE])
+    return StretchStatus(bits, (fine_runs, settled_runs, velocity_runs))
 
-    # Note 1: at rest on the command (used by SETTLED, and by IN_FINE after a stop).
-    if ctx.mode is StatusMode.ABORT:
-        settled_runs = no_runs
-    else:
-        at_rest = tc & stopped & (np.abs(trace.cmd_p - trace.act_p) < tol.position_fine) & velocity_ok
-        settled_runs = run_lengths(at_rest, counters.settled)
-    settled = settled_runs >= need
-    fine_runs = vel_runs = no_runs
-    at_velocity = false
 
-    if ctx.mode is StatusMode.ABORT:
-        bits = dict(in_fine_position=false, in_coarse_position=false, at_target=false, done=~false)
-    elif ctx.mode in (StatusMode.STOP, StatusMode.E_STOP):
-        settle_on = tol.settle_on_stop if ctx.mode is StatusMode.STOP else tol.settle_on_estop
-        in_fine, fine_runs = (settled, settled_runs) if settle_on else (false, no_runs)
-        bits = dict(in_fine_position=in_fine, in_coarse_position=false, at_target=false,
-                    done=in_fine if settle_on else stopped)
-    else:
-        # Note 3: after a point-to-point move, distance to the target.
-        distance = np.abs(ctx.target - trace.act_p)
-        fine_runs = run_lengths(tc & (distance < tol.position_fine) & velocity_ok, counters.fine)
-        in_fine = fine_runs >= need
-        in_coarse = distance < tol.position_coarse
-        if ctx.velocity_target is not None:
-            # During a velocity move (until its frame ends) these bits are FALSE;
-            # IN_FINE and DONE already require TC.
-            in_coarse = in_coarse & tc
-            ramp_done = ~tc & (trace.rel >= ctx.ramp_end)
-            vel_runs = run_lengths(ramp_done & velocity_ok, counters.velocity)
-            at_velocity = vel_runs >= need
-        # AT_TARGET: "TRUE when command = target" (002's table), at rest there; an axis of a
-        # SYNC_START move that arrives early is at its target while the others still move.
-        at_target = (trace.cmd_p == ctx.target) & stopped & (not ctx.holding)
-        if ctx.velocity_target is not None:
-            at_target = false
-        bits = dict(in_fine_position=in_fine, in_coarse_position=in_coarse, at_target=at_target,
-                    done=tc & in_fine)
+def _columns(rows: StatusRows) -> dict[str, np.ndarray]:
+    return {f.name: getattr(rows, f.name)[:, None] for f in fields(rows)}
 
-    bits.update(settled=settled, at_velocity=at_velocity, trajectory_complete=tc)
-    runs = {"fine": fine_runs, "settled": settled_runs, "velocity": vel_runs}
-    return StatusTrace({k: np.asarray(v, dtype=bool) for k, v in bits.items()}, runs)
+
+def _trajectory_complete(rel: np.ndarray, stopped: np.ndarray, col: dict[str, np.ndarray],
+                         out: np.ndarray) -> np.ndarray:
+    """TC: every frame executed (after a stop: the command has stopped)."""
+    np.greater_equal(rel, col["tc_after"], out=out)
+    out |= col["tc_always"]
+    np.copyto(out, stopped, where=col["stop"])
+    return out
+
+
+def _select(rows: np.ndarray, chosen: Runs, other: Runs) -> Runs:
+    """Runs that are ``chosen``'s on ``rows`` and ``other``'s elsewhere."""
+    if not rows.any():
+        return other
+    return _PickedRuns(rows, chosen, other)
+
+
+@dataclass(slots=True)
+class _PickedRuns:
+    rows: np.ndarray
+    chosen: Runs
+    other: Runs
+
+    def at(self, index: int) -> np.ndarray:
+        return np.where(self.rows, self.chosen.at(index), self.other.at(index))
 
 
 def rising_edges(previous: bool, bits: np.ndarray) -> np.ndarray:

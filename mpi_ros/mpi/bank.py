@@ -1,0 +1,211 @@
+"""Every axis' state as arrays across axes, owned by the controller.
+
+The values at the current sample (command and actual position, velocity, acceleration,
+profile time), the status bits and the settling counters live here, one column per axis;
+an :class:`~.axis.Axis` is a view of its column plus the plan it runs. Beside them sit
+the *rows* a stretch is computed from, one per axis: the command piece and plant anchor
+in force (:class:`CommandRows`, :class:`PlantRows`), what the status bits depend on
+(:class:`~.status.StatusRows`) and each supervisor's feedrate clock (:class:`ClockRows`).
+An axis rebuilds its rows only when something they derive from changes (its plan,
+anchor, mode, owner, clock or tolerances mark them stale), so a stretch costs array
+operations across axes, not Python calls per axis.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from enum import IntEnum
+
+import numpy as np
+
+from .clock import ProfileClock
+from .plant import Transient, _FreeTable
+from .status import BITS, StatusRows
+
+_MAX_TERMS = 7  # coefficients of a piece's steady response (plant._MAX_DEGREE + 1)
+_AT_REST = 1 << 30  # settling counters of an axis that has long been at rest
+
+
+class Kind(IntEnum):
+    """How a stretch computes an axis."""
+
+    STEADY = 0  # at rest, settled on its command: every sample is the same
+    PIECE = 1  # one command piece and one plant anchor: rows of closed forms
+    SAMPLED = 2  # coasting, or the command follows the actual: one axis at a time
+
+
+def _arrays(cls, count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (), **fill: float):
+    """An instance of the row dataclass ``cls`` with every field an array of ``count``."""
+    def make(name: str) -> np.ndarray:
+        if name in ints:
+            return np.zeros(count, dtype=np.int64)
+        if name in flags:
+            return np.zeros(count, dtype=bool)
+        return np.full(count, fill.get(name, 0.0))
+    return cls(**{f.name: make(f.name) for f in fields(cls)})
+
+
+@dataclass(slots=True)
+class CommandRows:
+    """The command each axis follows. ``planned`` rows run a plan through their owner's
+    clock (index ``clock``), evaluated in the segment ``segment`` (valid while the profile
+    time stays in [seg_lo, seg_hi)); the others rest at ``rest``."""
+
+    planned: np.ndarray
+    clock: np.ndarray
+    tau_start: np.ndarray
+    duration: np.ndarray
+    target: np.ndarray
+    final_velocity: np.ndarray
+    truncated: np.ndarray  # a frame hit the 16,384,000-sample limit
+    segment: np.ndarray  # -1: none chosen yet
+    seg_lo: np.ndarray
+    seg_hi: np.ndarray
+    seg_start: np.ndarray
+    p: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    j: np.ndarray
+    rest: np.ndarray
+
+    @classmethod
+    def empty(cls, count: int) -> "CommandRows":
+        return _arrays(cls, count, ints=("clock", "segment"), flags=("planned", "truncated"))
+
+    def set_segment(self, row: int, plan, index: int) -> None:
+        """Evaluate ``row`` in segment ``index`` of ``plan``'s table (the profile times that
+        SegmentTable.index maps to it: [end of the one before, its end), open at the ends)."""
+        table = plan.table
+        self.segment[row] = index
+        self.seg_lo[row] = table.end[index - 1] if index > 0 else -math.inf
+        self.seg_hi[row] = table.end[index] if index < table.count - 1 else math.inf
+        self.seg_start[row] = table.start[index]
+        self.p[row], self.v[row], self.a[row], self.j[row] = table.p[index], table.v[index], table.a[index], table.j[index]
+
+
+@dataclass(slots=True)
+class PlantRows:
+    """The servo of each axis from the anchor of its current command piece: the steady
+    response (polynomial coefficients in time from the anchor, low first, zero-padded to
+    (axes, 7)) and the transient (plant.Transient; zero where there is none)."""
+
+    steady_y: np.ndarray
+    steady_dy: np.ndarray
+    anchor_t: np.ndarray
+    piece_end: np.ndarray  # time the command piece ends (the next breakpoint)
+    terms: np.ndarray  # coefficients in use (the longest row decides how many are evaluated)
+    k0: np.ndarray
+    v0: np.ndarray
+    v1: np.ndarray
+    m0: np.ndarray
+    m1: np.ndarray
+    decayed_after: np.ndarray  # -inf: no transient; inf: never dropped
+    table: np.ndarray  # index into AxisBank.tables
+    resolution: np.ndarray
+    snap_after: np.ndarray  # at rest: seconds past the anchor from which it snaps onto the command (Axis.commit)
+
+    @classmethod
+    def empty(cls, count: int) -> "PlantRows":
+        rows = _arrays(cls, count, ints=("terms", "k0", "table"), piece_end=math.inf, snap_after=math.inf)
+        rows.steady_y = np.zeros((count, _MAX_TERMS))
+        rows.steady_dy = np.zeros((count, _MAX_TERMS))
+        return rows
+
+    def set_steady(self, row: int, y: list[float], dy: list[float]) -> None:
+        """The steady response's coefficients (plant.Forced); rows are evaluated in groups
+        of the same length, exactly as plant.poly_eval evaluates one."""
+        self.steady_y[row] = 0.0
+        self.steady_dy[row] = 0.0
+        self.steady_y[row, :len(y)] = y
+        self.steady_dy[row, :len(dy)] = dy
+        self.terms[row] = len(y)
+
+    def set_transient(self, row: int, transient: Transient | None, table: int) -> None:
+        if transient is None:
+            self.k0[row], self.v0[row], self.v1[row], self.m0[row], self.m1[row] = 0, 0.0, 0.0, 0.0, 0.0
+            self.decayed_after[row] = -math.inf
+            return
+        self.k0[row] = transient.k0
+        self.v0[row], self.v1[row], self.m0[row], self.m1[row] = transient.v0, transient.v1, transient.m0, transient.m1
+        self.decayed_after[row] = transient.decayed_after
+        self.table[row] = table
+
+
+@dataclass(slots=True)
+class ClockRows:
+    """Each supervisor's feedrate clock (clock.ProfileClock) as columns, by supervisor number."""
+
+    t0: np.ndarray
+    tau0: np.ndarray
+    f0: np.ndarray
+    f1: np.ndarray
+    t_end: np.ndarray
+    rate: np.ndarray
+
+    @classmethod
+    def empty(cls, count: int) -> "ClockRows":
+        return _arrays(cls, count, f0=1.0, f1=1.0)
+
+    def set(self, number: int, clock: ProfileClock) -> None:
+        self.t0[number], self.tau0[number], self.t_end[number] = clock.t0, clock.tau0, clock.t_end
+        self.f0[number], self.f1[number], self.rate[number] = clock.f0, clock.f1, clock.rate
+
+    def evaluate(self, numbers: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """tau, feedrate and its slope of clocks ``numbers`` at times ``t``: (clocks, samples)
+        arrays, each element computed exactly as ProfileClock.tau and .feedrates compute it."""
+        t0, tau0, f0, f1 = (a[numbers, None] for a in (self.t0, self.tau0, self.f0, self.f1))
+        t_end, rate = self.t_end[numbers, None], self.rate[numbers, None]
+        dt = np.minimum(t, t_end) - t0
+        tau = tau0 + dt * (f0 + 0.5 * rate * dt)
+        tau += f1 * np.maximum(t - t_end, 0.0)
+        in_ramp = t < t_end
+        if not in_ramp.any():
+            return tau, np.broadcast_to(f1, tau.shape), np.zeros(tau.shape)
+        f = np.where(in_ramp, f0 + rate * (t - t0), f1)
+        return tau, f, np.where(in_ramp, rate, 0.0)
+
+
+class AxisBank:
+    """The axes' state and rows (see the module docstring), indexed by axis number."""
+
+    def __init__(self, axis_count: int, supervisor_count: int):
+        self.count = axis_count
+        # values at the controller's current sample (raw positions)
+        self.cmd_p = np.zeros(axis_count)
+        self.cmd_v = np.zeros(axis_count)
+        self.cmd_a = np.zeros(axis_count)
+        self.act_p = np.zeros(axis_count)
+        self.act_v = np.zeros(axis_count)
+        self.rel = np.full(axis_count, math.nan)  # profile time into the plan (nan without one)
+        # A new controller's axes rest settled on their command.
+        self.bits = np.ones((len(BITS), axis_count), dtype=bool)
+        self.bits[BITS.index("at_velocity")] = False
+        self.runs = np.zeros((3, axis_count), dtype=np.int64)  # status.FINE_RUN, SETTLED_RUN, VELOCITY_RUN
+        self.runs[:2] = _AT_REST
+        # rows
+        self.stale = np.ones(axis_count, dtype=bool)
+        self.kind = np.full(axis_count, Kind.SAMPLED, dtype=np.int8)
+        self.owner = np.full(axis_count, -1, dtype=np.int64)
+        self.plans: list = [None] * axis_count
+        self.command = CommandRows.empty(axis_count)
+        self.plant = PlantRows.empty(axis_count)
+        self.status = StatusRows.empty(axis_count)
+        self.clocks = ClockRows.empty(supervisor_count)
+        self.tables: list[_FreeTable] = []
+
+    def table_index(self, table: _FreeTable) -> int:
+        """A small number for a free-response table (axes with identical loops share one)."""
+        for i, known in enumerate(self.tables):
+            if known is table:
+                return i
+        self.tables.append(table)
+        return len(self.tables) - 1
+
+    def clock_changed(self, number: int, clock: ProfileClock) -> None:
+        """Supervisor ``number`` runs a new clock: its axes' pieces end here."""
+        self.clocks.set(number, clock)
+        self.stale |= self.owner == number
+
+    def reset_counters(self, row: int) -> None:
+        self.runs[:, row] = 0
