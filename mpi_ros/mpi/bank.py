@@ -152,16 +152,19 @@ class ClockRows:
         self.f0[number], self.f1[number], self.rate[number] = clock.f0, clock.f1, clock.rate
 
     def evaluate(self, numbers: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """tau, feedrate and its slope of clocks ``numbers`` at times ``t``: (clocks, samples)
-        arrays, each element computed exactly as ProfileClock.tau and .feedrates compute it."""
+        """tau, feedrate and its slope of clocks ``numbers`` at times ``t``, each element
+        computed exactly as ProfileClock.tau and .feedrates compute it: tau as (clocks,
+        samples), the feedrate and slope as (clocks, 1) columns where no clock ramps."""
         t0, tau0, f0, f1 = (a[numbers, None] for a in (self.t0, self.tau0, self.f0, self.f1))
         t_end, rate = self.t_end[numbers, None], self.rate[numbers, None]
+        if t[0] >= t_end.max():
+            # Past every ramp: min(t, t_end) is t_end and max(t - t_end, 0) is t - t_end, to the bit.
+            dt = t_end - t0
+            return tau0 + dt * (f0 + 0.5 * rate * dt) + f1 * (t - t_end), f1, np.zeros_like(f1)
         dt = np.minimum(t, t_end) - t0
         tau = tau0 + dt * (f0 + 0.5 * rate * dt)
         tau += f1 * np.maximum(t - t_end, 0.0)
         in_ramp = t < t_end
-        if not in_ramp.any():
-            return tau, np.broadcast_to(f1, tau.shape), np.zeros(tau.shape)
         f = np.where(in_ramp, f0 + rate * (t - t0), f1)
         return tau, f, np.where(in_ramp, rate, 0.0)
 

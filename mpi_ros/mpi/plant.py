@@ -309,6 +309,13 @@ class _FreeTable:
         pr, qr = _windows(self._p2, r0, n), _windows(self._q2, r0, n)
         return bp * pr + self.kappa * bq * qr, bp * qr + bq * pr
 
+    def vanished(self, m0: np.ndarray) -> np.ndarray:
+        """Per row: is Phi((m0_r + i) dt) exactly zero for every i < _TABLE? (its block
+        factor has underflowed to zeros, and so have all later ones)"""
+        blocks = m0 // _TABLE
+        self._blocks(int(blocks.max()) + 1)
+        return (blocks > 0) & (self._bp[blocks] == 0.0) & (self._bq[blocks] == 0.0)
+
     def _block_rows(self, blocks: np.ndarray, r0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         """The block factor of every count of each row: one block per row (a column),
         or, for a row that crosses into the next block, two runs of a full row."""

@@ -38,6 +38,7 @@ class Stretch:
     act_p: np.ndarray
     act_v: np.ndarray
     rel: np.ndarray  # profile time into the plan (nan without one)
+    shape: tuple[int, int] = (0, 0)
     pieces: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # rows of one piece
     traced: dict[int, AxisTrace] = field(default_factory=dict)  # axes traced one at a time
 
@@ -51,7 +52,7 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
     t = samples / rate
     shape = (bank.count, len(samples))
-    out = Stretch(samples, t, *(np.empty(shape) for _ in _VALUES))
+    out = Stretch(samples, t, *(np.empty(shape) for _ in _VALUES), shape=shape)
     _steady(bank, np.flatnonzero(bank.kind == Kind.STEADY), out)
     one_piece = (bank.kind == Kind.PIECE) & (t[-1] < bank.plant.piece_end)
     rows, fell = _command(bank, np.flatnonzero(one_piece), t, out)
@@ -92,7 +93,7 @@ def _command(bank: AxisBank, rows: np.ndarray, t: np.ndarray, out: Stretch) -> t
     kept = _planned(bank, moving, t, out)
     if len(kept) == len(moving):
         return rows, rows[:0]
-    return np.concatenate((resting, kept)), np.setdiff1d(moving, kept, assume_unique=True)
+    return np.union1d(resting, kept), np.setdiff1d(moving, kept, assume_unique=True)
 
 
 def _planned(bank: AxisBank, rows: np.ndarray, t: np.ndarray, out: Stretch) -> np.ndarray:
@@ -101,28 +102,30 @@ def _planned(bank: AxisBank, rows: np.ndarray, t: np.ndarray, out: Stretch) -> n
     cmd = bank.command
     numbers, which = np.unique(cmd.clock[rows], return_inverse=True)
     tau, f, df = bank.clocks.evaluate(numbers, t)
-    rel = tau[which] - cmd.tau_start[rows, None]
-    duration = cmd.duration[rows, None]
-    inside = np.minimum(rel, duration)
-    keep = _in_one_segment(bank, rows, inside)
+    rel = tau[which]
+    rel -= cmd.tau_start[rows, None]
+    lo, hi = rel.min(axis=1), rel.max(axis=1)
+    duration = cmd.duration[rows]
+    # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
+    keep = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
     if not keep.all():
-        rows, which, rel, duration, inside = rows[keep], which[keep], rel[keep], duration[keep], inside[keep]
-    if not len(rows):
-        return rows
-    p, dp, ddp = _segment(cmd, rows, rel, duration, inside)
+        rows, which, rel, lo, hi = rows[keep], which[keep], rel[keep], lo[keep], hi[keep]
+        if not len(rows):
+            return rows
+    p, dp, ddp = _segment(cmd, rows, rel, lo, hi)
     f, df = f[which], df[which]
-    out.cmd_p[rows] = p
-    out.cmd_v[rows] = dp * f
-    out.cmd_a[rows] = ddp * f * f + dp * df
-    out.rel[rows] = rel
+    _place(out, "cmd_p", rows, p)
+    _place(out, "cmd_v", rows, dp * f)
+    _place(out, "cmd_a", rows, ddp * f * f + dp * df)
+    _place(out, "rel", rows, rel)
     return rows
 
 
-def _in_one_segment(bank: AxisBank, rows: np.ndarray, inside: np.ndarray) -> np.ndarray:
-    """Per row: does the whole stretch fall in one segment of the plan? A row that moved
-    on to another segment gets it here (one axis at a time, only when that happens)."""
+def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Per row: does the whole stretch (profile times ``lo`` .. ``hi`` in the table) fall in
+    one segment of the plan? A row that moved on to another segment gets it here (one axis
+    at a time, only when that happens)."""
     cmd = bank.command
-    lo, hi = inside.min(axis=1), inside.max(axis=1)
     keep = (lo >= cmd.seg_lo[rows]) & (hi < cmd.seg_hi[rows])
     for i in np.flatnonzero(~keep).tolist():
         row = int(rows[i])
@@ -134,24 +137,76 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, inside: np.ndarray) -> np.
     return keep
 
 
-def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, duration: np.ndarray,
-             inside: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Position, d/dtau, d2/dtau2 of each row's segment (SegmentTable.evaluate's sums), and
-    from the plan's end on its end state (AxisPlan.evaluate)."""
-    start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
-    dt = inside - start
-    jerk = dt * j
-    pos = p + dt * (v + dt * (a / 2.0 + jerk / 6.0))
-    vel = v + dt * (a + jerk / 2.0)
-    acc = a + jerk
-    complete = rel >= duration
-    if complete.any():
+def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
+             hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position, d/dtau, d2/dtau2 of each row's plan at profile times ``rel`` (whose extremes
+    are ``lo``, ``hi``): its segment (SegmentTable.evaluate) until the plan's end, the end
+    state from there on (AxisPlan.evaluate). Velocity and acceleration may come back as
+    (rows, 1) columns, constant over the stretch."""
+    duration = cmd.duration[rows]
+    inside = rel if (hi < duration).all() else np.minimum(rel, duration[:, None])
+    linear = _linear(cmd, rows, np.minimum(lo, duration))
+    if linear.all():
+        pos, vel, acc = _linear_segment(cmd, rows, inside)
+    elif not linear.any():
+        pos, vel, acc = _cubic_segment(cmd, rows, inside)
+    else:
+        pos, vel, acc = np.empty_like(rel), np.empty_like(rel), np.empty_like(rel)
+        for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
+            pos[group], vel[group], acc[group] = evaluate(cmd, rows[group], inside[group])
+    if (hi >= duration).any():
+        duration = duration[:, None]
+        complete = rel >= duration
         target, final = cmd.target[rows, None], cmd.final_velocity[rows, None]
         extra = np.maximum(rel - duration, 0.0)
         pos = np.where(complete, target + final * extra, pos)
         vel = np.where(complete, final, vel)
         acc = np.where(complete, 0.0, acc)
     return pos, vel, acc
+
+
+def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
+    """Rows whose segment has acceleration and jerk +0.0 and whose stretch starts in it
+    (dt >= +0): SegmentTable.evaluate's sums reduce there to p + dt v' and v', v' = v + 0.0,
+    to the bit (+0 times a finite dt >= +0 is +0, and x + +0 is x but for x = -0.0)."""
+    a, j = cmd.a[rows], cmd.j[rows]
+    return (a == 0.0) & (j == 0.0) & ~np.signbit(a) & ~np.signbit(j) & (lo >= cmd.seg_start[rows])
+
+
+def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray):
+    velocity = cmd.v[rows, None] + 0.0
+    pos = inside - cmd.seg_start[rows, None]
+    pos *= velocity
+    pos += cmd.p[rows, None]
+    return pos, velocity, np.zeros_like(velocity)
+
+
+def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray):
+    """SegmentTable.evaluate's sums, operation for operation."""
+    start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
+    dt = inside - start
+    jerk = dt * j
+    pos = jerk / 6.0
+    pos += a / 2.0
+    pos *= dt
+    pos += v
+    pos *= dt
+    pos += p
+    vel = jerk / 2.0
+    vel += a
+    vel *= dt
+    vel += v
+    jerk += a
+    return pos, vel, jerk
+
+
+def _place(out: Stretch, name: str, rows: np.ndarray, values: np.ndarray) -> None:
+    """Rows (or columns, constant over the stretch) of values into the stretch; a fresh
+    full array for every axis (``rows`` are sorted) is taken as it is."""
+    if len(rows) == out.shape[0] and values.shape == out.shape:
+        setattr(out, name, values)
+    else:
+        getattr(out, name)[rows] = values
 
 
 # -- the servo ----------------------------------------------------------------------------
@@ -162,13 +217,14 @@ def _servo(bank: AxisBank, rows: np.ndarray, samples: np.ndarray, t: np.ndarray,
     plant = bank.plant
     s = t - plant.anchor_t[rows, None]
     y, dy = _steady_response(plant, rows, s)
-    _add_transient(bank, rows, samples, s, y, dy)
-    out.act_p[rows] = _read(plant.resolution[rows], y)
-    out.act_v[rows] = dy
+    y, dy = _add_transient(bank, rows, samples, s, y, dy)
+    _place(out, "act_p", rows, _read(plant.resolution[rows], y))
+    _place(out, "act_v", rows, dy)
 
 
 def _steady_response(plant: PlantRows, rows: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The steady response's polynomials, rows of the same length at once."""
+    """The steady response's polynomials, rows of the same length at once (a constant one
+    as a column)."""
     terms = plant.terms[rows]
     if (terms == terms[0]).all():
         return _steady_group(plant, rows, s, int(terms[0]))
@@ -185,35 +241,70 @@ def _steady_group(plant: PlantRows, rows: np.ndarray, s: np.ndarray, terms: int)
 
 
 def _horner(coefficients: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """plant.poly_eval, one polynomial per row (coefficients low first)."""
-    out = np.repeat(coefficients[:, -1:], s.shape[1], axis=1)
-    for k in range(coefficients.shape[1] - 2, -1, -1):
+    """plant.poly_eval, one polynomial per row (coefficients low first); a constant stays
+    a column."""
+    count = coefficients.shape[1]
+    if count == 1:
+        return coefficients.copy()
+    out = coefficients[:, -1:] * s
+    out += coefficients[:, -2, None]
+    for k in range(count - 3, -1, -1):
         out *= s
         out += coefficients[:, k, None]
     return out
 
 
 def _add_transient(bank: AxisBank, rows: np.ndarray, samples: np.ndarray, s: np.ndarray,
-                   y: np.ndarray, dy: np.ndarray) -> None:
-    """Plant.response's transient, added in place to the rows that have one."""
+                   y: np.ndarray, dy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Plant.response's transient added to the rows that have one."""
     plant = bank.plant
-    decayed = plant.decayed_after[rows]
-    has = decayed > -math.inf
-    if not has.any():
-        return
-    sub = slice(None) if has.all() else np.flatnonzero(has)
-    rows, decayed = rows[sub], decayed[sub]
+    live = _live_transients(bank, rows, int(samples[0]), y, dy)
+    if not live.any():
+        return y, dy
+    y, dy = _full(y, s.shape), _full(dy, s.shape)
+    sub = slice(None) if live.all() else np.flatnonzero(live)
+    rows, decayed = rows[sub], plant.decayed_after[rows[sub]]
     p, q = _free(bank, rows, int(samples[0]), len(samples))
-    h0 = p * plant.v0[rows, None] + q * plant.m0[rows, None]
-    h1 = p * plant.v1[rows, None] + q * plant.m1[rows, None]
+    h0 = p * plant.v0[rows, None]
+    h0 += q * plant.m0[rows, None]
+    h1 = p * plant.v1[rows, None]
+    h1 += q * plant.m1[rows, None]
     if np.isposinf(decayed).all():
         y[sub] += h0
         dy[sub] += h1
-        return
+        return y, dy
     # At rest on a constant command the transient is dropped once it has decayed.
     settled = s[sub] >= decayed[:, None]
     y[sub] = np.where(settled, y[sub], y[sub] + h0)
     dy[sub] = np.where(settled, dy[sub], dy[sub] + h1)
+    return y, dy
+
+
+def _full(values: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """``values`` as a full array of ``shape`` that may be changed in place."""
+    return values if values.shape == shape else np.broadcast_to(values, shape).copy()
+
+
+def _live_transients(bank: AxisBank, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """Per row: must its transient be added? Not without one; nor where the free response
+    has underflowed to exact zeros over the whole stretch (a long-settled loop), since
+    adding a zero changes nothing, unless a value is itself a zero (whose sign it might
+    flip): there it is added as ever."""
+    plant = bank.plant
+    live = plant.decayed_after[rows] > -math.inf
+    if not live.any():
+        return live
+    vanished = np.zeros(len(rows), dtype=bool)
+    m0 = first - plant.k0[rows]
+    tables = plant.table[rows]
+    for index in np.unique(tables[live]).tolist():
+        group = live & (tables == index)
+        vanished[group] = bank.tables[index].vanished(m0[group])
+    if vanished.any():
+        zeros = (np.broadcast_to(y, (len(rows), y.shape[1]))[vanished] == 0.0).any(axis=1)
+        zeros |= (np.broadcast_to(dy, (len(rows), dy.shape[1]))[vanished] == 0.0).any(axis=1)
+        vanished[np.flatnonzero(vanished)[zeros]] = False
+    return live & ~vanished
 
 
 def _free(bank: AxisBank, rows: np.ndarray, first: int, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -230,12 +321,21 @@ def _free(bank: AxisBank, rows: np.ndarray, first: int, n: int) -> tuple[np.ndar
 
 
 def _read(resolution: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Plant.read, one encoder per row."""
+    """Plant.read, one encoder per row (y/1.0 and x*1.0 are x to the bit: skipped)."""
     if (resolution == resolution[0]).all():
         step = float(resolution[0])
-        return np.floor(y / step + 0.5) * step if step > 0.0 else y
-    out = y.copy()
+        if step <= 0.0:
+            return y
+        if step == 1.0:
+            out = y + 0.5
+            return np.floor(out, out=out)
+        out = y / step
+        out += 0.5
+        np.floor(out, out=out)
+        out *= step
+        return out
+    out = np.broadcast_to(y, (len(resolution), y.shape[1])).copy()
     counted = np.flatnonzero(resolution > 0.0)
     step = resolution[counted, None]
-    out[counted] = np.floor(y[counted] / step + 0.5) * step
+    out[counted] = np.floor(out[counted] / step + 0.5) * step
     return out
