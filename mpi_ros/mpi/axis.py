@@ -386,6 +386,7 @@ class Axis:
         bank.stale[row] = False
         bank.plans[row] = self.plan
         bank.command.truncated[row] = self.plan is not None and self.plan.truncated
+        bank.command.duration[row] = self.plan.duration if self.plan is not None else math.inf
         bank.status.set(row, self.status_mode, self.in_position, self.rate, self.target, self.holding, self.plan)
         if self.steady(clock):
             bank.kind[row] = Kind.STEADY
@@ -421,7 +422,7 @@ class Axis:
             return
         rows.clock[row] = self.owner
         rows.tau_start[row] = self.tau_start
-        rows.duration[row], rows.target[row] = plan.duration, plan.target
+        rows.target[row] = plan.target
         rows.final_velocity[row] = plan.final_velocity
         rows.segment[row] = -1  # chosen where the profile time is, when the controller steps
         rows.seg_lo[row], rows.seg_hi[row] = math.inf, -math.inf

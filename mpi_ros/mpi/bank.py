@@ -151,16 +151,20 @@ class ClockRows:
         self.t0[number], self.tau0[number], self.t_end[number] = clock.t0, clock.tau0, clock.t_end
         self.f0[number], self.f1[number], self.rate[number] = clock.f0, clock.f1, clock.rate
 
-    def evaluate(self, numbers: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate(self, numbers: np.ndarray, t: np.ndarray, scratch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """tau, feedrate and its slope of clocks ``numbers`` at times ``t``, each element
         computed exactly as ProfileClock.tau and .feedrates compute it: tau as (clocks,
         samples), the feedrate and slope as (clocks, 1) columns where no clock ramps."""
         t0, tau0, f0, f1 = (a[numbers, None] for a in (self.t0, self.tau0, self.f0, self.f1))
         t_end, rate = self.t_end[numbers, None], self.rate[numbers, None]
         if t[0] >= t_end.max():
-            # Past every ramp: min(t, t_end) is t_end and max(t - t_end, 0) is t - t_end, to the bit.
+            # Past every ramp min(t, t_end) is t_end and max(t - t_end, 0) is t - t_end, to the
+            # bit: tau = ramp + f1 (t - t_end), the ramp's part one number per clock.
             dt = t_end - t0
-            return tau0 + dt * (f0 + 0.5 * rate * dt) + f1 * (t - t_end), f1, np.zeros_like(f1)
+            tau = np.subtract(t, t_end, out=scratch.take("tau", (len(numbers), len(t))))
+            tau *= f1
+            tau += tau0 + dt * (f0 + 0.5 * rate * dt)
+            return tau, f1, np.zeros_like(f1)
         dt = np.minimum(t, t_end) - t0
         tau = tau0 + dt * (f0 + 0.5 * rate * dt)
         tau += f1 * np.maximum(t - t_end, 0.0)
@@ -196,6 +200,22 @@ class AxisBank:
         self.status = StatusRows.empty(axis_count)
         self.clocks = ClockRows.empty(supervisor_count)
         self.tables: list[_FreeTable] = []
+        self._memo: dict = {}
+
+    def refresh(self, refresh_row) -> None:
+        """Rebuild the stale rows (``refresh_row(number)`` does one)."""
+        stale = np.flatnonzero(self.stale)
+        if len(stale):
+            self._memo.clear()
+            for row in stale.tolist():
+                refresh_row(row)
+
+    def memo(self, key, compute):
+        """A value derived from the rows, kept until one changes (``compute()`` makes it)."""
+        value = self._memo.get(key)
+        if value is None:
+            value = self._memo[key] = compute()
+        return value
 
     def table_index(self, table: _FreeTable) -> int:
         """A small number for a free-response table (axes with identical loops share one)."""
@@ -209,6 +229,7 @@ class AxisBank:
         """Supervisor ``number`` runs a new clock: its axes' pieces end here."""
         self.clocks.set(number, clock)
         self.stale |= self.owner == number
+        self._memo.clear()
 
     def reset_counters(self, row: int) -> None:
         self.runs[:, row] = 0

@@ -60,6 +60,7 @@ class Controller:
         self.rate = float(self.config.sample_rate)
         self.sample = 0
         self.bank = AxisBank(self.config.axis_count, self.config.supervisor_count)
+        self._scratch = stretches.Scratch()  # the arrays of a stretch, reused by the next one
         self.axes = [
             Axis(n, self.bank, self.rate, in_position or AxisInPosition(), plant or PlantConfig())
             for n in range(self.config.axis_count)
@@ -304,9 +305,8 @@ class Controller:
 
     def _advance(self, k1: int) -> None:
         k0 = self.sample
-        for row in np.flatnonzero(self.bank.stale).tolist():
-            self.axes[row].refresh(self._clock(self.axes[row]))
-        stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate)
+        self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])))
+        stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch)
         status = compute(stretch, self.bank.status, self.bank.runs)
         stop = len(stretch) - 1
         event_at = None
@@ -365,14 +365,12 @@ class Controller:
     def _frame_time_limits(self, stop: int, stretch: Stretch) -> list[tuple[int, int, int, MPIEventType, str]]:
         """spec 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
         ends abruptly, reported when the axis gets there."""
+        command = self.bank.command
+        rows = np.flatnonzero(command.truncated)
+        rows = rows[self.bank.rel[rows] < command.duration[rows]]  # not there yet (nan: no plan running)
+        reached = stretch.rel[rows, : stop + 1] >= command.duration[rows, None]
         found = []
-        for number in np.flatnonzero(self.bank.command.truncated).tolist():
-            axis = self.axes[number]
-            plan = axis.plan
-            if plan is None or not plan.truncated or not axis.rel < plan.duration:
-                continue
-            crossed = np.flatnonzero(stretch.rel[number, : stop + 1] >= plan.duration)
-            if len(crossed):
-                found.append((int(stretch.samples[crossed[0]]), number, -1, MPIEventType.FRAME_TIME_LIMIT,
-                              "a frame reached 16,384,000 samples: the axis stopped abruptly"))
+        for i in np.flatnonzero(reached.any(axis=1)).tolist():
+            found.append((int(stretch.samples[np.argmax(reached[i])]), int(rows[i]), -1, MPIEventType.FRAME_TIME_LIMIT,
+                          "a frame reached 16,384,000 samples: the axis stopped abruptly"))
         return found

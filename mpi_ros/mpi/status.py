@@ -104,6 +104,10 @@ class Runs:
     mixed: np.ndarray  # indices of the rows that change
     mixed_runs: np.ndarray  # (len(mixed), samples)
 
+    @classmethod
+    def never(cls, count: int) -> "Runs":
+        return cls(np.zeros(count, dtype=np.int64), np.zeros(count, dtype=bool), _NONE, _NONE)
+
     def at(self, index: int) -> np.ndarray:
         """Every row's run length at stretch sample ``index``."""
         out = np.where(self.every, self.carry + (index + 1), 0)
@@ -112,19 +116,26 @@ class Runs:
         return out
 
 
-def settle(criterion: np.ndarray, carry: np.ndarray, need: np.ndarray, out: np.ndarray) -> Runs:
-    """``out`` = the criterion has held for ``need`` samples (per row), and its runs."""
+def settle(criterion: np.ndarray | None, carry: np.ndarray, need: np.ndarray, out: np.ndarray) -> Runs:
+    """``out`` = the criterion (None: false throughout) has held for ``need`` samples (per
+    row), and its runs."""
+    if criterion is None or not criterion.any():
+        out[...] = False
+        return Runs.never(len(carry))
     n = criterion.shape[1]
     every = criterion.all(axis=1)
-    some = criterion.any(axis=1)
     # A row that holds throughout has run carry + i + 1 at sample i: on from i = need - 1 - carry.
     first = np.where(every, need - 1 - carry, n)
     np.greater_equal(np.arange(n), first[:, None], out=out)
-    mixed = np.flatnonzero(some & ~every)
-    runs = run_lengths(criterion[mixed], carry[mixed]) if len(mixed) else np.zeros((0, n), dtype=np.int64)
-    if len(mixed):
-        out[mixed] = runs >= need[mixed, None]
+    mixed = np.flatnonzero(criterion.any(axis=1) & ~every)
+    if not len(mixed):
+        return Runs(carry, every, mixed, _NONE)
+    runs = run_lengths(criterion[mixed], carry[mixed])
+    out[mixed] = runs >= need[mixed, None]
     return Runs(carry, every, mixed, runs)
+
+
+_FLAGS = ("stop", "abort", "settle_on", "moving", "velocity", "tc_always", "at_target_ok")
 
 
 @dataclass(slots=True)
@@ -135,7 +146,7 @@ class StatusRows:
 
     stop: np.ndarray  # STOP or E_STOP: TC is "command velocity = 0"
     abort: np.ndarray
-    settle_on: np.ndarray  # stop rows: settleOnStop (STOP) or settleOnEstop (E_STOP)
+    settle_on: np.ndarray  # a stop with settling: settleOnStop (STOP) or settleOnEstop (E_STOP)
     moving: np.ndarray  # POINT_TO_POINT or VELOCITY
     velocity: np.ndarray  # a VELOCITY move
     tc_always: np.ndarray  # no plan: the trajectory is complete
@@ -147,17 +158,27 @@ class StatusRows:
     coarse: np.ndarray
     velocity_tol: np.ndarray
     need: np.ndarray  # samples a criterion must hold
+    col: dict[str, np.ndarray] = field(default_factory=dict)  # (axes, 1) views of the above
+    _any: dict[str, bool] = field(default_factory=dict)  # has any row the flag? (until a row changes)
 
     @classmethod
     def empty(cls, count: int) -> "StatusRows":
-        flags = {"stop", "abort", "settle_on", "moving", "velocity", "tc_always", "at_target_ok"}
-        return cls(**{f.name: np.zeros(count, dtype=bool if f.name in flags else
-                                       (np.int64 if f.name == "need" else float))
-                      for f in fields(cls)})
+        names = [f.name for f in fields(cls) if f.name not in ("col", "_any")]
+        rows = cls(**{name: np.zeros(count, dtype=bool if name in _FLAGS else
+                                     (np.int64 if name == "need" else float)) for name in names})
+        rows.col = {name: getattr(rows, name)[:, None] for name in names}
+        return rows
+
+    def any(self, flag: str) -> bool:
+        found = self._any.get(flag)
+        if found is None:
+            found = self._any[flag] = bool(getattr(self, flag).any())
+        return found
 
     def set(self, row: int, mode: StatusMode, in_position: AxisInPosition, sample_rate: float,
             target: float, holding: bool, plan) -> None:
         """Row ``row`` for an axis in ``mode`` running ``plan`` (an AxisPlan or None)."""
+        self._any.clear()
         stop = mode in (StatusMode.STOP, StatusMode.E_STOP)
         velocity = plan is not None and plan.velocity_target is not None
         # A held move has not started; the last frame of a FINAL_VEL move runs on at the
@@ -165,7 +186,8 @@ class StatusRows:
         never = holding or (plan is not None and plan.final_velocity != 0.0)
         self.stop[row] = stop
         self.abort[row] = mode is StatusMode.ABORT
-        self.settle_on[row] = in_position.settle_on_stop if mode is StatusMode.STOP else in_position.settle_on_estop
+        self.settle_on[row] = stop and (in_position.settle_on_stop if mode is StatusMode.STOP
+                                        else in_position.settle_on_estop)
         self.moving[row] = moving = mode in (StatusMode.POINT_TO_POINT, StatusMode.VELOCITY)
         self.velocity[row] = moving and velocity
         self.tc_always[row] = not never and plan is None
@@ -185,7 +207,7 @@ class StretchStatus:
     (b in :data:`BITS` order), and the settling runs to carry on from any sample."""
 
     bits: np.ndarray
-    runs: tuple[Runs, Runs, Runs]  # FINE_RUN, SETTLED_RUN, VELOCITY_RUN
+    runs: tuple["Runs | _PickedRuns", Runs, Runs]  # FINE_RUN, SETTLED_RUN, VELOCITY_RUN
     _ever: dict[int, list[bool]] = field(default_factory=dict)
 
     def ever(self, bit: int) -> list[bool]:
@@ -202,58 +224,96 @@ class StretchStatus:
 
 def compute(trace, rows: StatusRows, counters: np.ndarray) -> StretchStatus:
     """Status bits of every axis at every sample of a stretch (``trace`` has (axes, samples)
-    arrays cmd_p, cmd_v, act_p, act_v, rel; ``counters`` the (3, axes) carried runs)."""
-    col = _columns(rows)
+    arrays cmd_p, cmd_v, act_p, act_v, rel; ``counters`` the (3, axes) carried runs). A
+    criterion that cannot hold anywhere (say, no trajectory complete) is not computed."""
+    col = rows.col
     bits = np.empty((len(BITS),) + trace.cmd_p.shape, dtype=bool)
     velocity_ok = np.abs(trace.cmd_v - trace.act_v) < col["velocity_tol"]
     stopped = np.abs(trace.cmd_v) < _STOPPED_VELOCITY
-    tc = _trajectory_complete(trace.rel, stopped, col, bits[TC])
+    tc = _trajectory_complete(trace.rel, stopped, rows, bits[TC])
+    complete = bool(tc.any())
     # Note 1: at rest on the command (SETTLED; IN_FINE after a stop with settling on).
-    at_rest = tc & stopped & (np.abs(trace.cmd_p - trace.act_p) < col["fine"]) & velocity_ok & ~col["abort"]
+    at_rest = tc & stopped if complete else None
+    if at_rest is not None and at_rest.any():
+        at_rest &= np.abs(trace.cmd_p - trace.act_p) < col["fine"]
+        at_rest &= velocity_ok
+        at_rest &= ~col["abort"]
     settled_runs = settle(at_rest, counters[SETTLED_RUN], rows.need, bits[SETTLED])
-    # Note 3: after a point-to-point move, distance to the target.
-    distance = np.abs(col["target"] - trace.act_p)
-    fine_runs = settle(tc & (distance < col["fine"]) & velocity_ok & col["moving"], counters[FINE_RUN],
-                       rows.need, bits[IN_FINE])
-    stop_settling = col["stop"] & col["settle_on"]
-    np.copyto(bits[IN_FINE], bits[SETTLED], where=stop_settling)
-    fine_runs = _select(rows.stop & rows.settle_on, settled_runs, fine_runs)
-    # During a velocity move (until its frame ends) IN_COARSE is FALSE; IN_FINE and DONE need TC.
-    np.logical_and(col["moving"] & (distance < col["coarse"]), tc | ~col["velocity"], out=bits[IN_COARSE])
-    ramp_done = ~tc & (trace.rel >= col["ramp_end"]) & col["velocity"]
-    velocity_runs = settle(ramp_done & velocity_ok, counters[VELOCITY_RUN], rows.need, bits[AT_VELOCITY])
+    fine_runs = _in_position(trace, rows, tc, complete, velocity_ok, counters, bits)
+    if rows.any("settle_on"):
+        # After a stop with settling on, IN_FINE is the note-1 criterion.
+        np.copyto(bits[IN_FINE], bits[SETTLED], where=rows.col["settle_on"])
+        fine_runs = _PickedRuns(rows.settle_on, settled_runs, fine_runs)
+    velocity_runs = _at_velocity(trace, rows, tc, velocity_ok, counters, bits)
     # AT_TARGET: "TRUE when command = target" (002's table), at rest there; an axis of a
     # SYNC_START move that arrives early is at its target while the others still move.
-    np.logical_and(col["at_target_ok"] & (trace.cmd_p == col["target"]), stopped, out=bits[AT_TARGET])
-    done = col["moving"] & tc & bits[IN_FINE]
-    done |= col["stop"] & ~col["settle_on"] & stopped
-    done |= stop_settling & bits[IN_FINE]
-    np.logical_or(done, col["abort"], out=bits[DONE])
+    if rows.any("at_target_ok"):
+        np.logical_and(col["at_target_ok"] & (trace.cmd_p == col["target"]), stopped, out=bits[AT_TARGET])
+    else:
+        bits[AT_TARGET] = False
+    _done(rows, tc, stopped, bits)
     return StretchStatus(bits, (fine_runs, settled_runs, velocity_runs))
 
 
-def _columns(rows: StatusRows) -> dict[str, np.ndarray]:
-    return {f.name: getattr(rows, f.name)[:, None] for f in fields(rows)}
-
-
-def _trajectory_complete(rel: np.ndarray, stopped: np.ndarray, col: dict[str, np.ndarray],
-                         out: np.ndarray) -> np.ndarray:
+def _trajectory_complete(rel: np.ndarray, stopped: np.ndarray, rows: StatusRows, out: np.ndarray) -> np.ndarray:
     """TC: every frame executed (after a stop: the command has stopped)."""
-    np.greater_equal(rel, col["tc_after"], out=out)
-    out |= col["tc_always"]
-    np.copyto(out, stopped, where=col["stop"])
+    np.greater_equal(rel, rows.col["tc_after"], out=out)
+    if rows.any("tc_always"):
+        out |= rows.col["tc_always"]
+    if rows.any("stop"):
+        np.copyto(out, stopped, where=rows.col["stop"])
     return out
 
 
-def _select(rows: np.ndarray, chosen: Runs, other: Runs) -> Runs:
-    """Runs that are ``chosen``'s on ``rows`` and ``other``'s elsewhere."""
-    if not rows.any():
-        return other
-    return _PickedRuns(rows, chosen, other)
+def _in_position(trace, rows: StatusRows, tc: np.ndarray, complete: bool, velocity_ok: np.ndarray,
+                 counters: np.ndarray, bits: np.ndarray) -> Runs:
+    """Note 3 (after a point-to-point move, distance to the target): IN_FINE and
+    IN_COARSE, which during a velocity move (until its frame ends) are FALSE."""
+    col = rows.col
+    coarse_possible = complete or bool((rows.moving & ~rows.velocity).any())
+    distance = np.abs(col["target"] - trace.act_p) if coarse_possible else None
+    fine = None
+    if complete:
+        fine = tc & (distance < col["fine"])
+        fine &= velocity_ok
+        fine &= col["moving"]
+    runs = settle(fine, counters[FINE_RUN], rows.need, bits[IN_FINE])
+    if coarse_possible:
+        np.logical_and(col["moving"] & (distance < col["coarse"]), tc | ~col["velocity"], out=bits[IN_COARSE])
+    else:
+        bits[IN_COARSE] = False
+    return runs
+
+
+def _at_velocity(trace, rows: StatusRows, tc: np.ndarray, velocity_ok: np.ndarray, counters: np.ndarray,
+                 bits: np.ndarray) -> Runs:
+    """AT_VELOCITY (velocity moves): the ramp done, at the velocity for the settling time."""
+    ramp_done = None
+    if rows.any("velocity"):
+        ramp_done = trace.rel >= rows.col["ramp_end"]
+        ramp_done &= ~tc
+        ramp_done &= velocity_ok
+        ramp_done &= rows.col["velocity"]
+    return settle(ramp_done, counters[VELOCITY_RUN], rows.need, bits[AT_VELOCITY])
+
+
+def _done(rows: StatusRows, tc: np.ndarray, stopped: np.ndarray, bits: np.ndarray) -> None:
+    """DONE: TC and IN_FINE after a move; after a stop, command velocity = 0 (or, settling
+    on, IN_FINE); always after ABORT."""
+    col = rows.col
+    done = np.logical_and(tc, bits[IN_FINE], out=bits[DONE])
+    done &= col["moving"]
+    if rows.any("stop"):
+        done |= col["stop"] & ~col["settle_on"] & stopped
+        done |= col["settle_on"] & bits[IN_FINE]
+    if rows.any("abort"):
+        done |= col["abort"]
 
 
 @dataclass(slots=True)
 class _PickedRuns:
+    """Runs that are ``chosen``'s on ``rows`` and ``other``'s elsewhere."""
+
     rows: np.ndarray
     chosen: Runs
     other: Runs

@@ -6,9 +6,12 @@ anchor hold over the whole stretch (nearly every axis, nearly always) is one row
 closed forms evaluated together with the others (its supervisor's feedrate clock, the
 constant-jerk segment, the servo's steady response and transient); the rest (coasting,
 command following the actual, a breakpoint inside the stretch) are traced one axis at a
-time (Axis.trace). Every element is computed by the same operations, in the same order,
-as the one-axis code computes it, so a value never depends on which way it was computed,
-and so never on how the samples were batched.
+time (Axis.trace). Every element is computed by the same operations as the one-axis code
+computes it, or by fewer that give the same bits (each such shortcut says why), so a
+value never depends on which way it was computed, and so never on how the samples were
+batched.
+
+The arrays live in a :class:`Scratch` and are reused by the next stretch.
 """
 
 from __future__ import annotations
@@ -26,6 +29,24 @@ from .clock import ProfileClock
 _VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")
 
 
+class Scratch:
+    """Arrays by name, reused from stretch to stretch. A fresh array of a megabyte (32 axes
+    x 4096 samples) costs its page faults every time (the allocator hands large blocks
+    back to the system), more than the arithmetic done on it."""
+
+    def __init__(self) -> None:
+        self._buffers: dict[tuple[str, type], np.ndarray] = {}
+
+    def take(self, name: str, shape: tuple[int, ...], dtype: type = float) -> np.ndarray:
+        """A (view of an) array of ``shape``, valid until ``name`` is taken again."""
+        buffer = self._buffers.get((name, dtype))
+        if buffer is None or buffer.ndim != len(shape) or any(b < s for b, s in zip(buffer.shape, shape)):
+            grown = shape if buffer is None or buffer.ndim != len(shape) else \
+                tuple(max(b, s) for b, s in zip(buffer.shape, shape))
+            buffer = self._buffers[(name, dtype)] = np.empty(grown, dtype=dtype)
+        return buffer[tuple(slice(0, s) for s in shape)]
+
+
 @dataclass(slots=True)
 class Stretch:
     """Every sample of one stretch of every axis (raw positions), ``values[axis, i]``."""
@@ -38,27 +59,59 @@ class Stretch:
     act_p: np.ndarray
     act_v: np.ndarray
     rel: np.ndarray  # profile time into the plan (nan without one)
-    shape: tuple[int, int] = (0, 0)
+    scratch: Scratch
     pieces: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # rows of one piece
     traced: dict[int, AxisTrace] = field(default_factory=dict)  # axes traced one at a time
 
     def __len__(self) -> int:
         return len(self.samples)
 
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.cmd_p.shape
+
+    def into(self, name: str, rows: np.ndarray) -> np.ndarray | None:
+        """The array ``name`` to compute ``rows`` in directly: all of it when the rows are
+        every axis (sorted, as they always are), else None (a temporary, then :meth:`place`)."""
+        return getattr(self, name) if len(rows) == self.shape[0] else None
+
+    def place(self, name: str, rows: np.ndarray, values: np.ndarray) -> None:
+        """``values`` (rows, or (rows, 1) columns constant over the stretch) into ``name``."""
+        array = getattr(self, name)
+        if values is not array:
+            array[rows] = values
+
+    def temporary(self, name: str, rows: np.ndarray) -> np.ndarray:
+        """A scratch (rows, samples) array (never one of the stretch's own)."""
+        return self.scratch.take("~" + name, (len(rows), len(self.samples)))
+
+    def target(self, name: str, rows: np.ndarray) -> np.ndarray:
+        """Where to compute ``name`` of ``rows``: :meth:`into` it, else a temporary."""
+        into = self.into(name, rows)
+        return into if into is not None else self.temporary(name, rows)
+
+    def into_if_full(self, name: str, rows: np.ndarray, *operands: np.ndarray) -> np.ndarray | None:
+        """:meth:`into`, when ``operands`` broadcast to (rows, samples) (not to columns)."""
+        if np.broadcast_shapes(*(x.shape for x in operands))[1] == 1:
+            return None
+        return self.into(name, rows)
+
 
 def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileClock | None],
-          k0: int, k1: int, rate: float) -> Stretch:
+          k0: int, k1: int, rate: float, scratch: Scratch) -> Stretch:
     """Samples k0+1 .. k1 of every axis, from the bank's (fresh) rows; changes nothing."""
     samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
     t = samples / rate
     shape = (bank.count, len(samples))
-    out = Stretch(samples, t, *(np.empty(shape) for _ in _VALUES), shape=shape)
+    out = Stretch(samples, t, *(scratch.take(name, shape) for name in _VALUES), scratch=scratch)
     _steady(bank, np.flatnonzero(bank.kind == Kind.STEADY), out)
     one_piece = (bank.kind == Kind.PIECE) & (t[-1] < bank.plant.piece_end)
-    rows, fell = _command(bank, np.flatnonzero(one_piece), t, out)
-    _servo(bank, rows, samples, t, out)
+    rows, fell = _command(bank, np.flatnonzero(one_piece), out)
+    _servo(bank, rows, out)
     out.pieces = rows
-    traced = np.union1d(np.flatnonzero((bank.kind != Kind.STEADY) & ~one_piece), fell)
+    traced = np.flatnonzero((bank.kind != Kind.STEADY) & ~one_piece)
+    if len(fell):
+        traced = np.union1d(traced, fell)
     for row in traced.tolist():
         axis = axes[row]
         out.traced[row] = one = axis.trace(k0, k1, clock_of(axis))
@@ -79,7 +132,7 @@ def _steady(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
 
 
 # -- the command ------------------------------------------------------------------------
-def _command(bank: AxisBank, rows: np.ndarray, t: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
+def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
     """Command of ``rows``; returns (rows done, rows whose segment changes inside the stretch)."""
     planned = bank.command.planned[rows]
     resting = rows[~planned]
@@ -90,19 +143,19 @@ def _command(bank: AxisBank, rows: np.ndarray, t: np.ndarray, out: Stretch) -> t
     if not planned.any():
         return rows, rows[:0]
     moving = rows[planned]
-    kept = _planned(bank, moving, t, out)
+    kept = _planned(bank, moving, out)
     if len(kept) == len(moving):
         return rows, rows[:0]
     return np.union1d(resting, kept), np.setdiff1d(moving, kept, assume_unique=True)
 
 
-def _planned(bank: AxisBank, rows: np.ndarray, t: np.ndarray, out: Stretch) -> np.ndarray:
+def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> np.ndarray:
     """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate),
     for the rows that stay in one segment; returns those rows."""
     cmd = bank.command
-    numbers, which = np.unique(cmd.clock[rows], return_inverse=True)
-    tau, f, df = bank.clocks.evaluate(numbers, t)
-    rel = tau[which]
+    numbers, which = bank.memo(("clocks", rows.tobytes()), lambda: np.unique(cmd.clock[rows], return_inverse=True))
+    tau, f, df = bank.clocks.evaluate(numbers, out.t, out.scratch)
+    rel = np.take(tau, which, axis=0, out=out.target("rel", rows))
     rel -= cmd.tau_start[rows, None]
     lo, hi = rel.min(axis=1), rel.max(axis=1)
     duration = cmd.duration[rows]
@@ -112,12 +165,16 @@ def _planned(bank: AxisBank, rows: np.ndarray, t: np.ndarray, out: Stretch) -> n
         rows, which, rel, lo, hi = rows[keep], which[keep], rel[keep], lo[keep], hi[keep]
         if not len(rows):
             return rows
-    p, dp, ddp = _segment(cmd, rows, rel, lo, hi)
+    p, dp, ddp = _segment(cmd, rows, rel, lo, hi, out)
     f, df = f[which], df[which]
-    _place(out, "cmd_p", rows, p)
-    _place(out, "cmd_v", rows, dp * f)
-    _place(out, "cmd_a", rows, ddp * f * f + dp * df)
-    _place(out, "rel", rows, rel)
+    out.place("cmd_p", rows, p)
+    out.place("cmd_v", rows, np.multiply(dp, f, out=out.into_if_full("cmd_v", rows, dp, f)))
+    # ddp f f + dp df; dp and ddp are both columns or both full, f and df likewise.
+    acceleration = np.multiply(ddp, f, out=out.into_if_full("cmd_a", rows, ddp, f))
+    acceleration *= f
+    acceleration += dp * df
+    out.place("cmd_a", rows, acceleration)
+    out.place("rel", rows, rel)
     return rows
 
 
@@ -137,8 +194,8 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     return keep
 
 
-def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
-             hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+             out: Stretch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, d/dtau, d2/dtau2 of each row's plan at profile times ``rel`` (whose extremes
     are ``lo``, ``hi``): its segment (SegmentTable.evaluate) until the plan's end, the end
     state from there on (AxisPlan.evaluate). Velocity and acceleration may come back as
@@ -146,14 +203,15 @@ def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray
     duration = cmd.duration[rows]
     inside = rel if (hi < duration).all() else np.minimum(rel, duration[:, None])
     linear = _linear(cmd, rows, np.minimum(lo, duration))
+    position = out.into("cmd_p", rows)
     if linear.all():
-        pos, vel, acc = _linear_segment(cmd, rows, inside)
+        pos, vel, acc = _linear_segment(cmd, rows, inside, position)
     elif not linear.any():
-        pos, vel, acc = _cubic_segment(cmd, rows, inside)
+        pos, vel, acc = _cubic_segment(cmd, rows, inside, position)
     else:
         pos, vel, acc = np.empty_like(rel), np.empty_like(rel), np.empty_like(rel)
         for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
-            pos[group], vel[group], acc[group] = evaluate(cmd, rows[group], inside[group])
+            pos[group], vel[group], acc[group] = evaluate(cmd, rows[group], inside[group], None)
     if (hi >= duration).any():
         duration = duration[:, None]
         complete = rel >= duration
@@ -173,20 +231,20 @@ def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
     return (a == 0.0) & (j == 0.0) & ~np.signbit(a) & ~np.signbit(j) & (lo >= cmd.seg_start[rows])
 
 
-def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray):
+def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray, into: np.ndarray | None):
     velocity = cmd.v[rows, None] + 0.0
-    pos = inside - cmd.seg_start[rows, None]
+    pos = np.subtract(inside, cmd.seg_start[rows, None], out=into)
     pos *= velocity
     pos += cmd.p[rows, None]
     return pos, velocity, np.zeros_like(velocity)
 
 
-def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray):
-    """SegmentTable.evaluate's sums, operation for operation."""
+def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray, into: np.ndarray | None):
+    """SegmentTable.evaluate's sums, operation for operation (x + y and x y commute)."""
     start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
     dt = inside - start
     jerk = dt * j
-    pos = jerk / 6.0
+    pos = np.divide(jerk, 6.0, out=into)
     pos += a / 2.0
     pos *= dt
     pos += v
@@ -200,53 +258,45 @@ def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray):
     return pos, vel, jerk
 
 
-def _place(out: Stretch, name: str, rows: np.ndarray, values: np.ndarray) -> None:
-    """Rows (or columns, constant over the stretch) of values into the stretch; a fresh
-    full array for every axis (``rows`` are sorted) is taken as it is."""
-    if len(rows) == out.shape[0] and values.shape == out.shape:
-        setattr(out, name, values)
-    else:
-        getattr(out, name)[rows] = values
-
-
 # -- the servo ----------------------------------------------------------------------------
-def _servo(bank: AxisBank, rows: np.ndarray, samples: np.ndarray, t: np.ndarray, out: Stretch) -> None:
+def _servo(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
     """Actual position and velocity of ``rows`` from their anchors (Plant.response, read)."""
     if not len(rows):
         return
     plant = bank.plant
-    s = t - plant.anchor_t[rows, None]
-    y, dy = _steady_response(plant, rows, s)
-    y, dy = _add_transient(bank, rows, samples, s, y, dy)
-    _place(out, "act_p", rows, _read(plant.resolution[rows], y))
-    _place(out, "act_v", rows, dy)
+    s = np.subtract(out.t, plant.anchor_t[rows, None], out=out.temporary("s", rows))
+    y, dy = _steady_response(plant, rows, s, out)
+    y, dy = _add_transient(bank, rows, s, y, dy, out)
+    out.place("act_p", rows, _read(plant.resolution[rows], y, out.into("act_p", rows)))
+    out.place("act_v", rows, dy)
 
 
-def _steady_response(plant: PlantRows, rows: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _steady_response(plant: PlantRows, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
     """The steady response's polynomials, rows of the same length at once (a constant one
     as a column)."""
     terms = plant.terms[rows]
     if (terms == terms[0]).all():
-        return _steady_group(plant, rows, s, int(terms[0]))
+        return _steady_group(plant, rows, s, int(terms[0]), out.temporary("y", rows))
     y, dy = np.empty_like(s), np.empty_like(s)
     for count in np.unique(terms).tolist():
         group = np.flatnonzero(terms == count)
-        y[group], dy[group] = _steady_group(plant, rows[group], s[group], count)
+        y[group], dy[group] = _steady_group(plant, rows[group], s[group], count, None)
     return y, dy
 
 
-def _steady_group(plant: PlantRows, rows: np.ndarray, s: np.ndarray, terms: int) -> tuple[np.ndarray, np.ndarray]:
-    return (_horner(plant.steady_y[rows, :terms], s),
-            _horner(plant.steady_dy[rows, :max(1, terms - 1)], s))
+def _steady_group(plant: PlantRows, rows: np.ndarray, s: np.ndarray, terms: int,
+                  into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    return (_horner(plant.steady_y[rows, :terms], s, into),
+            _horner(plant.steady_dy[rows, :max(1, terms - 1)], s, None))
 
 
-def _horner(coefficients: np.ndarray, s: np.ndarray) -> np.ndarray:
+def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) -> np.ndarray:
     """plant.poly_eval, one polynomial per row (coefficients low first); a constant stays
     a column."""
     count = coefficients.shape[1]
     if count == 1:
         return coefficients.copy()
-    out = coefficients[:, -1:] * s
+    out = np.multiply(coefficients[:, -1:], s, out=into)
     out += coefficients[:, -2, None]
     for k in range(count - 3, -1, -1):
         out *= s
@@ -254,17 +304,18 @@ def _horner(coefficients: np.ndarray, s: np.ndarray) -> np.ndarray:
     return out
 
 
-def _add_transient(bank: AxisBank, rows: np.ndarray, samples: np.ndarray, s: np.ndarray,
-                   y: np.ndarray, dy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _add_transient(bank: AxisBank, rows: np.ndarray, s: np.ndarray, y: np.ndarray, dy: np.ndarray,
+                   out: Stretch) -> tuple[np.ndarray, np.ndarray]:
     """Plant.response's transient added to the rows that have one."""
     plant = bank.plant
-    live = _live_transients(bank, rows, int(samples[0]), y, dy)
+    first, n = int(out.samples[0]), len(out.samples)
+    live = _live_transients(bank, rows, first, y, dy, out)
     if not live.any():
         return y, dy
     y, dy = _full(y, s.shape), _full(dy, s.shape)
     sub = slice(None) if live.all() else np.flatnonzero(live)
     rows, decayed = rows[sub], plant.decayed_after[rows[sub]]
-    p, q = _free(bank, rows, int(samples[0]), len(samples))
+    p, q = _free(bank, rows, first, n)
     h0 = p * plant.v0[rows, None]
     h0 += q * plant.m0[rows, None]
     h1 = p * plant.v1[rows, None]
@@ -285,7 +336,8 @@ def _full(values: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
     return values if values.shape == shape else np.broadcast_to(values, shape).copy()
 
 
-def _live_transients(bank: AxisBank, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+def _live_transients(bank: AxisBank, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray,
+                     out: Stretch) -> np.ndarray:
     """Per row: must its transient be added? Not without one; nor where the free response
     has underflowed to exact zeros over the whole stretch (a long-settled loop), since
     adding a zero changes nothing, unless a value is itself a zero (whose sign it might
@@ -294,17 +346,26 @@ def _live_transients(bank: AxisBank, rows: np.ndarray, first: int, y: np.ndarray
     live = plant.decayed_after[rows] > -math.inf
     if not live.any():
         return live
-    vanished = np.zeros(len(rows), dtype=bool)
     m0 = first - plant.k0[rows]
     tables = plant.table[rows]
-    for index in np.unique(tables[live]).tolist():
-        group = live & (tables == index)
-        vanished[group] = bank.tables[index].vanished(m0[group])
+    if (tables == tables[0]).all():
+        vanished = live & bank.tables[int(tables[0])].vanished(m0)
+    else:
+        vanished = np.zeros(len(rows), dtype=bool)
+        for index in np.unique(tables[live]).tolist():
+            group = live & (tables == index)
+            vanished[group] = bank.tables[index].vanished(m0[group])
     if vanished.any():
-        zeros = (np.broadcast_to(y, (len(rows), y.shape[1]))[vanished] == 0.0).any(axis=1)
-        zeros |= (np.broadcast_to(dy, (len(rows), dy.shape[1]))[vanished] == 0.0).any(axis=1)
-        vanished[np.flatnonzero(vanished)[zeros]] = False
+        vanished &= ~(_has_zero(y, vanished, out) | _has_zero(dy, vanished, out))
     return live & ~vanished
+
+
+def _has_zero(values: np.ndarray, rows: np.ndarray, out: Stretch) -> np.ndarray:
+    """Per row (False where ``rows`` is not set): does it hold a zero?"""
+    if values.shape[1] == 1:
+        return rows & (values[:, 0] == 0.0)
+    zero = np.equal(values, 0.0, out=out.scratch.take("zero", values.shape, bool))
+    return rows & zero.any(axis=1)
 
 
 def _free(bank: AxisBank, rows: np.ndarray, first: int, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -320,21 +381,21 @@ def _free(bank: AxisBank, rows: np.ndarray, first: int, n: int) -> tuple[np.ndar
     return p, q
 
 
-def _read(resolution: np.ndarray, y: np.ndarray) -> np.ndarray:
+def _read(resolution: np.ndarray, y: np.ndarray, into: np.ndarray | None) -> np.ndarray:
     """Plant.read, one encoder per row (y/1.0 and x*1.0 are x to the bit: skipped)."""
     if (resolution == resolution[0]).all():
         step = float(resolution[0])
         if step <= 0.0:
             return y
         if step == 1.0:
-            out = y + 0.5
+            out = np.add(y, 0.5, out=into if y.shape[1] > 1 else None)
             return np.floor(out, out=out)
-        out = y / step
+        out = np.divide(y, step, out=into if y.shape[1] > 1 else None)
         out += 0.5
         np.floor(out, out=out)
         out *= step
         return out
-    out = np.broadcast_to(y, (len(resolution), y.shape[1])).copy()
+    out = _full(y, (len(resolution), y.shape[1])).copy()
     counted = np.flatnonzero(resolution > 0.0)
     step = resolution[counted, None]
     out[counted] = np.floor(out[counted] / step + 0.5) * step

@@ -47,35 +47,31 @@ class SteppingMixin:
 
     def _scan_move(self, stretch, status, conditions: dict) -> None:
         """A move done; a velocity move at its velocity."""
-        axes = [plan.axis for plan in self.current.plans]
+        move = self.current
         # A move that ends moving (FINAL_VEL) is never DONE: the next appended move takes
         # over at its trajectory's end; with none, the axes go on at the final velocity
         # (MOVING) until a modify, an append or a stop.
-        ends_moving = self._ends_moving()
-        if ends_moving and self.queue:
-            conditions["move_done"] = np.logical_and.reduce(
-                [stretch.rel[plan.axis] >= plan.duration for plan in self.current.plans])
-        elif not ends_moving:
-            together = self._together(status, DONE, axes)
-            if together is not None:
-                conditions["move_done"] = together
-        if self.current.is_velocity and not self._at_velocity_sent:
+        if move.ends_moving:
+            if self.queue:
+                conditions["move_done"] = np.logical_and.reduce(
+                    [stretch.rel[plan.axis] >= plan.duration for plan in move.plans])
+        else:
+            self._all_axes(conditions, "move_done", status, DONE)
+        if move.is_velocity and not self._at_velocity_sent:
             # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
-            together = self._together(status, AT_VELOCITY, axes)
-            if together is not None:
-                conditions["at_velocity"] = together
+            self._all_axes(conditions, "at_velocity", status, AT_VELOCITY)
 
-    @staticmethod
-    def _together(status, bit: int, axes: list[int]) -> np.ndarray | None:
-        """Per sample: is ``bit`` set on every axis of ``axes``? (None: on no sample)"""
+    def _all_axes(self, conditions: dict, key: str, status, bit: int) -> None:
+        """``conditions[key]``: per sample, is ``bit`` set on every axis of the current move?
+        (left out where it never is: an axis without it anywhere in the stretch)"""
         ever = status.ever(bit)
-        if not all(ever[n] for n in axes):
-            return None
-        return np.logical_and.reduce(status.bits[bit, axes], axis=0)
+        axes = [plan.axis for plan in self.current.plans]
+        if all(ever[n] for n in axes):
+            conditions[key] = np.logical_and.reduce(status.bits[bit, axes], axis=0)
 
     def _ends_moving(self) -> bool:
         """The current move ends at its target with a velocity (FINAL_VEL)."""
-        return self.current is not None and any(p.final_velocity != 0.0 for p in self.current.plans)
+        return self.current is not None and self.current.ends_moving
 
     def cruising(self) -> bool:
         """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
