@@ -307,7 +307,7 @@ class Controller:
         k0 = self.sample
         self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])))
         stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch)
-        status = compute(stretch, self.bank.status, self.bank.runs)
+        status = compute(stretch, self.bank.status, self.bank.runs, self._scratch)
         stop = len(stretch) - 1
         event_at = None
         supervisors = self.supervisors

@@ -296,18 +296,26 @@ class _FreeTable:
         pr, qr = self.p[r], self.q[r]
         return bp * pr + self.kappa * bq * qr, bp * qr + bq * pr
 
-    def window(self, m0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    def window(self, m0: np.ndarray, n: int, scratch=None) -> tuple[np.ndarray, np.ndarray]:
         """(p, q) of Phi((m0_r + i) dt) for rows r and 0 <= i < n <= _TABLE: for each row
         what :meth:`at` gives for m0_r + arange(n). Rows read the table directly while
         every count stays below _TABLE, else as blocks x remainders; the two agree where
-        both apply (block 0 is exactly Phi(0) = I), so any mix of rows is exact."""
+        both apply (block 0 is exactly Phi(0) = I), so any mix of rows is exact. The
+        arrays come from ``scratch`` (stretch.Scratch) if given."""
+        def take(name: str) -> np.ndarray | None:
+            return None if scratch is None else scratch.take("free." + name, (len(m0), n))
         if int(m0.max()) + n <= _TABLE:
-            return _windows(self.p, m0, n), _windows(self.q, m0, n)
+            return _windows(self.p, m0, n, take("p")), _windows(self.q, m0, n, take("q"))
         blocks, r0 = np.divmod(m0, _TABLE)
         self._blocks(int(blocks.max()) + 1)
         bp, bq = self._block_rows(blocks, r0, n)
-        pr, qr = _windows(self._p2, r0, n), _windows(self._q2, r0, n)
-        return bp * pr + self.kappa * bq * qr, bp * qr + bq * pr
+        pr, qr = _windows(self._p2, r0, n, take("pr")), _windows(self._q2, r0, n, take("qr"))
+        # bp pr + kappa bq qr and bp qr + bq pr, as `at` sums them
+        p = np.multiply(bp, pr, out=take("p"))
+        p += np.multiply(self.kappa * bq, qr, out=take("product"))
+        q = np.multiply(bp, qr, out=take("q"))
+        q += np.multiply(bq, pr, out=take("product"))
+        return p, q
 
     def vanished(self, m0: np.ndarray) -> np.ndarray:
         """Per row: is Phi((m0_r + i) dt) exactly zero for every i < _TABLE? (its block
@@ -338,9 +346,19 @@ class _FreeTable:
         return np.array(self.block_k)[n] * self.k[r]
 
 
-def _windows(table: np.ndarray, starts: np.ndarray, n: int) -> np.ndarray:
-    """Rows table[s : s + n] for each start s (copies of contiguous runs)."""
-    return sliding_window_view(table, n)[starts]
+def _windows(table: np.ndarray, starts: np.ndarray, n: int, out: np.ndarray | None = None) -> np.ndarray:
+    """Rows table[s : s + n] for each start s (copies of contiguous runs), into ``out`` if
+    given. Long rows are copied one by one: np.take would first copy the whole (virtual)
+    window view."""
+    if out is None or n < 256:
+        windows = sliding_window_view(table, n)[starts]
+        if out is None:
+            return windows
+        out[...] = windows
+        return out
+    for row, start in enumerate(starts.tolist()):
+        out[row] = table[start:start + n]
+    return out
 
 
 def _poly_eval_scalar(c: list[float], s: float) -> float:

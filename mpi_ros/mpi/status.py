@@ -222,33 +222,54 @@ class StretchStatus:
         return np.stack([r.at(index) for r in self.runs])
 
 
-def compute(trace, rows: StatusRows, counters: np.ndarray) -> StretchStatus:
+class _Arrays:
+    """Named scratch arrays of a stretch's shape (stretch.Scratch), reused by the next one."""
+
+    def __init__(self, scratch, shape: tuple[int, int]):
+        self.scratch, self.shape = scratch, shape
+
+    def real(self, name: str) -> np.ndarray:
+        return self.scratch.take("status." + name, self.shape)
+
+    def flag(self, name: str) -> np.ndarray:
+        return self.scratch.take("status." + name, self.shape, bool)
+
+    def absolute_difference(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        difference = np.subtract(a, b, out=self.real("difference"))
+        return np.abs(difference, out=difference)
+
+
+def compute(trace, rows: StatusRows, counters: np.ndarray, scratch) -> StretchStatus:
     """Status bits of every axis at every sample of a stretch (``trace`` has (axes, samples)
     arrays cmd_p, cmd_v, act_p, act_v, rel; ``counters`` the (3, axes) carried runs). A
     criterion that cannot hold anywhere (say, no trajectory complete) is not computed."""
     col = rows.col
-    bits = np.empty((len(BITS),) + trace.cmd_p.shape, dtype=bool)
-    velocity_ok = np.abs(trace.cmd_v - trace.act_v) < col["velocity_tol"]
-    stopped = np.abs(trace.cmd_v) < _STOPPED_VELOCITY
+    work = _Arrays(scratch, trace.cmd_p.shape)
+    bits = scratch.take("status.bits", (len(BITS),) + trace.cmd_p.shape, bool)
+    velocity_ok = np.less(work.absolute_difference(trace.cmd_v, trace.act_v), col["velocity_tol"],
+                          out=work.flag("velocity_ok"))
+    stopped = np.less(np.abs(trace.cmd_v, out=work.real("difference")), _STOPPED_VELOCITY, out=work.flag("stopped"))
     tc = _trajectory_complete(trace.rel, stopped, rows, bits[TC])
     complete = bool(tc.any())
     # Note 1: at rest on the command (SETTLED; IN_FINE after a stop with settling on).
-    at_rest = tc & stopped if complete else None
+    at_rest = np.logical_and(tc, stopped, out=work.flag("at_rest")) if complete else None
     if at_rest is not None and at_rest.any():
-        at_rest &= np.abs(trace.cmd_p - trace.act_p) < col["fine"]
+        at_rest &= np.less(work.absolute_difference(trace.cmd_p, trace.act_p), col["fine"], out=work.flag("near"))
         at_rest &= velocity_ok
         at_rest &= ~col["abort"]
     settled_runs = settle(at_rest, counters[SETTLED_RUN], rows.need, bits[SETTLED])
-    fine_runs = _in_position(trace, rows, tc, complete, velocity_ok, counters, bits)
+    fine_runs = _in_position(trace, rows, tc, complete, velocity_ok, counters, bits, work)
     if rows.any("settle_on"):
         # After a stop with settling on, IN_FINE is the note-1 criterion.
         np.copyto(bits[IN_FINE], bits[SETTLED], where=rows.col["settle_on"])
         fine_runs = _PickedRuns(rows.settle_on, settled_runs, fine_runs)
-    velocity_runs = _at_velocity(trace, rows, tc, velocity_ok, counters, bits)
+    velocity_runs = _at_velocity(trace, rows, tc, velocity_ok, counters, bits, work)
     # AT_TARGET: "TRUE when command = target" (002's table), at rest there; an axis of a
     # SYNC_START move that arrives early is at its target while the others still move.
     if rows.any("at_target_ok"):
-        np.logical_and(col["at_target_ok"] & (trace.cmd_p == col["target"]), stopped, out=bits[AT_TARGET])
+        at_target = np.equal(trace.cmd_p, col["target"], out=bits[AT_TARGET])
+        at_target &= stopped
+        at_target &= col["at_target_ok"]
     else:
         bits[AT_TARGET] = False
     _done(rows, tc, stopped, bits)
@@ -266,32 +287,35 @@ def _trajectory_complete(rel: np.ndarray, stopped: np.ndarray, rows: StatusRows,
 
 
 def _in_position(trace, rows: StatusRows, tc: np.ndarray, complete: bool, velocity_ok: np.ndarray,
-                 counters: np.ndarray, bits: np.ndarray) -> Runs:
+                 counters: np.ndarray, bits: np.ndarray, work: _Arrays) -> Runs:
     """Note 3 (after a point-to-point move, distance to the target): IN_FINE and
     IN_COARSE, which during a velocity move (until its frame ends) are FALSE."""
     col = rows.col
     coarse_possible = complete or bool((rows.moving & ~rows.velocity).any())
-    distance = np.abs(col["target"] - trace.act_p) if coarse_possible else None
+    distance = work.absolute_difference(col["target"], trace.act_p) if coarse_possible else None
     fine = None
     if complete:
-        fine = tc & (distance < col["fine"])
+        fine = np.less(distance, col["fine"], out=work.flag("fine"))
+        fine &= tc
         fine &= velocity_ok
         fine &= col["moving"]
     runs = settle(fine, counters[FINE_RUN], rows.need, bits[IN_FINE])
     if coarse_possible:
-        np.logical_and(col["moving"] & (distance < col["coarse"]), tc | ~col["velocity"], out=bits[IN_COARSE])
+        coarse = np.less(distance, col["coarse"], out=bits[IN_COARSE])
+        coarse &= col["moving"]
+        coarse &= np.logical_or(tc, ~col["velocity"], out=work.flag("complete_or_not_velocity"))
     else:
         bits[IN_COARSE] = False
     return runs
 
 
 def _at_velocity(trace, rows: StatusRows, tc: np.ndarray, velocity_ok: np.ndarray, counters: np.ndarray,
-                 bits: np.ndarray) -> Runs:
+                 bits: np.ndarray, work: _Arrays) -> Runs:
     """AT_VELOCITY (velocity moves): the ramp done, at the velocity for the settling time."""
     ramp_done = None
     if rows.any("velocity"):
-        ramp_done = trace.rel >= rows.col["ramp_end"]
-        ramp_done &= ~tc
+        ramp_done = np.greater_equal(trace.rel, rows.col["ramp_end"], out=work.flag("ramp_done"))
+        ramp_done &= np.logical_not(tc, out=work.flag("incomplete"))
         ramp_done &= velocity_ok
         ramp_done &= rows.col["velocity"]
     return settle(ramp_done, counters[VELOCITY_RUN], rows.need, bits[AT_VELOCITY])

@@ -32,19 +32,19 @@ _VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")
 class Scratch:
     """Arrays by name, reused from stretch to stretch. A fresh array of a megabyte (32 axes
     x 4096 samples) costs its page faults every time (the allocator hands large blocks
-    back to the system), more than the arithmetic done on it."""
+    back to the system), more than the arithmetic done on it. Each is the start of a flat
+    buffer, so it is contiguous whatever its shape."""
 
     def __init__(self) -> None:
         self._buffers: dict[tuple[str, type], np.ndarray] = {}
 
     def take(self, name: str, shape: tuple[int, ...], dtype: type = float) -> np.ndarray:
-        """A (view of an) array of ``shape``, valid until ``name`` is taken again."""
+        """An array of ``shape`` (contents undefined), valid until ``name`` is taken again."""
+        size = math.prod(shape)
         buffer = self._buffers.get((name, dtype))
-        if buffer is None or buffer.ndim != len(shape) or any(b < s for b, s in zip(buffer.shape, shape)):
-            grown = shape if buffer is None or buffer.ndim != len(shape) else \
-                tuple(max(b, s) for b, s in zip(buffer.shape, shape))
-            buffer = self._buffers[(name, dtype)] = np.empty(grown, dtype=dtype)
-        return buffer[tuple(slice(0, s) for s in shape)]
+        if buffer is None or len(buffer) < size:
+            buffer = self._buffers[(name, dtype)] = np.empty(size, dtype=dtype)
+        return buffer[:size].reshape(shape)
 
 
 @dataclass(slots=True)
@@ -312,14 +312,14 @@ def _add_transient(bank: AxisBank, rows: np.ndarray, s: np.ndarray, y: np.ndarra
     live = _live_transients(bank, rows, first, y, dy, out)
     if not live.any():
         return y, dy
-    y, dy = _full(y, s.shape), _full(dy, s.shape)
+    y, dy = _full(y, s.shape, out, "y"), _full(dy, s.shape, out, "dy")
     sub = slice(None) if live.all() else np.flatnonzero(live)
     rows, decayed = rows[sub], plant.decayed_after[rows[sub]]
-    p, q = _free(bank, rows, first, n)
-    h0 = p * plant.v0[rows, None]
-    h0 += q * plant.m0[rows, None]
-    h1 = p * plant.v1[rows, None]
-    h1 += q * plant.m1[rows, None]
+    p, q = _free(bank, rows, first, n, out.scratch)
+    h0 = np.multiply(p, plant.v0[rows, None], out=out.temporary("h0", rows))
+    h0 += np.multiply(q, plant.m0[rows, None], out=out.temporary("product", rows))
+    h1 = np.multiply(p, plant.v1[rows, None], out=out.temporary("h1", rows))
+    h1 += np.multiply(q, plant.m1[rows, None], out=out.temporary("product", rows))
     if np.isposinf(decayed).all():
         y[sub] += h0
         dy[sub] += h1
@@ -331,9 +331,13 @@ def _add_transient(bank: AxisBank, rows: np.ndarray, s: np.ndarray, y: np.ndarra
     return y, dy
 
 
-def _full(values: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
-    """``values`` as a full array of ``shape`` that may be changed in place."""
-    return values if values.shape == shape else np.broadcast_to(values, shape).copy()
+def _full(values: np.ndarray, shape: tuple[int, int], out: Stretch, name: str) -> np.ndarray:
+    """``values`` (or a column) as a full array of ``shape`` that may be changed in place."""
+    if values.shape == shape:
+        return values
+    full = out.scratch.take("~full." + name, shape)
+    full[...] = values
+    return full
 
 
 def _live_transients(bank: AxisBank, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray,
@@ -368,12 +372,12 @@ def _has_zero(values: np.ndarray, rows: np.ndarray, out: Stretch) -> np.ndarray:
     return rows & zero.any(axis=1)
 
 
-def _free(bank: AxisBank, rows: np.ndarray, first: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+def _free(bank: AxisBank, rows: np.ndarray, first: int, n: int, scratch: Scratch) -> tuple[np.ndarray, np.ndarray]:
     """(p, q) of the free response at every sample of each row, from its loop's table."""
     tables = bank.plant.table[rows]
     m0 = first - bank.plant.k0[rows]
     if (tables == tables[0]).all():
-        return bank.tables[int(tables[0])].window(m0, n)
+        return bank.tables[int(tables[0])].window(m0, n, scratch)
     p, q = np.empty((len(rows), n)), np.empty((len(rows), n))
     for index in np.unique(tables).tolist():
         group = np.flatnonzero(tables == index)
@@ -395,7 +399,7 @@ def _read(resolution: np.ndarray, y: np.ndarray, into: np.ndarray | None) -> np.
         np.floor(out, out=out)
         out *= step
         return out
-    out = _full(y, (len(resolution), y.shape[1])).copy()
+    out = np.broadcast_to(y, (len(resolution), y.shape[1])).copy()
     counted = np.flatnonzero(resolution > 0.0)
     step = resolution[counted, None]
     out[counted] = np.floor(out[counted] / step + 0.5) * step
