@@ -372,7 +372,8 @@ class Axis:
                 break
         if self.plan is None and self.mode is CommandMode.SERVO and not self.holding:
             anchor = self._settle_anchor(anchor, t)
-        self.state = anchor
+        if anchor is not self.state:
+            self.state = anchor
 
     def snap(self, t: float) -> None:
         """The rest the loop has reached by ``t`` (see :meth:`_settle_anchor`), for an axis
@@ -405,14 +406,22 @@ class Axis:
         end = times[i] if i < len(times) else math.inf
         forced = self._forced(key, self.state.t, end, clock)
         self._write_command(clock)
-        rows, row = self._bank.plant, self.number
-        rows.anchor_t[row], rows.piece_end[row] = self.state.t, end
-        rows.set_steady(row, forced.y, forced.dy)
-        transient = self.plant.transient(self.state, forced, self.rate)
-        rows.set_transient(row, transient, self._bank.table_index(transient.table) if transient else 0)
-        rows.resolution[row] = self.plant.config.encoder_resolution
+        bank, row = self._bank, self.number
+        bank.plant.set_piece(row, self.state, end, forced, self.plant, self.rate, bank.table_index)
         at_rest = self.plan is None and not self.holding
-        rows.snap_after[row] = self.plant.quiet_after(self.state, forced.y) if at_rest else math.inf
+        bank.plant.snap_after[row] = self.plant.quiet_after(self.state, forced.y) if at_rest else math.inf
+
+    def continuations(self, t_last: float, clock: ProfileClock | None) -> list[tuple[PlantState, float, float, Forced]]:
+        """The command pieces after the current one that start by ``t_last``, each with the
+        plant anchor at its start: (anchor, start, end, steady response), the anchors
+        advanced from piece to piece as :meth:`_trace_plant` advances them."""
+        state = self.state
+        pieces = self._pieces(state.t, t_last, clock)
+        following = []
+        for (_, end, forced), (start, nxt_end, nxt_forced) in zip(pieces, pieces[1:]):
+            state = self._advance_piece(state, forced, end)
+            following.append((state, start, nxt_end, nxt_forced))
+        return following
 
     def _write_command(self, clock: ProfileClock | None) -> None:
         rows, row, plan = self._bank.command, self.number, self.plan

@@ -20,7 +20,7 @@ from enum import IntEnum
 import numpy as np
 
 from .clock import ProfileClock
-from .plant import Transient, _FreeTable
+from .plant import Forced, Plant, PlantState, Transient, _FreeTable
 from .status import BITS, StatusRows
 
 _MAX_TERMS = 7  # coefficients of a piece's steady response (plant._MAX_DEGREE + 1)
@@ -112,16 +112,27 @@ class PlantRows:
         rows.steady_dy = np.zeros((count, _MAX_TERMS))
         return rows
 
-    def set_steady(self, row: int, y: list[float], dy: list[float]) -> None:
-        """The steady response's coefficients (plant.Forced); rows are evaluated in groups
-        of the same length, exactly as plant.poly_eval evaluates one."""
+    def set_piece(self, row: int, anchor: PlantState, end: float, forced: Forced, plant: Plant, rate: float,
+                  table_index) -> None:
+        """Row ``row``: the servo ``plant`` from ``anchor`` through a command piece ending at
+        ``end`` with steady response ``forced`` (``table_index(table)`` numbers free-response
+        tables)."""
+        self.anchor_t[row], self.piece_end[row] = anchor.t, end
+        self._set_steady(row, trim_leading_zeros(forced.y), trim_leading_zeros(forced.dy))
+        transient = plant.transient(anchor, forced, rate)
+        self._set_transient(row, transient, table_index(transient.table) if transient else 0)
+        self.resolution[row] = plant.config.encoder_resolution
+
+    def _set_steady(self, row: int, y: list[float], dy: list[float]) -> None:
+        """The steady response's coefficients; rows are evaluated in groups of the same
+        length, exactly as plant.poly_eval evaluates one."""
         self.steady_y[row] = 0.0
         self.steady_dy[row] = 0.0
         self.steady_y[row, :len(y)] = y
         self.steady_dy[row, :len(dy)] = dy
         self.terms[row] = len(y)
 
-    def set_transient(self, row: int, transient: Transient | None, table: int) -> None:
+    def _set_transient(self, row: int, transient: Transient | None, table: int) -> None:
         if transient is None:
             self.k0[row], self.v0[row], self.v1[row], self.m0[row], self.m1[row] = 0, 0.0, 0.0, 0.0, 0.0
             self.decayed_after[row] = -math.inf
@@ -130,6 +141,19 @@ class PlantRows:
         self.v0[row], self.v1[row], self.m0[row], self.m1[row] = transient.v0, transient.v1, transient.m0, transient.m1
         self.decayed_after[row] = transient.decayed_after
         self.table[row] = table
+
+
+def trim_leading_zeros(coefficients: list[float]) -> list[float]:
+    """Coefficients (low first) that give what Horner's scheme (plant.poly_eval) gives for
+    ``coefficients`` at every s > 0, to the bit: a leading -0.0 passes the next coefficient
+    on unchanged (-0 s + c is c), a leading +0.0 passes it on as c + 0.0 (only a -0.0
+    changes: to +0.0)."""
+    out = list(coefficients)
+    while len(out) > 1 and out[-1] == 0.0:
+        leading = out.pop()
+        if not math.copysign(1.0, leading) < 0.0:
+            out[-1] = out[-1] + 0.0
+    return out
 
 
 @dataclass(slots=True)

@@ -339,8 +339,8 @@ class Controller:
         bank.bits[:] = status.bits[:, :, stop]
         bank.runs[:] = status.counters_at(stop)
         t = float(stretch.t[stop])
-        for row, one in stretch.traced.items():
-            self.axes[row].keep_anchor(one.anchors, t)
+        for row, anchors in stretch.anchors.items():
+            self.axes[row].keep_anchor(anchors, t)
         rows = stretch.pieces
         plant = bank.plant
         for row in rows[t - plant.anchor_t[rows] >= plant.snap_after[rows]].tolist():

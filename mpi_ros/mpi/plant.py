@@ -287,11 +287,11 @@ class _FreeTable:
         self._bq = np.array(self.block_q)
 
     def at(self, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(p, q) of Phi(m dt) for sample counts m >= 0."""
-        if len(m) == 0 or m[-1] < _TABLE:
+        """(p, q) of Phi(m dt) for sample counts m >= 0 (any shape)."""
+        if m.size == 0 or m.max() < _TABLE:
             return self.p[m], self.q[m]
         n, r = np.divmod(m, _TABLE)
-        self._blocks(int(n[-1]))
+        self._blocks(int(n.max()))
         bp, bq = self._bp[n], self._bq[n]
         pr, qr = self.p[r], self.q[r]
         return bp * pr + self.kappa * bq * qr, bp * qr + bq * pr

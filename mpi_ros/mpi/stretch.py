@@ -22,9 +22,10 @@ from typing import Callable
 
 import numpy as np
 
-from .axis import Axis, AxisTrace
+from .axis import Axis
 from .bank import AxisBank, CommandRows, Kind, PlantRows
 from .clock import ProfileClock
+from .plant import PlantState
 
 _VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")
 
@@ -61,7 +62,7 @@ class Stretch:
     rel: np.ndarray  # profile time into the plan (nan without one)
     scratch: Scratch
     pieces: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # rows of one piece
-    traced: dict[int, AxisTrace] = field(default_factory=dict)  # axes traced one at a time
+    anchors: dict[int, list[PlantState]] = field(default_factory=dict)  # plant anchors of the others
 
     def __len__(self) -> int:
         return len(self.samples)
@@ -105,16 +106,20 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     shape = (bank.count, len(samples))
     out = Stretch(samples, t, *(scratch.take(name, shape) for name in _VALUES), scratch=scratch)
     _steady(bank, np.flatnonzero(bank.kind == Kind.STEADY), out)
-    one_piece = (bank.kind == Kind.PIECE) & (t[-1] < bank.plant.piece_end)
-    rows, fell = _command(bank, np.flatnonzero(one_piece), out)
-    _servo(bank, rows, out)
-    out.pieces = rows
-    traced = np.flatnonzero((bank.kind != Kind.STEADY) & ~one_piece)
-    if len(fell):
-        traced = np.union1d(traced, fell)
-    for row in traced.tolist():
+    rows = np.flatnonzero(bank.kind == Kind.PIECE)
+    if len(rows):
+        _command(bank, rows, out)
+        act_p, act_v = _servo(bank.plant, bank.tables, rows, out, direct=True)
+        out.place("act_p", rows, act_p)
+        out.place("act_v", rows, act_v)
+        ending = t[-1] >= bank.plant.piece_end[rows]
+        out.pieces = rows[~ending]
+        if ending.any():
+            _following_pieces(bank, axes, clock_of, rows[ending], out)
+    for row in np.flatnonzero(bank.kind == Kind.SAMPLED).tolist():
         axis = axes[row]
-        out.traced[row] = one = axis.trace(k0, k1, clock_of(axis))
+        one = axis.trace(k0, k1, clock_of(axis))
+        out.anchors[row] = one.anchors
         for name in _VALUES:
             getattr(out, name)[row] = getattr(one, name)
     return out
@@ -132,26 +137,20 @@ def _steady(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
 
 
 # -- the command ------------------------------------------------------------------------
-def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
-    """Command of ``rows``; returns (rows done, rows whose segment changes inside the stretch)."""
+def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
+    """Command of ``rows``: a plan read through the supervisor's clock, or the rest."""
     planned = bank.command.planned[rows]
     resting = rows[~planned]
     if len(resting):
         out.cmd_p[resting] = bank.command.rest[resting, None]
         out.cmd_v[resting] = out.cmd_a[resting] = 0.0
         out.rel[resting] = math.nan
-    if not planned.any():
-        return rows, rows[:0]
-    moving = rows[planned]
-    kept = _planned(bank, moving, out)
-    if len(kept) == len(moving):
-        return rows, rows[:0]
-    return np.union1d(resting, kept), np.setdiff1d(moving, kept, assume_unique=True)
+    if planned.any():
+        _planned(bank, rows[planned], out)
 
 
-def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> np.ndarray:
-    """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate),
-    for the rows that stay in one segment; returns those rows."""
+def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
+    """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate)."""
     cmd = bank.command
     numbers, which = bank.memo(("clocks", rows.tobytes()), lambda: np.unique(cmd.clock[rows], return_inverse=True))
     tau, f, df = bank.clocks.evaluate(numbers, out.t, out.scratch)
@@ -160,12 +159,11 @@ def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> np.ndarray:
     lo, hi = rel.min(axis=1), rel.max(axis=1)
     duration = cmd.duration[rows]
     # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
-    keep = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
-    if not keep.all():
-        rows, which, rel, lo, hi = rows[keep], which[keep], rel[keep], lo[keep], hi[keep]
-        if not len(rows):
-            return rows
-    p, dp, ddp = _segment(cmd, rows, rel, lo, hi, out)
+    single = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
+    if single.all():
+        p, dp, ddp = _segment(cmd, rows, rel, lo, hi, out)
+    else:
+        p, dp, ddp = _segments(bank, rows, rel, lo, hi, single, out)
     f, df = f[which], df[which]
     out.place("cmd_p", rows, p)
     out.place("cmd_v", rows, np.multiply(dp, f, out=out.into_if_full("cmd_v", rows, dp, f)))
@@ -175,7 +173,20 @@ def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> np.ndarray:
     acceleration += dp * df
     out.place("cmd_a", rows, acceleration)
     out.place("rel", rows, rel)
-    return rows
+
+
+def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+              single: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_segment` for the rows that stay in one segment; the plan's own evaluation
+    (AxisPlan.evaluate, one row at a time) for those that move on to another inside the stretch."""
+    shape = rel.shape
+    p, dp, ddp = np.empty(shape), np.empty(shape), np.empty(shape)
+    if single.any():
+        p[single], dp[single], ddp[single] = _segment(bank.command, rows[single], rel[single], lo[single],
+                                                      hi[single], None)
+    for i in np.flatnonzero(~single).tolist():
+        p[i], dp[i], ddp[i] = bank.plans[int(rows[i])].evaluate(rel[i])
+    return p, dp, ddp
 
 
 def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -195,7 +206,7 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
 
 
 def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-             out: Stretch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+             out: Stretch | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, d/dtau, d2/dtau2 of each row's plan at profile times ``rel`` (whose extremes
     are ``lo``, ``hi``): its segment (SegmentTable.evaluate) until the plan's end, the end
     state from there on (AxisPlan.evaluate). Velocity and acceleration may come back as
@@ -203,7 +214,7 @@ def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray
     duration = cmd.duration[rows]
     inside = rel if (hi < duration).all() else np.minimum(rel, duration[:, None])
     linear = _linear(cmd, rows, np.minimum(lo, duration))
-    position = out.into("cmd_p", rows)
+    position = out.into("cmd_p", rows) if out is not None else None
     if linear.all():
         pos, vel, acc = _linear_segment(cmd, rows, inside, position)
     elif not linear.any():
@@ -259,16 +270,43 @@ def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray, into:
 
 
 # -- the servo ----------------------------------------------------------------------------
-def _servo(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
-    """Actual position and velocity of ``rows`` from their anchors (Plant.response, read)."""
-    if not len(rows):
-        return
-    plant = bank.plant
+def _servo(plant: PlantRows, tables: list, rows: np.ndarray, out: Stretch, direct: bool,
+           following: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Actual position and velocity (Plant.response, read) of ``rows`` of ``plant``, at
+    every sample of the stretch; ``direct``: into the stretch's own arrays where it can;
+    ``following``: pieces that start inside the stretch (the samples before a row's anchor
+    come out meaningless, to be left out)."""
     s = np.subtract(out.t, plant.anchor_t[rows, None], out=out.temporary("s", rows))
     y, dy = _steady_response(plant, rows, s, out)
-    y, dy = _add_transient(bank, rows, s, y, dy, out)
-    out.place("act_p", rows, _read(plant.resolution[rows], y, out.into("act_p", rows)))
-    out.place("act_v", rows, dy)
+    y, dy = _add_transient(plant, tables, rows, s, y, dy, out, following)
+    return _read(plant.resolution[rows], y, out.into("act_p", rows) if direct else None), dy
+
+
+def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileClock | None],
+                      rows: np.ndarray, out: Stretch) -> None:
+    """Axes whose command piece ends inside the stretch: every following piece, from its
+    plant anchor (advanced from piece to piece by the scalar code), is one more row, all
+    evaluated together, each kept over the samples of its piece."""
+    t = out.t
+    pieces: list[tuple[int, float, float]] = []  # axis, start, end
+    followers = []
+    for row in rows.tolist():
+        axis = axes[row]
+        out.anchors[row] = [axis.state]
+        for anchor, start, end, forced in axis.continuations(float(t[-1]), clock_of(axis)):
+            followers.append((anchor, end, forced, axis.plant, axis.rate))
+            pieces.append((row, start, end))
+            out.anchors[row].append(anchor)
+    rows_of = PlantRows.empty(len(followers))
+    for i, piece in enumerate(followers):
+        rows_of.set_piece(i, *piece, bank.table_index)
+    act_p, act_v = _servo(rows_of, bank.tables, np.arange(len(pieces)), out, direct=False, following=True)
+    shape = (len(pieces), len(t))
+    act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
+    for i, (row, start, end) in enumerate(pieces):
+        first, last = np.searchsorted(t, (start, end), side="left").tolist()
+        out.act_p[row, first:last] = act_p[i, first:last]
+        out.act_v[row, first:last] = act_v[i, first:last]
 
 
 def _steady_response(plant: PlantRows, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
@@ -304,18 +342,20 @@ def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) ->
     return out
 
 
-def _add_transient(bank: AxisBank, rows: np.ndarray, s: np.ndarray, y: np.ndarray, dy: np.ndarray,
-                   out: Stretch) -> tuple[np.ndarray, np.ndarray]:
+def _add_transient(plant: PlantRows, tables: list, rows: np.ndarray, s: np.ndarray, y: np.ndarray,
+                   dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
     """Plant.response's transient added to the rows that have one."""
-    plant = bank.plant
     first, n = int(out.samples[0]), len(out.samples)
-    live = _live_transients(bank, rows, first, y, dy, out)
+    if following:
+        live = plant.decayed_after[rows] > -math.inf
+    else:
+        live = _live_transients(plant, tables, rows, first, y, dy, out)
     if not live.any():
         return y, dy
     y, dy = _full(y, s.shape, out, "y"), _full(dy, s.shape, out, "dy")
     sub = slice(None) if live.all() else np.flatnonzero(live)
     rows, decayed = rows[sub], plant.decayed_after[rows[sub]]
-    p, q = _free(bank, rows, first, n, out.scratch)
+    p, q = _free(plant, tables, rows, out.samples, out.scratch, following)
     h0 = np.multiply(p, plant.v0[rows, None], out=out.temporary("h0", rows))
     h0 += np.multiply(q, plant.m0[rows, None], out=out.temporary("product", rows))
     h1 = np.multiply(p, plant.v1[rows, None], out=out.temporary("h1", rows))
@@ -340,25 +380,24 @@ def _full(values: np.ndarray, shape: tuple[int, int], out: Stretch, name: str) -
     return full
 
 
-def _live_transients(bank: AxisBank, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray,
-                     out: Stretch) -> np.ndarray:
+def _live_transients(plant: PlantRows, tables: list, rows: np.ndarray, first: int, y: np.ndarray,
+                     dy: np.ndarray, out: Stretch) -> np.ndarray:
     """Per row: must its transient be added? Not without one; nor where the free response
     has underflowed to exact zeros over the whole stretch (a long-settled loop), since
     adding a zero changes nothing, unless a value is itself a zero (whose sign it might
     flip): there it is added as ever."""
-    plant = bank.plant
     live = plant.decayed_after[rows] > -math.inf
     if not live.any():
         return live
     m0 = first - plant.k0[rows]
-    tables = plant.table[rows]
-    if (tables == tables[0]).all():
-        vanished = live & bank.tables[int(tables[0])].vanished(m0)
+    which = plant.table[rows]
+    if (which == which[0]).all():
+        vanished = live & tables[int(which[0])].vanished(m0)
     else:
         vanished = np.zeros(len(rows), dtype=bool)
-        for index in np.unique(tables[live]).tolist():
-            group = live & (tables == index)
-            vanished[group] = bank.tables[index].vanished(m0[group])
+        for index in np.unique(which[live]).tolist():
+            group = live & (which == index)
+            vanished[group] = tables[index].vanished(m0[group])
     if vanished.any():
         vanished &= ~(_has_zero(y, vanished, out) | _has_zero(dy, vanished, out))
     return live & ~vanished
@@ -372,16 +411,21 @@ def _has_zero(values: np.ndarray, rows: np.ndarray, out: Stretch) -> np.ndarray:
     return rows & zero.any(axis=1)
 
 
-def _free(bank: AxisBank, rows: np.ndarray, first: int, n: int, scratch: Scratch) -> tuple[np.ndarray, np.ndarray]:
-    """(p, q) of the free response at every sample of each row, from its loop's table."""
-    tables = bank.plant.table[rows]
-    m0 = first - bank.plant.k0[rows]
-    if (tables == tables[0]).all():
-        return bank.tables[int(tables[0])].window(m0, n, scratch)
+def _free(plant: PlantRows, tables: list, rows: np.ndarray, samples: np.ndarray, scratch: Scratch,
+          following: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(p, q) of the free response at every sample of each row, from its loop's table (for
+    ``following`` rows, sample counts before the anchor read as 0)."""
+    which = plant.table[rows]
+    first, n = int(samples[0]), len(samples)
+    if not following and (which == which[0]).all():
+        return tables[int(which[0])].window(first - plant.k0[rows], n, scratch)
     p, q = np.empty((len(rows), n)), np.empty((len(rows), n))
-    for index in np.unique(tables).tolist():
-        group = np.flatnonzero(tables == index)
-        p[group], q[group] = bank.tables[index].window(m0[group], n)
+    for index in np.unique(which).tolist():
+        group = np.flatnonzero(which == index)
+        if following:
+            p[group], q[group] = tables[index].at(np.maximum(samples - plant.k0[rows[group], None], 0))
+        else:
+            p[group], q[group] = tables[index].window(first - plant.k0[rows[group]], n)
     return p, q
 
 
