@@ -72,6 +72,14 @@ class _Derived:
         axis._bank.stale[axis.number] = True
 
 
+class _Anchor(_Derived):
+    """The plant anchor: moving it changes only the axis' servo rows (a lighter rebuild)."""
+
+    def __set__(self, axis: "Axis", value) -> None:
+        setattr(axis, self.slot, value)
+        axis._bank.moved[axis.number] = True
+
+
 class _Value:
     """A value of the axis at the current sample, kept in the bank's arrays."""
 
@@ -93,7 +101,7 @@ class Axis:
     mode: CommandMode = _Derived()
     holding: bool = _Derived()  # a hold frame is waiting for its trigger
     # plant, anchored at the start of the current command piece
-    state: PlantState = _Derived()
+    state: PlantState = _Anchor()
     plant: Plant = _Derived()
     # status
     status_mode: StatusMode = _Derived()
@@ -385,13 +393,18 @@ class Axis:
         """Write this axis' rows in the bank from its plan, anchor, mode and tolerances."""
         bank, row = self._bank, self.number
         bank.stale[row] = False
-        bank.plans[row] = self.plan
         bank.command.truncated[row] = self.plan is not None and self.plan.truncated
         bank.command.duration[row] = self.plan.duration if self.plan is not None else math.inf
         bank.status.set(row, self.status_mode, self.in_position, self.rate, self.target, self.holding, self.plan)
+        self._write_command(clock)
+        self.reanchor(clock)
+
+    def reanchor(self, clock: ProfileClock | None) -> None:
+        """Rewrite the rows that depend on the plant anchor (all that changed)."""
+        bank, row = self._bank, self.number
+        bank.moved[row] = False
         if self.steady(clock):
             bank.kind[row] = Kind.STEADY
-            bank.command.rest[row] = self.rest
         elif self.mode is CommandMode.SERVO:
             bank.kind[row] = Kind.PIECE
             self._write_piece(clock)
@@ -405,7 +418,6 @@ class Axis:
         i = bisect.bisect_right(times, self.state.t)
         end = times[i] if i < len(times) else math.inf
         forced = self._forced(key, self.state.t, end, clock)
-        self._write_command(clock)
         bank, row = self._bank, self.number
         bank.plant.set_piece(row, self.state, end, forced, self.plant, self.rate, bank.table_index)
         at_rest = self.plan is None and not self.holding
@@ -427,14 +439,15 @@ class Axis:
         rows, row, plan = self._bank.command, self.number, self.plan
         rows.rest[row] = self.rest
         rows.planned[row] = planned = plan is not None and clock is not None
-        if not planned:
-            return
-        rows.clock[row] = self.owner
-        rows.tau_start[row] = self.tau_start
-        rows.target[row] = plan.target
-        rows.final_velocity[row] = plan.final_velocity
-        rows.segment[row] = -1  # chosen where the profile time is, when the controller steps
-        rows.seg_lo[row], rows.seg_hi[row] = math.inf, -math.inf
+        if self._bank.plans[row] is not plan:
+            self._bank.plans[row] = plan
+            rows.segment[row] = -1  # chosen where the profile time is, when the controller steps
+            rows.seg_lo[row], rows.seg_hi[row] = math.inf, -math.inf
+        if planned:
+            rows.clock[row] = self.owner
+            rows.tau_start[row] = self.tau_start
+            rows.target[row] = plan.target
+            rows.final_velocity[row] = plan.final_velocity
 
     def _settle_anchor(self, anchor: PlantState, t: float) -> PlantState:
         """Once the loop at rest has decayed below the quiet level, snap it exactly onto

@@ -215,7 +215,8 @@ class AxisBank:
         self.runs = np.zeros((3, axis_count), dtype=np.int64)  # status.FINE_RUN, SETTLED_RUN, VELOCITY_RUN
         self.runs[:2] = _AT_REST
         # rows
-        self.stale = np.ones(axis_count, dtype=bool)
+        self.stale = np.ones(axis_count, dtype=bool)  # rebuild every row of the axis
+        self.moved = np.zeros(axis_count, dtype=bool)  # its plant anchor moved: rebuild those rows
         self.kind = np.full(axis_count, Kind.SAMPLED, dtype=np.int8)
         self.owner = np.full(axis_count, -1, dtype=np.int64)
         self.plans: list = [None] * axis_count
@@ -226,13 +227,16 @@ class AxisBank:
         self.tables: list[_FreeTable] = []
         self._memo: dict = {}
 
-    def refresh(self, refresh_row) -> None:
-        """Rebuild the stale rows (``refresh_row(number)`` does one)."""
-        stale = np.flatnonzero(self.stale)
-        if len(stale):
+    def refresh(self, refresh_row, reanchor_row) -> None:
+        """Rebuild the stale rows (``refresh_row(number)`` does an axis), and those of the
+        axes whose anchor moved (``reanchor_row(number)``)."""
+        stale, moved = np.flatnonzero(self.stale), np.flatnonzero(self.moved & ~self.stale)
+        if len(stale) or len(moved):
             self._memo.clear()
             for row in stale.tolist():
                 refresh_row(row)
+            for row in moved.tolist():
+                reanchor_row(row)
 
     def memo(self, key, compute):
         """A value derived from the rows, kept until one changes (``compute()`` makes it)."""

@@ -305,7 +305,8 @@ class Controller:
 
     def _advance(self, k1: int) -> None:
         k0 = self.sample
-        self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])))
+        self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])),
+                          lambda row: self.axes[row].reanchor(self._clock(self.axes[row])))
         stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch)
         status = compute(stretch, self.bank.status, self.bank.runs, self._scratch)
         stop = len(stretch) - 1
