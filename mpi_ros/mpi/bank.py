@@ -238,6 +238,10 @@ class AxisBank:
             for row in moved.tolist():
                 reanchor_row(row)
 
+    def of_kind(self, kind: Kind) -> np.ndarray:
+        """The axes (sorted) a stretch computes as ``kind``."""
+        return self.memo(kind, lambda: np.flatnonzero(self.kind == kind))
+
     def memo(self, key, compute):
         """A value derived from the rows, kept until one changes (``compute()`` makes it)."""
         value = self._memo.get(key)

@@ -367,7 +367,7 @@ class Controller:
         """spec 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
         ends abruptly, reported when the axis gets there."""
         command = self.bank.command
-        rows = np.flatnonzero(command.truncated)
+        rows = self.bank.memo("truncated", lambda: np.flatnonzero(command.truncated))
         rows = rows[self.bank.rel[rows] < command.duration[rows]]  # not there yet (nan: no plan running)
         reached = stretch.rel[rows, : stop + 1] >= command.duration[rows, None]
         found = []

@@ -38,14 +38,21 @@ class Scratch:
 
     def __init__(self) -> None:
         self._buffers: dict[tuple[str, type], np.ndarray] = {}
+        self._views: dict[tuple[str, type], tuple[tuple[int, ...], np.ndarray]] = {}
 
     def take(self, name: str, shape: tuple[int, ...], dtype: type = float) -> np.ndarray:
         """An array of ``shape`` (contents undefined), valid until ``name`` is taken again."""
+        key = (name, dtype)
+        last = self._views.get(key)
+        if last is not None and last[0] == shape:
+            return last[1]
         size = math.prod(shape)
-        buffer = self._buffers.get((name, dtype))
+        buffer = self._buffers.get(key)
         if buffer is None or len(buffer) < size:
-            buffer = self._buffers[(name, dtype)] = np.empty(size, dtype=dtype)
-        return buffer[:size].reshape(shape)
+            buffer = self._buffers[key] = np.empty(size, dtype=dtype)
+        view = buffer[:size].reshape(shape)
+        self._views[key] = (shape, view)
+        return view
 
 
 @dataclass(slots=True)
@@ -105,8 +112,8 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     t = samples / rate
     shape = (bank.count, len(samples))
     out = Stretch(samples, t, *(scratch.take(name, shape) for name in _VALUES), scratch=scratch)
-    _steady(bank, np.flatnonzero(bank.kind == Kind.STEADY), out)
-    rows = np.flatnonzero(bank.kind == Kind.PIECE)
+    _steady(bank, bank.of_kind(Kind.STEADY), out)
+    rows = bank.of_kind(Kind.PIECE)
     if len(rows):
         _command(bank, rows, out)
         act_p, act_v = _servo(bank.plant, bank.tables, rows, out, direct=True)
@@ -116,7 +123,7 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
         out.pieces = rows[~ending]
         if ending.any():
             _following_pieces(bank, axes, clock_of, rows[ending], out)
-    for row in np.flatnonzero(bank.kind == Kind.SAMPLED).tolist():
+    for row in bank.of_kind(Kind.SAMPLED).tolist():
         axis = axes[row]
         one = axis.trace(k0, k1, clock_of(axis))
         out.anchors[row] = one.anchors

@@ -65,9 +65,11 @@ class SteppingMixin:
         """``conditions[key]``: per sample, is ``bit`` set on every axis of the current move?
         (left out where it never is: an axis without it anywhere in the stretch)"""
         ever = status.ever(bit)
-        axes = [plan.axis for plan in self.current.plans]
-        if all(ever[n] for n in axes):
-            conditions[key] = np.logical_and.reduce(status.bits[bit, axes], axis=0)
+        axes = self.current.plan_axes
+        for number in axes:
+            if not ever[number]:
+                return
+        conditions[key] = np.logical_and.reduce(status.bits[bit, list(axes)], axis=0)
 
     def _ends_moving(self) -> bool:
         """The current move ends at its target with a velocity (FINAL_VEL)."""
