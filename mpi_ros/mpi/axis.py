@@ -17,6 +17,7 @@ Positions seen by users are raw positions minus the origin (mpiAxisOriginSet).
 from __future__ import annotations
 
 import bisect
+import itertools
 import math
 from dataclasses import dataclass, field
 from enum import Enum
@@ -430,7 +431,7 @@ class Axis:
         state = self.state
         pieces = self._pieces(state.t, t_last, clock)
         following = []
-        for (_, end, forced), (start, nxt_end, nxt_forced) in zip(pieces, pieces[1:]):
+        for (_, end, forced), (start, nxt_end, nxt_forced) in itertools.pairwise(pieces):
             state = self._advance_piece(state, forced, end)
             following.append((state, start, nxt_end, nxt_forced))
         return following

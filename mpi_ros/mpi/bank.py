@@ -16,23 +16,26 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 from enum import IntEnum
+from typing import Callable, Hashable, TypeVar
 
 import numpy as np
 
 from .clock import ProfileClock
-from .plant import Forced, Plant, PlantState, Transient, _FreeTable
+from .plant import _MAX_DEGREE, Forced, Plant, PlantState, Transient, _FreeTable
 from .status import BITS, StatusRows
 
-_MAX_TERMS = 7  # coefficients of a piece's steady response (plant._MAX_DEGREE + 1)
+VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")  # an axis' values at a sample
+_MAX_TERMS = _MAX_DEGREE + 1  # coefficients of a piece's steady response
 _AT_REST = 1 << 30  # settling counters of an axis that has long been at rest
+T = TypeVar("T")
 
 
 class Kind(IntEnum):
     """How a stretch computes an axis."""
 
     STEADY = 0  # at rest, settled on its command: every sample is the same
-    PIECE = 1  # one command piece and one plant anchor: rows of closed forms
-    SAMPLED = 2  # coasting, or the command follows the actual: one axis at a time
+    PIECE = 1  # command pieces from a plant anchor: rows of closed forms (one per piece)
+    SAMPLED = 2  # coasting, or the command follows the actual: one axis at a time (Axis.trace)
 
 
 def _arrays(cls, count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (), **fill: float):
@@ -60,6 +63,7 @@ class CommandRows:
     final_velocity: np.ndarray
     truncated: np.ndarray  # a frame hit the 16,384,000-sample limit
     segment: np.ndarray  # -1: none chosen yet
+    linear: np.ndarray  # its acceleration and jerk are +0.0 (see stretch._linear)
     seg_lo: np.ndarray
     seg_hi: np.ndarray
     seg_start: np.ndarray
@@ -71,7 +75,7 @@ class CommandRows:
 
     @classmethod
     def empty(cls, count: int) -> "CommandRows":
-        return _arrays(cls, count, ints=("clock", "segment"), flags=("planned", "truncated"))
+        return _arrays(cls, count, ints=("clock", "segment"), flags=("planned", "truncated", "linear"))
 
     def set_segment(self, row: int, plan, index: int) -> None:
         """Evaluate ``row`` in segment ``index`` of ``plan``'s table (the profile times that
@@ -81,7 +85,10 @@ class CommandRows:
         self.seg_lo[row] = table.end[index - 1] if index > 0 else -math.inf
         self.seg_hi[row] = table.end[index] if index < table.count - 1 else math.inf
         self.seg_start[row] = table.start[index]
-        self.p[row], self.v[row], self.a[row], self.j[row] = table.p[index], table.v[index], table.a[index], table.j[index]
+        for name in ("p", "v", "a", "j"):
+            getattr(self, name)[row] = getattr(table, name)[index]
+        a, j = float(table.a[index]), float(table.j[index])
+        self.linear[row] = a == 0.0 and j == 0.0 and not math.copysign(1.0, a) < 0.0 and not math.copysign(1.0, j) < 0.0
 
 
 @dataclass(slots=True)
@@ -202,13 +209,10 @@ class AxisBank:
 
     def __init__(self, axis_count: int, supervisor_count: int):
         self.count = axis_count
-        # values at the controller's current sample (raw positions)
-        self.cmd_p = np.zeros(axis_count)
-        self.cmd_v = np.zeros(axis_count)
-        self.cmd_a = np.zeros(axis_count)
-        self.act_p = np.zeros(axis_count)
-        self.act_v = np.zeros(axis_count)
-        self.rel = np.full(axis_count, math.nan)  # profile time into the plan (nan without one)
+        # values at the controller's current sample (raw positions), in VALUES order, one block
+        self.values = np.zeros((len(VALUES), axis_count))
+        self.cmd_p, self.cmd_v, self.cmd_a, self.act_p, self.act_v, self.rel = self.values
+        self.rel[:] = math.nan  # profile time into the plan (nan without one)
         # A new controller's axes rest settled on their command.
         self.bits = np.ones((len(BITS), axis_count), dtype=bool)
         self.bits[BITS.index("at_velocity")] = False
@@ -219,7 +223,7 @@ class AxisBank:
         self.moved = np.zeros(axis_count, dtype=bool)  # its plant anchor moved: rebuild those rows
         self.kind = np.full(axis_count, Kind.SAMPLED, dtype=np.int8)
         self.owner = np.full(axis_count, -1, dtype=np.int64)
-        self.plans: list = [None] * axis_count
+        self.plans: list = [None] * axis_count  # the AxisPlan each row was written for
         self.command = CommandRows.empty(axis_count)
         self.plant = PlantRows.empty(axis_count)
         self.status = StatusRows.empty(axis_count)
@@ -227,7 +231,7 @@ class AxisBank:
         self.tables: list[_FreeTable] = []
         self._memo: dict = {}
 
-    def refresh(self, refresh_row, reanchor_row) -> None:
+    def refresh(self, refresh_row: Callable[[int], None], reanchor_row: Callable[[int], None]) -> None:
         """Rebuild the stale rows (``refresh_row(number)`` does an axis), and those of the
         axes whose anchor moved (``reanchor_row(number)``)."""
         stale, moved = np.flatnonzero(self.stale), np.flatnonzero(self.moved & ~self.stale)
@@ -242,7 +246,7 @@ class AxisBank:
         """The axes (sorted) a stretch computes as ``kind``."""
         return self.memo(kind, lambda: np.flatnonzero(self.kind == kind))
 
-    def memo(self, key, compute):
+    def memo(self, key: Hashable, compute: Callable[[], T]) -> T:
         """A value derived from the rows, kept until one changes (``compute()`` makes it)."""
         value = self._memo.get(key)
         if value is None:

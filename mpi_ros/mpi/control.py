@@ -335,10 +335,9 @@ class Controller:
     def _commit(self, stop: int, stretch: Stretch, status: StretchStatus) -> None:
         """Keep every axis' state at stretch sample ``stop``."""
         bank = self.bank
-        for name in ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel"):
-            getattr(bank, name)[:] = getattr(stretch, name)[:, stop]
+        bank.values[:] = stretch.values[:, :, stop]
         bank.bits[:] = status.bits[:, :, stop]
-        bank.runs[:] = status.counters_at(stop)
+        status.counters_at(stop, out=bank.runs)
         t = float(stretch.t[stop])
         for row, anchors in stretch.anchors.items():
             self.axes[row].keep_anchor(anchors, t)

@@ -135,7 +135,7 @@ def settle(criterion: np.ndarray | None, carry: np.ndarray, need: np.ndarray, ou
     return Runs(carry, every, mixed, runs)
 
 
-_FLAGS = ("stop", "abort", "settle_on", "moving", "velocity", "tc_always", "at_target_ok")
+_FLAGS = ("stop", "abort", "settle_on", "moving", "velocity", "point_to_point", "tc_always", "at_target_ok")
 
 
 @dataclass(slots=True)
@@ -149,6 +149,7 @@ class StatusRows:
     settle_on: np.ndarray  # a stop with settling: settleOnStop (STOP) or settleOnEstop (E_STOP)
     moving: np.ndarray  # POINT_TO_POINT or VELOCITY
     velocity: np.ndarray  # a VELOCITY move
+    point_to_point: np.ndarray  # moving, not a VELOCITY move: IN_COARSE by distance alone
     tc_always: np.ndarray  # no plan: the trajectory is complete
     tc_after: np.ndarray  # profile time from which TC holds (inf: never)
     ramp_end: np.ndarray
@@ -190,6 +191,7 @@ class StatusRows:
                                         else in_position.settle_on_estop)
         self.moving[row] = moving = mode in (StatusMode.POINT_TO_POINT, StatusMode.VELOCITY)
         self.velocity[row] = moving and velocity
+        self.point_to_point[row] = moving and not velocity
         self.tc_always[row] = not never and plan is None
         self.tc_after[row] = plan.duration if plan is not None and not never else math.inf
         self.ramp_end[row] = plan.ramp_end if plan is not None else 0.0
@@ -217,9 +219,10 @@ class StretchStatus:
             found = self._ever[bit] = self.bits[bit].any(axis=1).tolist()
         return found
 
-    def counters_at(self, index: int) -> np.ndarray:
-        """(3, axes) settling counters at stretch sample ``index``."""
-        return np.stack([r.at(index) for r in self.runs])
+    def counters_at(self, index: int, out: np.ndarray) -> None:
+        """``out`` = the (3, axes) settling counters at stretch sample ``index``."""
+        for row, runs in zip(out, self.runs):
+            row[:] = runs.at(index)
 
 
 class _Arrays:
@@ -291,7 +294,7 @@ def _in_position(trace, rows: StatusRows, tc: np.ndarray, complete: bool, veloci
     """Note 3 (after a point-to-point move, distance to the target): IN_FINE and
     IN_COARSE, which during a velocity move (until its frame ends) are FALSE."""
     col = rows.col
-    coarse_possible = complete or bool((rows.moving & ~rows.velocity).any())
+    coarse_possible = complete or rows.any("point_to_point")
     distance = work.absolute_difference(col["target"], trace.act_p) if coarse_possible else None
     fine = None
     if complete:

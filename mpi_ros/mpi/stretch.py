@@ -23,12 +23,9 @@ from typing import Callable
 import numpy as np
 
 from .axis import Axis
-from .bank import AxisBank, CommandRows, Kind, PlantRows
+from .bank import VALUES, AxisBank, CommandRows, Kind, PlantRows
 from .clock import ProfileClock
 from .plant import PlantState
-
-_VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")
-
 
 class Scratch:
     """Arrays by name, reused from stretch to stretch. A fresh array of a megabyte (32 axes
@@ -67,6 +64,7 @@ class Stretch:
     act_p: np.ndarray
     act_v: np.ndarray
     rel: np.ndarray  # profile time into the plan (nan without one)
+    values: np.ndarray  # the six above as one (6, axes, samples) block, in bank.VALUES order
     scratch: Scratch
     pieces: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # rows of one piece
     anchors: dict[int, list[PlantState]] = field(default_factory=dict)  # plant anchors of the others
@@ -110,8 +108,8 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     """Samples k0+1 .. k1 of every axis, from the bank's (fresh) rows; changes nothing."""
     samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
     t = samples / rate
-    shape = (bank.count, len(samples))
-    out = Stretch(samples, t, *(scratch.take(name, shape) for name in _VALUES), scratch=scratch)
+    values = scratch.take("values", (len(VALUES), bank.count, len(samples)))
+    out = Stretch(samples, t, *values, values=values, scratch=scratch)
     _steady(bank, bank.of_kind(Kind.STEADY), out)
     rows = bank.of_kind(Kind.PIECE)
     if len(rows):
@@ -127,7 +125,7 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
         axis = axes[row]
         one = axis.trace(k0, k1, clock_of(axis))
         out.anchors[row] = one.anchors
-        for name in _VALUES:
+        for name in VALUES:
             getattr(out, name)[row] = getattr(one, name)
     return out
 
@@ -242,11 +240,11 @@ def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray
 
 
 def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
-    """Rows whose segment has acceleration and jerk +0.0 and whose stretch starts in it
-    (dt >= +0): SegmentTable.evaluate's sums reduce there to p + dt v' and v', v' = v + 0.0,
-    to the bit (+0 times a finite dt >= +0 is +0, and x + +0 is x but for x = -0.0)."""
-    a, j = cmd.a[rows], cmd.j[rows]
-    return (a == 0.0) & (j == 0.0) & ~np.signbit(a) & ~np.signbit(j) & (lo >= cmd.seg_start[rows])
+    """Rows whose segment has acceleration and jerk +0.0 (CommandRows.linear) and whose
+    stretch starts in it (dt >= +0): SegmentTable.evaluate's sums reduce there to p + dt v'
+    and v', v' = v + 0.0, to the bit (+0 times a finite dt >= +0 is +0, and x + +0 is x but
+    for x = -0.0)."""
+    return cmd.linear[rows] & (lo >= cmd.seg_start[rows])
 
 
 def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray, into: np.ndarray | None):
@@ -352,11 +350,10 @@ def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) ->
 def _add_transient(plant: PlantRows, tables: list, rows: np.ndarray, s: np.ndarray, y: np.ndarray,
                    dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
     """Plant.response's transient added to the rows that have one."""
-    first, n = int(out.samples[0]), len(out.samples)
     if following:
         live = plant.decayed_after[rows] > -math.inf
     else:
-        live = _live_transients(plant, tables, rows, first, y, dy, out)
+        live = _live_transients(plant, tables, rows, int(out.samples[0]), y, dy, out)
     if not live.any():
         return y, dy
     y, dy = _full(y, s.shape, out, "y"), _full(dy, s.shape, out, "dy")
