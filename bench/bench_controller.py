@@ -27,6 +27,10 @@ import tarfile
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from mpi_ros.mpi import Controller
 
 REPO = Path(__file__).resolve().parent.parent
 # (axes, supervisors, motion, batch, samples)
@@ -40,7 +44,7 @@ CASES = [
 
 
 # -- the measuring process ------------------------------------------------------------------
-def _controller(axes: int, supervisors: int):
+def _controller(axes: int, supervisors: int) -> Controller:
     from mpi_ros.mpi import Controller, ControllerConfig, MPIAction
 
     ctl = Controller(ControllerConfig(axis_count=axes, supervisor_count=supervisors))
@@ -52,7 +56,7 @@ def _controller(axes: int, supervisors: int):
     return ctl
 
 
-def _velocity(ctl) -> None:
+def _velocity(ctl: Controller) -> None:
     from mpi_ros.mpi import MotionAttr, MotionParams, MPIMotionType, Trajectory
 
     for n, ms in enumerate(ctl.supervisors):
@@ -61,7 +65,7 @@ def _velocity(ctl) -> None:
     ctl.step(2000)  # past the ramps
 
 
-def _restart_idle(ctl, flips: list[int]) -> None:
+def _restart_idle(ctl: Controller, flips: list[int]) -> None:
     """Start the next S-curve move of every idle supervisor (back and forth)."""
     from mpi_ros.mpi import MotionAttr, MotionParams, MPIMotionType, MPIState, Trajectory
 

@@ -16,13 +16,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 from enum import IntEnum
-from typing import Callable, Hashable, TypeVar
+from typing import TYPE_CHECKING, Callable, Hashable, TypeVar
 
 import numpy as np
 
 from .clock import ProfileClock
 from .plant import _MAX_DEGREE, Forced, Plant, PlantState, Transient, _FreeTable
 from .status import BITS, StatusRows
+
+if TYPE_CHECKING:
+    from .frames import AxisPlan
+    from .stretch import Scratch
 
 VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")  # an axis' values at a sample
 _MAX_TERMS = _MAX_DEGREE + 1  # coefficients of a piece's steady response
@@ -38,7 +42,7 @@ class Kind(IntEnum):
     SAMPLED = 2  # coasting, or the command follows the actual: one axis at a time (Axis.trace)
 
 
-def _arrays(cls, count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (), **fill: float):
+def _arrays(cls: type[T], count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (), **fill: float) -> T:
     """An instance of the row dataclass ``cls`` with every field an array of ``count``."""
     def make(name: str) -> np.ndarray:
         if name in ints:
@@ -77,7 +81,7 @@ class CommandRows:
     def empty(cls, count: int) -> "CommandRows":
         return _arrays(cls, count, ints=("clock", "segment"), flags=("planned", "truncated", "linear"))
 
-    def set_segment(self, row: int, plan, index: int) -> None:
+    def set_segment(self, row: int, plan: AxisPlan, index: int) -> None:
         """Evaluate ``row`` in segment ``index`` of ``plan``'s table (the profile times that
         SegmentTable.index maps to it: [end of the one before, its end), open at the ends)."""
         table = plan.table
@@ -120,7 +124,7 @@ class PlantRows:
         return rows
 
     def set_piece(self, row: int, anchor: PlantState, end: float, forced: Forced, plant: Plant, rate: float,
-                  table_index) -> None:
+                  table_index: Callable[[_FreeTable], int]) -> None:
         """Row ``row``: the servo ``plant`` from ``anchor`` through a command piece ending at
         ``end`` with steady response ``forced`` (``table_index(table)`` numbers free-response
         tables)."""
@@ -182,7 +186,8 @@ class ClockRows:
         self.t0[number], self.tau0[number], self.t_end[number] = clock.t0, clock.tau0, clock.t_end
         self.f0[number], self.f1[number], self.rate[number] = clock.f0, clock.f1, clock.rate
 
-    def evaluate(self, numbers: np.ndarray, t: np.ndarray, scratch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate(self, numbers: np.ndarray, t: np.ndarray,
+                 scratch: Scratch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """tau, feedrate and its slope of clocks ``numbers`` at times ``t``, each element
         computed exactly as ProfileClock.tau and .feedrates compute it: tau as (clocks,
         samples), the feedrate and slope as (clocks, 1) columns where no clock ramps."""

@@ -39,6 +39,9 @@ from .stretch import Stretch
 from .types import IoSpace, MPIState
 
 MAX_STRETCH = 4096  # samples computed at once
+# Elements (axes x samples) of a stretch at most: its arrays stay a few megabytes (they live in
+# a scratch reused from stretch to stretch), and with many axes a shorter stretch loses nothing.
+_STRETCH_ELEMENTS = 32 * MAX_STRETCH
 # The event of each status bit turning on, in status.BITS order (the order they are emitted
 # in when several turn on in one sample).
 _EDGE_EVENTS = tuple(MPIEventType[name.upper()] for name in BITS[:EVENT_BITS])
@@ -286,8 +289,9 @@ class Controller:
         if samples < 0:
             raise ValueError("samples must be >= 0")
         end = self.sample + int(samples)
+        longest = max(64, min(MAX_STRETCH, _STRETCH_ELEMENTS // len(self.axes)))
         while self.sample < end:
-            self._advance(min(end, self.sample + MAX_STRETCH))
+            self._advance(min(end, self.sample + longest))
 
     def run_until(self, condition: Callable[["Controller"], bool], max_samples: int, chunk: int = 1) -> bool:
         """Step ``chunk`` samples at a time until ``condition`` holds (True) or

@@ -20,11 +20,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from .params import PlantConfig
+
+if TYPE_CHECKING:
+    from .stretch import Scratch
 
 _MAX_DEGREE = 6  # cubic segments composed with a quadratic feedrate time warp
 _QUIET = 1e-12  # homogeneous amplitude below which the loop counts as settled (counts)
@@ -296,7 +300,7 @@ class _FreeTable:
         pr, qr = self.p[r], self.q[r]
         return bp * pr + self.kappa * bq * qr, bp * qr + bq * pr
 
-    def window(self, m0: np.ndarray, n: int, scratch=None) -> tuple[np.ndarray, np.ndarray]:
+    def window(self, m0: np.ndarray, n: int, scratch: Scratch | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(p, q) of Phi((m0_r + i) dt) for rows r and 0 <= i < n <= _TABLE: for each row
         what :meth:`at` gives for m0_r + arange(n). Rows read the table directly while
         every count stays below _TABLE, else as blocks x remainders; the two agree where

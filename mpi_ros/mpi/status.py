@@ -28,10 +28,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 from enum import Enum
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .params import AxisInPosition
+
+if TYPE_CHECKING:
+    from .frames import AxisPlan
+    from .stretch import Scratch, Stretch
 
 _STOPPED_VELOCITY = 1e-9
 _NONE = np.zeros(0, dtype=np.int64)  # counts/s: "command velocity = 0"
@@ -177,7 +182,7 @@ class StatusRows:
         return found
 
     def set(self, row: int, mode: StatusMode, in_position: AxisInPosition, sample_rate: float,
-            target: float, holding: bool, plan) -> None:
+            target: float, holding: bool, plan: AxisPlan | None) -> None:
         """Row ``row`` for an axis in ``mode`` running ``plan`` (an AxisPlan or None)."""
         self._any.clear()
         stop = mode in (StatusMode.STOP, StatusMode.E_STOP)
@@ -228,7 +233,7 @@ class StretchStatus:
 class _Arrays:
     """Named scratch arrays of a stretch's shape (stretch.Scratch), reused by the next one."""
 
-    def __init__(self, scratch, shape: tuple[int, int]):
+    def __init__(self, scratch: Scratch, shape: tuple[int, int]) -> None:
         self.scratch, self.shape = scratch, shape
 
     def real(self, name: str) -> np.ndarray:
@@ -242,7 +247,7 @@ class _Arrays:
         return np.abs(difference, out=difference)
 
 
-def compute(trace, rows: StatusRows, counters: np.ndarray, scratch) -> StretchStatus:
+def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scratch) -> StretchStatus:
     """Status bits of every axis at every sample of a stretch (``trace`` has (axes, samples)
     arrays cmd_p, cmd_v, act_p, act_v, rel; ``counters`` the (3, axes) carried runs). A
     criterion that cannot hold anywhere (say, no trajectory complete) is not computed."""
@@ -289,7 +294,7 @@ def _trajectory_complete(rel: np.ndarray, stopped: np.ndarray, rows: StatusRows,
     return out
 
 
-def _in_position(trace, rows: StatusRows, tc: np.ndarray, complete: bool, velocity_ok: np.ndarray,
+def _in_position(trace: Stretch, rows: StatusRows, tc: np.ndarray, complete: bool, velocity_ok: np.ndarray,
                  counters: np.ndarray, bits: np.ndarray, work: _Arrays) -> Runs:
     """Note 3 (after a point-to-point move, distance to the target): IN_FINE and
     IN_COARSE, which during a velocity move (until its frame ends) are FALSE."""
@@ -312,7 +317,7 @@ def _in_position(trace, rows: StatusRows, tc: np.ndarray, complete: bool, veloci
     return runs
 
 
-def _at_velocity(trace, rows: StatusRows, tc: np.ndarray, velocity_ok: np.ndarray, counters: np.ndarray,
+def _at_velocity(trace: Stretch, rows: StatusRows, tc: np.ndarray, velocity_ok: np.ndarray, counters: np.ndarray,
                  bits: np.ndarray, work: _Arrays) -> Runs:
     """AT_VELOCITY (velocity moves): the ramp done, at the velocity for the settling time."""
     ramp_done = None

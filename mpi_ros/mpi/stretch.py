@@ -247,7 +247,8 @@ def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
     return cmd.linear[rows] & (lo >= cmd.seg_start[rows])
 
 
-def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray, into: np.ndarray | None):
+def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+                    into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     velocity = cmd.v[rows, None] + 0.0
     pos = np.subtract(inside, cmd.seg_start[rows, None], out=into)
     pos *= velocity
@@ -255,7 +256,8 @@ def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray, into
     return pos, velocity, np.zeros_like(velocity)
 
 
-def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray, into: np.ndarray | None):
+def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+                   into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """SegmentTable.evaluate's sums, operation for operation (x + y and x y commute)."""
     start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
     dt = inside - start

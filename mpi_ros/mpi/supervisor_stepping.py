@@ -7,14 +7,20 @@ happens, stops there, and calls :meth:`transition`.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Callable
+
 import numpy as np
 
-from .axis import CommandMode
+from .axis import Axis, CommandMode
 from .events import MPIEventType
 from .holds import HoldWait
 from .messages import Message
 from .status import AT_VELOCITY, DONE, StatusMode
 from .types import HoldType, MPIState
+
+if TYPE_CHECKING:
+    from .status import StretchStatus
+    from .stretch import Stretch
 
 OK = Message.MPIMessageOK
 
@@ -22,7 +28,7 @@ OK = Message.MPIMessageOK
 class SteppingMixin:
     """The transitions of MotionSupervisor."""
 
-    def scan(self, stretch, status) -> int | None:
+    def scan(self, stretch: Stretch, status: StretchStatus) -> int | None:
         """The first sample of a stretch (stretch.Stretch, status.StretchStatus) at which a
         transition of this supervisor happens, or None.
 
@@ -45,7 +51,7 @@ class SteppingMixin:
         firsts = [int(np.argmax(fired)) for fired in conditions.values() if fired.any()]
         return min(firsts) if firsts else None
 
-    def _scan_move(self, stretch, status, conditions: dict) -> None:
+    def _scan_move(self, stretch: Stretch, status: StretchStatus, conditions: dict) -> None:
         """A move done; a velocity move at its velocity."""
         move = self.current
         # A move that ends moving (FINAL_VEL) is never DONE: the next appended move takes
@@ -61,7 +67,7 @@ class SteppingMixin:
             # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
             self._all_axes(conditions, "at_velocity", status, AT_VELOCITY)
 
-    def _all_axes(self, conditions: dict, key: str, status, bit: int) -> None:
+    def _all_axes(self, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
         """``conditions[key]``: per sample, is ``bit`` set on every axis of the current move?
         (left out where it never is: an axis without it anywhere in the stretch)"""
         ever = status.ever(bit)
@@ -80,14 +86,14 @@ class SteppingMixin:
         return self._ends_moving() and all(
             self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in self.current.plans)
 
-    def _stop_complete(self, t, status, settle) -> np.ndarray:
+    def _stop_complete(self, t: np.ndarray, status: StretchStatus, settle: Callable[[Axis], bool]) -> np.ndarray:
         ready = t >= self._stop_end - 1e-12
         for axis in self.axes:
             if settle(axis):
                 ready = ready & status.bits[DONE, axis.number]
         return ready
 
-    def _hold_trigger(self, wait: HoldWait, stretch) -> np.ndarray:
+    def _hold_trigger(self, wait: HoldWait, stretch: Stretch) -> np.ndarray:
         if wait.watches_position:
             number = wait.hold.number
             raw = stretch.act_p[number] if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else stretch.cmd_p[number]
