@@ -112,13 +112,15 @@ class PlantRows:
     m0: np.ndarray
     m1: np.ndarray
     decayed_after: np.ndarray  # -inf: no transient; inf: never dropped
+    vanishing: np.ndarray  # sample from which the transient is exact zeros (inf: never)
     table: np.ndarray  # index into AxisBank.tables
     resolution: np.ndarray
     snap_after: np.ndarray  # at rest: seconds past the anchor from which it snaps onto the command (Axis.commit)
 
     @classmethod
     def empty(cls, count: int) -> "PlantRows":
-        rows = _arrays(cls, count, ints=("terms", "k0", "table"), piece_end=math.inf, snap_after=math.inf)
+        rows = _arrays(cls, count, ints=("terms", "k0", "table"), piece_end=math.inf, snap_after=math.inf,
+                       vanishing=math.inf)
         rows.steady_y = np.zeros((count, _MAX_TERMS))
         rows.steady_dy = np.zeros((count, _MAX_TERMS))
         return rows
@@ -151,6 +153,7 @@ class PlantRows:
         self.k0[row] = transient.k0
         self.v0[row], self.v1[row], self.m0[row], self.m1[row] = transient.v0, transient.v1, transient.m0, transient.m1
         self.decayed_after[row] = transient.decayed_after
+        self.vanishing[row] = transient.k0 + transient.table.vanishing_count()
         self.table[row] = table
 
 
@@ -186,23 +189,41 @@ class ClockRows:
         self.t0[number], self.tau0[number], self.t_end[number] = clock.t0, clock.tau0, clock.t_end
         self.f0[number], self.f1[number], self.rate[number] = clock.f0, clock.f1, clock.rate
 
-    def evaluate(self, numbers: np.ndarray, t: np.ndarray,
-                 scratch: Scratch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """tau, feedrate and its slope of clocks ``numbers`` at times ``t``, each element
-        computed exactly as ProfileClock.tau and .feedrates compute it: tau as (clocks,
-        samples), the feedrate and slope as (clocks, 1) columns where no clock ramps."""
+    def columns(self, numbers: np.ndarray) -> "ClockColumns":
+        """Clocks ``numbers`` as (clocks, 1) columns (kept by the bank until a clock changes)."""
         t0, tau0, f0, f1 = (a[numbers, None] for a in (self.t0, self.tau0, self.f0, self.f1))
         t_end, rate = self.t_end[numbers, None], self.rate[numbers, None]
-        if t[0] >= t_end.max():
+        dt = t_end - t0
+        tau_end = tau0 + dt * (f0 + 0.5 * rate * dt)  # as ProfileClock.tau sums it at t >= t_end
+        return ClockColumns(t0, tau0, f0, f1, t_end, rate, tau_end, float(t_end.max()), np.zeros_like(f1))
+
+
+@dataclass(frozen=True, slots=True)
+class ClockColumns:
+    t0: np.ndarray
+    tau0: np.ndarray
+    f0: np.ndarray
+    f1: np.ndarray
+    t_end: np.ndarray
+    rate: np.ndarray
+    tau_end: np.ndarray
+    last_end: float
+    no_slope: np.ndarray
+
+    def evaluate(self, t: np.ndarray, scratch: Scratch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """tau, feedrate and its slope at times ``t``, each element computed exactly as
+        ProfileClock.tau and .feedrates compute it: tau as (clocks, samples), the feedrate
+        and slope as (clocks, 1) columns where no clock ramps."""
+        if t[0] >= self.last_end:
             # Past every ramp min(t, t_end) is t_end and max(t - t_end, 0) is t - t_end, to the
-            # bit: tau = ramp + f1 (t - t_end), the ramp's part one number per clock.
-            dt = t_end - t0
-            tau = np.subtract(t, t_end, out=scratch.take("tau", (len(numbers), len(t))))
-            tau *= f1
-            tau += tau0 + dt * (f0 + 0.5 * rate * dt)
-            return tau, f1, np.zeros_like(f1)
+            # bit: tau = tau_end + f1 (t - t_end).
+            tau = np.subtract(t, self.t_end, out=scratch.take("tau", (len(self.t0), len(t))))
+            tau *= self.f1
+            tau += self.tau_end
+            return tau, self.f1, self.no_slope
+        t0, f0, f1, t_end, rate = self.t0, self.f0, self.f1, self.t_end, self.rate
         dt = np.minimum(t, t_end) - t0
-        tau = tau0 + dt * (f0 + 0.5 * rate * dt)
+        tau = self.tau0 + dt * (f0 + 0.5 * rate * dt)
         tau += f1 * np.maximum(t - t_end, 0.0)
         in_ramp = t < t_end
         f = np.where(in_ramp, f0 + rate * (t - t0), f1)

@@ -249,6 +249,7 @@ def _first_sample(t: float, rate: float) -> int:
 
 _TABLES: dict[tuple[float, float, float, float], "_FreeTable"] = {}  # shared by identical loops
 _TABLE = 4096  # samples of free response tabulated; further ones are products of two
+_BLOCKS_WATCHED = 64  # blocks of _TABLE samples searched for an exact underflow (about 2 min at 2 kHz)
 
 
 class _FreeTable:
@@ -256,7 +257,7 @@ class _FreeTable:
     from the C library's scalar functions (the same on every CPU); beyond, products
     Phi((a + b) dt) = Phi(a dt) Phi(b dt), using M^2 = kappa I."""
 
-    __slots__ = ("p", "q", "k", "kappa", "block_p", "block_q", "block_k", "_p2", "_q2", "_bp", "_bq")
+    __slots__ = ("p", "q", "k", "kappa", "block_p", "block_q", "block_k", "_p2", "_q2", "_bp", "_bq", "_vanishing")
 
     def __init__(self, p, q, k, kappa: float):
         self.p, self.q, self.k, self.kappa = p, q, k, kappa
@@ -269,6 +270,7 @@ class _FreeTable:
         self._q2 = np.concatenate((q[:_TABLE], q[:_TABLE]))
         self._bp = np.array(self.block_p)
         self._bq = np.array(self.block_q)
+        self._vanishing: float | None = None
 
     @classmethod
     def build(cls, plant: "Plant", rate: float) -> "_FreeTable":
@@ -321,12 +323,18 @@ class _FreeTable:
         q += np.multiply(bq, pr, out=take("product"))
         return p, q
 
-    def vanished(self, m0: np.ndarray) -> np.ndarray:
-        """Per row: is Phi((m0_r + i) dt) exactly zero for every i < _TABLE? (its block
-        factor has underflowed to zeros, and so have all later ones)"""
-        blocks = m0 // _TABLE
-        self._blocks(int(blocks.max()) + 1)
-        return (blocks > 0) & (self._bp[blocks] == 0.0) & (self._bq[blocks] == 0.0)
+    def vanishing_count(self) -> float:
+        """The sample count from which Phi(m dt) is exactly zero: the start of the first block
+        whose factor has underflowed to zeros (every later one is zero too, as products of
+        it); inf if none has within _BLOCKS_WATCHED blocks (a slow loop)."""
+        if self._vanishing is None:
+            self._vanishing = math.inf
+            for n in range(1, _BLOCKS_WATCHED):
+                self._blocks(n)
+                if self.block_p[n] == 0.0 and self.block_q[n] == 0.0:
+                    self._vanishing = float(n * _TABLE)
+                    break
+        return self._vanishing
 
     def _block_rows(self, blocks: np.ndarray, r0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         """The block factor of every count of each row: one block per row (a column),

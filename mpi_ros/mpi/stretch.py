@@ -23,7 +23,7 @@ from typing import Callable
 import numpy as np
 
 from .axis import Axis
-from .bank import VALUES, AxisBank, CommandRows, Kind, PlantRows
+from .bank import VALUES, AxisBank, ClockColumns, CommandRows, Kind, PlantRows
 from .clock import ProfileClock
 from .plant import PlantState
 
@@ -157,8 +157,8 @@ def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
 def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
     """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate)."""
     cmd = bank.command
-    numbers, which = bank.memo(("clocks", rows.tobytes()), lambda: np.unique(cmd.clock[rows], return_inverse=True))
-    tau, f, df = bank.clocks.evaluate(numbers, out.t, out.scratch)
+    which, clocks = bank.memo(("clocks", rows.tobytes()), lambda: _clocks_of(bank, rows))
+    tau, f, df = clocks.evaluate(out.t, out.scratch)
     rel = np.take(tau, which, axis=0, out=out.target("rel", rows))
     rel -= cmd.tau_start[rows, None]
     lo, hi = rel.min(axis=1), rel.max(axis=1)
@@ -192,6 +192,12 @@ def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
     for i in np.flatnonzero(~single).tolist():
         p[i], dp[i], ddp[i] = bank.plans[int(rows[i])].evaluate(rel[i])
     return p, dp, ddp
+
+
+def _clocks_of(bank: AxisBank, rows: np.ndarray) -> tuple[np.ndarray, ClockColumns]:
+    """Each row's index among the clocks its rows run on, and those clocks."""
+    numbers, which = np.unique(bank.command.clock[rows], return_inverse=True)
+    return which, bank.clocks.columns(numbers)
 
 
 def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -355,7 +361,7 @@ def _add_transient(plant: PlantRows, tables: list, rows: np.ndarray, s: np.ndarr
     if following:
         live = plant.decayed_after[rows] > -math.inf
     else:
-        live = _live_transients(plant, tables, rows, int(out.samples[0]), y, dy, out)
+        live = _live_transients(plant, rows, int(out.samples[0]), y, dy, out)
     if not live.any():
         return y, dy
     y, dy = _full(y, s.shape, out, "y"), _full(dy, s.shape, out, "dy")
@@ -386,8 +392,8 @@ def _full(values: np.ndarray, shape: tuple[int, int], out: Stretch, name: str) -
     return full
 
 
-def _live_transients(plant: PlantRows, tables: list, rows: np.ndarray, first: int, y: np.ndarray,
-                     dy: np.ndarray, out: Stretch) -> np.ndarray:
+def _live_transients(plant: PlantRows, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray,
+                     out: Stretch) -> np.ndarray:
     """Per row: must its transient be added? Not without one; nor where the free response
     has underflowed to exact zeros over the whole stretch (a long-settled loop), since
     adding a zero changes nothing, unless a value is itself a zero (whose sign it might
@@ -395,15 +401,7 @@ def _live_transients(plant: PlantRows, tables: list, rows: np.ndarray, first: in
     live = plant.decayed_after[rows] > -math.inf
     if not live.any():
         return live
-    m0 = first - plant.k0[rows]
-    which = plant.table[rows]
-    if (which == which[0]).all():
-        vanished = live & tables[int(which[0])].vanished(m0)
-    else:
-        vanished = np.zeros(len(rows), dtype=bool)
-        for index in np.unique(which[live]).tolist():
-            group = live & (which == index)
-            vanished[group] = tables[index].vanished(m0[group])
+    vanished = live & (first >= plant.vanishing[rows])
     if vanished.any():
         vanished &= ~(_has_zero(y, vanished, out) | _has_zero(dy, vanished, out))
     return live & ~vanished
