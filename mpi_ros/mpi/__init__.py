@@ -32,6 +32,10 @@ Where each spec concept lives (spec = ../shared/spec; 000 motion objects, 002 ax
 | motion log (meiMotionLogOpen/Print/Close)                 | log.py |
 | mpiMotionStatus / mpiAxisStatus / frame buffer status     | snapshot.py |
 | Controller: sample clock, step/run_until, objects, events | control.py |
+| every axis' state as arrays across axes, and the rows a   | bank.py |
+|   stretch is computed from (command piece, plant anchor,  |   |
+|   status inputs, supervisors' clocks)                     |   |
+| every axis over a stretch of samples at once              | stretch.py |
 
 Start with ``Controller``: create it, ``create_motion``, ``axis_list_set``, ``start``,
 then ``step(n)`` or ``run_until(...)``. Every call answers a ``Message``.

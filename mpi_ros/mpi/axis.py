@@ -1,9 +1,13 @@
 """Axis: command, actual and error positions, origin, the simulated servo, status.
 
 The command follows the plan of the move loaded on the axis (read through the owning
-supervisor's feedrate clock), or rests at a fixed position. ``trace`` computes every
-sample of a stretch at once (vectorised over time) without changing the axis;
-``commit`` then keeps the state up to one of those samples. Values at a sample depend
+supervisor's feedrate clock), or rests at a fixed position. An Axis is a view of its
+column in the controller's AxisBank (the values at the current sample, status bits,
+settling counters) plus what only changes on a command: its plan, the plant anchor,
+the mode. From those it writes its rows in the bank (:meth:`refresh`), from which the
+controller computes every axis over a stretch at once (stretch.py); the few axes that
+cannot be written as rows (coasting, command following the actual, a breakpoint inside
+the stretch) are traced here one at a time (:meth:`trace`). Values at a sample depend
 only on the command history (plant anchors sit at command breakpoints), never on how
 the stretch was cut, so stepping 1 sample at a time or 10,000 at once agree exactly.
 
@@ -13,18 +17,20 @@ Positions seen by users are raw positions minus the origin (mpiAxisOriginSet).
 from __future__ import annotations
 
 import bisect
+import itertools
 import math
 from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
 
+from .bank import AxisBank, Kind
 from .clock import ProfileClock
 from .frames import AxisPlan
 from .messages import Message
 from .params import AxisInPosition, PlantConfig, check_position
 from .plant import Forced, Plant, PlantState, compose
-from .status import AxisStatusBits, SettleCounters, StatusMode
+from .status import AxisStatusBits, StatusMode, bits_of, column_of
 from .types import MPIState
 
 
@@ -47,46 +53,108 @@ class AxisTrace:
         return len(self.samples)
 
 
-_AT_REST = 1 << 30  # settling counters of an axis that has long been at rest
-
-
 class CommandMode(Enum):
     SERVO = "SERVO"  # command drives the loop
     FOLLOW_ACTUAL = "FOLLOW_ACTUAL"  # settleOnEstopCmdEqAct: command = previous actual
     COAST = "COAST"  # amplifier off (ABORT): the motor coasts
 
 
+class _Derived:
+    """An attribute the axis' rows in the bank derive from: setting it marks them stale."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.slot = "_" + name
+
+    def __get__(self, axis: "Axis | None", owner: type | None = None):
+        return self if axis is None else getattr(axis, self.slot)
+
+    def __set__(self, axis: "Axis", value) -> None:
+        setattr(axis, self.slot, value)
+        axis._bank.stale[axis.number] = True
+
+
+class _Anchor(_Derived):
+    """The plant anchor: moving it changes only the axis' servo rows (a lighter rebuild)."""
+
+    def __set__(self, axis: "Axis", value) -> None:
+        setattr(axis, self.slot, value)
+        axis._bank.moved[axis.number] = True
+
+
+class _Value:
+    """A value of the axis at the current sample, kept in the bank's arrays."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, axis: "Axis | None", owner: type | None = None):
+        return self if axis is None else float(getattr(axis._bank, self.name)[axis.number])
+
+    def __set__(self, axis: "Axis", value: float) -> None:
+        getattr(axis._bank, self.name)[axis.number] = value
+
+
 class Axis:
-    def __init__(self, number: int, sample_rate: float, in_position: AxisInPosition, plant: PlantConfig):
+    # command
+    plan: AxisPlan | None = _Derived()
+    tau_start: float = _Derived()
+    rest: float = _Derived()  # raw command when no plan is loaded
+    mode: CommandMode = _Derived()
+    holding: bool = _Derived()  # a hold frame is waiting for its trigger
+    # plant, anchored at the start of the current command piece
+    state: PlantState = _Anchor()
+    plant: Plant = _Derived()
+    # status
+    status_mode: StatusMode = _Derived()
+    target: float = _Derived()
+    in_position: AxisInPosition = _Derived()  # replaced whole, never changed in place
+    # values at the current sample
+    cmd_p: float = _Value()
+    cmd_v: float = _Value()
+    cmd_a: float = _Value()
+    act_p: float = _Value()
+    act_v: float = _Value()
+    rel: float = _Value()  # profile time into the plan (nan without one)
+
+    def __init__(self, number: int, bank: AxisBank, sample_rate: float, in_position: AxisInPosition,
+                 plant: PlantConfig):
         self.number = number
+        self._bank = bank
         self.rate = sample_rate
         self.in_position = in_position.copy()
         self.plant = Plant(plant)
         self.origin = 0.0
         self.enabled = True  # an enabled axis (MPIMessageOBJECT_NOT_ENABLED otherwise)
-        # command
-        self.plan: AxisPlan | None = None
+        self.plan = None
         self.tau_start = 0.0
-        self.rest = 0.0  # raw command when no plan is loaded
+        self.rest = 0.0
         self.mode = CommandMode.SERVO
-        self.holding = False  # a hold frame is waiting for its trigger
-        self.owner: int = -1  # supervisor commanding the axis
+        self.holding = False
+        self.owner = -1
         self.move_id = 0
         self.element_id = 0
-        # plant (anchored at the start of the current command piece)
         self.state = PlantState(0.0, 0.0, 0.0)
         self._cache: dict = {}
-        # values at the current sample
-        self.sample = 0
-        self.cmd_p = self.cmd_v = self.cmd_a = 0.0
-        self.act_p = self.act_v = 0.0
-        self.rel = math.nan
-        # status
         self.status_mode = StatusMode.POINT_TO_POINT
         self.target = 0.0
-        # A new controller's axes rest settled on their command.
-        self.status = AxisStatusBits(True, True, True, True, True, False, True)
-        self.counters = SettleCounters(_AT_REST, _AT_REST, 0)
+
+    @property
+    def owner(self) -> int:
+        """The supervisor commanding the axis (-1: none); its clock drives the plan."""
+        return int(self._bank.owner[self.number])
+
+    @owner.setter
+    def owner(self, number: int) -> None:
+        self._bank.owner[self.number] = number
+        self._bank.stale[self.number] = True
+
+    @property
+    def status(self) -> AxisStatusBits:
+        return bits_of(self._bank.bits[:, self.number])
+
+    @status.setter
+    def status(self, bits: AxisStatusBits) -> None:
+        self._bank.bits[:, self.number] = column_of(bits)
 
     # -- positions (user coordinates) ------------------------------------------------
     @property
@@ -196,7 +264,7 @@ class Axis:
         self.tau_start = tau_start
         self.holding = False
         self.target = plan.target
-        self.counters = SettleCounters()
+        self._bank.reset_counters(self.number)
 
     def unload(self, t: float, clock: ProfileClock | None) -> None:
         """Drop the plan; the command rests where it is now."""
@@ -327,25 +395,85 @@ class Axis:
             held = float(self.plant.read(np.array([state.y]))[0])
         return y, dy, anchors
 
-    def commit(self, trace: AxisTrace, index: int) -> None:
-        """Keep the state at ``trace`` sample ``index``."""
-        t = float(trace.t[index])
+    def keep_anchor(self, anchors: list[PlantState], t: float) -> None:
+        """After a stretch traced here (:meth:`trace`): the plant anchor in force at time ``t``
+        of it (the controller keeps the values)."""
         anchor = self.state
-        for candidate in trace.anchors:
+        for candidate in anchors:
             if candidate.t <= t:
                 anchor = candidate
             else:
                 break
         if self.plan is None and self.mode is CommandMode.SERVO and not self.holding:
             anchor = self._settle_anchor(anchor, t)
-        self.state = anchor
-        self.sample = int(trace.samples[index])
-        self.cmd_p = float(trace.cmd_p[index])
-        self.cmd_v = float(trace.cmd_v[index])
-        self.cmd_a = float(trace.cmd_a[index])
-        self.act_p = float(trace.act_p[index])
-        self.act_v = float(trace.act_v[index])
-        self.rel = float(trace.rel[index])
+        if anchor is not self.state:
+            self.state = anchor
+
+    def snap(self, t: float) -> None:
+        """The rest the loop has reached by ``t`` (see :meth:`_settle_anchor`), for an axis
+        computed in rows: PlantRows.snap_after says when."""
+        self.state = PlantState(t, self.rest, 0.0)
+
+    # -- rows ------------------------------------------------------------------------
+    def refresh(self, clock: ProfileClock | None) -> None:
+        """Write this axis' rows in the bank from its plan, anchor, mode and tolerances."""
+        bank, row = self._bank, self.number
+        bank.stale[row] = False
+        bank.command.truncated[row] = self.plan is not None and self.plan.truncated
+        bank.command.duration[row] = self.plan.duration if self.plan is not None else math.inf
+        bank.status.set(row, self.status_mode, self.in_position, self.rate, self.target, self.holding, self.plan)
+        self._write_command(clock)
+        self.reanchor(clock)
+
+    def reanchor(self, clock: ProfileClock | None) -> None:
+        """Rewrite the rows that depend on the plant anchor (all that changed)."""
+        bank, row = self._bank, self.number
+        bank.moved[row] = False
+        if self.steady(clock):
+            bank.kind[row] = Kind.STEADY
+        elif self.mode is CommandMode.SERVO:
+            bank.kind[row] = Kind.PIECE
+            self._write_piece(clock)
+        else:
+            bank.kind[row] = Kind.SAMPLED
+
+    def _write_piece(self, clock: ProfileClock | None) -> None:
+        """The command piece that starts at the anchor (what :meth:`_pieces` gives first)."""
+        key = self._piece_key(clock)
+        times = self._boundary_times(key, clock)
+        i = bisect.bisect_right(times, self.state.t)
+        end = times[i] if i < len(times) else math.inf
+        forced = self._forced(key, self.state.t, end, clock)
+        bank, row = self._bank, self.number
+        bank.plant.set_piece(row, self.state, end, forced, self.plant, self.rate, bank.table_index)
+        at_rest = self.plan is None and not self.holding
+        bank.plant.snap_after[row] = self.plant.quiet_after(self.state, forced.y) if at_rest else math.inf
+
+    def continuations(self, t_last: float, clock: ProfileClock | None) -> list[tuple[PlantState, float, float, Forced]]:
+        """The command pieces after the current one that start by ``t_last``, each with the
+        plant anchor at its start: (anchor, start, end, steady response), the anchors
+        advanced from piece to piece as :meth:`_trace_plant` advances them."""
+        state = self.state
+        pieces = self._pieces(state.t, t_last, clock)
+        following = []
+        for (_, end, forced), (start, nxt_end, nxt_forced) in itertools.pairwise(pieces):
+            state = self._advance_piece(state, forced, end)
+            following.append((state, start, nxt_end, nxt_forced))
+        return following
+
+    def _write_command(self, clock: ProfileClock | None) -> None:
+        rows, row, plan = self._bank.command, self.number, self.plan
+        rows.rest[row] = self.rest
+        rows.planned[row] = planned = plan is not None and clock is not None
+        if self._bank.plans[row] is not plan:
+            self._bank.plans[row] = plan
+            rows.segment[row] = -1  # chosen where the profile time is, when the controller steps
+            rows.seg_lo[row], rows.seg_hi[row] = math.inf, -math.inf
+        if planned:
+            rows.clock[row] = self.owner
+            rows.tau_start[row] = self.tau_start
+            rows.target[row] = plan.target
+            rows.final_velocity[row] = plan.final_velocity
 
     def _settle_anchor(self, anchor: PlantState, t: float) -> PlantState:
         """Once the loop at rest has decayed below the quiet level, snap it exactly onto
@@ -354,7 +482,7 @@ class Axis:
         if anchor.y == self.rest and anchor.dy == 0.0:
             return anchor
         forced = self.plant.prepare([self.rest])
-        if self.plant.quiet(anchor, forced.y, after=t - anchor.t):
+        if t - anchor.t >= self.plant.quiet_after(anchor, forced.y):
             return PlantState(t, self.rest, 0.0)
         return anchor
 

@@ -17,7 +17,10 @@ from typing import Callable
 
 import numpy as np
 
+from . import stretch as stretches
 from .axis import Axis
+from .bank import AxisBank
+from .clock import ProfileClock
 from .events import Event, MPIEventType
 from .io import IoImage
 from .messages import STATE_MESSAGES, Message
@@ -31,18 +34,17 @@ from .params import (
     check_settling_reachable,
 )
 from .snapshot import AxisSnapshot
-from .status import StatusContext, compute, rising_edges
+from .status import BITS, EVENT_BITS, StretchStatus, compute, rising_edges
+from .stretch import Stretch
 from .types import IoSpace, MPIState
 
 MAX_STRETCH = 4096  # samples computed at once
-_EDGE_EVENTS = {
-    "done": MPIEventType.DONE,
-    "in_fine_position": MPIEventType.IN_FINE_POSITION,
-    "in_coarse_position": MPIEventType.IN_COARSE_POSITION,
-    "at_target": MPIEventType.AT_TARGET,
-    "settled": MPIEventType.SETTLED,
-    "at_velocity": MPIEventType.AT_VELOCITY,
-}
+# Elements (axes x samples) of a stretch at most: its arrays stay a few megabytes (they live in
+# a scratch reused from stretch to stretch), and with many axes a shorter stretch loses nothing.
+_STRETCH_ELEMENTS = 32 * MAX_STRETCH
+# The event of each status bit turning on, in status.BITS order (the order they are emitted
+# in when several turn on in one sample).
+_EDGE_EVENTS = tuple(MPIEventType[name.upper()] for name in BITS[:EVENT_BITS])
 
 EventListener = Callable[[Event], None]
 
@@ -64,8 +66,10 @@ class Controller:
                 raise ValueError(f"{what}.{verdict.detail}")
         self.rate = float(self.config.sample_rate)
         self.sample = 0
+        self.bank = AxisBank(self.config.axis_count, self.config.supervisor_count)
+        self._scratch = stretches.Scratch()  # the arrays of a stretch, reused by the next one
         self.axes = [
-            Axis(n, self.rate, in_position or AxisInPosition(), plant or PlantConfig())
+            Axis(n, self.bank, self.rate, in_position or AxisInPosition(), plant or PlantConfig())
             for n in range(self.config.axis_count)
         ]
         self.io = IoImage(self.config.io_words, self.config.motors)
@@ -292,8 +296,9 @@ class Controller:
         if samples < 0:
             raise ValueError("samples must be >= 0")
         end = self.sample + int(samples)
+        longest = max(64, min(MAX_STRETCH, _STRETCH_ELEMENTS // len(self.axes)))
         while self.sample < end:
-            self._advance(min(end, self.sample + MAX_STRETCH))
+            self._advance(min(end, self.sample + longest))
 
     def run_until(self, condition: Callable[["Controller"], bool], max_samples: int, chunk: int = 1) -> bool:
         """Step ``chunk`` samples at a time until ``condition`` holds (True) or
@@ -305,73 +310,78 @@ class Controller:
             self.step(min(chunk, limit - self.sample))
         return True
 
-    def _clock(self, axis: Axis):
+    def _clock(self, axis: Axis) -> ProfileClock | None:
         owner = self.supervisor(axis.owner)
         return owner.clock if owner is not None else None
 
-    def _context(self, axis: Axis) -> StatusContext:
-        plan = axis.plan
-        return StatusContext(
-            mode=axis.status_mode,
-            target=axis.target,
-            in_position=axis.in_position,
-            sample_rate=self.rate,
-            holding=axis.holding,
-            plan_duration=plan.duration if plan is not None else 0.0,
-            velocity_target=plan.velocity_target if plan is not None else None,
-            ramp_end=plan.ramp_end if plan is not None else 0.0,
-            has_plan=plan is not None,
-            ends_moving=plan is not None and plan.final_velocity != 0.0,
-        )
-
     def _advance(self, k1: int) -> None:
         k0 = self.sample
-        traces = {a.number: a.trace(k0, k1, self._clock(a)) for a in self.axes}
-        statuses = {a.number: compute(traces[a.number], self._context(a), a.counters) for a in self.axes}
-        samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
-        t = samples / self.rate
-        stop = len(samples) - 1
+        self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])),
+                          lambda row: self.axes[row].reanchor(self._clock(self.axes[row])))
+        stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch)
+        status = compute(stretch, self.bank.status, self.bank.runs, self._scratch)
+        stop = len(stretch) - 1
         event_at = None
-        for ms in self.supervisors:
-            hits = ms.scan(samples, t, traces, statuses)
-            if hits is not None:
-                found = np.flatnonzero(hits)
-                if len(found) and found[0] <= stop:
-                    stop = int(found[0])
-                    event_at = stop
-        self._status_events(stop, traces, statuses)
-        for ms in self.supervisors:
-            if ms.log is not None and not ms.log.full:
-                ms.log.record(samples[: stop + 1], ms.state.name,
-                              [(traces[n].cmd_p[: stop + 1] - self.axes[n].origin,
-                                traces[n].act_p[: stop + 1] - self.axes[n].origin,
-                                traces[n].cmd_v[: stop + 1]) for n in ms.mapped])
-        for axis in self.axes:
-            axis.commit(traces[axis.number], stop)
-            axis.status = statuses[axis.number].at(stop)
-            axis.counters = statuses[axis.number].counters_at(stop)
-        self.sample = int(samples[stop])
+        supervisors = self.supervisors
+        for ms in supervisors:
+            first = ms.scan(stretch, status)
+            if first is not None and first <= stop:
+                stop = event_at = first
+        self._status_events(stop, stretch, status)
+        self._log(stop, stretch, supervisors)
+        self._commit(stop, stretch, status)
+        self.sample = int(stretch.samples[stop])
         if event_at is not None:
-            for ms in self.supervisors:
-                ms.transition(stop, samples)
+            for ms in supervisors:
+                ms.transition(stop, stretch.samples)
 
-    def _status_events(self, stop: int, traces, statuses) -> None:
+    def _log(self, stop: int, stretch: Stretch, supervisors: list[MotionSupervisor]) -> None:
+        for ms in supervisors:
+            if ms.log is not None and not ms.log.full:
+                ms.log.record(stretch.samples[: stop + 1], ms.state.name,
+                              [(stretch.cmd_p[n, : stop + 1] - self.axes[n].origin,
+                                stretch.act_p[n, : stop + 1] - self.axes[n].origin,
+                                stretch.cmd_v[n, : stop + 1]) for n in ms.mapped])
+
+    def _commit(self, stop: int, stretch: Stretch, status: StretchStatus) -> None:
+        """Keep every axis' state at stretch sample ``stop``."""
+        bank = self.bank
+        bank.values[:] = stretch.values[:, :, stop]
+        bank.bits[:] = status.bits[:, :, stop]
+        status.counters_at(stop, out=bank.runs)
+        t = float(stretch.t[stop])
+        for row, anchors in stretch.anchors.items():
+            self.axes[row].keep_anchor(anchors, t)
+        rows = stretch.pieces
+        plant = bank.plant
+        for row in rows[t - plant.anchor_t[rows] >= plant.snap_after[rows]].tolist():
+            self.axes[row].snap(t)
+
+    def _status_events(self, stop: int, stretch: Stretch, status: StretchStatus) -> None:
         """Events for status bits that turn on in samples up to ``stop``, in sample order."""
         found: list[tuple[int, int, int, MPIEventType, str]] = []  # sample, axis, rank, type, detail
-        for axis in self.axes:
-            status = statuses[axis.number]
-            samples = traces[axis.number].samples
-            for rank, (name, kind) in enumerate(_EDGE_EVENTS.items()):
-                for i in rising_edges(getattr(axis.status, name), status.bits[name][: stop + 1]):
-                    found.append((int(samples[i]), axis.number, rank, kind, ""))
-            plan = axis.plan
-            if plan is not None and plan.truncated and axis.rel < plan.duration:
-                crossed = np.flatnonzero(traces[axis.number].rel[: stop + 1] >= plan.duration)
-                if len(crossed):
-                    found.append((int(samples[crossed[0]]), axis.number, -1, MPIEventType.FRAME_TIME_LIMIT,
-                                  "a frame reached 16,384,000 samples: the axis stopped abruptly"))
+        bits = status.bits[:EVENT_BITS, :, : stop + 1]
+        before = self.bank.bits[:EVENT_BITS]
+        # Only a bit that is on somewhere, and not on throughout after being on, can rise.
+        rising = bits.any(axis=2) & ~(bits.all(axis=2) & before)
+        for rank, number in zip(*np.nonzero(rising)):
+            for i in rising_edges(bool(before[rank, number]), bits[rank, number]):
+                found.append((int(stretch.samples[i]), int(number), int(rank), _EDGE_EVENTS[rank], ""))
+        found += self._frame_time_limits(stop, stretch)
         for sample, number, _, kind, detail in sorted(found, key=lambda e: e[:3]):
             axis = self.axes[number]
             self.emit(kind, supervisor=axis.owner, axis=number, move_id=axis.move_id,
                       element_id=axis.element_id, detail=detail, sample=sample)
 
+    def _frame_time_limits(self, stop: int, stretch: Stretch) -> list[tuple[int, int, int, MPIEventType, str]]:
+        """spec 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
+        ends abruptly, reported when the axis gets there."""
+        command = self.bank.command
+        rows = self.bank.memo("truncated", lambda: np.flatnonzero(command.truncated))
+        rows = rows[self.bank.rel[rows] < command.duration[rows]]  # not there yet (nan: no plan running)
+        reached = stretch.rel[rows, : stop + 1] >= command.duration[rows, None]
+        found = []
+        for i in np.flatnonzero(reached.any(axis=1)).tolist():
+            found.append((int(stretch.samples[np.argmax(reached[i])]), int(rows[i]), -1, MPIEventType.FRAME_TIME_LIMIT,
+                          "a frame reached 16,384,000 samples: the axis stopped abruptly"))
+        return found

@@ -109,10 +109,15 @@ class Move:
     element_id: int = 0
     event_mask: MPIEventType = MPIEventType.NONE
     serial: int = field(default_factory=next_serial)
+    # Facts the controller asks every stretch (a move's plans never change once compiled).
+    is_velocity: bool = field(init=False)  # a VELOCITY move
+    ends_moving: bool = field(init=False)  # FINAL_VEL: the axes go on at their final velocity
+    plan_axes: tuple[int, ...] = field(init=False)  # the axes of its plans, in order
 
-    @property
-    def is_velocity(self) -> bool:
-        return any(plan.is_velocity for plan in self.plans)
+    def __post_init__(self) -> None:
+        self.plan_axes = tuple(plan.axis for plan in self.plans)
+        self.is_velocity = any(plan.is_velocity for plan in self.plans)
+        self.ends_moving = any(plan.final_velocity != 0.0 for plan in self.plans)
 
     @property
     def axes(self) -> list[int]:

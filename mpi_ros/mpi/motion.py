@@ -99,6 +99,16 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         self.action_callback: ActionCallback | None = None
         self.move_ends: list[MoveEnd] = []  # how each move ended, in order (drained by the owner)
 
+    @property
+    def clock(self) -> ProfileClock:
+        """The feedrate clock this supervisor's axes read their plans through (clock.py)."""
+        return self._clock
+
+    @clock.setter
+    def clock(self, clock: ProfileClock) -> None:
+        self._clock = clock
+        self._ctl.bank.clock_changed(self.number, clock)
+
     # ================================================================= handles ====
     def validate(self) -> Message:
         """mpiMotionValidate."""

@@ -20,10 +20,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from .params import PlantConfig
+
+if TYPE_CHECKING:
+    from .stretch import Scratch
 
 _MAX_DEGREE = 6  # cubic segments composed with a quadratic feedrate time warp
 _QUIET = 1e-12  # homogeneous amplitude below which the loop counts as settled (counts)
@@ -44,6 +49,26 @@ class PlantState:
     t: float
     y: float
     dy: float
+
+
+@dataclass(frozen=True, slots=True)
+class Transient:
+    """The decaying (homogeneous) part of a piece's response, from its anchor: at whole
+    sample k it adds Phi((k - k0) dt) v = p v + q M v, with v the free state at the
+    first whole sample k0 at or after the anchor and (p, q) from the loop's table."""
+
+    k0: int
+    v0: float
+    v1: float
+    m0: float  # M v
+    m1: float
+    decayed_after: float  # seconds past the anchor from which it is dropped (inf: never)
+    table: "_FreeTable"
+
+    def at(self, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Its position and velocity parts at whole ``samples``."""
+        p, q = self.table.at(samples - self.k0)
+        return p * self.v0 + q * self.m0, p * self.v1 + q * self.m1
 
 
 class Plant:
@@ -117,32 +142,40 @@ class Plant:
         m0, m1 = self._apply_m(e0, e1)
         return p * e0 + q * m0, p * e1 + q * m1
 
-    def _grid(self, rate: float) -> "_FreeTable":
+    def table(self, rate: float) -> "_FreeTable":
+        """The free response of this loop at whole samples of ``rate`` (shared by identical loops)."""
         key = (self.config.bandwidth_hz, self.config.damping, self._coast, rate)
         table = _TABLES.get(key)
         if table is None:
             table = _TABLES[key] = _FreeTable.build(self, rate)
         return table
 
-    def _homogeneous(self, e0: float, e1: float, t0: float, samples: np.ndarray,
-                     rate: float) -> tuple[np.ndarray, np.ndarray]:
-        """Free response from error state (e0, e1) at time ``t0``, at whole samples.
-
-        Only + and x per sample, with tables built once by the C library's scalar
-        functions: numpy's vectorised exp/sin/cos differ in the last bit between CPUs
-        (AVX-512 or not), and replay must be exact on any machine. The sample grid is
-        reached from the anchor in a way that depends only on the anchor: a first step
-        to the first sample at or after ``t0`` (scalar), then whole samples (tables)."""
-        k0 = _first_sample(t0, rate)
-        v0, v1 = self._homogeneous_at(e0, e1, k0 / rate - t0)
-        m0, m1 = self._apply_m(v0, v1)
-        p, q = self._grid(rate).at(samples - k0)
-        return p * v0 + q * m0, p * v1 + q * m1
-
     def prepare(self, u: list[float]) -> "Forced":
         """The loop's steady response to a polynomial input (reusable for a piece)."""
         yp = self.particular(u)
         return Forced(yp, poly_der(yp))
+
+    def transient(self, state: PlantState, forced: "Forced", rate: float) -> "Transient | None":
+        """The decaying part of the response of a piece anchored at ``state``, reduced to
+        what every whole sample needs (None: below the quiet level from the anchor on).
+        The one place the anchor's free state is computed, for one axis and for rows of
+        axes alike, so both give the same bits."""
+        e0 = state.y - forced.y[0]
+        e1 = state.dy - forced.dy[0]
+        size = abs(e0) + abs(e1) / (-self._sigma)
+        if size <= _QUIET:
+            return None
+        # The sample grid is reached from the anchor in a way that depends only on the
+        # anchor: a first step to the first sample at or after it (scalar), then whole
+        # samples (tables, see _FreeTable).
+        k0 = _first_sample(state.t, rate)
+        v0, v1 = self._homogeneous_at(e0, e1, k0 / rate - state.t)
+        m0, m1 = self._apply_m(v0, v1)
+        # At rest on a constant command the loop counts as settled exactly once its
+        # transient has decayed below the quiet level. Where that is depends only on the
+        # anchor, so an anchor taken later (see Axis.commit) gives the same values.
+        decayed = self._settle_after(size) if len(forced.y) == 1 else math.inf
+        return Transient(k0, v0, v1, m0, m1, decayed, self.table(rate))
 
     def response(self, state: PlantState, forced: "Forced", samples: np.ndarray,
                  rate: float) -> tuple[np.ndarray, np.ndarray]:
@@ -150,30 +183,25 @@ class Plant:
         s = samples / rate - state.t
         y = poly_eval(forced.y, s)
         dy = poly_eval(forced.dy, s)
-        e0 = state.y - forced.y[0]
-        e1 = state.dy - forced.dy[0]
-        size = abs(e0) + abs(e1) / (-self._sigma)
-        if size <= _QUIET:
+        transient = self.transient(state, forced, rate)
+        if transient is None:
             return y, dy
-        h0, h1 = self._homogeneous(e0, e1, state.t, samples, rate)
-        if len(forced.y) == 1:
-            # At rest on a constant command the loop counts as settled exactly once its
-            # transient has decayed below the quiet level. Where that is depends only on
-            # the anchor, so an anchor taken later (see Axis.commit) gives the same values.
-            settled = s >= self._settle_after(size)
-            return np.where(settled, y, y + h0), np.where(settled, dy, dy + h1)
-        return y + h0, dy + h1
+        h0, h1 = transient.at(samples)
+        if math.isinf(transient.decayed_after):
+            return y + h0, dy + h1
+        settled = s >= transient.decayed_after
+        return np.where(settled, y, y + h0), np.where(settled, dy, dy + h1)
 
     def _settle_after(self, size: float) -> float:
         """Time for a transient of ``size`` to decay below the quiet level."""
         return math.log(size / _QUIET) / -self._sigma if size > _QUIET else 0.0
 
-    def quiet(self, state: PlantState, yp: list[float], after: float = 0.0) -> bool:
-        """True if the loop has settled onto the steady solution ``after`` s past ``state``
-        (the same test :meth:`response` applies sample by sample)."""
+    def quiet_after(self, state: PlantState, yp: list[float]) -> float:
+        """Seconds past ``state`` from which the loop counts as settled onto the steady
+        solution ``yp`` (the test :meth:`response` applies sample by sample)."""
         dyp0 = yp[1] if len(yp) > 1 else 0.0
         size = abs(state.y - yp[0]) + abs(state.dy - dyp0) / (-self._sigma)
-        return after >= self._settle_after(size)
+        return self._settle_after(size)
 
     def advance(self, state: PlantState, forced: "Forced", t: float) -> PlantState:
         """State at time ``t`` (within the piece that starts at ``state.t``); scalar math."""
@@ -194,7 +222,7 @@ class Plant:
         reached from the anchor like :meth:`_homogeneous` (tables, no vectorised exp)."""
         k0 = _first_sample(state.t, rate)
         first = math.exp(-(k0 / rate - state.t) / self._coast)
-        k = first * self._grid(rate).coast_at(samples - k0)
+        k = first * self.table(rate).coast_at(samples - k0)
         return state.y + state.dy * self._coast * (1.0 - k), state.dy * k
 
     def coast_to(self, state: PlantState, t: float) -> PlantState:
@@ -221,6 +249,7 @@ def _first_sample(t: float, rate: float) -> int:
 
 _TABLES: dict[tuple[float, float, float, float], "_FreeTable"] = {}  # shared by identical loops
 _TABLE = 4096  # samples of free response tabulated; further ones are products of two
+_BLOCKS_WATCHED = 64  # blocks of _TABLE samples searched for an exact underflow (about 2 min at 2 kHz)
 
 
 class _FreeTable:
@@ -228,13 +257,20 @@ class _FreeTable:
     from the C library's scalar functions (the same on every CPU); beyond, products
     Phi((a + b) dt) = Phi(a dt) Phi(b dt), using M^2 = kappa I."""
 
-    __slots__ = ("p", "q", "k", "kappa", "block_p", "block_q", "block_k")
+    __slots__ = ("p", "q", "k", "kappa", "block_p", "block_q", "block_k", "_p2", "_q2", "_bp", "_bq", "_vanishing")
 
     def __init__(self, p, q, k, kappa: float):
         self.p, self.q, self.k, self.kappa = p, q, k, kappa
         self.block_p: list[float] = [1.0]  # Phi(n _TABLE dt) for n = 0, 1, ... (grown on demand)
         self.block_q: list[float] = [0.0]
         self.block_k: list[float] = [1.0]
+        # The table twice over: the remainders of a run of samples that crosses a block
+        # boundary are then one contiguous window.
+        self._p2 = np.concatenate((p[:_TABLE], p[:_TABLE]))
+        self._q2 = np.concatenate((q[:_TABLE], q[:_TABLE]))
+        self._bp = np.array(self.block_p)
+        self._bq = np.array(self.block_q)
+        self._vanishing: float | None = None
 
     @classmethod
     def build(cls, plant: "Plant", rate: float) -> "_FreeTable":
@@ -245,22 +281,74 @@ class _FreeTable:
         return cls(p, q, k, plant._kappa)
 
     def _blocks(self, n: int) -> None:
+        if len(self.block_p) > n:
+            return
         while len(self.block_p) <= n:
             a, b = self.block_p[-1], self.block_q[-1]
             c, d = float(self.p[_TABLE]), float(self.q[_TABLE])
             self.block_p.append(a * c + self.kappa * b * d)
             self.block_q.append(a * d + b * c)
             self.block_k.append(self.block_k[-1] * float(self.k[_TABLE]))
+        self._bp = np.array(self.block_p)
+        self._bq = np.array(self.block_q)
 
     def at(self, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(p, q) of Phi(m dt) for sample counts m >= 0."""
-        if len(m) == 0 or m[-1] < _TABLE:
+        """(p, q) of Phi(m dt) for sample counts m >= 0 (any shape)."""
+        if m.size == 0 or m.max() < _TABLE:
             return self.p[m], self.q[m]
         n, r = np.divmod(m, _TABLE)
-        self._blocks(int(n[-1]))
-        bp, bq = np.array(self.block_p)[n], np.array(self.block_q)[n]
+        self._blocks(int(n.max()))
+        bp, bq = self._bp[n], self._bq[n]
         pr, qr = self.p[r], self.q[r]
         return bp * pr + self.kappa * bq * qr, bp * qr + bq * pr
+
+    def window(self, m0: np.ndarray, n: int, scratch: Scratch | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(p, q) of Phi((m0_r + i) dt) for rows r and 0 <= i < n <= _TABLE: for each row
+        what :meth:`at` gives for m0_r + arange(n). Rows read the table directly while
+        every count stays below _TABLE, else as blocks x remainders; the two agree where
+        both apply (block 0 is exactly Phi(0) = I), so any mix of rows is exact. The
+        arrays come from ``scratch`` (stretch.Scratch) if given."""
+        def take(name: str) -> np.ndarray | None:
+            return None if scratch is None else scratch.take("free." + name, (len(m0), n))
+        if int(m0.max()) + n <= _TABLE:
+            return _windows(self.p, m0, n, take("p")), _windows(self.q, m0, n, take("q"))
+        blocks, r0 = np.divmod(m0, _TABLE)
+        self._blocks(int(blocks.max()) + 1)
+        bp, bq = self._block_rows(blocks, r0, n)
+        pr, qr = _windows(self._p2, r0, n, take("pr")), _windows(self._q2, r0, n, take("qr"))
+        # bp pr + kappa bq qr and bp qr + bq pr, as `at` sums them
+        p = np.multiply(bp, pr, out=take("p"))
+        p += np.multiply(self.kappa * bq, qr, out=take("product"))
+        q = np.multiply(bp, qr, out=take("q"))
+        q += np.multiply(bq, pr, out=take("product"))
+        return p, q
+
+    def vanishing_count(self) -> float:
+        """The sample count from which Phi(m dt) is exactly zero: the start of the first block
+        whose factor has underflowed to zeros (every later one is zero too, as products of
+        it); inf if none has within _BLOCKS_WATCHED blocks (a slow loop)."""
+        if self._vanishing is None:
+            self._vanishing = math.inf
+            for n in range(1, _BLOCKS_WATCHED):
+                self._blocks(n)
+                if self.block_p[n] == 0.0 and self.block_q[n] == 0.0:
+                    self._vanishing = float(n * _TABLE)
+                    break
+        return self._vanishing
+
+    def _block_rows(self, blocks: np.ndarray, r0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """The block factor of every count of each row: one block per row (a column),
+        or, for a row that crosses into the next block, two runs of a full row."""
+        bp, bq = self._bp[blocks][:, None], self._bq[blocks][:, None]
+        crossing = np.flatnonzero(r0 + n > _TABLE)
+        if not len(crossing):
+            return bp, bq
+        bp, bq = np.repeat(bp, n, axis=1), np.repeat(bq, n, axis=1)
+        for row in crossing.tolist():
+            split, nxt = _TABLE - int(r0[row]), int(blocks[row]) + 1
+            bp[row, split:] = self._bp[nxt]
+            bq[row, split:] = self._bq[nxt]
+        return bp, bq
 
     def coast_at(self, m: np.ndarray) -> np.ndarray:
         if len(m) == 0 or m[-1] < _TABLE:
@@ -268,6 +356,21 @@ class _FreeTable:
         n, r = np.divmod(m, _TABLE)
         self._blocks(int(n[-1]))
         return np.array(self.block_k)[n] * self.k[r]
+
+
+def _windows(table: np.ndarray, starts: np.ndarray, n: int, out: np.ndarray | None = None) -> np.ndarray:
+    """Rows table[s : s + n] for each start s (copies of contiguous runs), into ``out`` if
+    given. Long rows are copied one by one: np.take would first copy the whole (virtual)
+    window view."""
+    if out is None or n < 256:
+        windows = sliding_window_view(table, n)[starts]
+        if out is None:
+            return windows
+        out[...] = windows
+        return out
+    for row, start in enumerate(starts.tolist()):
+        out[row] = table[start:start + n]
+    return out
 
 
 def _poly_eval_scalar(c: list[float], s: float) -> float:

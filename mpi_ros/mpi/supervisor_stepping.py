@@ -7,14 +7,20 @@ happens, stops there, and calls :meth:`transition`.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Callable
+
 import numpy as np
 
-from .axis import CommandMode
+from .axis import Axis, CommandMode
 from .events import MPIEventType
 from .holds import HoldWait
 from .messages import Message
-from .status import StatusMode
+from .status import AT_VELOCITY, DONE, StatusMode
 from .types import HoldType, MPIState
+
+if TYPE_CHECKING:
+    from .status import StretchStatus
+    from .stretch import Stretch
 
 OK = Message.MPIMessageOK
 
@@ -22,8 +28,9 @@ OK = Message.MPIMessageOK
 class SteppingMixin:
     """The transitions of MotionSupervisor."""
 
-    def scan(self, samples: np.ndarray, t: np.ndarray, traces, statuses) -> np.ndarray | None:
-        """Per sample of a stretch: does a transition of this supervisor happen there?
+    def scan(self, stretch: Stretch, status: StretchStatus) -> int | None:
+        """The first sample of a stretch (stretch.Stretch, status.StretchStatus) at which a
+        transition of this supervisor happens, or None.
 
         The conditions are kept until :meth:`transition` applies them.
         """
@@ -31,62 +38,69 @@ class SteppingMixin:
         state = self.own_state
         if self._holds and state in (MPIState.MOVING, MPIState.STOPPED):
             for axis_number, wait in self._holds.items():
-                conditions[("hold", axis_number)] = self._hold_trigger(wait, samples, traces)
+                conditions[("hold", axis_number)] = self._hold_trigger(wait, stretch)
         if state is MPIState.MOVING and self.current is not None and not self._holds:
-            # A move that ends moving (FINAL_VEL) is never DONE: the next appended move
-            # takes over at its trajectory's end; with none, the axes go on at the final
-            # velocity (MOVING) until a modify, an append or a stop.
-            ends_moving = self._ends_moving()
-            if not ends_moving or self.queue:
-                complete = np.ones(len(samples), dtype=bool)
-                for plan in self.current.plans:
-                    if ends_moving:
-                        complete &= traces[plan.axis].rel >= plan.duration
-                    else:
-                        complete &= statuses[plan.axis].bits["done"]
-                conditions["move_done"] = complete
-        if state is MPIState.MOVING and self.current is not None and self.current.is_velocity \
-                and not self._at_velocity_sent and not self._holds:
-            # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
-            together = np.ones(len(samples), dtype=bool)
-            for plan in self.current.plans:
-                together &= statuses[plan.axis].bits["at_velocity"]
-            conditions["at_velocity"] = together
+            self._scan_move(stretch, status, conditions)
         if state is MPIState.STOPPING:
-            conditions["stopped"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_stop)
+            conditions["stopped"] = self._stop_complete(stretch.t, status, lambda a: a.in_position.settle_on_stop)
         elif state is MPIState.STOPPING_ERROR:
             if self._error_at is not None:
-                conditions["error"] = samples >= self._error_at
+                conditions["error"] = stretch.samples >= self._error_at
             else:
-                conditions["error"] = self._stop_complete(t, statuses, lambda a: a.in_position.settle_on_estop)
-        if not conditions:
-            return None
-        return np.logical_or.reduce(list(conditions.values()))
+                conditions["error"] = self._stop_complete(stretch.t, status, lambda a: a.in_position.settle_on_estop)
+        firsts = [int(np.argmax(fired)) for fired in conditions.values() if fired.any()]
+        return min(firsts) if firsts else None
+
+    def _scan_move(self, stretch: Stretch, status: StretchStatus, conditions: dict) -> None:
+        """A move done; a velocity move at its velocity."""
+        move = self.current
+        # A move that ends moving (FINAL_VEL) is never DONE: the next appended move takes
+        # over at its trajectory's end; with none, the axes go on at the final velocity
+        # (MOVING) until a modify, an append or a stop.
+        if move.ends_moving:
+            if self.queue:
+                conditions["move_done"] = np.logical_and.reduce(
+                    [stretch.rel[plan.axis] >= plan.duration for plan in move.plans])
+        else:
+            self._all_axes(conditions, "move_done", status, DONE)
+        if move.is_velocity and not self._at_velocity_sent:
+            # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
+            self._all_axes(conditions, "at_velocity", status, AT_VELOCITY)
+
+    def _all_axes(self, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
+        """``conditions[key]``: per sample, is ``bit`` set on every axis of the current move?
+        (left out where it never is: an axis without it anywhere in the stretch)"""
+        ever = status.ever(bit)
+        axes = self.current.plan_axes
+        for number in axes:
+            if not ever[number]:
+                return
+        conditions[key] = np.logical_and.reduce(status.bits[bit, list(axes)], axis=0)
 
     def _ends_moving(self) -> bool:
         """The current move ends at its target with a velocity (FINAL_VEL)."""
-        return self.current is not None and any(p.final_velocity != 0.0 for p in self.current.plans)
+        return self.current is not None and self.current.ends_moving
 
     def cruising(self) -> bool:
         """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
         return self._ends_moving() and all(
             self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in self.current.plans)
 
-    def _stop_complete(self, t, statuses, settle) -> np.ndarray:
+    def _stop_complete(self, t: np.ndarray, status: StretchStatus, settle: Callable[[Axis], bool]) -> np.ndarray:
         ready = t >= self._stop_end - 1e-12
         for axis in self.axes:
-            if settle(axis) and axis.number in statuses:
-                ready = ready & statuses[axis.number].bits["done"]
+            if settle(axis):
+                ready = ready & status.bits[DONE, axis.number]
         return ready
 
-    def _hold_trigger(self, wait: HoldWait, samples, traces) -> np.ndarray:
+    def _hold_trigger(self, wait: HoldWait, stretch: Stretch) -> np.ndarray:
         if wait.watches_position:
-            trace = traces[wait.hold.number]
-            raw = trace.act_p if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else trace.cmd_p
-            fired = wait.position_trigger(raw - self._axis(wait.hold.number).origin)
+            number = wait.hold.number
+            raw = stretch.act_p[number] if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else stretch.cmd_p[number]
+            fired = wait.position_trigger(raw - self._axis(number).origin)
         else:
-            fired = np.full(len(samples), wait.static_trigger(self._ctl.io))
-        return fired | wait.timed_out(samples)
+            fired = np.full(len(stretch), wait.static_trigger(self._ctl.io))
+        return fired | wait.timed_out(stretch.samples)
 
     def transition(self, index: int, samples: np.ndarray) -> None:
         """Apply what :meth:`scan` found at stretch sample ``index`` (the controller is there)."""
