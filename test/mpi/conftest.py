@@ -57,6 +57,11 @@ def _supervisor(ctl: Controller, number: int, axes: list[int]):
     return ms
 
 
+def sharing_axis_1(ctl: Controller):
+    """Supervisor 0 on axes [0, 1] and supervisor 1 on [1, 2], both mapped."""
+    return _supervisor(ctl, 0, [0, 1]), _supervisor(ctl, 1, [1, 2])
+
+
 @pytest.fixture
 def ms(ctl):
     return _supervisor(ctl, 0, [0, 1])

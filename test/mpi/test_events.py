@@ -3,22 +3,14 @@ notify masks, latched events and their reset, supervisors that share axes."""
 
 from __future__ import annotations
 
-from mpi_ros.mpi import Controller, Event, MotionAttr, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi import Controller, Event, MotionAttr, MPIMotionType, MPIState
 from mpi_ros.mpi.events import MASK_ALL, MASK_AXIS, MASK_MOTION, MPIEventType
 from mpi_ros.mpi.messages import Message
 
+from .conftest import sharing_axis_1
+
 E = MPIEventType
 T = MPIMotionType
-
-
-def sharing_axis_1(ctl):
-    """Supervisor 0 on axes [0, 1] and supervisor 1 on [1, 2], both mapped."""
-    _, a = ctl.create_motion(0)
-    _, b = ctl.create_motion(1)
-    for ms, axes in ((a, [0, 1]), (b, [1, 2])):
-        ms.axis_list_set(axes)
-        ms.action(MPIAction.MAP)
-    return a, b
 
 
 def of(events, kind):

@@ -14,22 +14,12 @@ import pytest
 from mpi_ros.mpi import Controller, MotionAttr, MPIAction, MPIMotionType, MPIState
 from mpi_ros.mpi.messages import Message
 
-from .conftest import LONG_MOVE, drive_to, make_params, run_to_state
+from .conftest import LONG_MOVE, drive_to, make_params, run_to_state, sharing_axis_1
 from .test_state_machine import CELLS, command, observe
 
 S = MPIState
 T = MPIMotionType
 A = MPIAction
-
-
-def sharing_axis_1(ctl):
-    """Supervisor 0 on axes [0, 1] and supervisor 1 on [1, 2], both mapped."""
-    _, a = ctl.create_motion(0)
-    _, b = ctl.create_motion(1)
-    for ms, axes in ((a, [0, 1]), (b, [1, 2])):
-        assert ms.axis_list_set(axes).ok
-        assert ms.action(A.MAP).ok
-    return a, b
 
 
 def moving_axes(ctl) -> list[int]:
