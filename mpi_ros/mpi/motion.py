@@ -346,7 +346,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
         elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
             return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
-        # spec 000:971: HOLD is impossible with a modify "even when using the AUTO_START attribute"
+        # MPI 000, mpiMotionModify: HOLD is impossible with a modify "even when using the AUTO_START attribute"
         verdict = validate.check_attributes(motion_type, attrs, params, modify)
         if not verdict.ok:
             return verdict.message, verdict.detail
@@ -360,7 +360,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
             return Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed"
         # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
-        # (DESIGN.md table), and behind a move already cruising at its final velocity there
+        # (docs/state-machine.md), and behind a move already cruising at its final velocity there
         # is nothing to wait for: the new move starts from where the axes are (a modify).
         queued = append and state is MPIState.MOVING and (bool(self.queue) or not self.cruising())
         starts = self._starts(queued, state, modify and not auto_start)

@@ -1,6 +1,6 @@
 """mpiMotionAction: STOP, RESUME, E_STOP, ABORT, E_STOP_ABORT, RESET and MEIActionMAP.
 
-Each action answers per the DESIGN.md table; safety actions are never refused. Stops ramp
+Each action answers per docs/state-machine.md; safety actions are never refused. Stops ramp
 the supervisor's feedrate (clock.py); ABORT turns the amplifiers off.
 """
 

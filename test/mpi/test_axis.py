@@ -15,7 +15,7 @@ T = MPIMotionType
 
 
 def test_error_is_command_minus_actual(ctl, ms, params):
-    # spec 002:7 "The Axis object contains command, actual, and error position data"
+    # MPI 002, Axis Objects, introduction "The Axis object contains command, actual, and error position data"
     ms.start(T.TRAPEZOIDAL, params=params((5000.0, 0.0)))
     for _ in range(20):
         ctl.step(37)
@@ -46,7 +46,7 @@ def test_the_encoder_reads_whole_counts(ctl, ms, params):
 
 
 def test_origin_offsets_every_reported_position(ctl, ms, params, run_to):
-    # spec 002:32-33 mpiAxisOriginGet/Set; axis.py: "Positions seen by users are raw positions minus
+    # MPI 002, Configuration and Information Methods, <u>mpiAxisOriginGet</u> mpiAxisOriginGet/Set; axis.py: "Positions seen by users are raw positions minus
     # the origin"
     assert ctl.axis_origin_set(0, 100.0).ok
     assert ctl.axes[0].command_position == -100.0
@@ -58,13 +58,13 @@ def test_origin_offsets_every_reported_position(ctl, ms, params, run_to):
 
 
 def test_origin_must_be_finite(ctl):
-    # spec 000:3029 / DESIGN.md "bad input gets the spec's message and changes nothing"
+    # MPI 000, MPIMessagePARAM_INVALID / DESIGN.md "bad input gets the spec's message and changes nothing"
     assert ctl.axis_origin_set(0, float("nan")) is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].origin == 0.0
 
 
 def test_actual_position_set_moves_the_reading_not_the_command(ctl, ms):
-    # spec 002:24 mpiAxisActualPositionSet "Set actual position"
+    # MPI 002, Configuration and Information Methods, <u>mpiAxisActualPositionSet</u> mpiAxisActualPositionSet "Set actual position"
     assert ctl.axis_actual_position_set(0, 250.0).ok
     axis = ctl.axes[0]
     assert axis.actual_position == 250.0 and axis.command_position == 0.0
@@ -74,7 +74,7 @@ def test_actual_position_set_moves_the_reading_not_the_command(ctl, ms):
 
 
 def test_command_position_set_when_idle(ctl, ms):
-    # spec 002:605 "set the command position when the motion is in an IDLE state"
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET "set the command position when the motion is in an IDLE state"
     assert ctl.axis_command_position_set(1, -75.0).ok
     axis = ctl.axes[1]
     assert axis.command_position == -75.0 and ctl.axis_snapshot(1).target_position == -75.0
@@ -83,7 +83,7 @@ def test_command_position_set_when_idle(ctl, ms):
 
 @pytest.mark.parametrize("state", [MPIState.MOVING, MPIState.STOPPING, MPIState.STOPPED])
 def test_command_not_set_while_moving_stopping_or_stopped(ctl, ms, bring, state):
-    # spec 002:611 COMMAND_NOT_SET when "Axis is in a STOPPING, STOPPED, or MOVING state"
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET COMMAND_NOT_SET when "Axis is in a STOPPING, STOPPED, or MOVING state"
     bring(state)
     before = ctl.axes[0].cmd_p
     assert ctl.axis_command_position_set(0, 5.0) is M.MPIAxisMessageCOMMAND_NOT_SET
@@ -91,9 +91,9 @@ def test_command_not_set_while_moving_stopping_or_stopped(ctl, ms, bring, state)
 
 
 def test_command_not_set_while_the_command_follows_the_actual(ctl, params):
-    # spec 002:612 "disableAction ... CMD_EQ_ACT and the motor's Amp Enable is disabled"; 002:142
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET "disableAction ... CMD_EQ_ACT and the motor's Amp Enable is disabled"; MPI 002, mpiAxisValidate, return values
     # "the command position is continually set to the actual position"; here: an E_STOP with
-    # settleOnEstopCmdEqAct (002:480)
+    # settleOnEstopCmdEqAct (MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct)
     ctl = Controller(in_position=AxisInPosition(settle_on_estop_cmd_eq_act=True))
     _, ms = ctl.create_motion(0)
     ms.axis_list_set([0])
@@ -105,7 +105,7 @@ def test_command_not_set_while_the_command_follows_the_actual(ctl, params):
 
 
 def test_command_position_set_after_reset(ctl, ms, bring):
-    # spec 002:605 once IDLE again, the command position can be set
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET once IDLE again, the command position can be set
     bring(MPIState.ERROR)
     assert ms.action(MPIAction.RESET).ok
     assert ctl.axis_command_position_set(0, 5.0).ok
@@ -114,7 +114,7 @@ def test_command_position_set_after_reset(ctl, ms, bring):
 
 @pytest.mark.parametrize("number", [-1, 4, 99])
 def test_axis_invalid_out_of_range(ctl, number):
-    # spec 002:601 AXIS_INVALID "The axis number is out of range"
+    # MPI 002, MPIAxisMessageAXIS_INVALID AXIS_INVALID "The axis number is out of range"
     assert ctl.axis_command_position_set(number, 0.0) is M.MPIAxisMessageAXIS_INVALID
     assert ctl.axis_actual_position_set(number, 0.0) is M.MPIAxisMessageAXIS_INVALID
     assert ctl.axis_origin_set(number, 0.0) is M.MPIAxisMessageAXIS_INVALID
@@ -122,7 +122,7 @@ def test_axis_invalid_out_of_range(ctl, number):
 
 
 def test_non_finite_positions_are_refused(ctl):
-    # spec 000:3029 / DESIGN.md: bad input changes nothing
+    # MPI 000, MPIMessagePARAM_INVALID / DESIGN.md: bad input changes nothing
     assert ctl.axis_command_position_set(0, float("inf")) is M.MPIMessagePARAM_INVALID
     assert ctl.axis_actual_position_set(0, float("nan")) is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].cmd_p == 0.0 and ctl.axes[0].act_p == 0.0
@@ -131,7 +131,7 @@ def test_non_finite_positions_are_refused(ctl):
 @pytest.mark.parametrize("field,value", [("position_fine", -1.0), ("position_coarse", -1), ("velocity", -1.0),
                                          ("settling_time", float("nan"))])
 def test_in_position_values_are_checked(ctl, field, value):
-    # spec 002:472-476 tolerances and settling time are distances, a velocity and a duration
+    # MPI 002, MPIAxisInPosition, tolerance tolerances and settling time are distances, a velocity and a duration
     tol = AxisInPosition()
     setattr(tol, field, value)
     assert ctl.axis_in_position_set(0, tol) is M.MPIMessagePARAM_INVALID
@@ -140,7 +140,7 @@ def test_in_position_values_are_checked(ctl, field, value):
 
 
 def test_motion_position_get_one_value_per_axis(ctl, ms, params):
-    # spec 000:674 mpiMotionPositionGet: "actual and command arguments each point to an array with a
+    # MPI 000, mpiMotionPositionGet mpiMotionPositionGet: "actual and command arguments each point to an array with a
     # size equal to the number of axes"
     ms.start(T.TRAPEZOIDAL, params=params((300.0, -200.0)))
     ctl.step(500)
@@ -151,14 +151,14 @@ def test_motion_position_get_one_value_per_axis(ctl, ms, params):
 
 
 def test_motion_position_set(ctl, ms):
-    # spec 000:698 mpiMotionPositionSet "sets the actual and command position values for all axes"
+    # MPI 000, mpiMotionPositionSet mpiMotionPositionSet "sets the actual and command position values for all axes"
     assert ms.position_set([10.0, 20.0], [30.0, 40.0]).ok
     assert [a.actual_position for a in ctl.axes[:2]] == [10.0, 20.0]
     assert [a.command_position for a in ctl.axes[:2]] == [30.0, 40.0]
 
 
 def test_motion_position_set_checks_its_arrays(ctl, ms):
-    # spec 000:698 arrays "with a size equal to the number of axes"
+    # MPI 000, mpiMotionPositionSet arrays "with a size equal to the number of axes"
     assert ms.position_set([1.0], [1.0, 2.0]) is M.MPIMessagePARAM_INVALID
     assert ms.position_set([1.0, float("nan")], [1.0, 2.0]) is M.MPIMessagePARAM_INVALID
     assert [a.cmd_p for a in ctl.axes[:2]] == [0.0, 0.0] and [a.act_p for a in ctl.axes[:2]] == [0.0, 0.0]
@@ -167,7 +167,7 @@ def test_motion_position_set_checks_its_arrays(ctl, ms):
 
 
 def test_motion_position_set_while_moving_changes_nothing(ctl, ms, bring):
-    # spec 002:611 COMMAND_NOT_SET while MOVING
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET COMMAND_NOT_SET while MOVING
     bring(MPIState.MOVING)
     actual = [a.act_p for a in ctl.axes[:2]]
     assert ms.position_set([0.0, 0.0], [0.0, 0.0]) is M.MPIAxisMessageCOMMAND_NOT_SET
@@ -175,8 +175,8 @@ def test_motion_position_set_while_moving_changes_nothing(ctl, ms, bring):
 
 
 def test_motion_trajectory_reads_velocity_and_acceleration(ctl, ms, params):
-    # spec 000:753 mpiMotionTrajectory "reads the current velocity and acceleration for all axes";
-    # 000:755 the other fields cannot be read
+    # MPI 000, mpiMotionTrajectory mpiMotionTrajectory "reads the current velocity and acceleration for all axes";
+    # MPI 000, mpiMotionTrajectory the other fields cannot be read
     ms.start(T.TRAPEZOIDAL, params=params((3000.0, 4000.0)))
     ctl.step(50)  # accelerating at 10000 along (0.6, 0.8)
     message, values = ms.trajectory()
@@ -187,7 +187,7 @@ def test_motion_trajectory_reads_velocity_and_acceleration(ctl, ms, params):
 
 
 def test_axis_snapshot_reports_the_owner_and_frames(ctl, ms, ms1, params):
-    # spec 000:2115 frameCount; the axis status names the supervisor commanding it
+    # MPI 000, MEIMotionFrameBufferStatus, frameCount frameCount; the axis status names the supervisor commanding it
     ms1.start(T.TRAPEZOIDAL, params=params((100.0, 100.0)))
     snap = ctl.axis_snapshot(2)
     assert snap.supervisor == 1 and snap.state is MPIState.MOVING and snap.frame_count > 0

@@ -12,7 +12,7 @@ from mpi_ros.mpi.clock import ProfileClock
 
 
 def test_a_steady_clock_is_real_time_times_the_feedrate():
-    # spec 000:1997 normalFeedrate 1.0 = 100 %
+    # MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate 1.0 = 100 %
     clock = ProfileClock(0.0, 0.0, 1.0, 1.0, 0.0)
     assert clock.tau_at(2.5) == 2.5 and clock.feedrate(2.5) == 1.0
     half = ProfileClock(1.0, 3.0, 0.5, 0.5, 1.0)

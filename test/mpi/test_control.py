@@ -16,7 +16,7 @@ M = Message
 
 
 def test_defaults():
-    # issue 3: "sample rate (default 2000 Hz) ... frame buffer size (128)"; spec 000:628 "With the
+    # issue 3: "sample rate (default 2000 Hz) ... frame buffer size (128)"; MPI 000, mpiMotionStart "With the
     # sample rate configured for 2000 (default)"; DESIGN.md config/default.yaml 4 axes, 2 supervisors
     ctl = Controller()
     assert ctl.rate == 2000.0 and ctl.config.frame_buffer_size == 128
@@ -30,7 +30,7 @@ def test_sample_rate_must_be_positive():
 
 
 def test_create_selects_the_next_unused_supervisor():
-    # spec 000:135 "If number is -1, MotionCreate selects the next unused motion supervisor"
+    # MPI 000, mpiMotionCreate "If number is -1, MotionCreate selects the next unused motion supervisor"
     ctl = Controller()
     _, a = ctl.create_motion(-1)
     _, b = ctl.create_motion(-1)
@@ -40,21 +40,21 @@ def test_create_selects_the_next_unused_supervisor():
 
 @pytest.mark.parametrize("number", [-2, 2, 100])
 def test_create_out_of_range(number):
-    # spec 000:2158 MOTION_INVALID "if the motion supervisor number is less than zero or greater
-    # than or equal to MEIXmpMAX_MSs"; 000:140 MPIHandleVOID
+    # MPI 000, MPIMotionMessageMOTION_INVALID MOTION_INVALID "if the motion supervisor number is less than zero or greater
+    # than or equal to MEIXmpMAX_MSs"; MPI 000, mpiMotionCreate, return values MPIHandleVOID
     assert Controller().create_motion(number) == (M.MPIMotionMessageMOTION_INVALID, None)
 
 
 def test_create_twice_the_same_number():
-    # spec 000:140 "MPIHandleVOID if the object could not be created"
+    # MPI 000, mpiMotionCreate, return values "MPIHandleVOID if the object could not be created"
     ctl = Controller()
     ctl.create_motion(1)
     assert ctl.create_motion(1) == (M.MPIMotionMessageMOTION_INVALID, None)
 
 
 def test_validate_after_create_and_delete(ctl, ms):
-    # spec 000:182 "Always call mpiMotionValidate after creating"; 000:158 delete "invalidates its
-    # handle"; 000:160 "does not delete any of the Axis objects"
+    # MPI 000, mpiMotionValidate "Always call mpiMotionValidate after creating"; MPI 000, mpiMotionDelete delete "invalidates its
+    # handle"; MPI 000, mpiMotionDelete "does not delete any of the Axis objects"
     assert ms.validate().ok
     assert ctl.delete_motion(ms).ok
     assert ms.validate() is M.MPIMessageHANDLE_INVALID
@@ -66,7 +66,7 @@ def test_validate_after_create_and_delete(ctl, ms):
 
 
 def test_delete_while_moving(ctl, ms, bring):
-    # spec 000:9 the supervisor's axis map is not changed while the axes move
+    # MPI 000, Motion Objects, introduction the supervisor's axis map is not changed while the axes move
     bring(MPIState.MOVING)
     assert ctl.delete_motion(ms) is M.MPIMotionMessageMOVING
     assert ms.validate().ok
@@ -115,7 +115,7 @@ def test_a_long_move_simulates_far_faster_than_real_time(ctl, ms, params):
 
 
 def test_gates_and_io(ctl):
-    # spec 000:1740 meiControlGateGet/Set; io.py: the simulated I/O image
+    # MPI 000, MEIMotionAttrHoldTypeGATE meiControlGateGet/Set; io.py: the simulated I/O image
     assert ctl.gate_set(3, True).ok and ctl.gate_get(3) == (M.MPIMessageOK, True)
     assert ctl.gate_get(32)[0] is M.MPIMessagePARAM_INVALID
     assert ctl.io_set(IoSpace.MOTOR_DEDICATED_IO, 3, 0b101).ok
@@ -125,7 +125,7 @@ def test_gates_and_io(ctl):
 
 
 def test_supervisors_are_listed_by_number(ctl):
-    # spec 000:1110 mpiMotionNumber: the index of a Motion object
+    # MPI 000, mpiMotionNumber mpiMotionNumber: the index of a Motion object
     _, b = ctl.create_motion(1)
     _, a = ctl.create_motion(0)
     assert [s.number for s in ctl.supervisors] == [0, 1] and ctl.supervisor(1) is b
@@ -139,7 +139,7 @@ def test_drain_events_empties_the_queue(ctl, ms, params):
 
 
 def test_motion_snapshot(ctl, ms, params, run_to):
-    # spec 000:722 mpiMotionStatus "gets a Motion's status"
+    # MPI 000, mpiMotionStatus mpiMotionStatus "gets a Motion's status"
     ms.start(T.S_CURVE, params=params((1000.0, 0.0), jerk_percent=20.0))
     ctl.step(1000)
     snap = ms.snapshot()

@@ -27,15 +27,15 @@ def fill(ctl, ms, params, jerk_percent=50.0):
 
 
 def test_each_axis_has_a_128_frame_buffer(ctl, ms):
-    # spec 000:622 "Each axis has a 128 frame buffer (FIFO)"; 000:2114 size
+    # MPI 000, mpiMotionStart "Each axis has a 128 frame buffer (FIFO)"; MPI 000, MEIMotionFrameBufferStatus, size size
     assert ctl.config.frame_buffer_size == 128
     assert {s.size for s in ms.frame_buffer_status()[1]} == {128}
 
 
 def test_an_append_that_overflows_is_refused(ctl, ms, params):
-    # spec 000:622 "No provision has been made to check if the new frames will overwrite the
+    # MPI 000, mpiMotionStart "No provision has been made to check if the new frames will overwrite the
     # currently executing frames"; DESIGN.md: "Here the append is refused with a clear message and
-    # nothing moves unexpectedly"; 000:2236 FRAME_BUFFER_TOO_SMALL
+    # nothing moves unexpectedly"; MPI 000, MPIMotionMessageFRAME_BUFFER_TOO_SMALL FRAME_BUFFER_TOO_SMALL
     count, refusal = fill(ctl, ms, params)
     assert refusal is Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
     assert ctl.frame_count(0) <= 128 and ctl.frame_count(0) + 8 > 128  # an S-curve move is 7 + 1 frames
@@ -64,14 +64,14 @@ def test_the_refusal_changes_nothing(params):
 
 
 def test_room_frees_up_as_frames_execute(ctl, ms, params):
-    # spec 000:622 the buffer is a FIFO: executed frames leave it
+    # MPI 000, mpiMotionStart the buffer is a FIFO: executed frames leave it
     count, _ = fill(ctl, ms, params)
     ctl.step(8000)  # some moves done
     assert ms.start(T.S_CURVE, A.APPEND, params((0.0, 0.0), jerk_percent=50.0)).ok
 
 
 def test_a_larger_buffer_takes_more_moves(params):
-    # spec 000:2236 "increase the number of points in the frame buffer"
+    # MPI 000, MPIMotionMessageFRAME_BUFFER_TOO_SMALL "increase the number of points in the frame buffer"
     def capacity(size):
         ctl = Controller(ControllerConfig(frame_buffer_size=size))
         _, ms = ctl.create_motion(0)
@@ -82,7 +82,7 @@ def test_a_larger_buffer_takes_more_moves(params):
 
 
 def test_frame_count_decreases_as_the_move_runs(ctl, ms, params):
-    # spec 000:2115 frameCount "the number of frames in the controller's frame buffer"
+    # MPI 000, MEIMotionFrameBufferStatus, frameCount frameCount "the number of frames in the controller's frame buffer"
     ms.start(T.S_CURVE, params=params((2000.0, 0.0), jerk_percent=50.0))
     counts = []
     while ms.state is MPIState.MOVING:
@@ -92,7 +92,7 @@ def test_frame_count_decreases_as_the_move_runs(ctl, ms, params):
 
 
 def test_trapezoid_frames():
-    # spec 000:2784 "Number of frames/point vary with type of move (1frame/point for trapezoidal, to
+    # MPI 000, Diagram of mpiMotionStart "Number of frames/point vary with type of move (1frame/point for trapezoidal, to
     # 8 frames/point for S-curve)": here a trapezoid is accel, cruise, decel + the final frame
     plan = AxisPlan(0, [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.9, 50.0, 1e3, 0.0, 0.0),
                         Segment(0.1, 950.0, 1e3, -1e4, 0.0)], 0.0, 1000.0)
@@ -101,7 +101,7 @@ def test_trapezoid_frames():
 
 
 def test_plan_evaluation_ends_exactly_on_target():
-    # spec 002:630 AT_TARGET "TRUE when command = target": the command is the target exactly
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, AT_TARGET AT_TARGET "TRUE when command = target": the command is the target exactly
     seg = [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.1, 50.0, 1e3, -1e4, 0.0)]
     plan = AxisPlan(0, seg, 0.0, 100.0 + 1e-9)  # rounding in the segments is absorbed at the end
     p, v, a = plan.evaluate(np.array([0.05, plan.duration, plan.duration + 1.0]))
@@ -109,7 +109,7 @@ def test_plan_evaluation_ends_exactly_on_target():
 
 
 def test_plan_past_its_end_continues_at_the_final_velocity():
-    # spec 000:1589 FINAL_VEL: "a non-zero target velocity for point to point motion types"
+    # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL: "a non-zero target velocity for point to point motion types"
     plan = AxisPlan(0, [Segment(1.0, 0.0, 0.0, 100.0, 0.0)], 0.0, 50.0, final_velocity=100.0)
     p, v, a = plan.evaluate(np.array([1.5]))
     assert p[0] == pytest.approx(100.0) and v[0] == 100.0 and a[0] == 0.0
@@ -123,7 +123,7 @@ def test_an_empty_plan_holds_its_target():
 
 
 def test_frames_needed_counts_per_axis():
-    # spec 000:622 the buffer is per axis
+    # MPI 000, mpiMotionStart the buffer is per axis
     a = AxisPlan(0, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)], 0.0, 1.0)
     b = AxisPlan(1, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)] * 3, 0.0, 3.0)
     move = Move(0, T.TRAPEZOIDAL, A.NONE, [a, b])

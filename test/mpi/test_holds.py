@@ -1,5 +1,5 @@
 """HOLD (mpi_ros/mpi/holds.py, motion.py, io.py): a move waits until its trigger, spec
-000:2874-2888 and MEIMotionAttrHold* (000:1693-1802)."""
+MPI 000, MEIMotionAttrHOLD and MEIMotionAttrHold* (MPI 000, MEIMotionAttrHold)."""
 
 from __future__ import annotations
 
@@ -27,11 +27,11 @@ def still(ctl, samples=200):
 
 
 def test_gate_holds_until_opened(ctl, ms, params, run_to):
-    # spec 000:2880 "the motion will be held until a call to mpiControlGateSet() is made with the
-    # closed parameter set to FALSE"; 000:1786 gate 0..31
+    # MPI 000, MEIMotionAttrHOLD "the motion will be held until a call to mpiControlGateSet() is made with the
+    # closed parameter set to FALSE"; MPI 000, MEIMotionAttrHoldSource, gate gate 0..31
     ctl.gate_set(31, True)
     held_start(ms, params, Hold(type=HoldType.GATE, gate=31))
-    assert ms.state is MPIState.MOVING  # 000:2876 the HOLD frame is executing
+    assert ms.state is MPIState.MOVING  # MPI 000, MEIMotionAttrHOLD the HOLD frame is executing
     assert still(ctl, 2000)
     k = ctl.sample
     assert ctl.gate_set(31, False).ok
@@ -44,23 +44,23 @@ def test_gate_holds_until_opened(ctl, ms, params, run_to):
 
 
 def test_open_gate_does_not_hold(ctl, ms, params):
-    # spec 000:2880 the gate holds only while closed
+    # MPI 000, MEIMotionAttrHOLD the gate holds only while closed
     held_start(ms, params, Hold(type=HoldType.GATE, gate=2))
     ctl.step(1)
     assert ctl.axes[0].cmd_p > 0.0
 
 
 def test_gate_get(ctl):
-    # spec 000:1740 "See meiControlGateGet/Set(...)"
+    # MPI 000, MEIMotionAttrHoldTypeGATE "See meiControlGateGet/Set(...)"
     assert ctl.gate_get(5) == (M.MPIMessageOK, False)
     ctl.gate_set(5, True)
     assert ctl.gate_get(5) == (M.MPIMessageOK, True)
-    assert ctl.gate_set(32, True) is M.MPIMessagePARAM_INVALID  # 000:1786 "between 0 and 31"
+    assert ctl.gate_set(32, True) is M.MPIMessagePARAM_INVALID  # MPI 000, MEIMotionAttrHoldSource, gate "between 0 and 31"
 
 
 def test_input_hold_matches_mask_and_pattern(ctl, ms, params):
-    # spec 000:2882 "held until then value of the internal Xmp variable specified by source.input
-    # bitwise anded with source.mask matches source.pattern"; 000:1789
+    # MPI 000, MEIMotionAttrHOLD "held until then value of the internal Xmp variable specified by source.input
+    # bitwise anded with source.mask matches source.pattern"; MPI 000, MEIMotionAttrHoldSource, input.pattern
     hold = Hold(type=HoldType.INPUT, address=5, mask=0b1100, pattern=0b0100)
     ctl.io_set(IoSpace.IO, 5, 0b1111)
     held_start(ms, params, hold)
@@ -75,8 +75,8 @@ def test_input_hold_matches_mask_and_pattern(ctl, ms, params):
 @pytest.mark.parametrize("kind,space", [(HoldType.MOTOR_GENERAL_IO, IoSpace.MOTOR_GENERAL_IO),
                                         (HoldType.MOTOR_DEDICATED_IO, IoSpace.MOTOR_DEDICATED_IO)])
 def test_motor_io_hold(ctl, ms, params, kind, space):
-    # spec 000:1742 "Motion hold input triggers from a General IO bit"; 000:1743 "... from a
-    # Dedicated I/O bit"; 000:1790-1793 motor.number, mask, pattern; 000:2884
+    # MPI 000, MEIMotionAttrHoldTypeMOTOR_GENERAL_IO "Motion hold input triggers from a General IO bit"; MPI 000, MEIMotionAttrHoldTypeMOTOR_DEDICATED_IO "... from a
+    # Dedicated I/O bit"; MPI 000, MEIMotionAttrHoldSource, motor.number motor.number, mask, pattern; MPI 000, MEIMotionAttrHOLD
     held_start(ms, params, Hold(type=kind, number=2, mask=0x10, pattern=0x10))
     ctl.io_set(space, 1, 0x10)  # another motor
     assert still(ctl)
@@ -86,8 +86,8 @@ def test_motor_io_hold(ctl, ms, params, kind, space):
 
 
 def test_user_address_hold(ctl, ms, params):
-    # spec 000:1749 "Motion hold input trigger from a user specifiable controller memory address";
-    # 000:1796-1798 address, mask, pattern (DESIGN.md: address = an I/O word index)
+    # MPI 000, MEIMotionAttrHoldTypeUSER_ADDRESS "Motion hold input trigger from a user specifiable controller memory address";
+    # MPI 000, MEIMotionAttrHoldSource, user.address address, mask, pattern (DESIGN.md: address = an I/O word index)
     held_start(ms, params, Hold(type=HoldType.USER_ADDRESS, address=60, mask=-1, pattern=7))
     assert still(ctl)
     ctl.io_set(IoSpace.IO, 60, 7)
@@ -96,7 +96,7 @@ def test_user_address_hold(ctl, ms, params):
 
 
 def test_hold_type_none_does_not_hold(ctl, ms, params):
-    # spec 000:1739 "MEIMotionAttrHoldTypeNONE This type disables the hold trigger condition"
+    # MPI 000, MEIMotionAttrHoldTypeNONE "MEIMotionAttrHoldTypeNONE This type disables the hold trigger condition"
     held_start(ms, params, Hold(type=HoldType.NONE))
     ctl.step(1)
     assert ctl.axes[0].cmd_p > 0.0
@@ -115,8 +115,8 @@ def leader_and_follower(ctl, params, hold, attrs):
 
 @pytest.mark.parametrize("kind", [HoldType.AXIS_POSITION_COMMAND, HoldType.AXIS_POSITION_ACTUAL])
 def test_axis_position_hold_greater(ctl, params, kind):
-    # spec 000:1593 HOLD_GREATER "greater than or equal hold logic"; 000:1744-1745 trigger from an
-    # axis's actual / command position; 000:1794-1795 axis.number, axis.position
+    # MPI 000, MEIMotionAttrHOLD_GREATER HOLD_GREATER "greater than or equal hold logic"; MPI 000, MEIMotionAttrHoldTypeAXIS_POSITION_ACTUAL trigger from an
+    # axis's actual / command position; MPI 000, MEIMotionAttrHoldSource, axis.number axis.number, axis.position
     hold = Hold(type=kind, number=0, position=400.0)
     lead, follow = leader_and_follower(ctl, params, hold, A.HOLD | A.HOLD_GREATER)
     watched = ctl.axes[0]
@@ -131,7 +131,7 @@ def test_axis_position_hold_greater(ctl, params, kind):
 
 
 def test_axis_position_hold_less(ctl, params):
-    # spec 000:1592 HOLD_LESS "less than or equal hold logic"
+    # MPI 000, MEIMotionAttrHOLD_LESS HOLD_LESS "less than or equal hold logic"
     ctl.axis_command_position_set(0, 1000.0)
     ctl.step(5000)
     hold = Hold(type=HoldType.AXIS_POSITION_COMMAND, number=0, position=600.0)
@@ -149,7 +149,7 @@ def test_axis_position_hold_less(ctl, params):
 
 def test_axis_position_hold_without_less_or_greater_waits_for_the_crossing(ctl, params):
     # holds.py: neither HOLD_LESS nor HOLD_GREATER: "the position is reached from the side it
-    # starts on" (spec 000:1795 axis.position "A position comparison value")
+    # starts on" (MPI 000, MEIMotionAttrHoldSource, axis.position axis.position "A position comparison value")
     hold = Hold(type=HoldType.AXIS_POSITION_COMMAND, number=0, position=250.0)
     leader_and_follower(ctl, params, hold, A.HOLD)
     assert ctl.run_until(lambda c: not c.axes[2].holding, 10_000)
@@ -157,14 +157,14 @@ def test_axis_position_hold_without_less_or_greater_waits_for_the_crossing(ctl, 
 
 
 def test_hold_less_already_true_releases_at_once(ctl, params):
-    # spec 000:1592 "less than or equal": true at the start, the move is not held
+    # MPI 000, MEIMotionAttrHOLD_LESS "less than or equal": true at the start, the move is not held
     hold = Hold(type=HoldType.AXIS_POSITION_COMMAND, number=0, position=400.0)
     leader_and_follower(ctl, params, hold, A.HOLD | A.HOLD_LESS)
     assert not ctl.axes[2].holding
 
 
 def test_timeout_starts_the_move_anyway(ctl, ms, params):
-    # spec 000:2886 "The timeout field of MEIMotionAttrHold{} will cause the motion to start after the
+    # MPI 000, MEIMotionAttrHOLD "The timeout field of MEIMotionAttrHold{} will cause the motion to start after the
     # specified timeout period (in seconds), even if the other hold criteria have not been
     # satisfied"; DESIGN.md: "timeout in seconds ... seconds it is"
     ctl.gate_set(1, True)
@@ -181,7 +181,7 @@ def test_timeout_starts_the_move_anyway(ctl, ms, params):
 
 
 def test_zero_timeout_waits_forever(ctl, ms, params):
-    # spec 000:2886 "A value of zero for timeout causes the timeout feature to be disabled and
+    # MPI 000, MEIMotionAttrHOLD "A value of zero for timeout causes the timeout feature to be disabled and
     # forces the motion to wait for the hold criteria"
     ctl.gate_set(1, True)
     held_start(ms, params, Hold(type=HoldType.GATE, gate=1, timeout=0.0))
@@ -190,7 +190,7 @@ def test_zero_timeout_waits_forever(ctl, ms, params):
 
 
 def test_same_hold_starts_in_the_same_sample_across_supervisors(ctl, ms, ms1, params):
-    # spec 000:2888 "All axes holding with the same hold attributes (same gate, same input, mask,
+    # MPI 000, MEIMotionAttrHOLD "All axes holding with the same hold attributes (same gate, same input, mask,
     # and pattern) will start motion in the same sample even if the moves are specified using
     # different motion supervisors"
     ctl.gate_set(4, True)
@@ -207,7 +207,7 @@ def test_same_hold_starts_in_the_same_sample_across_supervisors(ctl, ms, ms1, pa
 
 
 def test_hold_is_refused_on_modify(ctl, ms, params, bring):
-    # spec 000:1591 "MPIMotionMessageATTRIBUTE_INVALID will be returned if MEIMotionAttrHOLD is used
+    # MPI 000, MEIMotionAttrHOLD "MPIMotionMessageATTRIBUTE_INVALID will be returned if MEIMotionAttrHOLD is used
     # with a mpiMotionModify(...) method"
     bring(MPIState.MOVING)
     hold = Hold(type=HoldType.GATE, gate=1)
@@ -216,8 +216,8 @@ def test_hold_is_refused_on_modify(ctl, ms, params, bring):
 
 @pytest.mark.parametrize("attr", [A.HOLD, A.HOLD_LESS, A.HOLD_GREATER])
 def test_hold_is_refused_on_modify_even_with_auto_start(ctl, ms, params, attr):
-    # spec 000:971 "It is impossible to use the HOLD attributes with mpiMotionModify, even when
-    # using the AUTO_START attribute"; 000:3016
+    # MPI 000, mpiMotionModify "It is impossible to use the HOLD attributes with mpiMotionModify, even when
+    # using the AUTO_START attribute"; MPI 000, MPIMotionMessageATTRIBUTE_INVALID
     hold = Hold(type=HoldType.GATE, gate=1)
     message = ms.modify(T.TRAPEZOIDAL, A.AUTO_START | attr, params(hold=[hold, hold]))
     assert message is M.MPIMotionMessageATTRIBUTE_INVALID
@@ -225,7 +225,7 @@ def test_hold_is_refused_on_modify_even_with_auto_start(ctl, ms, params, attr):
 
 
 def test_hold_with_append(ctl, ms, params, run_to):
-    # spec 000:2810 "The MEIMotionAttrHOLD attribute is supported with MPIMotionAttrMaskAPPEND"
+    # MPI 000, MPIMotionAttrAPPEND "The MEIMotionAttrHOLD attribute is supported with MPIMotionAttrMaskAPPEND"
     ctl.gate_set(3, True)
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     hold = Hold(type=HoldType.GATE, gate=3)
@@ -238,7 +238,7 @@ def test_hold_with_append(ctl, ms, params, run_to):
 
 
 def test_the_hold_frame_is_in_the_buffer(ctl, ms, params):
-    # spec 000:2876 "The HOLD attribute is applied at the beginning of the motion (one HOLD frame)"
+    # MPI 000, MEIMotionAttrHOLD "The HOLD attribute is applied at the beginning of the motion (one HOLD frame)"
     ctl.gate_set(3, True)
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     plain = ctl.frame_count(0)
@@ -251,7 +251,7 @@ def test_the_hold_frame_is_in_the_buffer(ctl, ms, params):
 
 
 def test_e_stop_while_holding_drops_the_move(ctl, ms, params, run_to):
-    # spec 000:917 E_STOP then ERROR; DESIGN.md: from ERROR only RESET leaves (nothing pending)
+    # MPI 000, mpiMotionAction E_STOP then ERROR; DESIGN.md: from ERROR only RESET leaves (nothing pending)
     ctl.gate_set(3, True)
     held_start(ms, params, Hold(type=HoldType.GATE, gate=3))
     ms.action(MPIAction.E_STOP)
@@ -263,7 +263,7 @@ def test_e_stop_while_holding_drops_the_move(ctl, ms, params, run_to):
 
 
 def test_io_words_are_32_bit(ctl):
-    # io.py: "Words are 32-bit" (an input word compared under a mask, spec 000:1789)
+    # io.py: "Words are 32-bit" (an input word compared under a mask, MPI 000, MEIMotionAttrHoldSource, input.pattern)
     assert ctl.io_set(IoSpace.IO, 0, 0xFFFFFFFF).ok
     assert ctl.io_get(IoSpace.IO, 0) == (M.MPIMessageOK, -1)
     assert ctl.io_set(IoSpace.IO, 0, 0x0, mask=0x0000FFFF).ok

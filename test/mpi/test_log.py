@@ -13,7 +13,7 @@ T = MPIMotionType
 
 
 def test_log_records_every_sample_up_to_max_entries(ctl, ms, params):
-    # spec 000:508 "meiMotionLogOpen allocates a memory buffer for motion logging"; 000:511
+    # MPI 000, meiMotionLogOpen "meiMotionLogOpen allocates a memory buffer for motion logging"; MPI 000, meiMotionLogOpen, maxEntries
     # maxEntries "The maximum number of log entries"
     assert ms.log_open(500).ok
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 100.0)))
@@ -47,7 +47,7 @@ def test_log_is_the_same_in_any_batches(params):
 
 
 def test_log_print_writes_the_buffer(tmp_path, ctl, ms, params):
-    # spec 000:536 "meiMotionLogPrint reads the motion log buffer entries and writes the data into a
+    # MPI 000, meiMotionLogPrint "meiMotionLogPrint reads the motion log buffer entries and writes the data into a
     # file specified by the fileName"
     ms.log_open(100)
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 100.0)))
@@ -62,13 +62,13 @@ def test_log_print_writes_the_buffer(tmp_path, ctl, ms, params):
 
 
 def test_log_print_to_a_bad_path(tmp_path, ms):
-    # spec 000:539 "*filename a pointer to a file name string" (a file that cannot be opened)
+    # MPI 000, meiMotionLogPrint, filename "*filename a pointer to a file name string" (a file that cannot be opened)
     ms.log_open(10)
     assert ms.log_print(str(tmp_path / "no" / "such" / "dir" / "x.csv")) is Message.MPIMessageFILE_OPEN_ERROR
 
 
 def test_log_close_frees_the_buffer(ctl, ms, params):
-    # spec 000:482 "meiMotionLogClose frees the memory buffer for motion logging"
+    # MPI 000, meiMotionLogClose "meiMotionLogClose frees the memory buffer for motion logging"
     ms.log_open(10)
     assert ms.log_close().ok
     assert ms.log is None
@@ -77,6 +77,6 @@ def test_log_close_frees_the_buffer(ctl, ms, params):
 
 
 def test_log_open_needs_entries(ms):
-    # spec 000:511 maxEntries "determines the log buffer memory size"
+    # MPI 000, meiMotionLogOpen, maxEntries maxEntries "determines the log buffer memory size"
     assert ms.log_open(0) is Message.MPIMessagePARAM_INVALID
     assert ms.log is None

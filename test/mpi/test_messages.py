@@ -7,7 +7,7 @@ import pytest
 from mpi_ros.mpi.messages import OK, STATE_MESSAGES, Message
 from mpi_ros.mpi.types import MPIState
 
-# spec 000:2124-2145, the MPIMotionMessage enum listing, in order (DESIGN.md: the listing's
+# MPI 000, MPIMotionMessage, the MPIMotionMessage enum listing, in order (DESIGN.md: the listing's
 # "Type_INVALID" / "Attribute_INVALID" are typos for the upper-case names of the descriptions).
 MOTION_MESSAGES = [
     "MOTION_INVALID", "AXIS_NOT_FOUND", "AXIS_COUNT", "AXIS_FRAME_COUNT", "TYPE_INVALID",
@@ -15,20 +15,20 @@ MOTION_MESSAGES = [
     "AUTO_START", "ILLEGAL_DELAY", "PROFILE_ERROR", "PROFILE_NOT_SUPPORTED", "PATH_ERROR",
     "FRAMES_LOW", "FRAMES_EMPTY", "FRAME_BUFFER_TOO_SMALL",
 ]
-# spec 000:2241-2247, MEIMotionMessage.
+# MPI 000, MEIMotionMessage, MEIMotionMessage.
 MEI_MOTION_MESSAGES = ["RESERVED0", "RESERVED1", "RESERVED2", "NO_AXES_MAPPED", "BAD_PATH_DATA"]
-# spec 002:588-592, MPIAxisMessage.
+# MPI 002, MPIAxisMessage, MPIAxisMessage.
 AXIS_MESSAGES = ["AXIS_INVALID", "COMMAND_NOT_SET", "NOT_MAPPED_TO_MS"]
 
 
 @pytest.mark.parametrize("name", MOTION_MESSAGES)
 def test_every_motion_message_of_the_spec_exists(name):
-    # spec 000:2124-2145 MPIMotionMessage enum
+    # MPI 000, MPIMotionMessage MPIMotionMessage enum
     assert Message[f"MPIMotionMessage{name}"].name == f"MPIMotionMessage{name}"
 
 
 def test_motion_messages_keep_the_order_of_the_spec_listing():
-    # spec 000:2124-2145: codes follow the enum listing (one module base plus the position)
+    # MPI 000, MPIMotionMessage: codes follow the enum listing (one module base plus the position)
     codes = [Message[f"MPIMotionMessage{name}"].code for name in MOTION_MESSAGES]
     assert codes == list(range(codes[0], codes[0] + len(codes)))
 
@@ -43,18 +43,18 @@ def test_the_typo_spellings_of_the_enum_listing_are_not_names():
 
 @pytest.mark.parametrize("name", MEI_MOTION_MESSAGES)
 def test_every_mei_motion_message_exists(name):
-    # spec 000:2241-2247 MEIMotionMessage enum
+    # MPI 000, MEIMotionMessage MEIMotionMessage enum
     assert Message[f"MEIMotionMessage{name}"].name == f"MEIMotionMessage{name}"
 
 
 @pytest.mark.parametrize("name", AXIS_MESSAGES)
 def test_every_axis_message_exists(name):
-    # spec 002:588-592 MPIAxisMessage enum
+    # MPI 002, MPIAxisMessage MPIAxisMessage enum
     assert Message[f"MPIAxisMessage{name}"].name == f"MPIAxisMessage{name}"
 
 
 def test_list_message_element_not_found_exists():
-    # spec 000:1141 mpiMotionAxis returns MEIListMessageELEMENT_NOT_FOUND
+    # MPI 000, mpiMotionAxis, return values mpiMotionAxis returns MEIListMessageELEMENT_NOT_FOUND
     assert Message.MEIListMessageELEMENT_NOT_FOUND.name == "MEIListMessageELEMENT_NOT_FOUND"
 
 
@@ -80,6 +80,6 @@ def test_from_name_round_trips_every_message():
 
 @pytest.mark.parametrize("state", ["IDLE", "MOVING", "STOPPING", "STOPPED", "STOPPING_ERROR", "ERROR"])
 def test_each_state_has_its_refusal_message(state):
-    # spec 000:2184-2204: a refused start/modify/action answers the message named after the state
+    # MPI 000, MPIMotionMessageIDLE: a refused start/modify/action answers the message named after the state
     assert STATE_MESSAGES[state] is Message[f"MPIMotionMessage{state}"]
     assert MPIState[state].name == state

@@ -39,8 +39,8 @@ def record(ctl, ms, samples):
 
 
 def test_stop_decelerates_to_zero_over_the_stop_time(params):
-    # spec 000:924 STOP "decelerates the axis (or axes) to a stop in the time specified by the stop
-    # time"; 000:2074 stop = 0.5 s; DESIGN.md "STOP ramps the feedrate to pauseFeedrate"
+    # MPI 000, MPIActionSTOP STOP "decelerates the axis (or axes) to a stop in the time specified by the stop
+    # time"; MPI 000, MPIMotionDecelTime, stop stop = 0.5 s; DESIGN.md "STOP ramps the feedrate to pauseFeedrate"
     ctl, ms = two_axes()
     ms.start(T.S_CURVE, params=params((30_000.0, 40_000.0), jerk_percent=50.0))
     ctl.step(1000)
@@ -54,7 +54,7 @@ def test_stop_decelerates_to_zero_over_the_stop_time(params):
 
 def test_stop_stays_on_the_path_and_resume_continues_it(params):
     # DESIGN.md: "STOP ramps the feedrate to pauseFeedrate over the stop time so RESUME continues on
-    # the same path"; spec 000:923 RESUME "the Motion will resume if it was stopped by a prior call"
+    # the same path"; MPI 000, MPIActionRESUME RESUME "the Motion will resume if it was stopped by a prior call"
     ctl, ms = two_axes()
     ms.log_open(1_000_000)
     ms.start(T.S_CURVE, params=params((3000.0, 4000.0), jerk_percent=60.0))
@@ -74,7 +74,7 @@ def test_stop_stays_on_the_path_and_resume_continues_it(params):
 
 
 def test_resume_ramps_the_feedrate_back_over_the_stop_time(params):
-    # DESIGN.md: feedrate ramps (clock.py "RESUME back"); spec 000:1997 normalFeedrate
+    # DESIGN.md: feedrate ramps (clock.py "RESUME back"); MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(1000)
@@ -89,7 +89,7 @@ def test_resume_ramps_the_feedrate_back_over_the_stop_time(params):
 
 
 def test_resume_then_stop_again(params):
-    # spec 000:923-924: STOP and RESUME can alternate; the move still ends on its target
+    # MPI 000, MPIActionRESUME: STOP and RESUME can alternate; the move still ends on its target
     ctl, ms = two_axes()
     ms.start(T.S_CURVE, params=params((2000.0, -1000.0), jerk_percent=30.0))
     for wait in (300, 150, 999):
@@ -103,8 +103,8 @@ def test_resume_then_stop_again(params):
 
 
 def test_e_stop_ramps_to_zero_over_the_e_stop_time(params):
-    # spec 000:920 E_STOP "will decelerate the axis (or axes) to a stop in the time specified by the
-    # eStop time"; 000:2075 eStop = 0.05 s
+    # MPI 000, MPIActionE_STOP E_STOP "will decelerate the axis (or axes) to a stop in the time specified by the
+    # eStop time"; MPI 000, MPIMotionDecelTime, eStop eStop = 0.05 s
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(1000)
@@ -127,7 +127,7 @@ def test_e_stop_stays_on_the_path(params):
 
 
 def test_abort_disables_the_amplifiers_and_freezes_the_command(params):
-    # spec 000:918 ABORT "will disable the PID control ..., and disable the amp enable outputs"
+    # MPI 000, MPIActionABORT ABORT "will disable the PID control ..., and disable the amp enable outputs"
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(1000)
@@ -142,7 +142,7 @@ def test_abort_disables_the_amplifiers_and_freezes_the_command(params):
 
 
 def test_reset_after_abort_sets_command_to_actual(params):
-    # spec 000:922 "If the error state was caused by an Abort action, then the command position of
+    # MPI 000, MPIActionRESET "If the error state was caused by an Abort action, then the command position of
     # associated axes will be set equal to the actual position during the Reset"
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
@@ -157,7 +157,7 @@ def test_reset_after_abort_sets_command_to_actual(params):
 
 
 def test_reset_after_e_stop_keeps_the_command(params):
-    # spec 000:922: only after an Abort is the command set to the actual position
+    # MPI 000, MPIActionRESET: only after an Abort is the command set to the actual position
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(1000)
@@ -170,7 +170,7 @@ def test_reset_after_e_stop_keeps_the_command(params):
 
 
 def test_e_stop_abort_decelerates_then_disables(params):
-    # spec 000:921 E_STOP_ABORT "will decelerate the axis (or axes) to a stop in the time specified
+    # MPI 000, MPIActionE_STOP_ABORT E_STOP_ABORT "will decelerate the axis (or axes) to a stop in the time specified
     # by the eStop time. Next, MotionAction will generate an MPIActionABORT"
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
@@ -186,7 +186,7 @@ def test_e_stop_abort_decelerates_then_disables(params):
 
 
 def test_abort_in_error_after_e_stop_disables(params):
-    # DESIGN.md table: ABORT in ERROR "OK, stays ERROR" (and does abort)
+    # docs/state-machine.md: ABORT in ERROR "OK, stays ERROR" (and does abort)
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(500)
@@ -198,7 +198,7 @@ def test_abort_in_error_after_e_stop_disables(params):
 
 
 def test_stop_before_the_move_would_end(params):
-    # spec 000:924: a STOP near the end of a move; the pending rest runs on RESUME
+    # MPI 000, MPIActionSTOP: a STOP near the end of a move; the pending rest runs on RESUME
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((1000.0, 0.0)))
     ctl.step(1500)  # 0.35 s of the profile left; the stop ramp runs 0.25 s of it
@@ -211,7 +211,7 @@ def test_stop_before_the_move_would_end(params):
 
 
 def test_velocity_move_stops_and_resumes(params):
-    # spec 000:924 STOP on a VELOCITY move; RESUME returns to the commanded velocity
+    # MPI 000, MPIActionSTOP STOP on a VELOCITY move; RESUME returns to the commanded velocity
     ctl, ms = two_axes()
     ms.start(T.VELOCITY, params=params((), velocity=-800.0))
     ctl.step(1000)
@@ -224,7 +224,7 @@ def test_velocity_move_stops_and_resumes(params):
 
 
 def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
-    # spec 000:1998 pauseFeedrate "the feed speed rate for the Stop action": with 0.5 the axes still
+    # MPI 000, MPIMotionConfig, pauseFeedrate pauseFeedrate "the feed speed rate for the Stop action": with 0.5 the axes still
     # move when STOPPED; DESIGN.md "A new start from STOPPED discards the pending profile": the new
     # move must start from the velocity the axes have (limits never exceeded)
     ctl, ms = two_axes()
@@ -242,7 +242,7 @@ def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
 
 
 def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(params):
-    # spec 000:1589 FINAL_VEL "a non-zero target velocity": the axis leaves the move at that
+    # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL "a non-zero target velocity": the axis leaves the move at that
     # velocity, so the supervisor stays MOVING (docs/decisions.md: never DONE, never IDLE while
     # the axis moves) and the next command is a modify that continues from the velocity
     # (limits never exceeded, DESIGN.md).
@@ -260,7 +260,7 @@ def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(par
 
 
 def test_stop_while_holding_then_resume(params):
-    # spec 000:2876 the HOLD frame is part of the motion: STOP and RESUME apply to it
+    # MPI 000, MEIMotionAttrHOLD the HOLD frame is part of the motion: STOP and RESUME apply to it
     ctl, ms = two_axes()
     ctl.gate_set(0, True)
     hold = Hold(type=HoldType.GATE, gate=0)
@@ -276,7 +276,7 @@ def test_stop_while_holding_then_resume(params):
 
 
 def test_append_in_stopped_follows_the_table(params):
-    # DESIGN.md table: start in STOPPED is "OK, pending profile dropped" and modify in STOPPED
+    # docs/state-machine.md: start in STOPPED is "OK, pending profile dropped" and modify in STOPPED
     # answers MPIMotionMessageSTOPPED; APPEND does not change either.
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((5000.0, 0.0)))
@@ -291,7 +291,7 @@ def test_append_in_stopped_follows_the_table(params):
 
 
 def test_command_position_can_be_set_in_error_after_abort():
-    # spec 002:611 COMMAND_NOT_SET while STOPPING, STOPPED or MOVING; ERROR is not among them
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET COMMAND_NOT_SET while STOPPING, STOPPED or MOVING; ERROR is not among them
     ctl, ms = two_axes()
     ms.action(MPIAction.ABORT)
     ctl.step(5)
@@ -315,7 +315,7 @@ def test_append_behind_a_cruising_final_velocity_move_continues_without_a_jump(p
 
 
 def test_a_move_that_starts_in_motion_cannot_wait(params):
-    # spec 000:2212 ILLEGAL_DELAY "non-zero delay value ... while in motion" and 000:971 "It is
+    # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "non-zero delay value ... while in motion" and MPI 000, mpiMotionModify "It is
     # impossible to use the HOLD attributes with mpiMotionModify": a move appended behind one that
     # ends moving (FINAL_VEL) starts in motion too, and a wait would stop the axes dead.
     ctl, ms = two_axes()

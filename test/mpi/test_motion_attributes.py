@@ -28,7 +28,7 @@ def run_idle(ctl, ms, limit=100_000):
 
 # ------------------------------------------------------------------ APPEND ----
 def test_append_begins_after_the_previous_completed_and_settled(ctl, ms, params):
-    # spec 000:1550 "The APPENDED profile will begin execution after the previous profile has
+    # MPI 000, MPIMotionAttrAPPEND "The APPENDED profile will begin execution after the previous profile has
     # completed and the settling criteria has been met"
     ms.start(T.TRAPEZOIDAL, params=params((1000.0, 0.0)))
     assert ms.start(T.TRAPEZOIDAL, A.APPEND, params((2000.0, 0.0))).ok
@@ -45,13 +45,13 @@ def test_append_begins_after_the_previous_completed_and_settled(ctl, ms, params)
 
 
 def test_append_on_an_idle_supervisor_is_a_start(ctl, ms, params):
-    # spec 000:1550 APPEND adds to "a previous motion profile": with none, the move starts
+    # MPI 000, MPIMotionAttrAPPEND APPEND adds to "a previous motion profile": with none, the move starts
     assert ms.start(T.TRAPEZOIDAL, A.APPEND, params((300.0, 0.0))).ok
     assert ms.state is MPIState.MOVING and not ms.queue
 
 
 def test_append_with_modify(ctl, ms, params):
-    # spec 000:1550 "The APPEND bit can be used with mpiMotionStart(...) or mpiMotionModify(...)"
+    # MPI 000, MPIMotionAttrAPPEND "The APPEND bit can be used with mpiMotionStart(...) or mpiMotionModify(...)"
     ms.start(T.TRAPEZOIDAL, params=params((500.0, 0.0)))
     ctl.step(10)
     assert ms.modify(T.TRAPEZOIDAL, A.APPEND, params((800.0, 100.0))).ok
@@ -61,7 +61,7 @@ def test_append_with_modify(ctl, ms, params):
 
 
 def test_append_velocity_move_after_a_point_to_point(ctl, ms, params):
-    # spec 000:2812 APPEND move types include Velocity
+    # MPI 000, Move Types: PT, PVT, Bessel, Bspline, Bspline2, S-Curve, Trapezoidal, Velocity, Frame APPEND move types include Velocity
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     assert ms.start(T.VELOCITY, A.APPEND, params((), velocity=-300.0)).ok
     ctl.step(6000)
@@ -70,11 +70,11 @@ def test_append_velocity_move_after_a_point_to_point(ctl, ms, params):
 
 # ------------------------------------------------------------------ AUTO_START ----
 def test_auto_start_after_the_move_finished(ctl, ms, params):
-    # spec 000:2816 "calls to mpiMotionModify(...) will automatically start a new motion if the
-    # previous motion is done"; 000:2208 answers MPIMotionMessageAUTO_START ("not an error")
+    # MPI 000, MPIMotionAttrAUTO_START "calls to mpiMotionModify(...) will automatically start a new motion if the
+    # previous motion is done"; MPI 000, MPIMotionMessageAUTO_START answers MPIMotionMessageAUTO_START ("not an error")
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     run_idle(ctl, ms)
-    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is M.MPIMotionMessageIDLE  # 000:2816
+    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is M.MPIMotionMessageIDLE  # MPI 000, MPIMotionAttrAUTO_START
     assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, params((0.0, 50.0))) is M.MPIMotionMessageAUTO_START
     run_idle(ctl, ms)
     assert [a.command_position for a in ms.axes] == [0.0, 50.0]
@@ -82,8 +82,8 @@ def test_auto_start_after_the_move_finished(ctl, ms, params):
 
 # ------------------------------------------------------------------ DELAY ----
 def test_delay_per_axis_before_the_profile(ctl, ms, params):
-    # spec 000:1556 DELAY "enables a time delay (seconds) before the motion profile begins";
-    # 000:2822 "an array of doubles that assign delay times for each Axis"
+    # MPI 000, MPIMotionAttrDELAY DELAY "enables a time delay (seconds) before the motion profile begins";
+    # MPI 000, MPIMotionAttrDELAY "an array of doubles that assign delay times for each Axis"
     assert ms.start(T.TRAPEZOIDAL, A.DELAY | A.SYNC_START,
                     params((100.0, 100.0), trajectory=[Trajectory(1000, 1e4, 1e4)] * 2, delay=[0.1, 0.25])).ok
     first_move = [None, None]
@@ -96,7 +96,7 @@ def test_delay_per_axis_before_the_profile(ctl, ms, params):
 
 
 def test_delay_on_auto_start_is_used(ctl, ms, params):
-    # spec 000:2212 "If it is currently not in motion and the AUTO_START attribute is set, this
+    # MPI 000, MPIMotionMessageILLEGAL_DELAY "If it is currently not in motion and the AUTO_START attribute is set, this
     # message will not be returned and the specified delay will be used at the beginning"
     message = ms.modify(T.TRAPEZOIDAL, A.AUTO_START | A.DELAY, params((100.0, 0.0), delay=[0.05, 0.05]))
     assert message is M.MPIMotionMessageAUTO_START
@@ -107,7 +107,7 @@ def test_delay_on_auto_start_is_used(ctl, ms, params):
 
 
 def test_illegal_delay_on_modify_in_motion(ctl, ms, params, bring):
-    # spec 000:2212 ILLEGAL_DELAY "Returned if a motion modify is called with a non-zero delay value
+    # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "Returned if a motion modify is called with a non-zero delay value
     # and the MPIMotionAttrDELAY attribute is set while in motion"
     bring(MPIState.MOVING)
     assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.0, 0.1])) is M.MPIMotionMessageILLEGAL_DELAY
@@ -127,7 +127,7 @@ def test_illegal_delay_while_the_axes_wait_out_a_delay(ctl, ms, params):
 
 
 def test_delay_with_velocity_move(ctl, ms, params):
-    # spec 000:2824 DELAY move types: S-Curve, Trapezoidal, Velocity
+    # MPI 000, Move Types: S-Curve, Trapezoidal, Velocity DELAY move types: S-Curve, Trapezoidal, Velocity
     ms.start(T.VELOCITY, A.DELAY, params((), velocity=100.0, delay=[0.01, 0.0]))
     ctl.step(20)
     assert ctl.axes[0].cmd_v == 0.0 and ctl.axes[1].cmd_v > 0.0
@@ -139,7 +139,7 @@ def test_delay_with_velocity_move(ctl, ms, params):
 @pytest.mark.parametrize("given,stored", [(1, 1), (32767, 32767), (-32768, -32768), (65535, -1),
                                           (70000, 4464), (-40000, 25536)])
 def test_id_is_16_bit(ctl, ms, params, given, stored):
-    # spec 000:1876 id "The id is limited to 16-bit resolution by the controller firmware";
+    # MPI 000, MPIMotionAttributes, id id "The id is limited to 16-bit resolution by the controller firmware";
     # DESIGN.md quirks are "reproduced and reported as events"
     assert ms.start(T.TRAPEZOIDAL, A.ID, params((10.0, 0.0), id=given)).ok
     assert ms.snapshot().move_id == stored and ctl.axes[0].move_id == stored
@@ -150,7 +150,7 @@ def test_id_is_16_bit(ctl, ms, params, given, stored):
 
 
 def test_modify_keeps_the_id_unless_given(ctl, ms, params):
-    # spec 000:1557 ID "can be used with mpiMotionStart(...) and mpiMotionModify(...)"
+    # MPI 000, MPIMotionAttrID ID "can be used with mpiMotionStart(...) and mpiMotionModify(...)"
     ms.start(T.TRAPEZOIDAL, A.ID, params((5000.0, 0.0), id=11))
     ctl.step(100)
     ms.modify(T.TRAPEZOIDAL, params=params((4000.0, 0.0)))
@@ -162,7 +162,7 @@ def test_modify_keeps_the_id_unless_given(ctl, ms, params):
 
 # ------------------------------------------------------------------ RELATIVE ----
 def test_relative_move(ctl, ms, params):
-    # spec 000:2844 "a move beginning at position 1000 with a position parameter value of 2000 will
+    # MPI 000, MPIMotionAttrRELATIVE "a move beginning at position 1000 with a position parameter value of 2000 will
     # move to position 2000. If the RELATIVE attribute is turned on, the final move position will
     # be 3000"
     ms.start(T.TRAPEZOIDAL, params=params((1000.0, 1000.0)))
@@ -173,7 +173,7 @@ def test_relative_move(ctl, ms, params):
 
 
 def test_relative_fraction_is_truncated(ctl, ms, params):
-    # spec 000:626 "When successive non-integer length relative motions are commanded, the
+    # MPI 000, mpiMotionStart "When successive non-integer length relative motions are commanded, the
     # fractional portion is truncated and discarded"; DESIGN.md: reported as an event
     for _ in range(4):
         ms.start(T.TRAPEZOIDAL, A.RELATIVE, params((10.75, -2.5)))
@@ -184,7 +184,7 @@ def test_relative_fraction_is_truncated(ctl, ms, params):
 
 
 def test_relative_with_append_adds_to_the_previous_target(ctl, ms, params):
-    # spec 000:1559 RELATIVE "Currently only supports APPEND and ID attributes"
+    # MPI 000, MPIMotionAttrRELATIVE RELATIVE "Currently only supports APPEND and ID attributes"
     ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0)))
     ms.start(T.TRAPEZOIDAL, A.APPEND | A.RELATIVE, params((50.0, 20.0)))
     run_idle(ctl, ms)
@@ -192,7 +192,7 @@ def test_relative_with_append_adds_to_the_previous_target(ctl, ms, params):
 
 
 def test_relative_is_not_shifted_by_the_origin(ctl, ms, params):
-    # spec 000:2844 relative = "a relative distance ... from the starting value"
+    # MPI 000, MPIMotionAttrRELATIVE relative = "a relative distance ... from the starting value"
     ctl.axis_origin_set(0, 1000.0)
     ms.start(T.TRAPEZOIDAL, A.RELATIVE, params((10.0, 0.0)))
     run_idle(ctl, ms)
@@ -217,9 +217,9 @@ def first_and_last_motion(ctl, ms, samples):
 
 
 def test_sync_end_ends_together(ctl, ms, params):
-    # spec 000:1560 SYNC_END "synchronizes the motion profiles for multiple axes so they will all end
+    # MPI 000, MPIMotionAttrSYNC_END SYNC_END "synchronizes the motion profiles for multiple axes so they will all end
     # at the same time. Delays are inserted before the shorter profiles. When enabled, each axis
-    # will use its own MPITrajectory values"; 000:2850
+    # will use its own MPITrajectory values"; MPI 000, MPIMotionAttrSYNC_END
     ms.start(T.TRAPEZOIDAL, A.SYNC_END, params((1000.0, 100.0), trajectory=SYNC_TRAJ))
     first, last = first_and_last_motion(ctl, ms, 3000)
     assert last[0] == last[1] and first[0] == 1 and first[1] > 1
@@ -227,15 +227,15 @@ def test_sync_end_ends_together(ctl, ms, params):
 
 
 def test_sync_start_starts_together(ctl, ms, params):
-    # spec 000:1561 SYNC_START "they will all start at the same time. Delays are inserted after the
-    # shorter profiles"; 000:2856
+    # MPI 000, MPIMotionAttrSYNC_START SYNC_START "they will all start at the same time. Delays are inserted after the
+    # shorter profiles"; MPI 000, MPIMotionAttrSYNC_START
     ms.start(T.TRAPEZOIDAL, A.SYNC_START, params((1000.0, 100.0), trajectory=SYNC_TRAJ))
     first, last = first_and_last_motion(ctl, ms, 3000)
     assert first == [1, 1] and last[1] < last[0]
 
 
 def test_without_sync_one_vector_trajectory(ctl, ms, params):
-    # spec 000:2550 "If more than one axis is associated with the motion and neither SYNC_START nor
+    # MPI 000, MPIMotionSCurve "If more than one axis is associated with the motion and neither SYNC_START nor
     # SYNC_END are specified, then only the first trajectory structure will be applied as the
     # vector trajectory for all the axes"
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 400.0), velocity=1000.0))
@@ -248,7 +248,7 @@ def test_without_sync_one_vector_trajectory(ctl, ms, params):
 
 # ------------------------------------------------------------------ FINAL_VEL ----
 def test_final_velocity_then_appended_move_keeps_the_speed(ctl, ms, params):
-    # spec 000:1589 FINAL_VEL "a non-zero target velocity for point to point motion types"; the
+    # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL "a non-zero target velocity for point to point motion types"; the
     # appended move starts from it (motion.py: "An appended move follows one that ends moving")
     ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[500.0, 0.0]))
     ms.start(T.TRAPEZOIDAL, A.APPEND, params((2000.0, 0.0)))
@@ -266,7 +266,7 @@ def test_final_velocity_then_appended_move_keeps_the_speed(ctl, ms, params):
 
 
 def test_final_velocity_above_the_velocity_is_a_profile_error(ms, params):
-    # spec 000:2216 PROFILE_ERROR "The motion profile is not possible with the specified constraints"
+    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "The motion profile is not possible with the specified constraints"
     message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[1500.0, 0.0]))
     assert message is M.MPIMotionMessagePROFILE_ERROR
 
@@ -279,8 +279,8 @@ def test_vector_final_velocity_off_the_line_is_param_invalid(ms, params):
 
 # ------------------------------------------------------------------ NO_REVERSAL ----
 def test_no_reversal_refuses_a_modify_behind_the_motion(ctl, ms, params, bring):
-    # spec 000:2216 PROFILE_ERROR "returned by mpiMotionModify when the NO_REVERSAL attribute mask
-    # is specified, but the specified target position is in the reverse direction"; 000:1590
+    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "returned by mpiMotionModify when the NO_REVERSAL attribute mask
+    # is specified, but the specified target position is in the reverse direction"; MPI 000, MEIMotionAttrNO_REVERSAL
     bring(MPIState.MOVING)
     where = ctl.axes[0].command_position
     assert ms.modify(T.TRAPEZOIDAL, A.NO_REVERSAL, params((where - 100.0, 0.0))) is M.MPIMotionMessagePROFILE_ERROR
@@ -290,7 +290,7 @@ def test_no_reversal_refuses_a_modify_behind_the_motion(ctl, ms, params, bring):
 
 
 def test_no_reversal_refuses_a_target_too_close_to_stop(ctl, ms, params, bring):
-    # spec 000:1590 NO_REVERSAL "prevents a motion profile from changing direction": a target the
+    # MPI 000, MEIMotionAttrNO_REVERSAL NO_REVERSAL "prevents a motion profile from changing direction": a target the
     # axis cannot stop before would need a reversal
     bring(MPIState.MOVING)
     where = ctl.axes[0].command_position
@@ -300,8 +300,8 @@ def test_no_reversal_refuses_a_target_too_close_to_stop(ctl, ms, params, bring):
 
 # ------------------------------------------------------------------ OUTPUT ----
 def test_output_bits_as_the_move_begins(ctl, ms, params):
-    # spec 000:2892 OUTPUT "configures a frame to toggle an output bit as a move begins"; 000:1828-1829
-    # offMask "bits to be turned OFF", onMask "bits to be turned ON"; 000:1853 type OUTPUT
+    # MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame to toggle an output bit as a move begins"; MPI 000, MEIMotionAttrOutput, offMask
+    # offMask "bits to be turned OFF", onMask "bits to be turned ON"; MPI 000, MEIMotionAttrOutputTypeOUTPUT type OUTPUT
     ctl.io_set(IoSpace.IO, 3, 0b1010)
     out = Output(type=OutputType.OUTPUT, address=3, on_mask=0b0101, off_mask=0b1000)
     assert ms.start(T.TRAPEZOIDAL, A.OUTPUT, params((100.0, 0.0), output=[out])).ok
@@ -309,20 +309,20 @@ def test_output_bits_as_the_move_begins(ctl, ms, params):
 
 
 def test_motor_output(ctl, ms, params):
-    # spec 000:1852 type MOTOR "configures a motor's output bit(s)"; 000:1827 motor number
+    # MPI 000, MEIMotionAttrOutputTypeMOTOR type MOTOR "configures a motor's output bit(s)"; MPI 000, MEIMotionAttrOutput, motor motor number
     out = Output(type=OutputType.MOTOR, motor=2, on_mask=0x100)
     ms.start(T.TRAPEZOIDAL, A.OUTPUT, params((100.0, 0.0), output=[out]))
     assert ctl.io_get(IoSpace.MOTOR_GENERAL_IO, 2)[1] == 0x100
 
 
 def test_output_type_none_sets_nothing(ctl, ms, params):
-    # spec 000:1851 NONE "disables the setting/clearing of output bit(s)"
+    # MPI 000, MEIMotionAttrOutputTypeNONE NONE "disables the setting/clearing of output bit(s)"
     ms.start(T.TRAPEZOIDAL, A.OUTPUT, params((100.0, 0.0), output=[Output(type=OutputType.NONE, on_mask=-1)]))
     assert all(ctl.io_get(IoSpace.IO, i)[1] == 0 for i in range(64))
 
 
 def test_output_of_an_appended_move_fires_when_it_begins(ctl, ms, params):
-    # spec 000:2892 "as a move begins": an appended move begins after the previous one
+    # MPI 000, MEIMotionAttrOUTPUT "as a move begins": an appended move begins after the previous one
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 0.0)))
     out = Output(type=OutputType.OUTPUT, address=0, on_mask=1)
     ms.start(T.TRAPEZOIDAL, A.APPEND | A.OUTPUT, params((0.0, 0.0), output=[out]))
@@ -338,9 +338,9 @@ JERK = Trajectory(1000.0, 10_000.0, 5_000.0, 0.0, 1e6, 5e5)
 
 @pytest.mark.parametrize("kind", [T.S_CURVE_JERK, T.VELOCITY_JERK])
 def test_jerk_types_need_firmware_option_21(ctl, ms, params, kind):
-    # spec 000:2645 "In the standard firmware, the MPIMotionTypeS_CURVE_JERK and
+    # MPI 000, MPIMotionType "In the standard firmware, the MPIMotionTypeS_CURVE_JERK and
     # MPIMotionTypeVELOCITY_JERK motion types are not supported and if specified, the MPI will return
-    # a profile not supported error"; 000:2220
+    # a profile not supported error"; MPI 000, MPIMotionMessagePROFILE_NOT_SUPPORTED
     assert ms.start(kind, params=params((100.0, 0.0), trajectory=[JERK])) is M.MPIMotionMessagePROFILE_NOT_SUPPORTED
     assert ms.state is MPIState.IDLE
 
@@ -353,7 +353,7 @@ def option_21():
 
 
 def test_s_curve_jerk_with_the_option(params):
-    # spec 000:2671 S_CURVE_JERK "specified by acceleration, velocity, deceleration,
+    # MPI 000, MPIMotionTypeS_CURVE_JERK S_CURVE_JERK "specified by acceleration, velocity, deceleration,
     # accelerationJerk, decelerationJerk, and final position"
     ctl, ms = option_21()
     assert ms.start(T.S_CURVE_JERK, params=params((3000.0, 4000.0), trajectory=[JERK])).ok
@@ -362,7 +362,7 @@ def test_s_curve_jerk_with_the_option(params):
 
 
 def test_velocity_jerk_with_the_option(params):
-    # spec 000:2674 VELOCITY_JERK "S-Curve acceleration to a constant velocity"
+    # MPI 000, MPIMotionTypeVELOCITY_JERK VELOCITY_JERK "S-Curve acceleration to a constant velocity"
     ctl, ms = option_21()
     assert ms.start(T.VELOCITY_JERK, params=params((), trajectory=[JERK])).ok
     ctl.step(4000)
@@ -372,7 +372,7 @@ def test_velocity_jerk_with_the_option(params):
 
 # ------------------------------------------------------------------ frame time limit ----
 def test_velocity_frame_stops_after_16384000_samples():
-    # spec 000:628 "The XMP firmware velocity frame execution time ... cannot exceed 16,384,000
+    # MPI 000, mpiMotionStart "The XMP firmware velocity frame execution time ... cannot exceed 16,384,000
     # samples ... the axes will stop abruptly after 16,384,000 samples. The motors will still
     # maintain servo control and no errors are reported"; DESIGN.md: reproduced and reported as an
     # event. At 100 Hz the ramp takes 10 samples, then the velocity frame runs its limit.
@@ -394,8 +394,8 @@ def test_velocity_frame_stops_after_16384000_samples():
 
 
 def test_point_to_point_frame_over_the_limit_is_cut_and_reported():
-    # spec 000:628 "The XMP firmware velocity frame execution time for point-to-point moves cannot
-    # exceed 16,384,000 samples"; 000:975 (modify alike)
+    # MPI 000, mpiMotionStart "The XMP firmware velocity frame execution time for point-to-point moves cannot
+    # exceed 16,384,000 samples"; MPI 000, mpiMotionModify (modify alike)
     ctl = Controller(ControllerConfig(sample_rate=100.0, axis_count=1, supervisor_count=1))
     _, ms = ctl.create_motion(0)
     ms.axis_list_set([0])

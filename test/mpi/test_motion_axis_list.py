@@ -1,4 +1,4 @@
-"""The axis list of a Motion object (mpi_ros/mpi/motion.py, spec 000:1118-1486) and MAP."""
+"""The axis list of a Motion object (mpi_ros/mpi/motion.py, MPI 000, mpiMotionAxis) and MAP."""
 
 from __future__ import annotations
 
@@ -23,15 +23,15 @@ def empty(big):
 
 
 def test_append_builds_the_list_in_order(empty):
-    # spec 000:1159 mpiMotionAxisAppend appends an Axis; 000:1394 ListGet writes the list
+    # MPI 000, mpiMotionAxisAppend mpiMotionAxisAppend appends an Axis; MPI 000, mpiMotionAxisListGet ListGet writes the list
     for n in (3, 1, 2):
         assert empty.axis_append(n).ok
     assert empty.axis_list_get() == (M.MPIMessageOK, [3, 1, 2])
-    assert empty.axis_count() == 3  # spec 000:1196
+    assert empty.axis_count() == 3  # MPI 000, mpiMotionAxisCount, return values
 
 
 def test_append_an_axis_already_on_the_list(empty):
-    # spec 000:1172 MPIMessageOBJECT_ON_LIST "axis is already on the list"
+    # MPI 000, mpiMotionAxisAppend, return values MPIMessageOBJECT_ON_LIST "axis is already on the list"
     empty.axis_append(1)
     assert empty.axis_append(1) is M.MPIMessageOBJECT_ON_LIST
     assert empty.axis_list_get()[1] == [1]
@@ -39,13 +39,13 @@ def test_append_an_axis_already_on_the_list(empty):
 
 @pytest.mark.parametrize("number", [-1, 10, 1000])
 def test_append_an_invalid_axis(empty, number):
-    # spec 000:1169 MPIMessageHANDLE_INVALID "Either motion or axis is an invalid handle"
+    # MPI 000, mpiMotionAxisAppend, return values MPIMessageHANDLE_INVALID "Either motion or axis is an invalid handle"
     assert empty.axis_append(number) is M.MPIMessageHANDLE_INVALID
     assert empty.axis_count() == 0
 
 
 def test_append_past_max_coord_axes(empty):
-    # spec 000:1170 MPIMessageUNSUPPORTED "The list already contains the maximum number of elements
+    # MPI 000, mpiMotionAxisAppend, return values MPIMessageUNSUPPORTED "The list already contains the maximum number of elements
     # (MEIXmpMAX_COORD_AXES)" = 8
     for n in range(8):
         assert empty.axis_append(n).ok
@@ -55,20 +55,20 @@ def test_append_past_max_coord_axes(empty):
 
 
 def test_list_set_past_max_coord_axes(empty):
-    # spec 000:1170 (the same limit for a list set at once)
+    # MPI 000, mpiMotionAxisAppend, return values (the same limit for a list set at once)
     assert empty.axis_list_set(list(range(9))) is M.MPIMessageUNSUPPORTED
     assert empty.axis_list_set(list(range(8))).ok
 
 
 def test_append_a_disabled_axis(big, empty):
-    # spec 000:1171 MPIMessageOBJECT_NOT_ENABLED "axis is not an enabled axis"
+    # MPI 000, mpiMotionAxisAppend, return values MPIMessageOBJECT_NOT_ENABLED "axis is not an enabled axis"
     big.axes[4].enabled = False
     assert empty.axis_append(4) is M.MPIMessageOBJECT_NOT_ENABLED
     assert empty.axis_list_set([4]) is M.MPIMessageOBJECT_NOT_ENABLED
 
 
 def test_insert_just_after_an_axis(empty):
-    # spec 000:1337 mpiMotionAxisInsert "inserts an Axis (insert) ... just after the specified Axis"
+    # MPI 000, mpiMotionAxisInsert mpiMotionAxisInsert "inserts an Axis (insert) ... just after the specified Axis"
     empty.axis_list_set([1, 2])
     assert empty.axis_insert(1, 5).ok
     assert empty.axis_insert(None, 7).ok  # first place (MPIHandleVOID)
@@ -76,7 +76,7 @@ def test_insert_just_after_an_axis(empty):
 
 
 def test_insert_after_an_axis_not_on_the_list(empty):
-    # spec 000:2162 AXIS_NOT_FOUND "The specified axis object is not available"
+    # MPI 000, MPIMotionMessageAXIS_NOT_FOUND AXIS_NOT_FOUND "The specified axis object is not available"
     empty.axis_list_set([1])
     assert empty.axis_insert(3, 4) is M.MPIMotionMessageAXIS_NOT_FOUND
     assert empty.axis_insert(1, 1) is M.MPIMessageOBJECT_ON_LIST
@@ -84,7 +84,7 @@ def test_insert_after_an_axis_not_on_the_list(empty):
 
 
 def test_remove_an_axis_not_on_the_list(big, empty):
-    # spec 000:2162 AXIS_NOT_FOUND "returned from mpiMotionAxisRemove if the axis that is being
+    # MPI 000, MPIMotionMessageAXIS_NOT_FOUND AXIS_NOT_FOUND "returned from mpiMotionAxisRemove if the axis that is being
     # removed is not a member of the motion object"
     empty.axis_list_set([1])
     empty.action(MPIAction.MAP)
@@ -93,18 +93,18 @@ def test_remove_an_axis_not_on_the_list(big, empty):
 
 
 def test_remove_an_axis_not_mapped(empty):
-    # spec 002:617 NOT_MAPPED_TO_MS "returned by ... mpiMotionAxisRemove when an axis is associated
+    # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS NOT_MAPPED_TO_MS "returned by ... mpiMotionAxisRemove when an axis is associated
     # with a motion object, but not mapped to a motion supervisor"
     empty.axis_list_set([1, 2])
     assert empty.axis_remove(1) is M.MPIAxisMessageNOT_MAPPED_TO_MS
-    assert empty.action(MPIAction.MAP).ok  # spec 002:617 "To correct this problem, map the axes"
+    assert empty.action(MPIAction.MAP).ok  # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS "To correct this problem, map the axes"
     assert empty.axis_remove(1).ok
     assert empty.axis_list_get()[1] == [2]
 
 
 @pytest.mark.parametrize("mapper", ["MAP", "RESET", "start", "event_notify_set"])
 def test_what_maps_the_axes(big, empty, mapper):
-    # spec 002:617 "map the axes ... by calling: mpiMotionAction with MEIActionMAP or
+    # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS "map the axes ... by calling: mpiMotionAction with MEIActionMAP or
     # MPIActionRESET, mpiMotionStart, mpiMotionModify, or mpiMotionEventNotifySet"
     empty.axis_list_set([1])
     if mapper in ("MAP", "RESET"):
@@ -115,12 +115,12 @@ def test_what_maps_the_axes(big, empty, mapper):
         big.step(100)
     else:
         assert empty.event_notify_set(empty.notify_mask).ok
-    assert empty.config_get()[1].axis_numbers == [1]  # spec 000:2017 the mapping on the controller
+    assert empty.config_get()[1].axis_numbers == [1]  # MPI 000, MEIMotionConfig, axisNumber the mapping on the controller
     assert empty.axis_remove(1).ok
 
 
 def test_delete_with_unmapped_axes(big, empty):
-    # spec 002:617 NOT_MAPPED_TO_MS "returned by mpiMotionDelete ..."
+    # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS NOT_MAPPED_TO_MS "returned by mpiMotionDelete ..."
     empty.axis_list_set([1])
     assert big.delete_motion(empty) is M.MPIAxisMessageNOT_MAPPED_TO_MS
     empty.action(MPIAction.MAP)
@@ -128,22 +128,22 @@ def test_delete_with_unmapped_axes(big, empty):
 
 
 def test_list_set_replaces_the_coordinate_system(empty):
-    # spec 000:1420 "Any existing coordinate system is completely replaced"
+    # MPI 000, mpiMotionAxisListSet "Any existing coordinate system is completely replaced"
     empty.axis_list_set([1, 2, 3])
     assert empty.axis_list_set([5]).ok
     assert empty.axis_list_get()[1] == [5]
-    assert empty.axis_list_set([]).ok  # spec 000:1422 NULL list when axisCount is zero
+    assert empty.axis_list_set([]).ok  # MPI 000, mpiMotionAxisListSet NULL list when axisCount is zero
     assert empty.axis_count() == 0
 
 
 def test_list_set_with_duplicates(empty):
-    # spec 000:1172 OBJECT_ON_LIST (an axis twice)
+    # MPI 000, mpiMotionAxisAppend, return values OBJECT_ON_LIST (an axis twice)
     assert empty.axis_list_set([1, 1]) is M.MPIMessageOBJECT_ON_LIST
     assert empty.axis_count() == 0
 
 
 def test_list_set_while_moving_is_refused(ctl, ms, bring):
-    # spec 000:9 "Motion Supervisor to axis maps should NOT be changed when the axes are moving"
+    # MPI 000, Motion Objects, introduction "Motion Supervisor to axis maps should NOT be changed when the axes are moving"
     bring(MPIState.MOVING)
     assert ms.axis_list_set([0]) is M.MPIMotionMessageMOVING
     assert ms.axis_remove(1) is M.MPIMotionMessageMOVING
@@ -151,8 +151,8 @@ def test_list_set_while_moving_is_refused(ctl, ms, bring):
 
 
 def test_axis_by_index(empty):
-    # spec 000:1131 mpiMotionAxis "returns the element at the position on the list indicated by
-    # index"; 000:1139-1141 MPIHandleVOID / ELEMENT_NOT_FOUND for index < 0 or >= count
+    # MPI 000, mpiMotionAxis mpiMotionAxis "returns the element at the position on the list indicated by
+    # index"; MPI 000, mpiMotionAxis, return values MPIHandleVOID / ELEMENT_NOT_FOUND for index < 0 or >= count
     empty.axis_list_set([4, 6])
     assert empty.axis_at(1) == (M.MPIMessageOK, 6)
     assert empty.axis_at(2) == (M.MEIListMessageELEMENT_NOT_FOUND, None)
@@ -160,8 +160,8 @@ def test_axis_by_index(empty):
 
 
 def test_first_next_last_previous(empty):
-    # spec 000:1216 First, 000:1249 Next, 000:1276 Last, 000:1363 Previous iterate the list;
-    # 000:1257 MPIHandleVOID after the last axis
+    # MPI 000, mpiMotionAxisFirst First, MPI 000, mpiMotionAxisNext Next, MPI 000, mpiMotionAxisLast Last, MPI 000, mpiMotionAxisPrevious Previous iterate the list;
+    # MPI 000, mpiMotionAxisNext, return values MPIHandleVOID after the last axis
     empty.axis_list_set([4, 6, 8])
     forward, (message, axis) = [], empty.axis_first()
     while axis is not None:
@@ -176,28 +176,28 @@ def test_first_next_last_previous(empty):
 
 
 def test_first_and_last_of_an_empty_list(empty):
-    # spec 000:1226, 000:1286 MPIHandleVOID "if motion is empty"
+    # MPI 000, mpiMotionAxisFirst, return values, MPI 000, mpiMotionAxisLast, return values MPIHandleVOID "if motion is empty"
     assert empty.axis_first() == (M.MPIMessageOK, None)
     assert empty.axis_last() == (M.MPIMessageOK, None)
 
 
 def test_next_of_an_axis_not_on_the_list(empty):
-    # spec 000:1258 MPIMessageHANDLE_INVALID
+    # MPI 000, mpiMotionAxisNext, return values MPIMessageHANDLE_INVALID
     empty.axis_list_set([4])
     assert empty.axis_next(5) == (M.MPIMessageHANDLE_INVALID, None)
     assert empty.axis_previous(5) == (M.MPIMessageHANDLE_INVALID, None)
 
 
 def test_index_of_an_axis(empty):
-    # spec 000:1309 "returns the position of axis on the list"; 000:1317 -1 if not found
+    # MPI 000, mpiMotionAxisIndex "returns the position of axis on the list"; MPI 000, mpiMotionAxisIndex, return values -1 if not found
     empty.axis_list_set([4, 6])
     assert empty.axis_index(6) == 1
     assert empty.axis_index(5) == -1
 
 
 def test_an_invalid_handle_everywhere(big, empty):
-    # spec 000:1197 count -1 "if motion is invalid"; 000:1317 index -1; 000:1139 MPIHandleVOID;
-    # 000:1169 HANDLE_INVALID
+    # MPI 000, mpiMotionAxisCount, return values count -1 "if motion is invalid"; MPI 000, mpiMotionAxisIndex, return values index -1; MPI 000, mpiMotionAxis, return values MPIHandleVOID;
+    # MPI 000, mpiMotionAxisAppend, return values HANDLE_INVALID
     empty.axis_list_set([4])
     empty.action(MPIAction.MAP)
     assert big.delete_motion(empty).ok
@@ -212,8 +212,8 @@ def test_an_invalid_handle_everywhere(big, empty):
 
 
 def test_map_writes_the_mapping(empty):
-    # spec 000:925 MEIActionMAP "will write the axis mapping relationship of the motion supervisor
-    # to the controller"; 000:2016-2017 axisCount / axisNumber are the mapping on the controller
+    # MPI 000, MEIActionMAP MEIActionMAP "will write the axis mapping relationship of the motion supervisor
+    # to the controller"; MPI 000, MEIMotionConfig, axisCount axisCount / axisNumber are the mapping on the controller
     empty.axis_list_set([3, 7])
     assert empty.config_get()[1].axis_numbers == []
     assert empty.action(MPIAction.MAP).ok
@@ -222,7 +222,7 @@ def test_map_writes_the_mapping(empty):
 
 
 def test_map_with_an_empty_list(big, empty):
-    # spec 000:2272 NO_AXES_MAPPED for an action with no axes
+    # MPI 000, MEIMotionMessageNO_AXES_MAPPED NO_AXES_MAPPED for an action with no axes
     assert empty.action(MPIAction.MAP) is M.MEIMotionMessageNO_AXES_MAPPED
     empty.axis_list_set([2])
     empty.action(MPIAction.MAP)
@@ -232,7 +232,7 @@ def test_map_with_an_empty_list(big, empty):
 
 
 def test_create_with_an_initial_axis(big):
-    # spec 000:135 "The axis parameter specifies the initial element in the list of Axis objects"
+    # MPI 000, mpiMotionCreate "The axis parameter specifies the initial element in the list of Axis objects"
     message, ms = big.create_motion(3, axis=5)
     assert message.ok and ms.axis_list_get()[1] == [5]
     message, none = big.create_motion(4, axis=99)

@@ -14,22 +14,22 @@ T = MPIMotionType
 
 
 def test_decel_time_defaults(ms):
-    # spec 000:2074 stop "The default value is .5 seconds"; 000:2075 eStop "The default value is
+    # MPI 000, MPIMotionDecelTime, stop stop "The default value is .5 seconds"; MPI 000, MPIMotionDecelTime, eStop eStop "The default value is
     # .05 seconds"
     config = ms.config_get()[1]
     assert config.decel_time.stop == 0.5 and config.decel_time.e_stop == 0.05
 
 
 def test_feedrate_defaults(ms):
-    # spec 000:1997 normalFeedrate "The default value is 1.0 (100%)"; 000:1998 pauseFeedrate "The
+    # MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate "The default value is 1.0 (100%)"; MPI 000, MPIMotionConfig, pauseFeedrate pauseFeedrate "The
     # default value is 0.0"
     config = ms.config_get()[1]
     assert config.normal_feedrate == 1.0 and config.pause_feedrate == 0.0
 
 
 def test_mei_config_fields(ms):
-    # spec 000:2015 userLabel (16 characters, not used by the controller); 000:2016-2017
-    # axisCount/axisNumber = the current mapping; 000:2018 blendLimit
+    # MPI 000, MEIMotionConfig, userLabel userLabel (16 characters, not used by the controller); MPI 000, MEIMotionConfig, axisCount
+    # axisCount/axisNumber = the current mapping; MPI 000, MEIMotionConfig, blendLimit blendLimit
     config = ms.config_get()[1]
     assert config.user_label == "" and config.axis_numbers == [0, 1] and config.axis_count == 2
     config.user_label = "x" * 16
@@ -40,14 +40,14 @@ def test_mei_config_fields(ms):
 
 
 def test_config_get_is_a_copy(ms):
-    # spec 000:206 ConfigGet "puts (writes) it in the structure pointed to by config"
+    # MPI 000, mpiMotionConfigGet ConfigGet "puts (writes) it in the structure pointed to by config"
     config = ms.config_get()[1]
     config.decel_time.stop = 3.0
     assert ms.config_get()[1].decel_time.stop == 0.5
 
 
 def test_config_set_cannot_change_the_mapping(ms):
-    # spec 000:2016-2017 axisCount/axisNumber report the mapping on the controller (MAP writes it)
+    # MPI 000, MEIMotionConfig, axisCount axisCount/axisNumber report the mapping on the controller (MAP writes it)
     config = ms.config_get()[1]
     config.axis_numbers = [3]
     assert ms.config_set(config).ok
@@ -64,7 +64,7 @@ def test_config_set_cannot_change_the_mapping(ms):
     lambda c: setattr(c, "user_label", "x" * 17),
 ])
 def test_config_set_refuses_bad_values(ms, change):
-    # spec 000:2015 userLabel 16 characters; 000:2018 blendLimit from -1.0 to 1.0; the times are
+    # MPI 000, MEIMotionConfig, userLabel userLabel 16 characters; MPI 000, MEIMotionConfig, blendLimit blendLimit from -1.0 to 1.0; the times are
     # durations and the feedrates fractions (DESIGN.md: bad input changes nothing)
     config = ms.config_get()[1]
     change(config)
@@ -73,7 +73,7 @@ def test_config_set_refuses_bad_values(ms, change):
 
 
 def test_decel_time_stop_is_used_by_stop(ctl, ms, params, run_to):
-    # spec 000:897-910 "The deceleration stop and Estop times can be set with mpiMotionConfigSet"
+    # MPI 000, mpiMotionAction "The deceleration stop and Estop times can be set with mpiMotionConfigSet"
     config = ms.config_get()[1]
     config.decel_time = DecelTime(stop=0.25, e_stop=0.01)
     ms.config_set(config)
@@ -90,7 +90,7 @@ def test_decel_time_stop_is_used_by_stop(ctl, ms, params, run_to):
 
 
 def test_normal_feedrate_scales_the_speed(ctl, ms, params):
-    # spec 000:1997 normalFeedrate "defines the normal feed speed rate"
+    # MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate "defines the normal feed speed rate"
     config = ms.config_get()[1]
     config.normal_feedrate = 0.5
     ms.config_set(config)
@@ -101,7 +101,7 @@ def test_normal_feedrate_scales_the_speed(ctl, ms, params):
 
 
 def test_normal_feedrate_change_while_moving_ramps(ctl, ms, params):
-    # spec 000:221-249 sample modifyFeedrate: the feedrate is changed with ConfigSet while moving;
+    # MPI 000, mpiMotionConfigGet, sample code sample modifyFeedrate: the feedrate is changed with ConfigSet while moving;
     # motion.py: "a new normal feedrate applies on the fly (ramped over the stop time while moving)"
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(1000)
@@ -115,7 +115,7 @@ def test_normal_feedrate_change_while_moving_ramps(ctl, ms, params):
 
 
 def test_pause_feedrate_is_the_speed_after_stop(ctl, ms, params, run_to):
-    # spec 000:1998 pauseFeedrate "defines the feed speed rate for the Stop action"
+    # MPI 000, MPIMotionConfig, pauseFeedrate pauseFeedrate "defines the feed speed rate for the Stop action"
     config = ms.config_get()[1]
     config.pause_feedrate = 0.25
     ms.config_set(config)
@@ -129,15 +129,15 @@ def test_pause_feedrate_is_the_speed_after_stop(ctl, ms, params, run_to):
 
 # ------------------------------------------------------------------ params ----
 def test_params_get_initially_empty(ms):
-    # spec 000:562 ParamsGet: "These motion parameters will be used if mpiMotionStart(...) is
+    # MPI 000, mpiMotionParamsGet ParamsGet: "These motion parameters will be used if mpiMotionStart(...) is
     # called with Null motion params"
     message, params = ms.params_get()
     assert message.ok and params.trajectory == [] and params.position == []
 
 
 def test_start_with_null_params_uses_the_stored_ones(ctl, ms, params, run_to):
-    # spec 000:618 "If params is Null, then the motion parameters that were set by the most recent
-    # call to mpiMotionParamsSet(...) will be used"; 000:592
+    # MPI 000, mpiMotionStart "If params is Null, then the motion parameters that were set by the most recent
+    # call to mpiMotionParamsSet(...) will be used"; MPI 000, mpiMotionParamsSet
     assert ms.params_set(params((300.0, -100.0))).ok
     assert ms.params_set(params((400.0, -200.0))).ok  # the most recent one wins
     assert ms.start(T.TRAPEZOIDAL, params=None).ok
@@ -147,13 +147,13 @@ def test_start_with_null_params_uses_the_stored_ones(ctl, ms, params, run_to):
 
 
 def test_start_with_null_params_and_nothing_stored(ms):
-    # spec 000:3018 / 000:3029: no usable parameters -> refused, nothing moves
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID / MPI 000, MPIMessagePARAM_INVALID: no usable parameters -> refused, nothing moves
     assert ms.start(T.TRAPEZOIDAL, params=None) is M.MPIMessagePARAM_INVALID
     assert ms.state is MPIState.IDLE
 
 
 def test_modify_with_null_params_uses_the_stored_ones(ctl, ms, params, run_to):
-    # spec 000:592 ParamsSet "These motion parameters will be used if mpiMotionStart(...) is called
+    # MPI 000, mpiMotionParamsSet ParamsSet "These motion parameters will be used if mpiMotionStart(...) is called
     # with a Null motion parameter" (and a modify alike)
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(300)
@@ -164,7 +164,7 @@ def test_modify_with_null_params_uses_the_stored_ones(ctl, ms, params, run_to):
 
 
 def test_params_set_keeps_a_copy(ms, params):
-    # spec 000:592 ParamsSet sets the parameters of the Motion object (later changes of the caller's
+    # MPI 000, mpiMotionParamsSet ParamsSet sets the parameters of the Motion object (later changes of the caller's
     # structure do not leak in)
     mine = params((1.0, 2.0))
     ms.params_set(mine)
@@ -203,8 +203,8 @@ def test_params_set_while_moving_that_the_move_refuses_changes_nothing(ctl, ms, 
 
 # ------------------------------------------------------------------ frame buffer status ----
 def test_frame_buffer_status(ctl, ms, params, run_to):
-    # spec 000:457 "gets a Motion object (motion) frame buffer status"; 000:2114 size "the size of
-    # the controller's frame buffer"; 000:2115 frameCount "the number of frames in the buffer"
+    # MPI 000, meiMotionFrameBufferStatus "gets a Motion object (motion) frame buffer status"; MPI 000, MEIMotionFrameBufferStatus, size size "the size of
+    # the controller's frame buffer"; MPI 000, MEIMotionFrameBufferStatus, frameCount frameCount "the number of frames in the buffer"
     message, status = ms.frame_buffer_status()
     assert message.ok and [(s.axis, s.size) for s in status] == [(0, 128), (1, 128)]
     ms.start(T.S_CURVE, params=params((5000.0, 0.0), jerk_percent=50.0))
@@ -218,8 +218,8 @@ def test_frame_buffer_status(ctl, ms, params, run_to):
 
 # ------------------------------------------------------------------ action callback ----
 def test_action_callback_sees_every_action(ctl, ms, params):
-    # spec 000:942 "the callback function is called whenever the MPI writes to the action variable"
-    # (start, modify, stop, abort, reset ...); 000:1512-1514 it receives the motion, the motion type
+    # MPI 000, meiMotionActionFunction "the callback function is called whenever the MPI writes to the action variable"
+    # (start, modify, stop, abort, reset ...); MPI 000, MEIMotionActionFunction, motion it receives the motion, the motion type
     # and the action
     calls = []
     assert ms.action_function(lambda motion, kind, action: calls.append((motion.number, kind, action))) is None
@@ -231,7 +231,7 @@ def test_action_callback_sees_every_action(ctl, ms, params):
 
 
 def test_action_function_returns_the_previous_callback(ms):
-    # spec 000:934 meiMotionActionFunction(motion, function) returns an MEIMotionActionFunction
+    # MPI 000, meiMotionActionFunction meiMotionActionFunction(motion, function) returns an MEIMotionActionFunction
     def first(*_):
         return None
 
@@ -241,7 +241,7 @@ def test_action_function_returns_the_previous_callback(ms):
 
 
 def test_action_callback_runs_on_every_call_even_refused(ms):
-    # spec 000:1504 "every time the application calls mpiMotionAction(...), the callback function
+    # MPI 000, MEIMotionActionFunction "every time the application calls mpiMotionAction(...), the callback function
     # will be executed"
     calls = []
     ms.action_function(lambda motion, kind, action: calls.append(action))

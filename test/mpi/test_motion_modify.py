@@ -37,7 +37,7 @@ def assert_smooth(velocity, accel_limit):
 
 @pytest.mark.parametrize("kind,jerk_percent", [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 0.0), (T.S_CURVE, 70.0)])
 def test_modify_to_a_farther_target(params, kind, jerk_percent):
-    # spec 000:969 "mpiMotionModify modifies the parameters of a Motion object (motion) if motion is
+    # MPI 000, mpiMotionModify "mpiMotionModify modifies the parameters of a Motion object (motion) if motion is
     # in progress"; the motion continues from where it is to the new target
     ctl, ms = rig()
     ms.start(kind, params=params((1000.0,), jerk_percent=jerk_percent))
@@ -53,7 +53,7 @@ def test_modify_to_a_farther_target(params, kind, jerk_percent):
 @pytest.mark.parametrize("kind,jerk_percent", [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0)])
 def test_modify_to_a_target_behind_reverses(params, kind, jerk_percent):
     # issue 3: "Modify on the fly from the current position, velocity and acceleration (including
-    # reversal)"; spec 000:2216 (a target "in the reverse direction" is legal without NO_REVERSAL)
+    # reversal)"; MPI 000, MPIMotionMessagePROFILE_ERROR (a target "in the reverse direction" is legal without NO_REVERSAL)
     ctl, ms = rig()
     ms.start(kind, params=params((5000.0,), jerk_percent=jerk_percent))
     ctl.step(1000)
@@ -79,7 +79,7 @@ def test_modify_a_target_too_close_to_stop_overshoots_and_comes_back(params):
 
 
 def test_modify_lowers_the_velocity_with_the_deceleration(params):
-    # spec 000:2548 the S-curve/trapezoid uses "velocity, acceleration, deceleration": slowing to a
+    # MPI 000, MPIMotionSCurve the S-curve/trapezoid uses "velocity, acceleration, deceleration": slowing to a
     # lower velocity limit is a deceleration
     ctl, ms = rig()
     ms.start(T.TRAPEZOIDAL, params=params((10_000.0,), velocity=1000.0))
@@ -123,7 +123,7 @@ def test_s_curve_jerk_modify_keeps_the_acceleration(params):
 
 
 def test_velocity_modify_changes_speed_and_direction(params):
-    # spec 000:969 VELOCITY moves can be modified; 000:2718 the acceleration is used for every ramp
+    # MPI 000, mpiMotionModify VELOCITY moves can be modified; MPI 000, MPIMotionVelocity the acceleration is used for every ramp
     # ("deceleration is ignored")
     ctl, ms = rig()
     ms.start(T.VELOCITY, params=params((), velocity=500.0, acceleration=5000.0, deceleration=1.0))
@@ -159,7 +159,7 @@ def test_a_velocity_modify_reaches_its_velocity_at_the_end_of_its_own_ramp(param
 
 
 def test_velocity_modify_to_zero_ends_the_move(params):
-    # spec 002:631 DONE after the velocity move is over; a velocity of zero ends the motion
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, DONE DONE after the velocity move is over; a velocity of zero ends the motion
     ctl, ms = rig()
     ms.start(T.VELOCITY, params=params((), velocity=500.0))
     ctl.step(500)
@@ -170,7 +170,7 @@ def test_velocity_modify_to_zero_ends_the_move(params):
 
 
 def test_point_to_point_modified_into_a_velocity_move(params):
-    # spec 000:969 the modifiable types include both point-to-point and VELOCITY
+    # MPI 000, mpiMotionModify the modifiable types include both point-to-point and VELOCITY
     ctl, ms = rig()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0,)))
     ctl.step(500)
@@ -180,7 +180,7 @@ def test_point_to_point_modified_into_a_velocity_move(params):
 
 
 def test_modify_is_one_move(params):
-    # spec 000:2806 MOTION_DONE when "the motion is complete": a modified motion is still one motion
+    # MPI 000, MPIMotionAttrAPPEND MOTION_DONE when "the motion is complete": a modified motion is still one motion
     ctl, ms = rig()
     ms.start(T.TRAPEZOIDAL, params=params((1000.0,)))
     for target in (1200.0, 900.0, 1500.0):
@@ -203,7 +203,7 @@ def test_modify_replaces_the_appended_moves(params):
 
 
 def test_vector_modify_along_the_line(params):
-    # spec 000:2550 one vector trajectory: a modify along the line keeps the axes on it
+    # MPI 000, MPIMotionSCurve one vector trajectory: a modify along the line keeps the axes on it
     ctl, ms = rig(axes=2)
     ms.start(T.S_CURVE, params=params((3000.0, 4000.0), jerk_percent=40.0))
     ctl.step(600)
@@ -252,7 +252,7 @@ def test_modify_during_the_resume_ramp(params):
 
 
 def test_modify_answers_stay_put_when_refused(params):
-    # spec 000:2184 modify in IDLE answers IDLE and nothing starts
+    # MPI 000, MPIMotionMessageIDLE modify in IDLE answers IDLE and nothing starts
     ctl, ms = rig()
     assert ms.modify(T.TRAPEZOIDAL, params=params((100.0,))) is Message.MPIMotionMessageIDLE
     ctl.step(1000)

@@ -31,7 +31,7 @@ def end(plan):
 
 
 def test_vector_move_is_one_profile_along_the_line():
-    # spec 000:2550 "only the first trajectory structure will be applied as the vector trajectory
+    # MPI 000, MPIMotionSCurve "only the first trajectory structure will be applied as the vector trajectory
     # for all the axes"
     move, notes = compile_()
     x, y = move.plans
@@ -51,7 +51,7 @@ def test_absolute_targets_include_the_origin():
 
 
 def test_sync_end_pads_the_start_of_shorter_profiles():
-    # spec 000:2850 "For all but the longest motion profile, wait frames will be added to the
+    # MPI 000, MPIMotionAttrSYNC_END "For all but the longest motion profile, wait frames will be added to the
     # beginning of the moves"
     trajectories = (TRAJ, Trajectory(50.0, 1000.0, 1000.0))  # 1.15 s and 2.0 s
     move, _ = compile_(A.SYNC_END, position=(1000.0, 100.0), trajectory=trajectories)
@@ -63,7 +63,7 @@ def test_sync_end_pads_the_start_of_shorter_profiles():
 
 
 def test_sync_start_pads_the_end_of_shorter_profiles():
-    # spec 000:2856 "For those axes that finish first, a delay frame will be added to the end"
+    # MPI 000, MPIMotionAttrSYNC_START "For those axes that finish first, a delay frame will be added to the end"
     trajectories = (TRAJ, Trajectory(50.0, 1000.0, 1000.0))  # 1.15 s and 2.0 s
     move, _ = compile_(A.SYNC_START, position=(1000.0, 100.0), trajectory=trajectories)
     fast, slow = move.plans
@@ -72,7 +72,7 @@ def test_sync_start_pads_the_end_of_shorter_profiles():
 
 
 def test_delay_prepends_a_wait_frame_per_axis():
-    # spec 000:2822 delay "assign delay times for each Axis"
+    # MPI 000, MPIMotionAttrDELAY delay "assign delay times for each Axis"
     move, _ = compile_(A.DELAY, delay=[0.5, 0.0])
     x, y = move.plans
     assert x.segments[0].duration == 0.5 and x.segments[0].v == 0.0
@@ -80,7 +80,7 @@ def test_delay_prepends_a_wait_frame_per_axis():
 
 
 def test_illegal_delay_only_while_moving():
-    # spec 000:2212 ILLEGAL_DELAY "non-zero delay value ... while in motion"
+    # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "non-zero delay value ... while in motion"
     with pytest.raises(PlanError) as refused:
         compile_(A.DELAY, moving=True, delay=[0.0, 0.1])
     assert refused.value.message is Message.MPIMotionMessageILLEGAL_DELAY
@@ -89,7 +89,7 @@ def test_illegal_delay_only_while_moving():
 
 
 def test_relative_targets_and_truncation():
-    # spec 000:2844 relative distances from the start; 000:626 "the fractional portion is truncated
+    # MPI 000, MPIMotionAttrRELATIVE relative distances from the start; MPI 000, mpiMotionStart "the fractional portion is truncated
     # and discarded"
     starts = [AxisStart(0, 1000.0), AxisStart(1, -5.0)]
     move, notes = compile_(A.RELATIVE, position=(2000.0, -3.9), starts=starts)
@@ -100,20 +100,20 @@ def test_relative_targets_and_truncation():
 
 @pytest.mark.parametrize("given,stored", [(32767, 32767), (32768, -32768), (-32769, 32767), (1 << 20, 0)])
 def test_id_truncated_to_16_bits(given, stored):
-    # spec 000:1876 "The id is limited to 16-bit resolution by the controller firmware"
+    # MPI 000, MPIMotionAttributes, id "The id is limited to 16-bit resolution by the controller firmware"
     move, notes = compile_(A.ID, id=given)
     assert move.id == stored
     assert [kind for kind, _ in notes.events] == ([] if given == stored else [E.ID_TRUNCATED])
 
 
 def test_id_without_the_attribute_is_zero():
-    # spec 000:1557 ID "enables an identification tag" (only with the attribute)
+    # MPI 000, MPIMotionAttrID ID "enables an identification tag" (only with the attribute)
     move, _ = compile_(id=77)
     assert move.id == 0
 
 
 def test_element_id_and_event_mask_only_with_their_attributes():
-    # spec 000:1558 ELEMENT_ID; 000:1588 EVENT
+    # MPI 000, MPIMotionAttrELEMENT_ID ELEMENT_ID; MPI 000, MEIMotionAttrEVENT EVENT
     move, _ = compile_(A.ELEMENT_ID | A.EVENT, element_id=[5, 6], event_mask=E.MOTION_DONE)
     assert (move.element_id, move.event_mask) == (5, E.MOTION_DONE)
     move, _ = compile_(element_id=[5], event_mask=E.MOTION_DONE)
@@ -121,7 +121,7 @@ def test_element_id_and_event_mask_only_with_their_attributes():
 
 
 def test_frame_longer_than_16384000_samples_is_cut():
-    # spec 000:628 "If the commanded motion exceeds the maximum frame time, the axes will stop
+    # MPI 000, mpiMotionStart "If the commanded motion exceeds the maximum frame time, the axes will stop
     # abruptly after 16,384,000 samples"
     move, notes = compile_(position=(1e6,), trajectory=(Trajectory(1.0, 1e4, 1e4),), rate=100.0)
     plan = move.plans[0]
@@ -132,13 +132,13 @@ def test_frame_longer_than_16384000_samples_is_cut():
 
 
 def test_long_move_within_the_limit_is_not_cut():
-    # spec 000:628 the limit is 16,384,000 samples (2.27 hours at 2000 Hz)
+    # MPI 000, mpiMotionStart the limit is 16,384,000 samples (2.27 hours at 2000 Hz)
     move, notes = compile_(position=(8_000_000.0,), trajectory=(Trajectory(1000.0, 1e4, 1e4),))
     assert not move.plans[0].truncated and notes.events == []
 
 
 def test_velocity_move_cruises_for_the_frame_limit():
-    # spec 000:628 "the maximum velocity time is 2.27 hours" (16,384,000 samples at 2000 Hz)
+    # MPI 000, mpiMotionStart "the maximum velocity time is 2.27 hours" (16,384,000 samples at 2000 Hz)
     move, _ = compile_(kind=T.VELOCITY, position=(), starts=[AxisStart(0, 0.0)],
                        trajectory=(Trajectory(500.0, 5000.0),))
     plan = move.plans[0]
@@ -155,7 +155,7 @@ def test_velocity_move_per_axis_trajectories():
 
 
 def test_final_velocity_plans_end_moving():
-    # spec 000:1898 finalVelocity "the target velocity for each axis"
+    # MPI 000, MEIMotionAttributes, finalVelocity finalVelocity "the target velocity for each axis"
     move, _ = compile_(A.FINAL_VEL, position=(1000.0,), final_velocity=[250.0])
     plan = move.plans[0]
     assert plan.final_velocity == 250.0
@@ -173,7 +173,7 @@ def test_final_velocity_off_the_vector_line():
 
 
 def test_no_reversal():
-    # spec 000:2216 PROFILE_ERROR "when the NO_REVERSAL attribute mask is specified, but the
+    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "when the NO_REVERSAL attribute mask is specified, but the
     # specified target position is in the reverse direction"
     moving = [AxisStart(0, 0.0, 1000.0)]
     with pytest.raises(PlanError) as refused:
@@ -210,7 +210,7 @@ def test_vector_modify_off_the_line_plans_each_axis():
 
 
 def test_hold_and_outputs_go_to_the_plans():
-    # spec 000:1899 hold "for each axis"; 000:2892 OUTPUT "configures a frame to toggle an output
+    # MPI 000, MEIMotionAttributes, hold hold "for each axis"; MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame to toggle an output
     # bit as a move begins" (on the first axis' frames)
     holds = [Hold(type=HoldType.GATE, gate=1), Hold(type=HoldType.GATE, gate=2)]
     output = Output(type=OutputType.OUTPUT, on_mask=1)

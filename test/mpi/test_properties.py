@@ -96,7 +96,7 @@ def speeding_up(seg, v_max: float):
 
 
 def check_segment_limits(plan, v_max: float, up: float, down: float) -> None:
-    """The same limits from the planned constant-jerk segments (spec 000:3048: the extremes of the
+    """The same limits from the planned constant-jerk segments (MPI 000, Streaming Point Motion Type Calculations: the extremes of the
     acceleration are at the segment ends)."""
     for seg in plan.segments:
         p1, v1, a1 = seg.end_state()
@@ -111,7 +111,7 @@ def check_segment_limits(plan, v_max: float, up: float, down: float) -> None:
 @given(kind=st.sampled_from([T.TRAPEZOIDAL, T.S_CURVE]), data=st.data(), distance=distances)
 def test_point_to_point_limits_and_target(kind, data, distance):
     # DESIGN.md quality bar: "limits never exceeded (|v| <= velocity, |a| <= acceleration/
-    # deceleration, jerk as configured, within float tolerance)"; spec 002:630 "command = target"
+    # deceleration, jerk as configured, within float tolerance)"; MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, AT_TARGET "command = target"
     traj = data.draw(trajectories(kind))
     ctl, ms = rig()
     assert ms.start(kind, params=MotionParams(trajectory=[traj], position=[distance])).ok
@@ -175,7 +175,7 @@ def test_modify_from_motion_keeps_the_limits(kind, data, distance, new_distance,
 @given(kind=st.sampled_from([T.TRAPEZOIDAL, T.S_CURVE]), data=st.data(),
        target=st.tuples(distances, distances), back=st.floats(-1.5, 1.5), when=st.floats(0.05, 0.9))
 def test_vector_moves_along_the_line(kind, data, target, back, when):
-    # spec 000:2550 "the first trajectory structure will be applied as the vector trajectory for all
+    # MPI 000, MPIMotionSCurve "the first trajectory structure will be applied as the vector trajectory for all
     # the axes": the path speed and acceleration obey the limits; a modify along the same line
     # (incl. back past the start) keeps the axes on it
     traj = data.draw(trajectories(kind))
@@ -202,12 +202,12 @@ def test_vector_moves_along_the_line(kind, data, target, back, when):
 @given(first=st.floats(-3000.0, 3000.0), second=st.floats(-3000.0, 3000.0), acc=accelerations,
        dec=accelerations, jerk=jerk_percents, when=st.floats(0.0, 0.3))
 def test_velocity_moves(first, second, acc, dec, jerk, when):
-    # spec 000:2673 VELOCITY "S-Curve acceleration to a constant velocity ... acceleration, velocity,
-    # and jerkPercent"; 000:2718 "deceleration is ignored": every ramp uses the acceleration
+    # MPI 000, MPIMotionTypeVELOCITY VELOCITY "S-Curve acceleration to a constant velocity ... acceleration, velocity,
+    # and jerkPercent"; MPI 000, MPIMotionVelocity "deceleration is ignored": every ramp uses the acceleration
     ctl, ms = rig()
     ms.start(T.VELOCITY, params=MotionParams(trajectory=[Trajectory(first, acc, dec, jerk)]))
     ctl.step(1 + int(when * RATE))
-    # a first velocity of 0 ends at once: the modify then starts anew (spec 000:2208 AUTO_START)
+    # a first velocity of 0 ends at once: the modify then starts anew (MPI 000, MPIMotionMessageAUTO_START AUTO_START)
     again = MotionParams(trajectory=[Trajectory(second, acc, dec, jerk)])
     message = ms.modify(T.VELOCITY, MotionAttr.AUTO_START, again)
     assert message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
@@ -223,8 +223,8 @@ def test_velocity_moves(first, second, acc, dec, jerk, when):
        action=st.sampled_from([MPIAction.STOP, MPIAction.E_STOP]), stop=st.floats(0.01, 1.0),
        e_stop=st.floats(0.001, 0.2), when=st.floats(0.0, 0.9), distance=distances)
 def test_stop_and_e_stop_reach_zero_within_their_time(kind, data, action, stop, e_stop, when, distance):
-    # spec 000:924 STOP "decelerates the axis (or axes) to a stop in the time specified by the stop
-    # time"; 000:920 E_STOP likewise in the eStop time; 000:2074-2075 MPIMotionDecelTime
+    # MPI 000, MPIActionSTOP STOP "decelerates the axis (or axes) to a stop in the time specified by the stop
+    # time"; MPI 000, MPIActionE_STOP E_STOP likewise in the eStop time; MPI 000, MPIMotionDecelTime, stop MPIMotionDecelTime
     traj = data.draw(trajectories(kind if kind is not T.VELOCITY else T.S_CURVE))
     ctl, ms = rig()
     config = ms.config_get()[1]

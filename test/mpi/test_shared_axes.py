@@ -66,7 +66,7 @@ def test_remapping_a_stopped_supervisor_leaves_no_axis_moving(ctl, ms, new_list,
 
 
 def test_map_of_other_axes_while_stopped_drops_the_pending_profile(ctl, ms):
-    # DESIGN state table: MAP is OK in STOPPED; RESUME then has nothing to continue.
+    # docs/state-machine.md: MAP is OK in STOPPED; RESUME then has nothing to continue.
     stopped_mid_move(ctl, ms)
     assert ms.axis_list_set([2]).ok
     assert ms.action(A.MAP).ok
@@ -168,7 +168,7 @@ def shared_in(state: MPIState):
     return ctl, a, b
 
 
-# Where a command from the sharing supervisor differs from DESIGN.md's table for the state it
+# Where a command from the sharing supervisor differs from docs/state-machine.md for the state it
 # shows (docs/decisions.md, "Supervisors and axes"): (state, command) -> (message, state after).
 SHARED_CELLS = {
     # It has no motion of its own to modify, and may not take axis 1 out of supervisor 0's.
@@ -203,7 +203,7 @@ SHARED_REFUSALS = [c for c in SHARED if c[2] is not Message.MPIMessageOK]
 
 @pytest.mark.parametrize("state,name,message,after", SHARED_REFUSALS, ids=[f"{c[0].name}-{c[1]}" for c in SHARED_REFUSALS])
 def test_refused_cell_from_the_sharing_supervisor_changes_nothing(state, name, message, after):
-    # DESIGN.md table: '"msg X" = refused with MPIMotionMessageX, nothing changes', on shared axes too
+    # docs/state-machine.md: '"msg X" = refused with MPIMotionMessageX, nothing changes', on shared axes too
     ctl_a, a, _ = shared_in(state)
     ctl_b, _, b = shared_in(state)
     assert command(b, name) is message

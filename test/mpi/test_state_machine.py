@@ -36,68 +36,68 @@ def command(ms, name: str) -> Message:
     return ms.action(MPIAction[name])
 
 
-# (state, command, message, state right after the call). One row per cell of DESIGN.md's table.
+# (state, command, message, state right after the call). One row per cell of docs/state-machine.md.
 CELLS = [
     # IDLE
-    (S.IDLE, "start", OK, S.MOVING),  # spec 000:618 start changes IDLE to MOVING
-    (S.IDLE, "modify", IDLE, S.IDLE),  # spec 000:2184 IDLE "returned from mpiMotionModify when IDLE"
-    (S.IDLE, "STOP", IDLE, S.IDLE),  # spec 000:2184 "also returned ... when a STOP ... in the IDLE state"
-    (S.IDLE, "RESUME", IDLE, S.IDLE),  # spec 000:2184 "... or RESUME is commanded when ... IDLE"
-    (S.IDLE, "RESET", OK, S.IDLE),  # DESIGN.md table: RESET in IDLE "OK, no change"
-    (S.IDLE, "E_STOP", OK, S.STOPPING_ERROR),  # spec 000:917 E_STOP -> STOPPING_ERROR -> ERROR
-    (S.IDLE, "ABORT", OK, S.STOPPING_ERROR),  # spec 000:917; DESIGN.md "Safety actions are never refused"
-    (S.IDLE, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # spec 000:917
-    (S.IDLE, "MAP", OK, S.IDLE),  # spec 000:925 MAP writes the axis mapping
+    (S.IDLE, "start", OK, S.MOVING),  # MPI 000, mpiMotionStart start changes IDLE to MOVING
+    (S.IDLE, "modify", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE IDLE "returned from mpiMotionModify when IDLE"
+    (S.IDLE, "STOP", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE "also returned ... when a STOP ... in the IDLE state"
+    (S.IDLE, "RESUME", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE "... or RESUME is commanded when ... IDLE"
+    (S.IDLE, "RESET", OK, S.IDLE),  # docs/state-machine.md: RESET in IDLE "OK, no change"
+    (S.IDLE, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction E_STOP -> STOPPING_ERROR -> ERROR
+    (S.IDLE, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction; DESIGN.md "Safety actions are never refused"
+    (S.IDLE, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.IDLE, "MAP", OK, S.IDLE),  # MPI 000, MEIActionMAP MAP writes the axis mapping
     # MOVING
-    (S.MOVING, "start", MOVING, S.MOVING),  # spec 000:2188 MOVING "returned from mpiMotionStart when MOVING"
-    (S.MOVING, "modify", OK, S.MOVING),  # spec 000:969 modify "if motion is in progress (MPIStateMOVING)"
-    (S.MOVING, "STOP", OK, S.STOPPING),  # spec 000:924 STOP: MOVING -> STOPPING
-    (S.MOVING, "RESUME", MOVING, S.MOVING),  # spec 000:2188 "when a RESUME ... is commanded ... MOVING"
-    (S.MOVING, "RESET", MOVING, S.MOVING),  # spec 000:2188 "... or RESET is commanded ... MOVING"
-    (S.MOVING, "E_STOP", OK, S.STOPPING_ERROR),  # spec 000:917
-    (S.MOVING, "ABORT", OK, S.STOPPING_ERROR),  # spec 000:917-918
-    (S.MOVING, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # spec 000:917, 921
-    (S.MOVING, "MAP", MOVING, S.MOVING),  # spec 000:9 maps "should NOT be changed when the axes are moving"
+    (S.MOVING, "start", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING MOVING "returned from mpiMotionStart when MOVING"
+    (S.MOVING, "modify", OK, S.MOVING),  # MPI 000, mpiMotionModify modify "if motion is in progress (MPIStateMOVING)"
+    (S.MOVING, "STOP", OK, S.STOPPING),  # MPI 000, MPIActionSTOP STOP: MOVING -> STOPPING
+    (S.MOVING, "RESUME", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING "when a RESUME ... is commanded ... MOVING"
+    (S.MOVING, "RESET", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING "... or RESET is commanded ... MOVING"
+    (S.MOVING, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.MOVING, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.MOVING, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction, 921
+    (S.MOVING, "MAP", MOVING, S.MOVING),  # MPI 000, Motion Objects, introduction maps "should NOT be changed when the axes are moving"
     # STOPPING
-    (S.STOPPING, "start", STOPPING, S.STOPPING),  # spec 000:2192 STOPPING from start "in the STOPPING state"
-    (S.STOPPING, "modify", STOPPING, S.STOPPING),  # spec 000:2192 "... or mpiMotionModify"
-    (S.STOPPING, "STOP", STOPPING, S.STOPPING),  # DESIGN.md table: STOP in STOPPING "msg STOPPING"
-    (S.STOPPING, "RESUME", STOPPING, S.STOPPING),  # spec 000:2192 "RESUME or RESET ... STOPPING state"
-    (S.STOPPING, "RESET", STOPPING, S.STOPPING),  # spec 000:2192
-    (S.STOPPING, "E_STOP", OK, S.STOPPING_ERROR),  # spec 000:917; DESIGN.md never refused
-    (S.STOPPING, "ABORT", OK, S.STOPPING_ERROR),  # spec 000:917
-    (S.STOPPING, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # spec 000:917
-    (S.STOPPING, "MAP", STOPPING, S.STOPPING),  # spec 000:9 (axes still moving)
+    (S.STOPPING, "start", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING STOPPING from start "in the STOPPING state"
+    (S.STOPPING, "modify", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING "... or mpiMotionModify"
+    (S.STOPPING, "STOP", STOPPING, S.STOPPING),  # docs/state-machine.md: STOP in STOPPING "msg STOPPING"
+    (S.STOPPING, "RESUME", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING "RESUME or RESET ... STOPPING state"
+    (S.STOPPING, "RESET", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING
+    (S.STOPPING, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction; DESIGN.md never refused
+    (S.STOPPING, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.STOPPING, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.STOPPING, "MAP", STOPPING, S.STOPPING),  # MPI 000, Motion Objects, introduction (axes still moving)
     # STOPPED
     (S.STOPPED, "start", OK, S.MOVING),  # DESIGN.md: "A new start from STOPPED discards the pending profile"
-    (S.STOPPED, "modify", STOPPED, S.STOPPED),  # DESIGN.md table: modify in STOPPED "msg STOPPED"
-    (S.STOPPED, "STOP", STOPPED, S.STOPPED),  # spec 000:2196 STOPPED "when a STOP ... already STOPPED"
-    (S.STOPPED, "RESUME", OK, S.MOVING),  # spec 000:923 RESUME continues a motion stopped by STOP
-    (S.STOPPED, "RESET", OK, S.IDLE),  # DESIGN.md table: RESET in STOPPED "OK, to IDLE, pending dropped"
-    (S.STOPPED, "E_STOP", OK, S.STOPPING_ERROR),  # spec 000:917
-    (S.STOPPED, "ABORT", OK, S.STOPPING_ERROR),  # spec 000:917
-    (S.STOPPED, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # spec 000:917
-    (S.STOPPED, "MAP", OK, S.STOPPED),  # DESIGN.md table: MAP in STOPPED "OK"
+    (S.STOPPED, "modify", STOPPED, S.STOPPED),  # docs/state-machine.md: modify in STOPPED "msg STOPPED"
+    (S.STOPPED, "STOP", STOPPED, S.STOPPED),  # MPI 000, MPIMotionMessageSTOPPED STOPPED "when a STOP ... already STOPPED"
+    (S.STOPPED, "RESUME", OK, S.MOVING),  # MPI 000, MPIActionRESUME RESUME continues a motion stopped by STOP
+    (S.STOPPED, "RESET", OK, S.IDLE),  # docs/state-machine.md: RESET in STOPPED "OK, to IDLE, pending dropped"
+    (S.STOPPED, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.STOPPED, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.STOPPED, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
+    (S.STOPPED, "MAP", OK, S.STOPPED),  # docs/state-machine.md: MAP in STOPPED "OK"
     # STOPPING_ERROR
-    (S.STOPPING_ERROR, "start", STOPPING_ERROR, S.STOPPING_ERROR),  # spec 000:2200 from mpiMotionStart
-    (S.STOPPING_ERROR, "modify", STOPPING_ERROR, S.STOPPING_ERROR),  # spec 000:2200 "... or mpiMotionModify"
-    (S.STOPPING_ERROR, "STOP", STOPPING_ERROR, S.STOPPING_ERROR),  # DESIGN.md table
-    (S.STOPPING_ERROR, "RESUME", STOPPING_ERROR, S.STOPPING_ERROR),  # spec 000:2200 "RESUME or RESET"
-    (S.STOPPING_ERROR, "RESET", STOPPING_ERROR, S.STOPPING_ERROR),  # spec 000:2200
-    (S.STOPPING_ERROR, "E_STOP", OK, S.STOPPING_ERROR),  # DESIGN.md table: safety actions "OK"
-    (S.STOPPING_ERROR, "ABORT", OK, S.STOPPING_ERROR),  # DESIGN.md table
-    (S.STOPPING_ERROR, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # DESIGN.md table
-    (S.STOPPING_ERROR, "MAP", STOPPING_ERROR, S.STOPPING_ERROR),  # DESIGN.md table: "msg STOPPING_ERROR"
+    (S.STOPPING_ERROR, "start", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR from mpiMotionStart
+    (S.STOPPING_ERROR, "modify", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR "... or mpiMotionModify"
+    (S.STOPPING_ERROR, "STOP", STOPPING_ERROR, S.STOPPING_ERROR),  # docs/state-machine.md
+    (S.STOPPING_ERROR, "RESUME", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR "RESUME or RESET"
+    (S.STOPPING_ERROR, "RESET", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR
+    (S.STOPPING_ERROR, "E_STOP", OK, S.STOPPING_ERROR),  # docs/state-machine.md: safety actions "OK"
+    (S.STOPPING_ERROR, "ABORT", OK, S.STOPPING_ERROR),  # docs/state-machine.md
+    (S.STOPPING_ERROR, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # docs/state-machine.md
+    (S.STOPPING_ERROR, "MAP", STOPPING_ERROR, S.STOPPING_ERROR),  # docs/state-machine.md: "msg STOPPING_ERROR"
     # ERROR
-    (S.ERROR, "start", ERROR, S.ERROR),  # spec 000:2204 ERROR from start "in an error state"; 000:3025
-    (S.ERROR, "modify", ERROR, S.ERROR),  # spec 000:2204 "... or mpiMotionModify"
-    (S.ERROR, "STOP", ERROR, S.ERROR),  # spec 000:2204 "when a STOP or RESUME is commanded ... ERROR"
-    (S.ERROR, "RESUME", ERROR, S.ERROR),  # spec 000:2204
-    (S.ERROR, "RESET", OK, S.IDLE),  # spec 000:922 RESET clears the error, to IDLE
-    (S.ERROR, "E_STOP", OK, S.ERROR),  # DESIGN.md table: "OK, stays ERROR"
-    (S.ERROR, "ABORT", OK, S.ERROR),  # DESIGN.md table
-    (S.ERROR, "E_STOP_ABORT", OK, S.ERROR),  # DESIGN.md table
-    (S.ERROR, "MAP", OK, S.ERROR),  # DESIGN.md table: MAP in ERROR "OK"
+    (S.ERROR, "start", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR ERROR from start "in an error state"; MPI 000, MPIMotionMessageERROR
+    (S.ERROR, "modify", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR "... or mpiMotionModify"
+    (S.ERROR, "STOP", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR "when a STOP or RESUME is commanded ... ERROR"
+    (S.ERROR, "RESUME", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR
+    (S.ERROR, "RESET", OK, S.IDLE),  # MPI 000, MPIActionRESET RESET clears the error, to IDLE
+    (S.ERROR, "E_STOP", OK, S.ERROR),  # docs/state-machine.md: "OK, stays ERROR"
+    (S.ERROR, "ABORT", OK, S.ERROR),  # docs/state-machine.md
+    (S.ERROR, "E_STOP_ABORT", OK, S.ERROR),  # docs/state-machine.md
+    (S.ERROR, "MAP", OK, S.ERROR),  # docs/state-machine.md: MAP in ERROR "OK"
 ]
 
 
@@ -129,7 +129,7 @@ REFUSALS = [c for c in CELLS if c[2] is not OK]
 
 @pytest.mark.parametrize("state,name,message,after", REFUSALS, ids=[f"{c[0].name}-{c[1]}" for c in REFUSALS])
 def test_refused_cell_changes_nothing(state, name, message, after, prepared):
-    # DESIGN.md table: '"msg X" = refused with MPIMotionMessageX, nothing changes'
+    # docs/state-machine.md: '"msg X" = refused with MPIMotionMessageX, nothing changes'
     ctl_a, ms_a = prepared(state)
     ctl_b, ms_b = prepared(state)
     assert command(ms_b, name) is message
@@ -139,19 +139,19 @@ def test_refused_cell_changes_nothing(state, name, message, after, prepared):
 @pytest.mark.parametrize("state", [S.IDLE, S.MOVING, S.STOPPING, S.STOPPED, S.STOPPING_ERROR])
 @pytest.mark.parametrize("action", ["E_STOP", "ABORT", "E_STOP_ABORT"])
 def test_safety_actions_end_in_error(state, action, prepared):
-    # spec 000:917 "the Motion will perform an emergency stop and/or abort on all axes, and then
+    # MPI 000, mpiMotionAction "the Motion will perform an emergency stop and/or abort on all axes, and then
     # change to the error state (MPIStateSTOPPING_ERROR to MPIStateERROR)"
     ctl, ms = prepared(state)
     assert ms.action(MPIAction[action]).ok
     assert ctl.run_until(lambda c: ms.state is S.ERROR, 1000)
     ctl.step(2000)
-    assert ms.state is S.ERROR  # spec 000:917 "you must first make a call to ... RESET"
+    assert ms.state is S.ERROR  # MPI 000, mpiMotionAction "you must first make a call to ... RESET"
 
 
 def test_modify_auto_start_in_idle_starts_and_answers_auto_start(prepared):
-    # spec 000:2208 AUTO_START "returned from mpiMotionModify when the AUTO_START attribute mask was
+    # MPI 000, MPIMotionMessageAUTO_START AUTO_START "returned from mpiMotionModify when the AUTO_START attribute mask was
     # specified and the motion was commanded while the motion supervisor is in the IDLE state";
-    # 000:1554 "converts a mpiMotionModify(...) call to a mpiMotionStart(...)"
+    # MPI 000, MPIMotionAttrAUTO_START "converts a mpiMotionModify(...) call to a mpiMotionStart(...)"
     ctl, ms = prepared(S.IDLE)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is Message.MPIMotionMessageAUTO_START
     assert ms.state is S.MOVING
@@ -162,13 +162,13 @@ def test_modify_auto_start_in_idle_starts_and_answers_auto_start(prepared):
 @pytest.mark.parametrize("state,message", [(S.STOPPING, STOPPING), (S.STOPPED, STOPPED),
                                            (S.STOPPING_ERROR, STOPPING_ERROR), (S.ERROR, ERROR)])
 def test_auto_start_does_not_start_outside_idle(state, message, prepared):
-    # spec 000:2208 AUTO_START converts a modify to a start only in the IDLE state
+    # MPI 000, MPIMotionMessageAUTO_START AUTO_START converts a modify to a start only in the IDLE state
     ctl, ms = prepared(state)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is message
 
 
 def test_modify_auto_start_while_moving_is_a_plain_modify(prepared):
-    # spec 000:1554 AUTO_START acts "if the modify occurs after the previous motion profile has
+    # MPI 000, MPIMotionAttrAUTO_START AUTO_START acts "if the modify occurs after the previous motion profile has
     # completed"; while moving the modify answers OK
     ctl, ms = prepared(S.MOVING)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is OK
@@ -187,18 +187,18 @@ def test_start_from_stopped_drops_the_pending_profile(prepared):
 
 
 def test_reset_from_stopped_drops_the_pending_profile(prepared):
-    # DESIGN.md table: RESET in STOPPED "OK, to IDLE, pending dropped"
+    # docs/state-machine.md: RESET in STOPPED "OK, to IDLE, pending dropped"
     ctl, ms = prepared(S.STOPPED)
     where = [a.command_position for a in ms.axes]
     assert ms.action(MPIAction.RESET).ok and ms.state is S.IDLE
     ctl.step(2000)
     assert ms.state is S.IDLE
     assert [a.command_position for a in ms.axes] == where
-    assert ms.action(MPIAction.RESUME) is IDLE  # spec 000:2184 "no motion profile pending"
+    assert ms.action(MPIAction.RESUME) is IDLE  # MPI 000, MPIMotionMessageIDLE "no motion profile pending"
 
 
 def test_resume_from_stopped_finishes_the_move():
-    # spec 000:923 RESUME: "the Motion will resume if it was stopped by a prior call to ...STOP"
+    # MPI 000, MPIActionRESUME RESUME: "the Motion will resume if it was stopped by a prior call to ...STOP"
     ctl = Controller()
     _, ms = ctl.create_motion(0)
     ms.axis_list_set([0, 1])
@@ -212,7 +212,7 @@ def test_resume_from_stopped_finishes_the_move():
 
 
 def test_stop_completes_to_stopped_after_the_stop_time(prepared):
-    # spec 000:924 STOP "decelerates the axis (or axes) to a stop in the time specified by the
+    # MPI 000, MPIActionSTOP STOP "decelerates the axis (or axes) to a stop in the time specified by the
     # stop time"; DESIGN.md: MOVING -> STOPPING (decelerate over decelTime.stop) -> STOPPED
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
@@ -224,7 +224,7 @@ def test_stop_completes_to_stopped_after_the_stop_time(prepared):
 
 
 def test_e_stop_completes_to_error_after_the_e_stop_time(prepared):
-    # spec 000:920 E_STOP "will decelerate the axis (or axes) to a stop in the time specified by
+    # MPI 000, MPIActionE_STOP E_STOP "will decelerate the axis (or axes) to a stop in the time specified by
     # the eStop time. After the Motion stops, the Motion will be set to the ERROR state."
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
@@ -236,7 +236,7 @@ def test_e_stop_completes_to_error_after_the_e_stop_time(prepared):
 
 
 def test_abort_reaches_error_at_the_next_sample(prepared):
-    # spec 000:918 ABORT "After the abort completes, the Motion will be set to the ERROR state";
+    # MPI 000, MPIActionABORT ABORT "After the abort completes, the Motion will be set to the ERROR state";
     # DESIGN.md "ABORT disables the servo at once"
     ctl, ms = prepared(S.MOVING)
     assert ms.action(MPIAction.ABORT).ok
@@ -246,7 +246,7 @@ def test_abort_reaches_error_at_the_next_sample(prepared):
 
 
 def test_e_stop_while_stopping_error_keeps_the_first_ramp(prepared):
-    # DESIGN.md table: E_STOP in STOPPING_ERROR is "OK" and does not restart the ramp
+    # docs/state-machine.md: E_STOP in STOPPING_ERROR is "OK" and does not restart the ramp
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
     assert ms.action(MPIAction.E_STOP).ok
@@ -257,7 +257,7 @@ def test_e_stop_while_stopping_error_keeps_the_first_ramp(prepared):
 
 
 def test_e_stop_abort_while_e_stopping_disables_at_the_end(prepared):
-    # spec 000:921 E_STOP_ABORT "first performs an E_STOP, and then performs an ABORT"
+    # MPI 000, MPIActionE_STOP_ABORT E_STOP_ABORT "first performs an E_STOP, and then performs an ABORT"
     ctl, ms = prepared(S.MOVING)
     assert ms.action(MPIAction.E_STOP).ok
     ctl.step(20)
@@ -268,7 +268,7 @@ def test_e_stop_abort_while_e_stopping_disables_at_the_end(prepared):
 
 
 def test_reset_in_error_returns_to_idle_and_allows_a_start(prepared):
-    # spec 000:922 RESET "change to the idle state (MPIStateIDLE), so that motion supervisor can
+    # MPI 000, MPIActionRESET RESET "change to the idle state (MPIStateIDLE), so that motion supervisor can
     # be restarted"
     ctl, ms = prepared(S.ERROR)
     assert ms.action(MPIAction.RESET).ok and ms.state is S.IDLE
@@ -279,7 +279,7 @@ def test_reset_in_error_returns_to_idle_and_allows_a_start(prepared):
 
 @pytest.mark.parametrize("action", ["STOP", "E_STOP", "ABORT", "E_STOP_ABORT", "RESET", "RESUME", "MAP"])
 def test_actions_without_axes_answer_no_axes_mapped(action):
-    # spec 000:2272 NO_AXES_MAPPED "returned by mpiMotionStart, mpiMotionModify or mpiMotionAction
+    # MPI 000, MEIMotionMessageNO_AXES_MAPPED NO_AXES_MAPPED "returned by mpiMotionStart, mpiMotionModify or mpiMotionAction
     # if there are no axes mapped to the motion object"
     ctl = Controller()
     _, ms = ctl.create_motion(0)
@@ -311,7 +311,7 @@ def test_stop_records_stop_until_stopped(prepared):
 @pytest.mark.parametrize("action,event", [("STOP", MPIEventType.STOP), ("E_STOP", MPIEventType.E_STOP),
                                           ("ABORT", MPIEventType.ABORT)])
 def test_actions_emit_their_event_at_the_command_sample(action, event, prepared):
-    # spec 000:927 "How STOP Events Work"; DESIGN.md: every command is recorded with its sample
+    # MPI 000, mpiMotionAction "How STOP Events Work"; DESIGN.md: every command is recorded with its sample
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
     ms.action(MPIAction[action])

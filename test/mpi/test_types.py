@@ -25,21 +25,21 @@ def test_state_numbers_are_the_ros_contract():
 
 
 def test_motion_types_in_the_order_of_the_spec():
-    # spec 000:2613-2631 MPIMotionType enum; 000:2685 MEIMotionTypeFRAME
+    # MPI 000, MPIMotionType MPIMotionType enum; MPI 000, MEIMotionType MEIMotionTypeFRAME
     assert [t.name for t in MPIMotionType] == [
         "INVALID", "PT", "PTF", "PVT", "PVTF", "SPLINE", "BESSEL", "BSPLINE", "BSPLINE2", "S_CURVE",
         "TRAPEZOIDAL", "S_CURVE_JERK", "VELOCITY", "VELOCITY_JERK", "CAM_LINEAR", "CAM_CUBIC", "FRAME"]
 
 
 def test_actions_include_every_mpi_action_and_map():
-    # spec 000:916-925 the actions of mpiMotionAction and MEIActionMAP
+    # MPI 000, mpiMotionAction the actions of mpiMotionAction and MEIActionMAP
     names = {a.name for a in MPIAction}
     assert {"STOP", "E_STOP", "ABORT", "E_STOP_ABORT", "RESET", "RESUME", "MAP"} <= names
 
 
 def test_attribute_masks_mpi_then_mei_in_spec_order():
-    # spec 000:1605-1619 MPIMotionAttrMask and 000:1666-1675 MEIMotionAttrMask; each is one bit
-    # (000:2766 mpiMotionAttrMaskBIT(attr) = 0x1 << attr)
+    # MPI 000, MPIMotionAttrMask MPIMotionAttrMask and MPI 000, MEIMotionAttrMask MEIMotionAttrMask; each is one bit
+    # (MPI 000, mpiMotionAttrMaskBIT mpiMotionAttrMaskBIT(attr) = 0x1 << attr)
     mpi = ["APPEND", "AUTO_START", "DELAY", "ID", "ELEMENT_ID", "RELATIVE", "SYNC_END", "SYNC_START",
            "REPEAT", "MASTER_START", "NO_BACKTRACK", "NO_BACKTRACK_HOLD"]
     mei = ["EVENT", "FINAL_VEL", "NO_REVERSAL", "HOLD", "HOLD_LESS", "HOLD_GREATER", "OUTPUT"]
@@ -59,7 +59,7 @@ def test_attribute_parse_accepts_names_and_rejects_unknown():
 
 
 def test_hold_and_output_types_in_spec_order():
-    # spec 000:1720-1730 MEIMotionAttrHoldType; 000:1841-1846 MEIMotionAttrOutputType
+    # MPI 000, MEIMotionAttrHoldType MEIMotionAttrHoldType; MPI 000, MEIMotionAttrOutputType MEIMotionAttrOutputType
     assert [t.name for t in HoldType] == [
         "INVALID", "NONE", "GATE", "INPUT", "MOTOR_GENERAL_IO", "MOTOR_DEDICATED_IO",
         "AXIS_POSITION_ACTUAL", "AXIS_POSITION_COMMAND", "USER_ADDRESS"]
@@ -68,13 +68,13 @@ def test_hold_and_output_types_in_spec_order():
 
 @pytest.mark.parametrize("kind", ["TRAPEZOIDAL", "S_CURVE", "VELOCITY", "PT", "PVT"])
 def test_modifiable_types_are_the_spec_list(kind):
-    # spec 000:969 "types of motion whose parameters can be modified while moving are
+    # MPI 000, mpiMotionModify "types of motion whose parameters can be modified while moving are
     # TRAPEZOIDAL, S_CURVE, VELOCITY, PT and PVT"
     assert MPIMotionType[kind] in MODIFIABLE_TYPES
 
 
 def test_jerk_types_are_the_firmware_option_types():
-    # spec 000:2645 S_CURVE_JERK and VELOCITY_JERK are only available with firmware option 21
+    # MPI 000, MPIMotionType S_CURVE_JERK and VELOCITY_JERK are only available with firmware option 21
     assert JERK_TYPES == {MPIMotionType.S_CURVE_JERK, MPIMotionType.VELOCITY_JERK}
     for kind in (MPIMotionType.PTF, MPIMotionType.SPLINE, MPIMotionType.FRAME, MPIMotionType.CAM_LINEAR):
         assert kind not in MODIFIABLE_TYPES

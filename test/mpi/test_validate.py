@@ -1,5 +1,5 @@
 """Validation of start/modify (mpi_ros/mpi/validate.py): spec 000's return table
-(000:3020-3035), the ATTRIBUTE_INVALID causes (000:2896-3018) and DESIGN.md's array rules.
+(MPI 000, Returns for mpiMotionStart and mpiMotionModify), the ATTRIBUTE_INVALID causes (MPI 000, MPIMotionMessageATTRIBUTE_INVALID) and DESIGN.md's array rules.
 A refused command answers the spec's message and changes nothing."""
 
 from __future__ import annotations
@@ -37,14 +37,14 @@ def full_params() -> MotionParams:
 
 # ------------------------------------------------------------------ motion type ----
 def test_type_invalid():
-    # spec 000:2174 MPIMotionMessageTYPE_INVALID: the motion type is not recognized
+    # MPI 000, MPIMotionMessageType_INVALID MPIMotionMessageTYPE_INVALID: the motion type is not recognized
     assert check_type(T.INVALID, False, False).message is M.MPIMotionMessageTYPE_INVALID
 
 
 @pytest.mark.parametrize("kind", [T.S_CURVE_JERK, T.VELOCITY_JERK])
 @pytest.mark.parametrize("modify", [False, True])
 def test_jerk_types_without_firmware_option_21_are_not_supported(kind, modify):
-    # spec 000:2220 PROFILE_NOT_SUPPORTED "returned by mpiMotionStart or mpiMotionModify when an
+    # MPI 000, MPIMotionMessagePROFILE_NOT_SUPPORTED PROFILE_NOT_SUPPORTED "returned by mpiMotionStart or mpiMotionModify when an
     # S_CURVE_JERK or VELOCITY_JERK motion type is commanded, but not supported by the firmware"
     assert check_type(kind, modify, False).message is M.MPIMotionMessagePROFILE_NOT_SUPPORTED
     # DESIGN.md: "on by configuration"
@@ -61,7 +61,7 @@ def test_cams_answer_unsupported_because_they_are_not_simulated_yet(kind):
 
 @pytest.mark.parametrize("kind", [T.PTF, T.PVTF, T.SPLINE, T.BESSEL, T.BSPLINE, T.BSPLINE2, T.FRAME])
 def test_types_that_cannot_be_modified(kind):
-    # spec 000:969 "The types of motion whose parameters can be modified while moving are
+    # MPI 000, mpiMotionModify "The types of motion whose parameters can be modified while moving are
     # TRAPEZOIDAL, S_CURVE, VELOCITY, PT and PVT"
     assert check_type(kind, True, True).message is M.MPIMessageUNSUPPORTED
 
@@ -69,14 +69,14 @@ def test_types_that_cannot_be_modified(kind):
 @pytest.mark.parametrize("kind", [T.TRAPEZOIDAL, T.S_CURVE, T.VELOCITY])
 @pytest.mark.parametrize("modify", [False, True])
 def test_point_to_point_and_velocity_types_are_accepted(kind, modify):
-    # spec 000:3031 supported list; 000:969 modifiable list
+    # MPI 000, MPIMessageUNSUPPORTED supported list; MPI 000, mpiMotionModify modifiable list
     assert check_type(kind, modify, False).ok
 
 
 # ------------------------------------------------------------------ attributes ----
 @pytest.mark.parametrize("kind", [T.PT, T.PTF, T.PVT, T.PVTF, T.BESSEL, T.BSPLINE, T.BSPLINE2])
 def test_path_types_allow_exactly_their_list(kind):
-    # spec 000:2902-2990 "PT (PTF, PVT, PVTF, BESSEL, BSPLINE, BSPLINE2) Moves are only permitted
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "PT (PTF, PVT, PVTF, BESSEL, BSPLINE, BSPLINE2) Moves are only permitted
     # to have motion attributes from the following list: APPEND RELATIVE ID ELEMENT_ID HOLD
     # HOLD_LESS HOLD_GREATER OUTPUT"
     params = full_params()
@@ -89,7 +89,7 @@ def test_path_types_allow_exactly_their_list(kind):
 
 
 def test_spline_allows_the_list_without_append():
-    # spec 000:2954-2962 SPLINE: RELATIVE ID ELEMENT_ID HOLD HOLD_LESS HOLD_GREATER OUTPUT (no APPEND)
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID SPLINE: RELATIVE ID ELEMENT_ID HOLD HOLD_LESS HOLD_GREATER OUTPUT (no APPEND)
     params = full_params()
     assert check_attributes(T.SPLINE, A.APPEND, params, False).message is M.MPIMotionMessageATTRIBUTE_INVALID
     for attr in PATH_ALLOWED[1:]:
@@ -97,7 +97,7 @@ def test_spline_allows_the_list_without_append():
 
 
 def test_frame_allows_append_and_id_only():
-    # spec 000:3001-3004 "FRAME Moves are only permitted to have ... APPEND, ID"
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "FRAME Moves are only permitted to have ... APPEND, ID"
     params = full_params()
     for attr in ALL_ATTRS:
         ok = check_attributes(T.FRAME, attr, params, False).ok
@@ -107,38 +107,38 @@ def test_frame_allows_append_and_id_only():
 @pytest.mark.parametrize("kind", [T.VELOCITY, T.VELOCITY_JERK])
 @pytest.mark.parametrize("attr", [A.SYNC_END, A.SYNC_START, A.FINAL_VEL, A.NO_REVERSAL])
 def test_velocity_moves_refuse_sync_final_vel_no_reversal(kind, attr):
-    # spec 000:2992-2997 "VELOCITY, VELOCITY_JERK Moves are not permitted to have SYNC_END,
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "VELOCITY, VELOCITY_JERK Moves are not permitted to have SYNC_END,
     # SYNC_START, FINAL_VEL, NO_REVERSAL"
     assert check_attributes(kind, attr, full_params(), False).message is M.MPIMotionMessageATTRIBUTE_INVALID
 
 
 @pytest.mark.parametrize("attr", [A.APPEND, A.AUTO_START, A.DELAY, A.ID, A.RELATIVE, A.EVENT, A.OUTPUT, A.HOLD])
 def test_velocity_moves_allow_the_other_attributes(attr):
-    # spec 000:2992 only SYNC_END/SYNC_START/FINAL_VEL/NO_REVERSAL are forbidden for VELOCITY
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID only SYNC_END/SYNC_START/FINAL_VEL/NO_REVERSAL are forbidden for VELOCITY
     assert check_attributes(T.VELOCITY, attr, full_params(), False).ok
 
 
 @pytest.mark.parametrize("attr", [A.REPEAT, A.MASTER_START, A.NO_BACKTRACK, A.NO_BACKTRACK_HOLD])
 def test_cam_attributes_on_a_point_to_point_move(attr):
-    # spec 000:1562-1566: REPEAT, MASTER_START and the NO_BACKTRACK pair are cam attributes
+    # MPI 000, MPIMotionAttrREPEAT: REPEAT, MASTER_START and the NO_BACKTRACK pair are cam attributes
     assert check_attributes(T.TRAPEZOIDAL, attr, full_params(), False).message is M.MPIMotionMessageATTRIBUTE_INVALID
 
 
 def test_no_backtrack_and_no_backtrack_hold_exclude_each_other():
-    # spec 000:1565 "This attribute cannot be specified with the MPIMotionAttrNO_BACKTRACK attribute"
+    # MPI 000, MPIMotionAttrREPEAT_NO_BACKTRACK "This attribute cannot be specified with the MPIMotionAttrNO_BACKTRACK attribute"
     verdict = check_attributes(T.CAM_LINEAR, A.NO_BACKTRACK | A.NO_BACKTRACK_HOLD, full_params(), False)
     assert verdict.message is M.MPIMotionMessageATTRIBUTE_INVALID
     assert check_attributes(T.CAM_LINEAR, A.NO_BACKTRACK, full_params(), False).ok
 
 
 @pytest.mark.parametrize("attr,field", [
-    (A.DELAY, "delay"),  # spec 000:3008
-    (A.FINAL_VEL, "final_velocity"),  # spec 000:3010
-    (A.HOLD, "hold"), (A.HOLD_LESS, "hold"), (A.HOLD_GREATER, "hold"),  # spec 000:3012
-    (A.OUTPUT, "output"),  # spec 000:3014
+    (A.DELAY, "delay"),  # MPI 000, MPIMotionMessageATTRIBUTE_INVALID
+    (A.FINAL_VEL, "final_velocity"),  # MPI 000, MPIMotionMessageATTRIBUTE_INVALID
+    (A.HOLD, "hold"), (A.HOLD_LESS, "hold"), (A.HOLD_GREATER, "hold"),  # MPI 000, MPIMotionMessageATTRIBUTE_INVALID
+    (A.OUTPUT, "output"),  # MPI 000, MPIMotionMessageATTRIBUTE_INVALID
 ])
 def test_attribute_with_null_data_is_attribute_invalid(attr, field):
-    # spec 000:3008-3014 "<attribute> specified and attributes <field> address is NULL"
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "<attribute> specified and attributes <field> address is NULL"
     # (DESIGN.md: a NULL pointer is an empty array here)
     params = full_params()
     setattr(params, field, [])
@@ -148,14 +148,14 @@ def test_attribute_with_null_data_is_attribute_invalid(attr, field):
 
 @pytest.mark.parametrize("attr", [A.HOLD, A.HOLD_LESS, A.HOLD_GREATER])
 def test_hold_attributes_are_not_permitted_on_modify(attr):
-    # spec 000:3016 "HOLD, HOLD_LESS, and HOLD_GREATER are not permitted during motion modifies";
-    # 000:1591-1593
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "HOLD, HOLD_LESS, and HOLD_GREATER are not permitted during motion modifies";
+    # MPI 000, MEIMotionAttrHOLD
     assert check_attributes(T.TRAPEZOIDAL, attr, full_params(), True).message is M.MPIMotionMessageATTRIBUTE_INVALID
     assert check_attributes(T.TRAPEZOIDAL, attr, full_params(), False).ok
 
 
 def test_hold_less_and_hold_greater_exclude_each_other():
-    # spec 000:1592-1593 HOLD_LESS is "less than or equal", HOLD_GREATER "greater than or equal":
+    # MPI 000, MEIMotionAttrHOLD_LESS HOLD_LESS is "less than or equal", HOLD_GREATER "greater than or equal":
     # both at once has no meaning (decision in validate.py: ATTRIBUTE_INVALID)
     verdict = check_attributes(T.TRAPEZOIDAL, A.HOLD_LESS | A.HOLD_GREATER, full_params(), False)
     assert verdict.message is M.MPIMotionMessageATTRIBUTE_INVALID
@@ -167,7 +167,7 @@ def params_verdict(params, kind=T.TRAPEZOIDAL, attrs=A.NONE, axis_count=2):
 
 
 def test_arg_invalid_past_max_coord_axes():
-    # spec 000:3030 MPIMessageARG_INVALID "Number of axes on the motion commanded exceeds
+    # MPI 000, MPIMessageARG_INVALID MPIMessageARG_INVALID "Number of axes on the motion commanded exceeds
     # MEIXmpMAX_COORD_AXES"
     verdict = params_verdict(p2p([0.0] * 9), axis_count=9)
     assert verdict.message is M.MPIMessageARG_INVALID
@@ -175,7 +175,7 @@ def test_arg_invalid_past_max_coord_axes():
 
 
 def test_one_trajectory_without_sync():
-    # spec 000:1657 "if neither SYNC_START nor SYNC_END are specified, then only one MPITrajectory
+    # MPI 000, MPIMotionAttrMaskNO_BACKTRACK_HOLD, remarks "if neither SYNC_START nor SYNC_END are specified, then only one MPITrajectory
     # structure will be used"; DESIGN.md: anything else is MPIMessagePARAM_INVALID
     assert params_verdict(p2p(trajectory=[TRAJ])).ok
     assert params_verdict(p2p(trajectory=[TRAJ, TRAJ])).message is M.MPIMessagePARAM_INVALID
@@ -184,19 +184,19 @@ def test_one_trajectory_without_sync():
 
 @pytest.mark.parametrize("attr", [A.SYNC_START, A.SYNC_END])
 def test_sync_needs_one_trajectory_per_axis(attr):
-    # spec 000:1560-1561 "When enabled, each axis will use its own MPITrajectory values"
+    # MPI 000, MPIMotionAttrSYNC_END "When enabled, each axis will use its own MPITrajectory values"
     assert params_verdict(p2p(trajectory=[TRAJ, TRAJ]), attrs=attr).ok
     assert params_verdict(p2p(trajectory=[TRAJ]), attrs=attr).message is M.MPIMessagePARAM_INVALID
 
 
 def test_position_has_one_value_per_axis():
-    # spec 000:2551 "Each position value specifies the target for each axis"; DESIGN.md array lengths
+    # MPI 000, MPIMotionSCurve "Each position value specifies the target for each axis"; DESIGN.md array lengths
     assert params_verdict(p2p([1.0])).message is M.MPIMessagePARAM_INVALID
     assert params_verdict(p2p([1.0, 2.0, 3.0])).message is M.MPIMessagePARAM_INVALID
 
 
 def test_velocity_ignores_position():
-    # spec 000:2551 "VELOCITY and VELOCITY_JERK do not require target positions and will ignore
+    # MPI 000, MPIMotionSCurve "VELOCITY and VELOCITY_JERK do not require target positions and will ignore
     # these values"
     assert params_verdict(p2p([]), kind=T.VELOCITY).ok
     assert params_verdict(p2p([float("nan")] * 5), kind=T.VELOCITY).ok
@@ -205,14 +205,14 @@ def test_velocity_ignores_position():
 @pytest.mark.parametrize("field", ["velocity", "acceleration", "deceleration"])
 @pytest.mark.parametrize("value", [0.0, -1.0, float("inf"), float("nan")])
 def test_point_to_point_limits_must_be_positive_and_finite(field, value):
-    # spec 000:3029 PARAM_INVALID "if the specified motion parameters are not valid with the type"
+    # MPI 000, MPIMessagePARAM_INVALID PARAM_INVALID "if the specified motion parameters are not valid with the type"
     traj = Trajectory(1000.0, 10_000.0, 10_000.0, 0.0)
     setattr(traj, field, value)
     assert params_verdict(p2p(trajectory=[traj])).message is M.MPIMessagePARAM_INVALID
 
 
 def test_velocity_move_velocity_may_be_negative_or_zero():
-    # spec 000:2718 velocity moves: "deceleration is ignored"; the velocity is signed
+    # MPI 000, MPIMotionVelocity velocity moves: "deceleration is ignored"; the velocity is signed
     for velocity in (-500.0, 0.0):
         assert params_verdict(p2p([], trajectory=[Trajectory(velocity, 1000.0, 0.0)]), kind=T.VELOCITY).ok
     bad = p2p([], trajectory=[Trajectory(100.0, 0.0, 0.0)])
@@ -221,20 +221,20 @@ def test_velocity_move_velocity_may_be_negative_or_zero():
 
 @pytest.mark.parametrize("jerk_percent,ok", [(0.0, True), (100.0, True), (-0.1, False), (100.1, False)])
 def test_jerk_percent_within_0_and_100(jerk_percent, ok):
-    # spec 000:2548 S-curve parameters are velocity, acceleration, deceleration and jerkPercent (a percentage)
+    # MPI 000, MPIMotionSCurve S-curve parameters are velocity, acceleration, deceleration and jerkPercent (a percentage)
     traj = Trajectory(1000.0, 10_000.0, 10_000.0, jerk_percent)
     assert params_verdict(p2p(trajectory=[traj]), kind=T.S_CURVE).ok is ok
 
 
 def test_jerk_types_need_positive_jerks():
-    # spec 000:2567 S_CURVE_JERK uses "accelerationJerk, and decelerationJerk"
+    # MPI 000, MPIMotionSCurveJerk S_CURVE_JERK uses "accelerationJerk, and decelerationJerk"
     assert params_verdict(p2p(trajectory=[JERK_TRAJ]), kind=T.S_CURVE_JERK).ok
     no_jerk = Trajectory(1000.0, 10_000.0, 10_000.0, 0.0, 0.0, 1e6)
     assert params_verdict(p2p(trajectory=[no_jerk]), kind=T.S_CURVE_JERK).message is M.MPIMessagePARAM_INVALID
 
 
 def test_non_finite_position_is_param_invalid():
-    # spec 000:3029 PARAM_INVALID
+    # MPI 000, MPIMessagePARAM_INVALID PARAM_INVALID
     assert params_verdict(p2p([float("nan"), 0.0])).message is M.MPIMessagePARAM_INVALID
     assert params_verdict(p2p([float("inf"), 0.0])).message is M.MPIMessagePARAM_INVALID
 
@@ -248,8 +248,8 @@ def test_non_finite_position_is_param_invalid():
     (A.HOLD, "hold", [Hold(type=HoldType.GATE)]),
 ])
 def test_per_axis_attribute_arrays(attr, field, value):
-    # spec 000:2822 "delay is a pointer to an array of doubles that assign delay times for each
-    # Axis"; 000:1898-1899 finalVelocity and hold "for each axis"
+    # MPI 000, MPIMotionAttrDELAY "delay is a pointer to an array of doubles that assign delay times for each
+    # Axis"; MPI 000, MEIMotionAttributes, finalVelocity finalVelocity and hold "for each axis"
     params = p2p()
     setattr(params, field, value)
     assert params_verdict(params, attrs=attr).message is M.MPIMessagePARAM_INVALID
@@ -257,27 +257,27 @@ def test_per_axis_attribute_arrays(attr, field, value):
 
 @pytest.mark.parametrize("hold,ok", [
     (Hold(type=HoldType.GATE, gate=31), True),
-    (Hold(type=HoldType.GATE, gate=32), False),  # spec 000:1786 gate "between 0 and 31"
+    (Hold(type=HoldType.GATE, gate=32), False),  # MPI 000, MEIMotionAttrHoldSource, gate gate "between 0 and 31"
     (Hold(type=HoldType.GATE, gate=-1), False),
     (Hold(type=HoldType.INPUT, address=63), True),
     (Hold(type=HoldType.INPUT, address=64), False),  # DESIGN.md: address = index of an I/O word
     (Hold(type=HoldType.MOTOR_GENERAL_IO, number=3), True),
     (Hold(type=HoldType.MOTOR_DEDICATED_IO, number=4), False),
-    (Hold(type=HoldType.AXIS_POSITION_ACTUAL, number=4), False),  # spec 000:1794 an axis's number
+    (Hold(type=HoldType.AXIS_POSITION_ACTUAL, number=4), False),  # MPI 000, MEIMotionAttrHoldSource, axis.number an axis's number
     (Hold(type=HoldType.AXIS_POSITION_COMMAND, number=3, position=5.0), True),
     (Hold(type=HoldType.INVALID), False),
     (Hold(type=HoldType.GATE, timeout=-1.0), False),
     (Hold(type=HoldType.GATE, timeout=float("nan")), False),
 ])
 def test_hold_sources(hold, ok):
-    # spec 000:1786-1798 MEIMotionAttrHoldSource fields
+    # MPI 000, MEIMotionAttrHoldSource, gate MEIMotionAttrHoldSource fields
     assert params_verdict(p2p(hold=[hold, hold]), attrs=A.HOLD).ok is ok
 
 
 @pytest.mark.parametrize("output,ok", [
     (Output(type=OutputType.OUTPUT, address=0, on_mask=1), True),
     (Output(type=OutputType.OUTPUT, address=64), False),  # DESIGN.md: an I/O word index
-    (Output(type=OutputType.MOTOR, motor=3), True),  # spec 000:1827 motor number
+    (Output(type=OutputType.MOTOR, motor=3), True),  # MPI 000, MEIMotionAttrOutput, motor motor number
     (Output(type=OutputType.MOTOR, motor=4), False),
     (Output(type=OutputType.INVALID), False),
     # MEIMotionAttrOutput.pointIndex "when multiple point motion is used": a point-to-point move
@@ -285,12 +285,12 @@ def test_hold_sources(hold, ok):
     (Output(type=OutputType.OUTPUT, address=0, on_mask=1, point_index=1), False),
 ])
 def test_output_targets(output, ok):
-    # spec 000:1825-1830 MEIMotionAttrOutput
+    # MPI 000, MEIMotionAttrOutput, type MEIMotionAttrOutput
     assert params_verdict(p2p(output=[output]), attrs=A.OUTPUT).ok is ok
 
 
 def test_element_id_needs_values():
-    # spec 000:1877 elementId "array defines the identity for each element"
+    # MPI 000, MPIMotionAttributes, elementId elementId "array defines the identity for each element"
     assert params_verdict(p2p(), attrs=A.ELEMENT_ID).message is M.MPIMessagePARAM_INVALID
     assert params_verdict(p2p(element_id=[7]), attrs=A.ELEMENT_ID).ok
 
@@ -329,8 +329,8 @@ def test_empty_count_past_a_c_long_is_param_invalid():
 
 # ------------------------------------------------------------------ through the supervisor ----
 def test_start_with_no_axes_answers_axis_count(ctl):
-    # spec 000:3026 MPIMotionMessageAXIS_COUNT "if the motion object has no axes"; 000:2166;
-    # 000:620 "There must be at least one Axis in the coordinate system"
+    # MPI 000, MPIMotionMessageAXIS_COUNT MPIMotionMessageAXIS_COUNT "if the motion object has no axes"; MPI 000, MPIMotionMessageAXIS_COUNT;
+    # MPI 000, mpiMotionStart "There must be at least one Axis in the coordinate system"
     _, ms = ctl.create_motion(0)
     assert ms.start(T.TRAPEZOIDAL, params=p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT
     assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT
@@ -348,14 +348,14 @@ def test_config_set_with_no_axes_answers_axis_count(ctl):
 
 
 def test_start_in_error_answers_error(ms, bring, params):
-    # spec 000:3025 MPIMotionMessageERROR "if MotionStart is called when the Motion Supervisor is
+    # MPI 000, MPIMotionMessageERROR MPIMotionMessageERROR "if MotionStart is called when the Motion Supervisor is
     # in the error state"
     bring(MPIState.ERROR)
     assert ms.start(T.TRAPEZOIDAL, params=params()) is M.MPIMotionMessageERROR
 
 
 def test_profile_error_when_the_profile_cannot_be_calculated(ms, params):
-    # spec 000:3027 PROFILE_ERROR "if the Motion profile specified by the parameters cannot be
+    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "if the Motion profile specified by the parameters cannot be
     # calculated correctly": a final velocity above the trajectory velocity
     message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[2000.0, 0.0]))
     assert message is M.MPIMotionMessagePROFILE_ERROR

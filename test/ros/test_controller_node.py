@@ -53,7 +53,7 @@ def test_events_arrive_in_order_with_move_ids_and_none_is_lost_in_a_burst(suite,
     drive(lambda: all(g.done for g in goals))
     seen = events.wait_for(lambda ms: sum(m.type == "MOTION_DONE" for m in ms) >= 10)
     done = [m for m in seen if m.type == "MOTION_DONE" and m.supervisor == 0]
-    # spec 000:2806 APPEND: "Each successful call ... will generate an MPIEventTypeMOTION_DONE"
+    # MPI 000, MPIMotionAttrAPPEND APPEND: "Each successful call ... will generate an MPIEventTypeMOTION_DONE"
     assert [m.move_id for m in done] == list(range(1, 11))
     assert [m.sample for m in seen] == sorted(m.sample for m in seen)
     controller_events = suite.runner.read(lambda ctl: len(ctl.events))
@@ -119,7 +119,7 @@ def test_axis_services_config_and_positions(suite, client, probe, service, appli
     goal = client.start({**S_CURVE, "position": [5000.0, 0.0]})
     applied.wait(3)
     drive(lambda: suite.runner.ctl.axes[0].cmd_v > 0.0)
-    # spec 002:611 mpiAxisCommandPositionSet: COMMAND_NOT_SET while the axis is MOVING
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET mpiAxisCommandPositionSet: COMMAND_NOT_SET while the axis is MOVING
     moving = service(probe, AxisPositionSet, "/mpi/axis0/position_set", AxisPositionSet.Request(which="COMMAND",
                                                                                                value=0.0))
     assert moving.message == "MPIAxisMessageCOMMAND_NOT_SET"
@@ -137,7 +137,7 @@ def test_gate_holds_a_move_until_it_opens(suite, client, probe, service, applied
                          "hold": [{"type": "GATE", "gate": 7}, {"type": "GATE", "gate": 7}]})
     applied.wait(2)
     suite.runner.step(2000)
-    # spec 000:2880 "the motion will be held until a call to mpiControlGateSet() with closed=FALSE"
+    # MPI 000, MEIMotionAttrHOLD "the motion will be held until a call to mpiControlGateSet() with closed=FALSE"
     assert suite.runner.read(lambda ctl: (ctl.axes[0].command_position, ctl.supervisor(0).state.name)) == (0.0, "MOVING")
     service(probe, GateSet, "/mpi/gate_set", GateSet.Request(gate=7, closed=False))
     drive(lambda: goal.done)

@@ -65,7 +65,7 @@ def test_e_stop_mid_move_ends_goal_with_error_then_reset_returns_idle(suite, cli
     assert (reply.message, reply.state_name) == ("MPIMessageOK", "STOPPING_ERROR")
     drive(lambda: goal.done)
     result = goal.wait(raise_on_error=False)
-    # spec 000:2204 MPIMotionMessageERROR: "in an error state due to an E_STOP or ABORT action"
+    # MPI 000, MPIMotionMessageERROR MPIMotionMessageERROR: "in an error state due to an E_STOP or ABORT action"
     assert goal.handle.status == GoalStatus.STATUS_ABORTED
     assert result.message == "MPIMotionMessageERROR" and "E_STOP" in result.detail
     assert result.state_name == "ERROR"
@@ -201,7 +201,7 @@ def test_start_while_moving_answers_moving_and_leaves_the_move_alone(suite, clie
     first = client.start(move([6000.0, 0.0]))
     applied.wait(1)
     drive(lambda: suite.runner.ctl.axes[0].command_position > 100.0)
-    # spec 000:2188 MPIMotionMessageMOVING: "A motion cannot be started if a motion is in progress"
+    # MPI 000, MPIMotionMessageMOVING MPIMotionMessageMOVING: "A motion cannot be started if a motion is in progress"
     second = client.start(move([0.0, 0.0]))
     assert second.wait(raise_on_error=False).message == "MPIMotionMessageMOVING"
     drive(lambda: first.done)
@@ -246,7 +246,7 @@ def test_e_stop_is_served_while_many_goals_execute(suite, client, applied, drive
 def test_trigger_services_answer_the_spec_message(suite, probe, service):
     from std_srvs.srv import Trigger
 
-    # DESIGN.md table: STOP in IDLE answers MPIMotionMessageIDLE; RESET in IDLE is OK.
+    # docs/state-machine.md: STOP in IDLE answers MPIMotionMessageIDLE; RESET in IDLE is OK.
     stop = service(probe, Trigger, "/mpi/ms0/stop", Trigger.Request())
     assert (stop.success, stop.message.split(":")[0]) == (False, "MPIMotionMessageIDLE")
     reset = service(probe, Trigger, "/mpi/ms0/reset", Trigger.Request())
@@ -264,7 +264,7 @@ def test_config_and_params_services_round_trip(suite, probe, service):
     from mpi_ros.srv import MotionConfigGet, MotionConfigSet, MotionParamsGet, MotionParamsSet
 
     config = service(probe, MotionConfigGet, "/mpi/ms0/config_get", MotionConfigGet.Request())
-    # spec 000:2074-2075 decelTime defaults .5 s / .05 s; spec 000:1997-1998 normalFeedrate 1.0, pauseFeedrate 0.0
+    # MPI 000, MPIMotionDecelTime, stop decelTime defaults .5 s / .05 s; MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate 1.0, pauseFeedrate 0.0
     assert (config.config.decel_time_stop, config.config.decel_time_e_stop) == pytest.approx((0.5, 0.05))
     assert (config.config.normal_feedrate, config.config.pause_feedrate) == (1.0, 0.0)
     assert list(config.config.axis_numbers) == [0, 1]
@@ -293,7 +293,7 @@ def test_start_with_stored_params(suite, client, probe, service, applied, drive)
     request.params.position = [250.0, 125.0]
     request.params.trajectory = [Trajectory(velocity=1000.0, acceleration=10000.0, deceleration=10000.0)]
     service(probe, MotionParamsSet, "/mpi/ms0/params_set", request)
-    # spec 000:618 mpiMotionStart: "If params is Null, the parameters set by the most recent
+    # MPI 000, mpiMotionStart mpiMotionStart: "If params is Null, the parameters set by the most recent
     # call to mpiMotionParamsSet(...) will be used"
     goal = client.start({"type": "TRAPEZOIDAL", "use_stored_params": True})
     applied.wait(2)
@@ -307,7 +307,7 @@ def test_axis_list_position_frame_buffer_and_event_services(suite, probe, servic
 
     listing = service(probe, AxisListGet, "/mpi/ms0/axis_list_get", AxisListGet.Request())
     assert list(listing.axis_numbers) == [0, 1] and list(listing.mapped_axis_numbers) == [0, 1]
-    # spec 000:1172 MPIMessageOBJECT_ON_LIST: "axis is already on the list"
+    # MPI 000, mpiMotionAxisAppend, return values MPIMessageOBJECT_ON_LIST: "axis is already on the list"
     edit = service(probe, AxisListEdit, "/mpi/ms0/axis_list_edit", AxisListEdit.Request(operation="APPEND", axis=1))
     assert edit.message == "MPIMessageOBJECT_ON_LIST" and list(edit.axis_numbers) == [0, 1]
     edit = service(probe, AxisListEdit, "/mpi/ms0/axis_list_edit", AxisListEdit.Request(operation="APPEND", axis=9))

@@ -27,7 +27,7 @@ def test_velocity_change_reaches_the_velocity_with_zero_acceleration(v, a, v1):
 
 
 def test_velocity_change_respects_the_acceleration_limit():
-    # spec 000:2567 accelerationJerk/decelerationJerk with acceleration/deceleration limits
+    # MPI 000, MPIMotionSCurveJerk accelerationJerk/decelerationJerk with acceleration/deceleration limits
     pieces = velocity_change(0.0, 0.0, 5000.0, 10_000.0, 1e5)
     accels = [s.a for s in chain(0.0, 0.0, 0.0, pieces)] + [integrate(0.0, 0.0, pieces)[2]]
     assert max(abs(x) for x in accels) == pytest.approx(10_000.0)
@@ -41,7 +41,7 @@ def test_velocity_change_limits_must_be_positive():
 @pytest.mark.parametrize("v0,a0,target", [(0.0, 0.0, 5000.0), (0.0, 0.0, 50.0), (800.0, 4000.0, 3000.0),
                                           (800.0, 4000.0, -500.0), (-300.0, 0.0, 1000.0)])
 def test_point_to_point_jerk_ends_on_target_at_rest(v0, a0, target):
-    # spec 000:2671 S_CURVE_JERK point to point "and final position"
+    # MPI 000, MPIMotionTypeS_CURVE_JERK S_CURVE_JERK point to point "and final position"
     accel, decel = (10_000.0, 2e5), (8_000.0, 1e5)
     segments = point_to_point_jerk(0.0, v0, a0, target, 0.0, 1000.0, accel, decel)
     p, v, a = segments[-1].end_state()
@@ -59,7 +59,7 @@ def test_point_to_point_jerk_needs_a_velocity():
 
 
 def test_velocity_jerk_ramps_then_cruises():
-    # spec 000:2674 VELOCITY_JERK "S-Curve acceleration to a constant velocity"
+    # MPI 000, MPIMotionTypeVELOCITY_JERK VELOCITY_JERK "S-Curve acceleration to a constant velocity"
     segments, ramp_time = velocity_jerk(0.0, 0.0, 0.0, 1000.0, 10_000.0, 1e5, 5e4, cruise=2.0)
     assert segments[-1].v == pytest.approx(1000.0) and segments[-1].duration == 2.0 and segments[-1].a == 0.0
     assert ramp_time == pytest.approx(sum(s.duration for s in segments[:-1]))

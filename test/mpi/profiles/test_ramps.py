@@ -24,7 +24,7 @@ def contiguous(plan, v_start, v_final):
 
 
 def test_long_move_is_accel_cruise_decel():
-    # spec 000:2672 TRAPEZOIDAL "specified by acceleration, velocity, deceleration and final position"
+    # MPI 000, MPIMotionTypeTRAPEZOIDAL TRAPEZOIDAL "specified by acceleration, velocity, deceleration and final position"
     plan = plan_point_to_point(10_000.0, 0.0, 0.0, 1000.0, 10_000.0, 5_000.0)
     assert [(r.v_start, r.v_end) for r in plan] == [(0.0, 1000.0), (1000.0, 1000.0), (1000.0, 0.0)]
     assert [r.duration for r in plan] == pytest.approx([0.1, 10.0 - 0.05 - 0.1, 0.2])
@@ -72,7 +72,7 @@ def test_overshoot_when_too_close_to_stop():
 
 
 def test_final_velocity():
-    # spec 000:1589 FINAL_VEL "a non-zero target velocity"
+    # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL "a non-zero target velocity"
     plan = plan_point_to_point(1000.0, 0.0, 300.0, 1000.0, 10_000.0, 10_000.0)
     assert plan[-1].v_end == 300.0 and distance(plan) == pytest.approx(1000.0)
     with pytest.raises(ProfileError):
@@ -81,7 +81,7 @@ def test_final_velocity():
 
 @pytest.mark.parametrize("limits", [(0.0, 1.0, 1.0), (1.0, 0.0, 1.0), (1.0, 1.0, -1.0)])
 def test_limits_must_be_positive(limits):
-    # spec 000:3027 PROFILE_ERROR "if the Motion profile ... cannot be calculated"
+    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "if the Motion profile ... cannot be calculated"
     with pytest.raises(ProfileError):
         plan_point_to_point(10.0, 0.0, 0.0, *limits)
 
@@ -112,7 +112,7 @@ def test_ramps_between_splits_at_zero():
 
 
 def test_velocity_plan_uses_the_acceleration_only():
-    # spec 000:2718 VELOCITY: "except deceleration is ignored"
+    # MPI 000, MPIMotionVelocity VELOCITY: "except deceleration is ignored"
     assert plan_velocity(1000.0, -1000.0, 5000.0) == [Ramp(0.4, 1000.0, -1000.0)]
     assert plan_velocity(3.0, 3.0, 1.0) == []
     with pytest.raises(ProfileError):

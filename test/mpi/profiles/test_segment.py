@@ -10,7 +10,7 @@ from mpi_ros.mpi.profiles.segment import Segment, SegmentTable, chain, end_state
 
 
 def test_state_at_is_constant_jerk_motion():
-    # spec 000:3048 "all motion is specified by constant-jerk segments of motion"
+    # MPI 000, Streaming Point Motion Type Calculations "all motion is specified by constant-jerk segments of motion"
     seg = Segment(2.0, 1.0, 2.0, 3.0, 6.0)
     assert seg.state_at(2.0) == (1.0 + 4.0 + 6.0 + 8.0, 2.0 + 6.0 + 12.0, 3.0 + 12.0)
 
@@ -41,7 +41,7 @@ def test_scaled_segment():
 
 
 def test_reverses():
-    # spec 000:1590 NO_REVERSAL "prevents a motion profile from changing direction"
+    # MPI 000, MEIMotionAttrNO_REVERSAL NO_REVERSAL "prevents a motion profile from changing direction"
     forward = point_to_point(0.0, 500.0, 1000.0, 0.0, 1000.0, 1e4, 1e4, 0.0)
     back = point_to_point(0.0, 500.0, -1000.0, 0.0, 1000.0, 1e4, 1e4, 0.0)
     assert not reverses(forward, 500.0) and reverses(back, 500.0)
@@ -49,7 +49,7 @@ def test_reverses():
 
 
 def test_velocity_move_segments():
-    # spec 000:2673 VELOCITY "S-Curve acceleration to a constant velocity ... jerkPercent"
+    # MPI 000, MPIMotionTypeVELOCITY VELOCITY "S-Curve acceleration to a constant velocity ... jerkPercent"
     segments, ramp = velocity_move(0.0, 0.0, 500.0, 5000.0, 50.0, cruise=1.0)
     assert ramp == pytest.approx(0.1)
     assert segments[-1].v == pytest.approx(500.0) and segments[-1].duration == 1.0
