@@ -1,12 +1,13 @@
 """Runs the controller on its own clock thread and serialises access to it.
 
 Python cannot sleep 500 us reliably, so the thread wakes every few milliseconds and
-steps, in one batch, the samples that wall time x scale says are due (DESIGN.md). A
-command first catches the controller up to the sample that is due now and is then
-applied, so it takes effect within one sample of arriving. One lock guards the
-controller; work that talks to ROS (publishing) runs after the lock is released, in
-order: on the clock thread while it runs (a command wakes it), else by the caller.
-Change hooks (``on_change``) run under the lock after every step batch and every
+steps, in one batch, the samples that wall time x scale says are due (DESIGN.md): it
+wakes as the next periodic stop (a status, say) becomes due and steps to it, not past it
+(see ``_clock_target``). A command first catches the controller up to the sample that is
+due now and is then applied, so it takes effect within one sample of arriving. One lock
+guards the controller; work that talks to ROS (publishing) runs after the lock is
+released, in order: on the clock thread while it runs (a command wakes it), else by the
+caller. Change hooks (``on_change``) run under the lock after every step batch and every
 command, so whoever follows the controller (the goals of the nodes) is told without
 a thread of its own waiting on it.
 
@@ -31,6 +32,8 @@ from .mpi.motion import MoveEnd
 _log = logging.getLogger("mpi_ros.runner")
 FAST_BATCH = 2000  # samples per batch when running as fast as possible
 _OUTCOMES_KEPT = 100_000
+_WAKE_MARGIN = 0.0002  # s the clock thread wakes after a periodic stop is due
+CATCH_UP = 10  # wake periods the clock thread steps at most before it publishes (when behind)
 
 Output = Callable[[], None]  # work to do outside the lock (e.g. publish)
 
@@ -119,13 +122,44 @@ class ControllerRunner:
         while self._running.is_set():
             try:
                 with self.lock:
-                    self._catch_up()
+                    if self.running:
+                        self._advance_to(self._clock_target(self.due_sample(), period))
                 self._flush()
             except Exception:  # noqa: BLE001 - the clock must keep running; the error is logged
                 _log.exception("controller clock: a step or its output failed")
             if self.time_scale:
-                self._wake.wait(period)
+                self._wake.wait(self._until_next_stop(period))
                 self._wake.clear()
+
+    def _clock_target(self, due: int, period: float) -> int:
+        """Where the clock thread steps to next.
+
+        The last periodic stop that is due, if it is less than a wake period behind ``due``,
+        else ``due``: every stretch stepped costs the controller a fixed amount whatever its
+        length (bench/RESULTS.md: about 0.25 ms at 32 axes), and the samples past the last stop are read by
+        nobody until the next one, so stepping them now would double the stretches.
+        Commands still catch up to ``due`` first (submit): they take effect at the sample
+        due, and nothing waits more than a wake period.
+
+        Behind by more than CATCH_UP wake periods (an overloaded machine), it catches up in
+        pieces of that size and publishes between them: caught up in one batch, the topics
+        would fall silent, and the work held for after it grow, for as long as it lasts."""
+        if not self._periodic or not self.time_scale:
+            return due
+        wake = period * self.time_scale * self.ctl.rate  # samples per wake
+        limit = min(due, self.ctl.sample + max(1, int(CATCH_UP * wake)))
+        last = max(p.next_sample + p.every * ((limit - p.next_sample) // p.every) for p in self._periodic)
+        return last if limit - last < wake else limit
+
+    def _until_next_stop(self, period: float) -> float:
+        """Seconds until the next periodic stop is due (at most ``period``): the clock thread
+        wakes as it becomes due, steps to it and publishes at once."""
+        if not self._periodic:
+            return period
+        ahead = min(p.next_sample for p in self._periodic) - self._anchor_sample
+        due_at = self._anchor_wall + ahead / (self.time_scale * self.ctl.rate)
+        # a little late rather than early: early, the sample due would still be the one before
+        return min(period, max(0.0, due_at - time.monotonic() + _WAKE_MARGIN))
 
     def due_sample(self) -> int:
         """The sample the controller should be at now."""

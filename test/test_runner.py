@@ -120,3 +120,28 @@ def test_deferred_work_of_a_command_runs_on_the_clock_thread_while_it_runs():
         runner.stop()
     runner.submit(Command("action", 0, request={"action": "RESET"}))
     assert ran == [("E_STOP", "mpi-controller-clock"), ("RESET", threading.current_thread().name)]
+
+
+def test_the_clock_thread_steps_to_the_last_periodic_stop_due_and_catches_up_in_pieces():
+    # Every stretch stepped costs the controller a fixed amount: the clock thread steps to the
+    # periodic stops (where something reads the controller), not a few samples past them.
+    from mpi_ros.runner import CATCH_UP
+
+    runner = ControllerRunner(config.load().build_controller(), time_scale=1.0)  # not started
+    runner.add_periodic(100.0, lambda ctl: None)  # every 20 samples
+    runner.add_periodic(1.0, lambda ctl: None)  # every 2000
+    period = 0.01  # s: 20 samples a wake
+    runner.step(20)  # the first stop is done
+    assert runner._clock_target(33, period) == 20  # nothing new is due: nothing to step
+    assert runner._clock_target(47, period) == 40
+    assert runner._clock_target(60, period) == 60
+    # behind by more than CATCH_UP wakes: a piece at a time, each ending at a stop
+    far = 20 + CATCH_UP * 20
+    assert runner._clock_target(5000, period) == far
+    runner.step(far - 20)
+    assert runner._clock_target(5000, period) == far + CATCH_UP * 20
+    # no periodic work, or as fast as possible: straight to the sample due
+    assert ControllerRunner(config.load().build_controller(), time_scale=1.0)._clock_target(47, period) == 47
+    fast = ControllerRunner(config.load().build_controller(), time_scale=0.0)
+    fast.add_periodic(100.0, lambda ctl: None)
+    assert fast._clock_target(2047, period) == 2047

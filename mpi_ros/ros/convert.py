@@ -16,7 +16,7 @@ import array
 import math
 import time
 import weakref
-from typing import Any
+from typing import Any, Iterable, Mapping
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -201,12 +201,34 @@ def servo_effort(axis) -> float:
     velocity. 0 while the amplifier is off (after ABORT the motor coasts)."""
     if not axis.amp_enabled:
         return 0.0
-    cfg = axis.plant.config
+    return _effort(axis.plant.config, axis.cmd_p - axis.act_p, axis.cmd_v, axis.act_v, axis.cmd_a)
+
+
+def _effort(cfg, error: float, cmd_v: float, act_v: float, cmd_a: float) -> float:
     w = 2.0 * math.pi * cfg.bandwidth_hz
-    effort = (w * w * (axis.cmd_p - axis.act_p)
-              + 2.0 * cfg.damping * w * (cfg.velocity_feedforward * axis.cmd_v - axis.act_v)
-              + cfg.acceleration_feedforward * axis.cmd_a)
+    effort = (w * w * error
+              + 2.0 * cfg.damping * w * (cfg.velocity_feedforward * cmd_v - act_v)
+              + cfg.acceleration_feedforward * cmd_a)
     return _finite(effort)
+
+
+def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
+                 ) -> tuple[list[float], list[float], list[float]]:
+    """Every axis' (actual position, actual velocity, servo effort): what /joint_states
+    carries. ``snapshots``: every axis' AxisSnapshot at the controller's sample, if they
+    were taken (the same values, read once: see snapshots.py)."""
+    if snapshots is None:
+        return ([float(a.actual_position) for a in ctl.axes], [float(a.act_v) for a in ctl.axes],
+                [servo_effort(a) for a in ctl.axes])
+    axes = [snapshots[a.number] for a in ctl.axes]
+    # snapshot values are the axis' own: position_error is cmd_p - act_p, as servo_effort reads it
+    effort = [_effort(a.plant.config, s.position_error, s.command_velocity, s.actual_velocity,
+                      s.command_acceleration) if s.amp_enabled else 0.0 for a, s in zip(ctl.axes, axes)]
+    return [float(s.actual_position) for s in axes], [float(s.actual_velocity) for s in axes], effort
+
+
+def joint_names(ctl) -> list[str]:
+    return [f"axis{a.number}" for a in ctl.axes]
 
 
 def joint_state(ctl, epoch_ns: int | None = None) -> JointState:
@@ -214,10 +236,8 @@ def joint_state(ctl, epoch_ns: int | None = None) -> JointState:
     servo's control effort (counts/s^2, see :func:`servo_effort`)."""
     msg = JointState()
     msg.header.stamp = stamp(ctl.sample, ctl.rate, epoch_ns)
-    msg.name = [f"axis{a.number}" for a in ctl.axes]
-    msg.position = [float(a.actual_position) for a in ctl.axes]
-    msg.velocity = [float(a.act_v) for a in ctl.axes]
-    msg.effort = [servo_effort(a) for a in ctl.axes]
+    msg.name = joint_names(ctl)
+    msg.position, msg.velocity, msg.effort = joint_values(ctl)
     return msg
 
 
@@ -268,11 +288,18 @@ def motion_event(event: Event, rate: float, epoch_ns: int | None = None) -> Moti
 
 
 def publish(node, publisher, msg) -> None:
-    """Publish unless the node's context has shut down (a Ctrl-C races the clock thread)."""
+    """Publish unless the node's context has shut down (a Ctrl-C races the clock thread).
+    ``msg``: a message of the publisher's type, or its CDR (bytes, published raw)."""
+    publish_all(node, ((publisher, msg),))
+
+
+def publish_all(node, sends: Iterable[tuple[Any, Any]]) -> None:
+    """``publish`` for each (publisher, message) of one node, the context checked once."""
     if not node.context.ok():
         return
     try:
-        publisher.publish(msg)
+        for publisher, msg in sends:
+            publisher.publish(msg)
     except RCLError:
         if node.context.ok():
             raise

@@ -59,7 +59,7 @@ from ..config import RosSettings
 from ..mpi.control import Controller
 from ..mpi.messages import Message
 from ..runner import ControllerRunner, Output
-from . import convert
+from . import convert, snapshots, wire
 from .goal_tracker import GoalBook, GoalEnd, TrackedGoal
 
 STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
@@ -173,6 +173,7 @@ class SupervisorNode(Node):
         self._goal_group = ReentrantCallbackGroup()
         self._service_group = ReentrantCallbackGroup()
         self._book = GoalBook(runner, number)
+        self._snapshots = snapshots.shared(runner)
         # Orders our own goal-state changes against an accepted cancel (see _mark_executing).
         self._transitions = threading.Lock()
         self._closing = threading.Condition()
@@ -234,10 +235,12 @@ class SupervisorNode(Node):
 
     # -- status -----------------------------------------------------------------------
     def _collect_status(self, ctl):
-        ms = ctl.supervisor(self.number)
-        if ms is None:
+        snap = self._snapshots.motion(ctl, self.number)  # read once a sample for every node (snapshots.py)
+        if snap is None:
             return None
-        msg = convert.motion_status(ms.snapshot(), ctl.rate, convert.epoch_of(ctl))
+        # packed straight into CDR and published raw where the interfaces allow (wire.py)
+        encode = wire.motion_status if wire.AVAILABLE else convert.motion_status
+        msg = encode(snap, ctl.rate, convert.epoch_of(ctl))
         return lambda: convert.publish(self, self._pub_status, msg)
 
     # -- goals: acceptance and cancel (executor threads) -------------------------------

@@ -1,0 +1,637 @@
+"""The whole suite under load, as a user sees it (issue 10).
+
+Two processes, so that every figure is the suite's and not the GIL of a shared probe:
+- the suite: ``mpi-ros run --time-scale 1 --config <generated YAML>`` (this source tree);
+- this process, the probe: it starts a VELOCITY move on every supervisor through its
+  MotionStart action (mpi_ros.client.MotionClient, the public client), waits until every
+  axis is at its velocity, then counts the messages of every status topic, /joint_states
+  and /clock against the wall clock over a window (raw subscriptions: the probe reads the
+  stamp from the CDR bytes, it deserializes nothing).
+
+Figures per case:
+- real time: controller time (the stamps of /mpi/ms0/status, ``epoch + sample / rate``)
+  elapsed over the window / wall time elapsed between the messages' publication (the
+  middleware's source timestamps) (target: within 1 %), and by how much the controller's
+  lag behind the wall clock varied;
+- every topic's rate: messages received in the window (the middleware's reception
+  timestamps, so a late probe does not count) / the window's length, against the
+  configured rate (target: within 2 %), the worst topic shown, and the messages lost
+  (stamps the controller published that never arrived);
+- the suite's CPU: utime + stime of its process (/proc/<pid>/stat, every thread) over the
+  window, as a share of one core (target for 32 axes: < 40 %), split into the Python
+  threads and the DDS threads (by thread name in /proc/<pid>/task);
+- the probe's own CPU, to judge what it takes from the suite on a 2-core machine.
+
+Cases: 32 axes in 16 two-axis supervisors with status and joint states at 100 Hz; 8 axes
+in 4 two-axis supervisors with status and joint states at 1 kHz.
+
+The machines are shared and noisy, so each case also runs the suite of a baseline revision
+(``--baseline``, extracted with git archive), alternating with this tree, ``--rounds`` times;
+the table gives the medians side by side, then every run.
+
+Where the time goes: ``--phases CASE`` runs the case once with the suite's clock thread timed
+by phase (its own CPU clock around every step, periodic callback and the publishing each
+leaves); ``--profile CASE`` runs it under cProfile (slower: ``--profile-time-scale``).
+
+    python -P bench/bench_suite.py [--seconds 20] [--rounds 2] [--case 32x100] [--baseline REV|none]
+    python -P bench/bench_suite.py --phases 8x1000 [--seconds 20]
+    python -P bench/bench_suite.py --profile 32x100 [--profile-time-scale 0.25]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import random
+import signal
+import statistics
+import struct
+import subprocess
+import sys
+import tarfile
+import tempfile
+import threading
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+# This source tree, not a stale installed copy (the installed package still supplies the
+# generated interfaces: mpi_ros/__init__.py), here and in the suite's process.
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO))
+os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)
+# Its own DDS domain (a pid-based one may be taken by a suite of a concurrent test run).
+os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(150, 200)))
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
+
+WAIT = 30.0
+BASELINE = "ca83577"  # the suite before issue 10's ROS-layer changes (wire.py, snapshots.py, the clock's stops)
+SETTLE = 2.0  # s between the last axis at velocity and the window (discovery, queues drained)
+_STAMP = struct.Struct("<iI")  # builtin_interfaces/Time, the first field of every topic counted
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    axes: int
+    status_rate: float  # Hz: MotionStatus, AxisStatus and JointState
+
+    @property
+    def supervisors(self) -> int:
+        return self.axes // 2
+
+
+CASES = {case.name: case for case in (Case("32x100", 32, 100.0), Case("8x1000", 8, 1000.0))}
+
+
+def suite_yaml(case: Case, directory: Path) -> Path:
+    """config/default.yaml with ``case.axes`` axes in two-axis supervisors and its rates."""
+    raw = yaml.safe_load((REPO / "config" / "default.yaml").read_text(encoding="utf-8"))
+    raw["axes"]["count"] = case.axes
+    raw["supervisors"] = [{"number": n, "axes": [2 * n, 2 * n + 1]} for n in range(case.supervisors)]
+    raw["ros"].update(status_rate=case.status_rate, joint_states_rate=case.status_rate)
+    path = directory / f"suite_{case.name}.yaml"
+    path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
+    return path
+
+
+# -- /proc ---------------------------------------------------------------------------------------
+def _ticks(stat: str) -> int:
+    fields = stat.rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])  # utime + stime
+
+
+def cpu_seconds(pid: int) -> float:
+    return _ticks(Path(f"/proc/{pid}/stat").read_text()) / os.sysconf("SC_CLK_TCK")
+
+
+def thread_cpu(pid: int) -> Counter:
+    """CPU seconds per thread name (comm) of a process, every thread summed by name."""
+    out: Counter = Counter()
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        try:
+            stat = (task / "stat").read_text()
+        except OSError:
+            continue  # the thread ended
+        name = stat[stat.index("(") + 1: stat.rindex(")")]
+        out[name] += _ticks(stat) / os.sysconf("SC_CLK_TCK")
+    return out
+
+
+def load_average() -> str:
+    return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+
+
+# -- the probe -------------------------------------------------------------------------------------
+@dataclass
+class Topic:
+    name: str
+    rate: float
+    # per message: (sent, received, stamp), ns; sent and received are the middleware's wall-clock
+    # times (source and reception timestamps), so the probe's own delays do not count
+    messages: list[tuple[int, int, int]] = field(default_factory=list)
+
+    def on_message(self, data: bytes, info: dict) -> None:
+        sec, nanosec = _STAMP.unpack_from(data, 4)  # after the 4-byte CDR header
+        self.messages.append((info["source_timestamp"], info["received_timestamp"], sec * 1_000_000_000 + nanosec))
+
+    def window(self, start: int, end: int) -> list[tuple[int, int, int]]:
+        """The messages received in [start, end) (ns, wall clock)."""
+        return [m for m in self.messages if start <= m[1] < end]
+
+
+@dataclass(frozen=True)
+class TopicFigures:
+    name: str
+    target: float
+    measured: float
+    lost: int
+
+    @property
+    def error(self) -> float:
+        return self.measured / self.target - 1.0
+
+
+def figures(topic: Topic, start: int, end: int) -> TopicFigures:
+    window = topic.window(start, end)
+    stamps = sorted({stamp for _, _, stamp in window})
+    expected = round((stamps[-1] - stamps[0]) * topic.rate / 1e9) + 1 if stamps else 0
+    return TopicFigures(topic.name, topic.rate, len(window) * 1e9 / (end - start), expected - len(stamps))
+
+
+def real_time(topic: Topic, start: int, end: int) -> tuple[float, float]:
+    """(controller time elapsed / wall time elapsed between the first and the last message
+    sent in the window, the most the controller was behind the wall clock in s: sent - stamp,
+    less the least of it)."""
+    window = topic.window(start, end)
+    if len(window) < 2:
+        return math.nan, math.nan  # the suite fell so far behind that nothing came
+    (sent0, _, stamp0), (sent1, _, stamp1) = window[0], window[-1]
+    lags = [sent - stamp for sent, _, stamp in window]
+    return (stamp1 - stamp0) / (sent1 - sent0), (max(lags) - min(lags)) / 1e9
+
+
+class Probe:
+    """A node of its own (in this process) that counts every topic, raw. rclpy's executor
+    takes one message per subscription and wait, through a task each: too slow for 14,000
+    messages a second on a shared core. Here one thread waits on every subscription and
+    takes everything queued at each wake."""
+
+    def __init__(self, context, case: Case):
+        from rclpy.node import Node
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from rosgraph_msgs.msg import Clock
+        from sensor_msgs.msg import JointState
+
+        from mpi_ros.msg import AxisStatus, MotionStatus
+
+        self.context = context
+        self.node = Node("bench_suite_probe", context=context)
+        # Deep queues: the probe never drops what arrived (/clock is offered best effort).
+        deep = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+        clock = QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT)
+        wanted = ([(MotionStatus, f"/mpi/ms{n}/status", case.status_rate, deep) for n in range(case.supervisors)]
+                  + [(AxisStatus, f"/mpi/axis{k}/status", case.status_rate, deep) for k in range(case.axes)]
+                  + [(JointState, "/joint_states", case.status_rate, deep), (Clock, "/clock", 100.0, clock)])
+        self.topics: dict[str, Topic] = {}
+        self._subscriptions = []
+        for msg_type, name, rate, qos in wanted:
+            self.topics[name] = Topic(name, rate)
+            subscription = self.node.create_subscription(msg_type, name, lambda _: None, qos, raw=True)
+            self._subscriptions.append((subscription, self.topics[name]))
+        self._stop = threading.Event()
+        self.thread = threading.Thread(target=self._drain, name="bench-probe", daemon=True)
+        self.thread.start()
+
+    def _drain(self) -> None:
+        from contextlib import ExitStack
+
+        from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+
+        with ExitStack() as held:  # the handles stay valid while the loop uses them
+            for subscription, _ in self._subscriptions:
+                held.enter_context(subscription.handle)
+            held.enter_context(self.context.handle)
+            wait_set = _rclpy.WaitSet(len(self._subscriptions), 0, 0, 0, 0, 0, self.context.handle)
+            while not self._stop.is_set():
+                wait_set.clear_entities()
+                for subscription, _ in self._subscriptions:
+                    wait_set.add_subscription(subscription.handle)
+                wait_set.wait(100_000_000)  # ns: a stop is seen within 0.1 s
+                ready = set(wait_set.get_ready_entities("subscription"))
+                for subscription, topic in self._subscriptions:
+                    if subscription.handle.pointer in ready:
+                        self._take_all(subscription, topic)
+
+    @staticmethod
+    def _take_all(subscription, topic: Topic) -> None:
+        handle = subscription.handle
+        while (taken := handle.take_message(subscription.msg_type, True)) is not None:
+            topic.on_message(*taken)
+
+    def close(self) -> None:
+        self._stop.set()
+        self.thread.join(timeout=2.0)
+        self.node.destroy_node()
+
+
+def start_moves(context, case: Case) -> int:
+    """A VELOCITY move on every supervisor, through its MotionStart action; returns how many
+    goals succeeded within WAIT (a VELOCITY goal succeeds when its axes are at velocity).
+    A suite that cannot keep up may answer late: its moves run all the same (a goal's
+    command is applied as it is accepted; one whose request is not taken in time does not
+    move), and the window shows how far behind."""
+    from mpi_ros.client import MotionClient
+    from mpi_ros.errors import NoResponse
+
+    at_velocity = 0
+    for n in range(case.supervisors):
+        with MotionClient(n, context=context, timeout=WAIT, node_name=f"bench_suite_ms{n}") as client:
+            assert client.wait_for_server(WAIT), f"/mpi/ms{n} did not come up"
+            try:
+                goal = client.start({"type": "VELOCITY",
+                                     "trajectory": [{"velocity": 1000.0 + 10.0 * n, "acceleration": 100_000.0}]})
+                at_velocity += goal.wait(WAIT).detail == "at velocity"
+            except NoResponse:
+                pass  # the goal's answer or its result came too late
+    return at_velocity
+
+
+# -- one case --------------------------------------------------------------------------------------
+@dataclass
+class Result:
+    case: Case
+    tree: str  # which source tree the suite ran: "working tree" or the baseline's revision
+    at_velocity: int  # goals answered "at velocity" within WAIT (of one per supervisor)
+    stopped: str | None  # None: it stopped on Ctrl-C; else what happened
+    seconds: float
+    real_time: float
+    lag: float  # s: how far the controller's lag behind the wall clock varied in the window
+    topics: list[TopicFigures]
+    suite_cpu: float  # share of one core
+    suite_threads: Counter  # CPU share of one core by thread name
+    probe_cpu: float
+    load_before: str
+    load_after: str
+
+    @property
+    def worst(self) -> TopicFigures:
+        return max(self.topics, key=lambda t: abs(t.error))
+
+
+def _mark(marks: str | None, what: str) -> None:
+    if marks is None:
+        return
+    Path(f"{marks}.{what}").touch()
+    if what == "end":  # the suite writes its table at once: let it before stopping it
+        deadline = time.monotonic() + 5.0
+        while not Path(f"{marks}.phases.md").exists() and time.monotonic() < deadline:
+            threading.Event().wait(0.01)
+
+
+def _stop(suite: subprocess.Popen) -> str | None:
+    """Ctrl-C the suite; None once it stopped, else what happened (a suite far behind real
+    time may not stop in time: that is a finding, not an error of the benchmark)."""
+    suite.send_signal(signal.SIGINT)
+    try:
+        suite.wait(timeout=WAIT)
+        return None
+    except subprocess.TimeoutExpired:
+        suite.kill()
+        suite.wait()
+        return f"did not stop within {WAIT:g} s of Ctrl-C (killed)"
+
+
+@dataclass
+class _Window:
+    """What was measured over the window: its ends (ns, wall clock), the CPU of the suite
+    (seconds, in all and by thread name) and of the probe, the load before and after."""
+
+    start: int
+    end: int
+    suite_cpu: float
+    suite_threads: Counter
+    probe_cpu: float
+    load_before: str
+    load_after: str
+
+
+def _window(pid: int, seconds: float, marks: str | None) -> _Window:
+    load_before = load_average()
+    cpu0, threads0, probe0 = cpu_seconds(pid), thread_cpu(pid), time.process_time()
+    _mark(marks, "start")
+    start = time.time_ns()  # the middleware's timestamps are wall-clock (system) time
+    threading.Event().wait(seconds)
+    end = time.time_ns()
+    _mark(marks, "end")
+    cpu1, threads1, probe1 = cpu_seconds(pid), thread_cpu(pid), time.process_time()
+    threads = Counter({name: threads1[name] - threads0.get(name, 0.0) for name in threads1})
+    return _Window(start, end, cpu1 - cpu0, threads, probe1 - probe0, load_before, load_average())
+
+
+def run_case(case: Case, seconds: float, command: list[str] | None = None, marks: str | None = None,
+             tree: Path = REPO, label: str = "working tree") -> Result:
+    """One run of ``case``; ``command`` starts the suite (default: mpi-ros run at time scale 1)
+    from the source ``tree`` (the installed package supplies the generated interfaces);
+    ``marks``: create <marks>.start and <marks>.end when the window begins and ends (serve_phases)."""
+    import rclpy
+
+    with tempfile.TemporaryDirectory(prefix="bench_suite_") as tmp:
+        config = suite_yaml(case, Path(tmp))
+        argv = command or [sys.executable, "-P", "-m", "mpi_ros.cli", "run", "--time-scale", "1"]
+        with open(Path(tmp) / "suite.log", "w") as log:
+            suite = subprocess.Popen([*argv, "--config", str(config)], cwd=tmp, stdout=subprocess.DEVNULL,
+                                     stderr=log, env={**os.environ, "PYTHONPATH": str(tree)})
+        context = rclpy.Context()
+        rclpy.init(context=context)
+        probe = None
+        try:
+            probe = Probe(context, case)
+            at_velocity = start_moves(context, case)
+            threading.Event().wait(SETTLE)
+            window = _window(suite.pid, seconds, marks)
+        finally:
+            if probe is not None:
+                probe.close()
+            context.try_shutdown()
+            stopped = _stop(suite)
+        if stopped is None and suite.returncode != 0:
+            raise RuntimeError(f"the suite exited with {suite.returncode}:\n{(Path(tmp) / 'suite.log').read_text()}")
+    start, end = window.start, window.end
+    wall = (end - start) / 1e9
+    return Result(case, label, at_velocity, stopped, wall, *real_time(probe.topics["/mpi/ms0/status"], start, end),
+                  [figures(topic, start, end) for topic in probe.topics.values()], window.suite_cpu / wall,
+                  Counter({name: cpu / wall for name, cpu in window.suite_threads.items()}),
+                  window.probe_cpu / wall, window.load_before, window.load_after)
+
+
+# -- profile -------------------------------------------------------------------------------------
+def serve_profiled(out: str, argv: list[str]) -> int:
+    """``mpi-ros run <argv>`` in this process, with cProfile on the controller's clock thread
+    (stepping, building the messages, publishing) and on the thread that spins the executor;
+    on exit each thread's stats go to <out>.<thread>.prof. Only for the profile: cProfile
+    slows what it watches, so the figures come from runs without it."""
+    import cProfile
+    import functools
+
+    from mpi_ros.cli import main as cli_main
+    from mpi_ros.ros.suite import Suite
+    from mpi_ros.runner import ControllerRunner
+
+    def profiled(method, name: str):
+        @functools.wraps(method)
+        def wrapper(*args, **kwargs):
+            profile = cProfile.Profile()
+            profile.enable()
+            try:
+                return method(*args, **kwargs)
+            finally:
+                profile.disable()
+                profile.dump_stats(f"{out}.{name}.prof")
+        return wrapper
+
+    ControllerRunner._loop = profiled(ControllerRunner._loop, "clock")
+    Suite.spin = profiled(Suite.spin, "executor")
+    return cli_main(["run", *argv])
+
+
+class _Phases:
+    """CPU time of the controller's clock thread by phase, measured with the thread's own CPU
+    clock (time.thread_time) around each: an exact split at a few microseconds a call,
+    where cProfile's per-call overhead swells the small functions and slows the suite
+    until it falls behind."""
+
+    def __init__(self) -> None:
+        self.cpu: Counter = Counter()
+        self.calls: Counter = Counter()
+        self.thread_cpu = 0.0
+
+    def timed(self, name: str, function):
+        def wrapper(*args, **kwargs):
+            start = time.thread_time()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                self.cpu[name] += time.thread_time() - start
+                self.calls[name] += 1
+        return wrapper
+
+    def producer(self, name: str, callback):
+        """A periodic callback or change hook: itself, then the output it returns, each timed."""
+        timed = self.timed(name, callback)
+
+        def wrapper(ctl):
+            output = timed(ctl)
+            return None if output is None else self.timed(f"{name} (output)", output)
+        return wrapper
+
+    def table(self, seconds: float) -> list[str]:
+        lines = [f"clock thread CPU: {self.thread_cpu / seconds * 100:.1f} % of one core over {seconds:.1f} s",
+                 "| phase | share of one core | calls/s | us per call |", "| --- | --- | --- | --- |"]
+        for name, cpu in self.cpu.most_common():
+            lines.append(f"| {name} | {cpu / seconds * 100:.1f} % | {self.calls[name] / seconds:.0f} "
+                         f"| {cpu / self.calls[name] * 1e6:.1f} |")
+        return lines
+
+
+def serve_phases(out: str, argv: list[str]) -> int:
+    """``mpi-ros run <argv>`` in this process with its clock thread's CPU split by phase
+    (_Phases): the controller's steps, each periodic callback and change hook (under the
+    runner's lock) and the output each returns (publishing, after the lock). Counts over
+    the probe's window, which it marks with the files <out>.start and <out>.end (a signal
+    would wait for the main thread, blocked in the executor's wait); the table goes to
+    <out>.phases.md."""
+    from mpi_ros.cli import main as cli_main
+    from mpi_ros.mpi.control import Controller
+    from mpi_ros.runner import ControllerRunner
+
+    phases = _Phases()
+    clock_thread: list[int] = []  # the CPU clock of the clock thread
+
+    def named(callback) -> str:
+        owner = getattr(callback, "__self__", None)
+        return f"{type(owner).__name__}.{callback.__name__}" if owner is not None else callback.__qualname__
+
+    add_periodic, on_change, loop = ControllerRunner.add_periodic, ControllerRunner.on_change, ControllerRunner._loop
+    ControllerRunner.add_periodic = lambda self, rate, callback: add_periodic(
+        self, rate, phases.producer(f"periodic {named(callback)}", callback))
+    ControllerRunner.on_change = lambda self, hook: on_change(self, phases.producer(f"change hook {named(hook)}", hook))
+    Controller.step = phases.timed("Controller.step (the core)", Controller.step)
+
+    def clock_loop(self) -> None:
+        clock_thread.append(time.pthread_getcpuclockid(threading.get_ident()))
+        loop(self)
+
+    ControllerRunner._loop = clock_loop
+    threading.Thread(target=_window_watch, args=(phases, clock_thread, out), daemon=True).start()
+    return cli_main(["run", *argv])
+
+
+def _window_watch(phases: _Phases, clock_thread: list[int], out: str) -> None:
+    """serve_phases: count from <out>.start to <out>.end, then write the table."""
+    pause = threading.Event()
+    while not Path(f"{out}.start").exists() or not clock_thread:
+        pause.wait(0.01)
+    phases.cpu.clear()
+    phases.calls.clear()
+    wall, cpu = time.monotonic(), time.clock_gettime(clock_thread[0])
+    while not Path(f"{out}.end").exists():
+        pause.wait(0.01)
+    phases.thread_cpu = time.clock_gettime(clock_thread[0]) - cpu
+    table = phases.table(time.monotonic() - wall)
+    Path(f"{out}.phases.md").write_text("\n".join(table) + "\n", encoding="utf-8")
+
+
+def profile(case: Case, seconds: float, out: Path, time_scale: float, top: int = 25) -> None:
+    """The case with the suite under cProfile (serve_profiled); prints each thread's top
+    functions by own time and by cumulative time. ``time_scale`` < 1 gives the profiled
+    suite the time the profiler takes (every status round does the same work, fewer of them
+    a second), so that it keeps up as the real one does; the figures of that run are
+    shown, but only the profile counts."""
+    import pstats
+
+    command = [sys.executable, "-P", str(Path(__file__).resolve()), "--serve-profiled", str(out), "--",
+               "--time-scale", f"{time_scale:g}"]
+    result = run_case(case, seconds, command)
+    print(f"Under cProfile, time scale {time_scale:g} (rates scale with it):")
+    print("\n".join(report([result])))
+    for name in ("clock", "executor"):
+        stats = pstats.Stats(f"{out}.{name}.prof")
+        print(f"\n== {name} thread ==")
+        stats.sort_stats("tottime").print_stats(top)
+        stats.sort_stats("cumulative").print_stats(top)
+
+
+def phases(case: Case, seconds: float, out: Path) -> None:
+    """The case with the suite's clock thread timed by phase (serve_phases), in real time."""
+    for stale in (".start", ".end", ".phases.md"):
+        Path(f"{out}{stale}").unlink(missing_ok=True)
+    command = [sys.executable, "-P", str(Path(__file__).resolve()), "--serve-phases", str(out), "--",
+               "--time-scale", "1"]
+    result = run_case(case, seconds, command, marks=str(out))
+    print("\n".join(report([result])))
+    print()
+    print(Path(f"{out}.phases.md").read_text(encoding="utf-8"))
+
+
+# -- report ----------------------------------------------------------------------------------------
+def _threads(shares: Counter) -> str:
+    python = shares.get("python", 0.0) + shares.get("python3", 0.0)
+    others = sorted(((share, name) for name, share in shares.items() if name not in ("python", "python3")),
+                    reverse=True)
+    shown = ", ".join(f"{name} {share * 100:.1f}" for share, name in others if share >= 0.005)
+    return f"Python threads {python * 100:.1f} %" + (f"; others: {shown} %" if shown else "")
+
+
+def rows(result: Result) -> list[str]:
+    case = result.case
+    worst = result.worst
+    lost = sum(t.lost for t in result.topics)
+    status = f"status and joint states at {case.status_rate:g} Hz"
+    return [
+        f"| {case.axes} axes, {case.supervisors} supervisors, {status}, every axis moving "
+        f"({len(result.topics)} topics, {result.seconds:.1f} s; load {result.load_before} -> {result.load_after}) "
+        f"| {result.tree} "
+        f"| {(result.real_time - 1) * 100:+.3f} % (lag varied by {result.lag * 1e3:.1f} ms) "
+        f"| worst topic {worst.name} {worst.measured:.2f} Hz "
+        f"({worst.error * 100:+.2f} %); {lost} message(s) lost in all"
+        + (f"; only {result.at_velocity} of {case.supervisors} goals answered within {WAIT:g} s"
+           if result.at_velocity < case.supervisors else "")
+        + (f"; {result.stopped}" if result.stopped else "") + " "
+        f"| {result.suite_cpu * 100:.1f} % ({_threads(result.suite_threads)}) | {result.probe_cpu * 100:.1f} % |",
+    ]
+
+
+def report(results: list[Result]) -> list[str]:
+    lines = ["| case | suite | real time (controller / wall - 1) | every topic's rate (worst) "
+             "| suite CPU, share of one core | probe CPU |", "| --- | --- | --- | --- | --- | --- |"]
+    for result in results:
+        lines += rows(result)
+    return lines
+
+
+def baseline_tree(revision: str, into: Path) -> Path | None:
+    """The package at ``revision`` (git archive), or None where there is no git history."""
+    try:
+        archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros"],
+                                 check=True, capture_output=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    (into / "tree.tar").write_bytes(archive)
+    with tarfile.open(into / "tree.tar") as tar:
+        tar.extractall(into / "tree", filter="data")
+    return into / "tree"
+
+
+def summary(results: list[Result]) -> list[str]:
+    """Per case and tree: the median of the runs (the machine is shared: compare side by side)."""
+    lines = ["| case | suite | runs | real time, median | worst topic, median | topics within 2 % in every run "
+             "| suite CPU, median (range) |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    for case in dict.fromkeys(r.case for r in results):
+        for tree in dict.fromkeys(r.tree for r in results):
+            runs = [r for r in results if r.case == case and r.tree == tree]
+            if not runs:
+                continue
+            cpu = sorted(r.suite_cpu * 100 for r in runs)
+            within = all(abs(t.error) <= 0.02 for r in runs for t in r.topics)
+            lines.append(f"| {case.name} | {tree} | {len(runs)} | "
+                         f"{(statistics.median(r.real_time for r in runs) - 1) * 100:+.3f} % | "
+                         f"{statistics.median(r.worst.error for r in runs) * 100:+.2f} % | "
+                         f"{'yes' if within else 'no'} | "
+                         f"{statistics.median(cpu):.1f} % ({cpu[0]:.1f}-{cpu[-1]:.1f}) |")
+    return lines
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--case", action="append", choices=sorted(CASES), help="default: every case")
+    parser.add_argument("--seconds", type=float, default=20.0, help="the measuring window (default 20)")
+    parser.add_argument("--rounds", type=int, default=2, help="runs of each case and tree (default 2)")
+    parser.add_argument("--baseline", default=BASELINE,
+                        help=f"also run the suite of this revision, alternating (default {BASELINE}; 'none': not)")
+    parser.add_argument("--profile", choices=sorted(CASES), help="run this case with the suite under cProfile")
+    parser.add_argument("--phases", choices=sorted(CASES),
+                        help="run this case with the clock thread's CPU split by phase (in real time)")
+    parser.add_argument("--profile-time-scale", type=float, default=1.0,
+                        help="the profiled suite's time scale (default 1; < 1 where the profiler makes it fall behind)")
+    parser.add_argument("--profile-out", default=str(Path(tempfile.gettempdir()) / "bench_suite"),
+                        help="where the profiles go (<this>.<thread>.prof)")
+    parser.add_argument("--serve-profiled", metavar="OUT", help=argparse.SUPPRESS)  # the profiled suite's process
+    parser.add_argument("--serve-phases", metavar="OUT", help=argparse.SUPPRESS)  # the timed suite's process
+    parser.add_argument("run_args", nargs="*", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.serve_profiled:
+        sys.exit(serve_profiled(args.serve_profiled, args.run_args))
+    if args.serve_phases:
+        sys.exit(serve_phases(args.serve_phases, args.run_args))
+    if args.phases:
+        phases(CASES[args.phases], args.seconds, Path(args.profile_out))
+        return
+    if args.profile:
+        profile(CASES[args.profile], args.seconds, Path(args.profile_out), args.profile_time_scale)
+        return
+    with tempfile.TemporaryDirectory(prefix="bench_suite_baseline_") as tmp:
+        trees = [(REPO, "working tree")]
+        if args.baseline != "none":
+            tree = baseline_tree(args.baseline, Path(tmp))
+            if tree is None:
+                print(f"(no baseline: `git archive {args.baseline}` failed)")
+            else:
+                trees.append((tree, args.baseline))
+        results = [run_case(CASES[name], args.seconds, tree=tree, label=label)
+                   for _ in range(args.rounds) for name in args.case or CASES for tree, label in trees]
+    print(f"`python -P bench/bench_suite.py --seconds {args.seconds:g} --rounds {args.rounds}` on "
+          f"{time.strftime('%Y-%m-%d')}, {os.cpu_count()} cores; the runs alternate between the trees.")
+    print()
+    print("\n".join(summary(results)))
+    print()
+    print("\n".join(report(results)))
+
+
+if __name__ == "__main__":
+    main()

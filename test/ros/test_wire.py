@@ -1,0 +1,139 @@
+"""The status topics are published as CDR packed by mpi_ros/ros/wire.py: the bytes must be
+exactly the canonical CDR of the messages convert.py builds from the same snapshots, so that
+subscribers, recorders and replay cannot tell the difference."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import pytest
+from rclpy.serialization import deserialize_message
+
+from mpi_ros import config
+from mpi_ros.bag import cdr
+from mpi_ros.mpi import MotionAttr, MotionParams, MPIAction, MPIMotionType, Trajectory
+from mpi_ros.mpi.types import MPIState
+from mpi_ros.msg import AxisStatus, MotionStatus
+from mpi_ros.ros import convert, wire
+
+EPOCH = 1_795_000_000_123_456_789
+
+
+def _controller(axes: int = 6, per: tuple[int, ...] = (1, 2, 3)):
+    """Supervisors of 1, 2 and 3 axes: every alignment an AxisStatus can start at in a MotionStatus."""
+    raw = config.load().raw
+    raw = config.merge(raw, {"axes": {"count": axes}})
+    first, supervisors = 0, []
+    for n, count in enumerate(per):
+        supervisors.append({"number": n, "axes": list(range(first, first + count))})
+        first += count
+    raw["supervisors"] = supervisors
+    return config.parse(raw).build_controller()
+
+
+def _moving_states(ctl):
+    """Snapshots along S-curves, a velocity move and an E_STOP: every state and flag changes."""
+    ctl.supervisors[0].start(MPIMotionType.S_CURVE, MotionAttr.NONE, MotionParams(
+        trajectory=[Trajectory(4000.0, 40000.0, 40000.0, 50.0)], position=[1234.5]))
+    ctl.supervisors[1].start(MPIMotionType.VELOCITY, MotionAttr.NONE, MotionParams(
+        trajectory=[Trajectory(-700.0, 9000.0, 9000.0, 0.0)]))
+    ctl.supervisors[2].start(MPIMotionType.TRAPEZOIDAL, MotionAttr.NONE, MotionParams(
+        trajectory=[Trajectory(3000.0, 30000.0, 30000.0, 0.0)], position=[-100.25, 2e6, 7.0]))
+    for step in range(60):
+        ctl.step(37)
+        if step == 30:
+            ctl.supervisors[2].action(MPIAction.E_STOP)
+        yield ctl
+
+
+def _same_message(data: bytes, msg) -> None:
+    """``data`` decodes to ``msg``, field for field (json spells NaN alike on both sides)."""
+    decoded = deserialize_message(data, type(msg))
+    assert json.dumps(convert.to_dict(decoded)) == json.dumps(convert.to_dict(msg))
+
+
+def test_the_installed_interfaces_have_the_layout_the_encoder_packs():
+    assert wire.AVAILABLE
+
+
+@pytest.mark.parametrize("epoch", [EPOCH, 0])
+def test_axis_and_motion_status_bytes_equal_the_canonical_cdr_of_convert(epoch):
+    ctl = _controller()
+    seen_states = set()
+    for ctl in _moving_states(ctl):
+        for axis in ctl.axes:
+            snap = ctl.axis_snapshot(axis.number)
+            msg = convert.axis_status(snap, ctl.rate, epoch)
+            assert wire.axis_status(snap, ctl.rate, epoch) == cdr.serialize(msg)
+            seen_states.add(snap.state)
+        for ms in ctl.supervisors:
+            snap = ms.snapshot()
+            msg = convert.motion_status(snap, ctl.rate, epoch)
+            data = wire.motion_status(snap, ctl.rate, epoch)
+            assert data == cdr.serialize(msg)
+            _same_message(data, msg)
+    assert {MPIState.MOVING, MPIState.IDLE, MPIState.STOPPING_ERROR} <= seen_states
+
+
+def test_edge_values_are_packed_as_convert_sets_them():
+    ctl = _controller()
+    snap = ctl.axis_snapshot(0)
+    if wire.FEEDFORWARD and hasattr(snap, "feedforward"):  # interfaces and core of issue 11
+        snap = dataclasses.replace(snap, feedforward=math.inf)  # a finite value is sent: 0.0
+    odd = dataclasses.replace(snap, sample=2**33 + 3, number=31, state=MPIState.STOPPING_ERROR,
+                              command_position=math.inf, actual_position=-math.inf, position_error=math.nan,
+                              target_position=math.nan, origin=-1e300, command_velocity=-0.0,
+                              move_id=-(2**31), element_id=2**31 - 1, frame_count=0, supervisor=-1)
+    msg = convert.axis_status(odd, ctl.rate, EPOCH)
+    assert wire.axis_status(odd, ctl.rate, EPOCH) == cdr.serialize(msg)
+    _same_message(wire.axis_status(odd, ctl.rate, EPOCH), msg)
+    motion = dataclasses.replace(ctl.supervisors[2].snapshot(), axes=(odd, snap), axis_numbers=(31, 0),
+                                 last_action="E_STOP", action_source="USER", motion_type="S_CURVE_JERK",
+                                 moves_pending=-3, feedrate=0.25)
+    msg = convert.motion_status(motion, ctl.rate, EPOCH)
+    assert wire.motion_status(motion, ctl.rate, EPOCH) == cdr.serialize(msg)
+    empty = dataclasses.replace(motion, axes=(), axis_numbers=(), last_action="", action_source="", motion_type="")
+    assert wire.motion_status(empty, ctl.rate, EPOCH) == cdr.serialize(convert.motion_status(empty, ctl.rate, EPOCH))
+
+
+def test_joint_state_bytes_equal_the_canonical_cdr_of_convert_from_the_axes_or_their_snapshots():
+    ctl = _controller()
+    names = convert.joint_names(ctl)
+    ctl.axes[4].origin = 12.5  # positions are reported minus the origin
+    for step, ctl in enumerate(_moving_states(ctl)):
+        if step == 40:
+            ctl.supervisors[1].action(MPIAction.ABORT)  # amplifier off: no effort
+        expected = cdr.serialize(convert.joint_state(ctl, EPOCH))
+        direct = convert.joint_values(ctl)
+        snapshots = {a.number: ctl.axis_snapshot(a.number) for a in ctl.axes}
+        assert convert.joint_values(ctl, snapshots) == direct
+        assert wire.joint_state(ctl.sample, ctl.rate, EPOCH, names, *direct) == expected
+    assert any(effort == 0.0 for effort in direct[2]) and any(effort != 0.0 for effort in direct[2])
+
+
+def test_snapshots_are_read_once_a_sample_and_read_again_after_a_command():
+    from mpi_ros.commands import Command
+    from mpi_ros.runner import ControllerRunner
+    from mpi_ros.ros.snapshots import shared
+
+    ctl = _controller(axes=8)  # axes 6 and 7: no supervisor maps them
+    runner = ControllerRunner(ctl, time_scale=None)
+    snapshots = shared(runner)
+    assert shared(runner) is snapshots
+    next(_moving_states(ctl))
+    reads = []
+    taken = ctl.axis_snapshot
+    ctl.axis_snapshot = lambda number: reads.append(number) or taken(number)  # counts the reads
+    first = {a.number: snapshots.axis(ctl, a.number) for a in ctl.axes}
+    assert snapshots.motion(ctl, 1).axes == (first[1], first[2])
+    assert sorted(reads) == list(range(8)) and snapshots.taken_axes(ctl) == first
+    assert first == {a.number: taken(a.number) for a in ctl.axes}
+
+    runner.submit(Command("action", 2, request={"action": "E_STOP"}))  # at the same sample
+    assert snapshots.taken_axes(ctl) is None
+    assert snapshots.motion(ctl, 2).state is MPIState.STOPPING_ERROR
+    assert snapshots.axis(ctl, 3).state is MPIState.STOPPING_ERROR
+    runner.step(1)
+    assert snapshots.axis(ctl, 0).sample == ctl.sample == first[0].sample + 1
