@@ -5,8 +5,7 @@
 
 The tour, on supervisor 0 (axes 0 and 1): an S-curve move; a jog modified in flight
 into a move to a target; STOP and RESUME; E_STOP, a move refused in ERROR, and RESET; a
-path move (PVT) once the controller runs paths (until then the step says so and is
-skipped); back home. Each step prints the `mpi-ros` command that does the same against a
+path move (PVT) through three points; back home. Each step prints the `mpi-ros` command that does the same against a
 running suite, then the controller's answer. While it runs, `mpi-ros status` in another
 shell shows the axes move.
 
@@ -387,9 +386,6 @@ def path_move(t: Tour) -> None:
            "mpi-ros move --goal \"{type: PVT, position: [1000, 1000, 2500, 500, 3000, 0], "
            "point_velocity: [1200, 600, 1000, -800, 0, 0], time: [1, 1, 1]}\"")
     result = t.client.start(PATH).wait(WAIT, raise_on_error=False)
-    if result.message == "MPIMessageUNSUPPORTED":
-        t.say(f"skipped: paths are not built yet (the controller answered {result.message}: {result.detail})")
-        return
     t.say(f"{result.message} (code {result.code}) {result.outcome}, state {result.state_name}, "
           f"at {positions(result.actual_position)}")
     from mpi_ros.errors import raise_for

@@ -266,6 +266,28 @@ class Axis:
         self.target = plan.target
         self._bank.reset_counters(self.number)
 
+    def extend(self, plan: AxisPlan, t: float, clock: ProfileClock) -> None:
+        """The path it runs, with points appended (paths.extend): the same profile up to now,
+        so it goes on from here in the same profile time, status counters and all."""
+        self.rebase(t, clock)
+        self.plan = plan
+        self.target = plan.target
+
+    @property
+    def current_element_id(self) -> int:
+        """The element id of the point a path runs toward (ELEMENT_ID per point), else the
+        move's."""
+        return self.element_id_at(self.rel)
+
+    def element_id_at(self, rel: float) -> int:
+        """:attr:`current_element_id` at profile time ``rel`` of the plan (nan: none)."""
+        plan = self.plan
+        if plan is not None and plan.element_ids:
+            found = plan.element_at(rel if math.isfinite(rel) else -math.inf)
+            if found is not None:
+                return found
+        return self.element_id
+
     def unload(self, t: float, clock: ProfileClock | None) -> None:
         """Drop the plan; the command rests where it is now."""
         self.rebase(t, clock)

@@ -21,10 +21,19 @@ from .profiles.segment import Segment, SegmentTable
 from .types import MotionAttr, MPIMotionType
 
 _serials = itertools.count(1)
+# A point's time is a sum of its dts in floating point, off the sample grid by rounding: a
+# point counts as reached from the sample within this many seconds of its time (far below
+# one sample at any rate the controller takes).
+POINT_TIME_TOLERANCE = 1e-9
 
 
 def next_serial() -> int:
     return next(_serials)
+
+
+def reached(rel):
+    """The profile time up to which points count as reached at profile time ``rel``."""
+    return rel + POINT_TIME_TOLERANCE
 
 
 @dataclass(slots=True)
@@ -45,13 +54,20 @@ class AxisPlan:
     start_velocity: float = 0.0  # velocity (profile time) the profile starts from
     start_acceleration: float = 0.0
     composite: str = ""  # why the segments are more than one profile (e.g. stop, then a new line)
+    # Paths (paths.py): profile time of the first segment (executed points are flushed from
+    # a streamed path), the time each point is reached, the element id while running toward
+    # each point, outputs applied at a later point (pointIndex > 0) with their times.
+    origin_time: float = 0.0
+    point_times: np.ndarray | None = None
+    element_ids: tuple[int, ...] = ()
+    timed_outputs: list[tuple[float, Output]] = field(default_factory=list)
     table: SegmentTable = field(init=False)
     duration: float = field(init=False)
 
     def __post_init__(self) -> None:
         if not self.segments:
             self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
-        self.table = SegmentTable(self.segments)
+        self.table = SegmentTable(self.segments, self.origin_time)
         self.duration = float(self.table.end[-1])
 
     @property
@@ -67,6 +83,20 @@ class AxisPlan:
         """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
         done = int(np.searchsorted(self.table.end, rel, side="right"))
         return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
+
+    def points_left(self, rel: float | np.ndarray) -> int | np.ndarray:
+        """Points of a path not reached by profile time ``rel`` (0 for other plans)."""
+        if self.point_times is None:
+            return 0 if np.ndim(rel) == 0 else np.zeros(np.shape(rel), dtype=np.int64)
+        return len(self.point_times) - np.searchsorted(self.point_times, reached(rel), side="right")
+
+    def element_at(self, rel: float) -> int | None:
+        """The element id of the point a path runs toward at ``rel`` (its last one once
+        there); None without per-point ids."""
+        if not self.element_ids or self.point_times is None:
+            return None
+        i = int(np.searchsorted(self.point_times, reached(rel), side="right"))
+        return self.element_ids[min(i, len(self.element_ids) - 1)]
 
     def evaluate(self, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, d/dtau and d2/dtau2 of the plan at relative profile times.
@@ -98,6 +128,32 @@ class AxisPlan:
 
 
 @dataclass(slots=True)
+class Stream:
+    """The streaming state of an open path (MPIMotionPoint, MPIMotionPathAttrMask)."""
+
+    open: bool  # final was false: more points are expected
+    empty_count: int  # E_STOP when fewer points are left while open (<= 0: disabled)
+    low_count: int  # FRAMES_LOW below this many points while open
+    low_sent: bool = False  # FRAMES_LOW sent since the buffer was last refilled
+    empty_sent: bool = False
+    peaks: list[tuple[float, float]] = field(default_factory=list)  # per axis: max |v|, max |a|
+    # Appended points not yet executed: (serial of the append, profile time of its last point
+    # on each axis). An append is a command of its own: it ends when its points are done.
+    chunks: list[tuple[int, dict[int, float]]] = field(default_factory=list)
+
+    def append(self, chunk: "Stream | None", open_: bool) -> None:
+        """Points were appended (``chunk``: theirs; None: none, the path is only closed)."""
+        self.open = open_
+        self.low_sent = self.empty_sent = False
+        if chunk is not None:
+            self.peaks = [(max(v, cv), max(a, ca)) for (v, a), (cv, ca) in zip(self.peaks, chunk.peaks)]
+
+    def describe_peaks(self, axes: Sequence[int]) -> str:
+        parts = [f"axis {n}: |v| {v:.6g} counts/s, |a| {a:.6g} counts/s^2" for n, (v, a) in zip(axes, self.peaks)]
+        return "path peaks " + "; ".join(parts)
+
+
+@dataclass(slots=True)
 class Move:
     """A started (or appended) move of a supervisor."""
 
@@ -109,6 +165,7 @@ class Move:
     element_id: int = 0
     event_mask: MPIEventType = MPIEventType.NONE
     serial: int = field(default_factory=next_serial)
+    stream: Stream | None = None  # a path move: its streaming state
     # Facts the controller asks every stretch (a move's plans never change once compiled).
     is_velocity: bool = field(init=False)  # a VELOCITY move
     ends_moving: bool = field(init=False)  # FINAL_VEL: the axes go on at their final velocity
@@ -122,6 +179,11 @@ class Move:
     @property
     def axes(self) -> list[int]:
         return [plan.axis for plan in self.plans]
+
+    def serials(self) -> set[int]:
+        """Its serial and those of the appends to it not yet done."""
+        chunks = self.stream.chunks if self.stream is not None else ()
+        return {self.serial, *(serial for serial, _ in chunks)}
 
     def plan_for(self, axis: int) -> AxisPlan | None:
         for plan in self.plans:

@@ -14,17 +14,15 @@ from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
-import numpy as np
-
-from . import validate
+from . import paths, validate
 from .axis import Axis, CommandMode
 from .clock import ProfileClock
 from .events import MPIEventType
-from .frames import Move, frames_needed
+from .frames import AxisPlan, Move, frames_needed, next_serial
 from .holds import HoldWait
 from .log import MotionLog
 from .messages import STATE_MESSAGES, Message
-from .params import MotionConfig, MotionParams, check_position
+from .params import MotionConfig, MotionParams, Output, check_position
 from .planner import AxisStart, PlanError, compile_move
 from .snapshot import FrameBufferStatus, MotionSnapshot
 from .status import StatusMode
@@ -311,8 +309,11 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         """Start or modify; returns (message, detail, serial of the move it made or changed)."""
         message, detail = self._command(motion_type, attrs, params, modify)
         serial = self.current.serial if self.current is not None else 0
-        if message in (OK, Message.MPIMotionMessageAUTO_START) and attrs & MotionAttr.APPEND and self.queue:
-            serial = self.queue[-1].serial
+        if message in (OK, Message.MPIMotionMessageAUTO_START) and attrs & MotionAttr.APPEND:
+            if self.queue:
+                serial = self.queue[-1].serial
+            elif self.current is not None and self.current.stream is not None and self.current.stream.chunks:
+                serial = self.current.stream.chunks[-1][0]  # the points just appended to the open path
         return message, detail, serial
 
     def _command(self, motion_type, attrs, params, modify) -> tuple[Message, str]:
@@ -323,7 +324,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             params = self.stored_params
         if not self.axis_list:
             return Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes"
-        verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21)
+        verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21,
+                                      append=MotionAttr.APPEND in attrs)
         if not verdict.ok:
             return verdict.message, verdict.detail
         state = self._state_for(self.axis_list)
@@ -346,15 +348,22 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
         elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
             return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
+        open_path = self._open_path() if append and state is MPIState.MOVING else None
+        if open_path is not None and motion_type not in paths.STREAMED_TYPES:
+            return Message.MPIMotionMessagePATH_ERROR, ("the path in progress is open (final false): append its "
+                                                        "points, or close it with final true, first")
         # MPI 000, mpiMotionModify: HOLD is impossible with a modify "even when using the AUTO_START attribute"
         verdict = validate.check_attributes(motion_type, attrs, params, modify)
         if not verdict.ok:
             return verdict.message, verdict.detail
         verdict = validate.check_params(
             motion_type, attrs, params, len(self.axis_list), self._ctl.config.io_words,
-            self._ctl.config.motors, len(self._ctl.axes))
+            self._ctl.config.motors, len(self._ctl.axes), sample_rate=self._ctl.rate,
+            append_to=open_path is not None)
         if not verdict.ok:
             return verdict.message, verdict.detail
+        if open_path is not None:
+            return self._append_points(open_path, motion_type, attrs, params)
         if modify and not auto_start and MotionAttr.DELAY in attrs and any(d != 0.0 for d in params.delay):
             # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
@@ -368,6 +377,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate)
         except PlanError as exc:
             return exc.message, exc.detail
+        if move.stream is not None:
+            move.stream.low_count = self._ctl.config.frame_buffer_size // 4
         if queued:
             message = self._check_frames(list(self.queue) + ([self.current] if self.current else []) + [move])
         else:
@@ -431,11 +442,60 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         return starts
 
     def _check_frames(self, moves: list[Move]) -> Message:
+        """Do the moves fit the frame buffer? A path's points need not: the library holds
+        what does not fit and loads it as the buffer drains (MPI 001, LOW_COUNT)."""
         size = self._ctl.config.frame_buffer_size
+        loaded = [move for move in moves if move.stream is None]
         for n in self.axis_list:
-            if frames_needed(moves, n) > size:
+            if frames_needed(loaded, n) > size:
                 return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
         return OK
+
+    def _open_path(self) -> Move | None:
+        """The path in progress, if it is open (more points are expected)."""
+        move = self.current
+        if move is None or move.stream is None or not move.stream.open or self.queue:
+            return None
+        return move
+
+    def _append_points(self, move: Move, motion_type: MPIMotionType, attrs: MotionAttr,
+                       params: MotionParams) -> tuple[Message, str]:
+        """APPEND to an open path: the points follow its last point (or start now, if it ran
+        out of points), planned like a path of their own from there (docs/paths.md). The
+        append is recorded as a chunk of the path: a command whose outcome comes when its last
+        point is reached."""
+        stream = move.stream
+        plans = {plan.axis: plan for plan in move.plans}
+        if stream is None or sorted(plans) != sorted(self.axis_list):
+            return Message.MPIMessagePARAM_INVALID, "the points' axes are not the axes of the open path"
+        t = self._ctl.time
+        tau = self.clock.tau_at(t)
+        nows = {n: tau - self._axis(n).tau_start for n in self.axis_list}
+        if paths.point_count(motion_type, params, len(self.axis_list)) == 0:
+            # No points: it only closes (or keeps open) the path, and is done with its last point.
+            stream.append(None, open_=not params.final)
+            stream.chunks.append((next_serial(), {n: paths.last_point_time(plans[n]) for n in self.axis_list}))
+            return OK, ""
+        starts = [AxisStart(n, *paths.end_state(plans[n], nows[n]), self._axis(n).origin) for n in self.axis_list]
+        try:
+            chunk, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate)
+        except PlanError as exc:
+            return exc.message, exc.detail
+        for kind, detail in notes.events:
+            self._emit(kind, detail=detail, move=move)
+        self._rebase(t)
+        ends = {new.axis: self._extend_plan(move, plans[new.axis], new, nows[new.axis], t) for new in chunk.plans}
+        stream.append(chunk.stream, open_=not params.final)
+        stream.chunks.append((chunk.serial, ends))
+        return OK, ""
+
+    def _extend_plan(self, move: Move, old: AxisPlan, new: AxisPlan, now: float, t: float) -> float:
+        """Put ``new``'s points after ``old``'s on its axis; returns when its last one is reached."""
+        outputs = [(0.0, out) for out in new.outputs] + new.timed_outputs
+        extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target)
+        move.plans[move.plans.index(old)] = extended
+        self._axis(new.axis).extend(extended, t, self.clock)
+        return paths.last_point_time(extended)
 
     def _rebase(self, t: float) -> None:
         for axis in self.axes:
@@ -443,8 +503,17 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 axis.rebase(t, self.clock)
 
     def _end_move(self, move: Move, message: Message, detail: str) -> None:
+        """Record how ``move`` ended (with the appends to it still pending)."""
+        if move.stream is not None:
+            detail = f"{detail}; {move.stream.describe_peaks(move.plan_axes)}"
+            for serial, _ in move.stream.chunks:
+                self._end_serial(serial, message, detail)
+            move.stream.chunks.clear()
+        self._end_serial(move.serial, message, detail)
+
+    def _end_serial(self, serial: int, message: Message, detail: str) -> None:
         axes = [self._axis(n) for n in self.mapped]
-        self.move_ends.append(MoveEnd(move.serial, message, self._ctl.sample, detail,
+        self.move_ends.append(MoveEnd(serial, message, self._ctl.sample, detail,
                                       tuple(a.command_position for a in axes),
                                       tuple(a.actual_position for a in axes)))
 
@@ -534,10 +603,13 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
 
     def _fire_outputs(self, plan) -> None:
         for output in plan.outputs:
-            if output.type is OutputType.MOTOR:
-                self._ctl.io.apply_masks(IoSpace.MOTOR_GENERAL_IO, output.motor, output.on_mask, output.off_mask)
-            elif output.type is OutputType.OUTPUT:
-                self._ctl.io.apply_masks(IoSpace.IO, output.address, output.on_mask, output.off_mask)
+            self._fire_output(output)
+
+    def _fire_output(self, output: Output) -> None:
+        if output.type is OutputType.MOTOR:
+            self._ctl.io.apply_masks(IoSpace.MOTOR_GENERAL_IO, output.motor, output.on_mask, output.off_mask)
+        elif output.type is OutputType.OUTPUT:
+            self._ctl.io.apply_masks(IoSpace.IO, output.address, output.on_mask, output.off_mask)
 
     # ================================================================= status ====
     def _at_velocity_reached(self) -> None:
@@ -562,7 +634,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             at_target=all(a.at_target for a in axes) if axes else True,
             settled=all(a.settled for a in axes) if axes else True,
             move_id=move.id if move else 0,
-            element_id=move.element_id if move else 0,
+            element_id=self._element_id(move),
             feedrate=self.clock.feedrate(self._ctl.time),
             last_action=self.last_action,
             action_source=self.action_source.value,
@@ -588,11 +660,21 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 fractions.append(1.0 if plan.duration <= 0.0 else min(1.0, max(0.0, axis.rel / plan.duration)))
         return min(fractions) if fractions else 0.0
 
+    def _element_id(self, move: Move | None) -> int:
+        """The move's element id; a path's, of the point its first axis runs toward."""
+        if move is None:
+            return 0
+        if move.stream is not None and move.plans:
+            axis = self._axis(move.plans[0].axis)
+            if axis.plan is move.plans[0]:
+                return axis.current_element_id
+        return move.element_id
+
     # ================================================================= events ====
     def _emit(self, kind: MPIEventType, axis: int = -1, move: Move | None = None, detail: str = "",
               sample: int | None = None) -> None:
         move = move or self.current
         self._ctl.emit(kind, supervisor=self.number, axis=axis,
-                       move_id=move.id if move else 0, element_id=move.element_id if move else 0,
+                       move_id=move.id if move else 0, element_id=self._element_id(move),
                        detail=detail, extra_mask=move.event_mask if move else MPIEventType.NONE,
                        sample=sample)

@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass, field
 
 from .events import MPIEventType
-from .frames import AxisPlan, Move
+from .frames import AxisPlan, Move, Stream
 from .messages import Message
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, MotionParams, Trajectory
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
@@ -30,6 +30,7 @@ from .profiles.point_to_point import point_to_point, reverses, velocity_move
 from .profiles.ramps import ProfileError, ramps_between
 from .profiles.scurve import reshape
 from .profiles.segment import Segment, chain
+from .paths import STREAMED_TYPES, PathStart, compile_path
 from .types import MotionAttr, MPIMotionType
 
 A = MotionAttr
@@ -247,8 +248,11 @@ def compile_move(
         raise PlanError(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
     if attrs & (A.HOLD | A.HOLD_LESS | A.HOLD_GREATER) and moving:
         raise PlanError(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
+    stream = None
     try:
-        if motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
+        if motion_type in STREAMED_TYPES:
+            plans, stream = _path_plans(motion_type, params, attrs, starts)
+        elif motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
             plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
@@ -262,8 +266,22 @@ def compile_move(
         id=_truncate_id(params.id, notes) if A.ID in attrs else 0,
         element_id=int(params.element_id[0]) if A.ELEMENT_ID in attrs and params.element_id else 0,
         event_mask=params.event_mask if A.EVENT in attrs else MPIEventType.NONE,
+        stream=stream,
     )
     return move, notes
+
+
+def path_starts(starts: list[AxisStart]) -> list[PathStart]:
+    return [PathStart(s.axis, s.position, s.velocity, s.origin) for s in starts]
+
+
+def _path_plans(motion_type, params, attrs, starts) -> tuple[list[AxisPlan], Stream]:
+    """A path's plans (paths.py) and its streaming state; the frame buffer's low count is
+    the supervisor's to set (it knows the buffer's size)."""
+    plans, peaks = compile_path(motion_type, attrs, params, path_starts(starts), A.RELATIVE in attrs)
+    for plan in plans:
+        _check_finite(plan.segments, plan.axis)
+    return plans, Stream(open=not params.final, empty_count=params.empty_count, low_count=0, peaks=peaks)
 
 
 def _holds_and_outputs(params: MotionParams, attrs: MotionAttr, index: int):

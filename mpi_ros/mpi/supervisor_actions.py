@@ -121,7 +121,7 @@ class ActionsMixin:
         self._emit(MPIEventType.RESUME)
         return OK, ""
 
-    def _e_stop(self, source: ActionSource, then_abort: bool = False) -> tuple[Message, str]:
+    def _e_stop(self, source: ActionSource, then_abort: bool = False, reason: str = "") -> tuple[Message, str]:
         self._map_if_unmapped()
         t = self._ctl.time
         if self.own_state is MPIState.ERROR:
@@ -142,7 +142,7 @@ class ActionsMixin:
             if axis.in_position.settle_on_estop_cmd_eq_act and axis.amp_enabled:
                 axis.follow_actual(t, self.clock)
         self._set_state(MPIState.STOPPING_ERROR, "E_STOP_ABORT" if then_abort else "E_STOP", source)
-        self._emit(MPIEventType.E_STOP)
+        self._emit(MPIEventType.E_STOP, detail=reason)
         return OK, ""
 
     def _e_stop_abort(self, source: ActionSource) -> tuple[Message, str]:

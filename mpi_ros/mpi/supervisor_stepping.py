@@ -13,10 +13,11 @@ import numpy as np
 
 from .axis import Axis, CommandMode
 from .events import MPIEventType
+from .frames import reached
 from .holds import HoldWait
 from .messages import Message
 from .status import AT_VELOCITY, DONE, StatusMode
-from .types import HoldType, MPIState
+from .types import ActionSource, HoldType, MPIState
 
 if TYPE_CHECKING:
     from .status import StretchStatus
@@ -52,8 +53,12 @@ class SteppingMixin:
         return min(firsts) if firsts else None
 
     def _scan_move(self, stretch: Stretch, status: StretchStatus, conditions: dict) -> None:
-        """A move done; a velocity move at its velocity."""
+        """A move done; a velocity move at its velocity; a path's outputs and buffer."""
         move = self.current
+        if move.stream is not None:
+            self._scan_path(stretch, conditions)
+            if move.stream.open:
+                return  # an open path is never done: more points are expected
         # A move that ends moving (FINAL_VEL) is never DONE: the next appended move takes
         # over at its trajectory's end; with none, the axes go on at the final velocity
         # (MOVING) until a modify, an append or a stop.
@@ -66,6 +71,34 @@ class SteppingMixin:
         if move.is_velocity and not self._at_velocity_sent:
             # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
             self._all_axes(conditions, "at_velocity", status, AT_VELOCITY)
+
+    def _scan_path(self, stretch: Stretch, conditions: dict) -> None:
+        """Outputs due at a later point; while the path is open, the points left in the
+        buffer: FRAMES_LOW below lowCount, FRAMES_EMPTY at none, and the E_STOP of MPI 000,
+        MPIMotionPoint, emptyCount ("If the number of points in the buffer is below
+        emptyCount, an E_STOP action will occur"; <= 0 disables, MotionParams.empty_count_disabled)."""
+        stream = self.current.stream
+        left = None
+        for plan in self.current.plans:
+            axis = self._axis(plan.axis)
+            if axis.plan is not plan:
+                continue
+            rel = np.nan_to_num(stretch.rel[plan.axis], nan=-np.inf)
+            if plan.timed_outputs:
+                conditions[("output", plan.axis)] = reached(rel) >= min(when for when, _ in plan.timed_outputs)
+            counts = plan.points_left(rel)
+            left = counts if left is None else np.minimum(left, counts)
+            if stream.chunks and plan.axis in stream.chunks[0][1]:
+                done = reached(rel) >= stream.chunks[0][1][plan.axis]
+                conditions["chunk"] = done & conditions.get("chunk", True)
+        if left is None or not stream.open:
+            return
+        if not stream.low_sent:
+            conditions["frames_low"] = left < stream.low_count
+        if not stream.empty_sent:
+            conditions["frames_empty"] = left == 0
+        if stream.empty_count > 0:
+            conditions["starving"] = left < stream.empty_count
 
     def _all_axes(self, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
         """``conditions[key]``: per sample, is ``bit`` set on every axis of the current move?
@@ -112,6 +145,12 @@ class SteppingMixin:
                 wait = self._holds.get(key[1])
                 if wait is not None:
                     self._release(key[1], wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
+            elif key[0] == "output":
+                self._due_outputs(key[1])
+            elif key in ("frames_low", "frames_empty", "starving"):
+                self._buffer_event(key)
+            elif key == "chunk":
+                self._chunk_done()
             elif key == "move_done":
                 self._move_done()
             elif key == "at_velocity":
@@ -120,6 +159,37 @@ class SteppingMixin:
                 self._set_state(MPIState.STOPPED, self.last_action, self.action_source)
             elif key == "error":
                 self._stop_on_error_complete()
+
+    def _due_outputs(self, axis_number: int) -> None:
+        """Apply the outputs whose point the path has reached (the controller is there)."""
+        axis = self._axis(axis_number)
+        plan = axis.plan
+        if plan is None or self.current is None or plan not in self.current.plans:
+            return
+        now = reached(axis.rel)
+        due = [out for when, out in plan.timed_outputs if when <= now]
+        plan.timed_outputs = [(when, out) for when, out in plan.timed_outputs if when > now]
+        for out in due:
+            self._fire_output(out)
+
+    def _chunk_done(self) -> None:
+        """The last point of the oldest pending append is reached: that append is done."""
+        chunks = self.current.stream.chunks
+        if chunks:
+            serial, _ = chunks.pop(0)
+            self._end_serial(serial, OK, "points executed")
+
+    def _buffer_event(self, key: str) -> None:
+        stream = self.current.stream
+        if key == "frames_low" and not stream.low_sent:
+            stream.low_sent = True
+            self._emit(MPIEventType.FRAMES_LOW, detail=f"fewer than {stream.low_count} points left: append more")
+        elif key == "frames_empty" and not stream.empty_sent:
+            stream.empty_sent = True
+            self._emit(MPIEventType.FRAMES_EMPTY, detail="no points left; the path rests on its last point")
+        elif key == "starving" and self.own_state is MPIState.MOVING:
+            self._e_stop(ActionSource.CONTROLLER, reason=f"fewer than emptyCount = {stream.empty_count} points left "
+                                                          "while more are expected (final false)")
 
     def _stop_on_error_complete(self) -> None:
         """E_STOP (or ABORT) has run its course: disable what must be, enter ERROR."""

@@ -23,7 +23,7 @@ SCENARIOS = {p.stem for p in (FIXTURES / "scenarios").glob("*.yaml")}
 
 def test_every_scenario_has_a_fixture():
     assert {b.name for b in BAGS} == SCENARIOS == {
-        "p2p_modify", "stop_resume", "estop_reset", "append_queue", "sync_end", "two_supervisors"}
+        "p2p_modify", "stop_resume", "estop_reset", "append_queue", "sync_end", "two_supervisors", "streamed_path"}
 
 
 @pytest.mark.parametrize("bag", BAGS, ids=[b.name for b in BAGS])
