@@ -191,6 +191,9 @@ def motion_params(data: Any) -> MotionParams:
         slave_position=numbers(data.get("slave_position"), "slave_position"),
         gear_ratio=numbers(data.get("gear_ratio"), "gear_ratio"),
         frames=_structs(UserFrame, data.get("frames"), "frames"),
+        behavior=integer(data.get("behavior", 0), "behavior"),
+        low_count=integer(data.get("low_count", 0), "low_count"),
+        expected_axes=integer(data.get("expected_axes", 0), "expected_axes"),
     )
 
 
@@ -225,6 +228,9 @@ def params_to_dict(params: MotionParams) -> dict[str, Any]:
         "slave_position": list(params.slave_position),
         "gear_ratio": list(params.gear_ratio),
         "frames": [plain(f) for f in params.frames],
+        "behavior": params.behavior,
+        "low_count": params.low_count,
+        "expected_axes": params.expected_axes,
     }
 
 

@@ -133,6 +133,7 @@ class Axis:
         self.owner = -1
         self.move_id = 0
         self.element_id = 0
+        self._held_feedforward = 0.0  # PTF/PVTF feedforward kept from move to move
         self.state = PlantState(0.0, 0.0, 0.0)
         self._cache: dict = {}
         self.status_mode = StatusMode.POINT_TO_POINT
@@ -260,6 +261,8 @@ class Axis:
     def load(self, plan: AxisPlan, tau_start: float, t: float, clock: ProfileClock) -> None:
         """Start executing ``plan`` at profile time ``tau_start`` (time ``t``)."""
         self.rebase(t, clock)
+        self._hold_feedforward()
+        plan.start_feedforward(self._held_feedforward)
         self.plan = plan
         self.tau_start = tau_start
         self.holding = False
@@ -270,8 +273,22 @@ class Axis:
         """The path it runs, with points appended (paths.extend): the same profile up to now,
         so it goes on from here in the same profile time, status counters and all."""
         self.rebase(t, clock)
+        self._hold_feedforward()
         self.plan = plan
         self.target = plan.target
+
+    @property
+    def feedforward(self) -> float:
+        """The PTF/PVTF feedforward (raw DAC counts) now: interpolated along the plan that has
+        one, else the value the last one left (MPI 000, MPIMotionPTF: not zeroed by other moves)."""
+        plan = self.plan
+        if plan is None:
+            return self._held_feedforward
+        return plan.feedforward_at(self.rel, self._held_feedforward)
+
+    def _hold_feedforward(self) -> None:
+        """Before the plan changes: keep the feedforward it has reached."""
+        self._held_feedforward = self.feedforward
 
     @property
     def current_element_id(self) -> int:
@@ -291,6 +308,7 @@ class Axis:
     def unload(self, t: float, clock: ProfileClock | None) -> None:
         """Drop the plan; the command rests where it is now."""
         self.rebase(t, clock)
+        self._hold_feedforward()
         self.plan = None
         self.rest = self.cmd_p
         self.target = self.rest

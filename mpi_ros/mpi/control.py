@@ -230,6 +230,7 @@ class Controller:
             element_id=axis.current_element_id,
             frame_count=self.frame_count(number),
             supervisor=axis.owner,
+            feedforward=axis.feedforward,
         )
 
     # -- gates and I/O -------------------------------------------------------------------

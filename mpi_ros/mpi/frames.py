@@ -10,6 +10,7 @@ spec 000 mpiMotionStart: "Each axis has a 128 frame buffer (FIFO)".
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, field
 from typing import Sequence
 
@@ -61,6 +62,10 @@ class AxisPlan:
     point_times: np.ndarray | None = None
     element_ids: tuple[int, ...] = ()
     timed_outputs: list[tuple[float, Output]] = field(default_factory=list)
+    # PTF/PVTF: the feedforward's knots (profile times, values), linear between them and held
+    # after the last; the first value is NaN until the axis fills in the one it holds (the
+    # feedforward is kept from move to move: MPI 000, MPIMotionPTF).
+    feedforward: tuple[np.ndarray, np.ndarray] | None = None
     table: SegmentTable = field(init=False)
     duration: float = field(init=False)
 
@@ -97,6 +102,21 @@ class AxisPlan:
             return None
         i = int(np.searchsorted(self.point_times, reached(rel), side="right"))
         return self.element_ids[min(i, len(self.element_ids) - 1)]
+
+    def start_feedforward(self, held: float) -> None:
+        """The axis loads the plan holding feedforward ``held``: its feedforward starts there."""
+        if self.feedforward is not None and math.isnan(self.feedforward[1][0]):
+            self.feedforward[1][0] = held
+
+    def feedforward_at(self, rel: float, held: float) -> float:
+        """The feedforward at profile time ``rel`` (``held`` before the plan's first point, or
+        without a feedforward of its own)."""
+        if self.feedforward is None:
+            return held
+        times, values = self.feedforward
+        if not math.isfinite(rel) or rel <= times[0]:
+            return held if math.isnan(values[0]) else float(values[0])
+        return float(np.interp(rel, times, values))
 
     def evaluate(self, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, d/dtau and d2/dtau2 of the plan at relative profile times.

@@ -22,7 +22,7 @@ from .frames import AxisPlan, Move, frames_needed, next_serial
 from .holds import HoldWait
 from .log import MotionLog
 from .messages import STATE_MESSAGES, Message
-from .params import MotionConfig, MotionParams, Output, check_position
+from .params import MotionConfig, MotionParams, Output, Verdict, check_position
 from .planner import AxisStart, PlanError, compile_move
 from .snapshot import FrameBufferStatus, MotionSnapshot
 from .status import StatusMode
@@ -96,6 +96,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         self.log: MotionLog | None = None
         self.action_callback: ActionCallback | None = None
         self.move_ends: list[MoveEnd] = []  # how each move ended, in order (drained by the owner)
+        # NO_HANDSHAKE / NO_WAIT (MPI 001): the sample of a start not yet acknowledged, at
+        # which status still reads IDLE ("until the controller begins the profile execution").
+        self._unacknowledged: int | None = None
 
     @property
     def clock(self) -> ProfileClock:
@@ -295,19 +298,24 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
     def start(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
               params: MotionParams | None = None) -> Message:
         """mpiMotionStart (params None: the parameters stored with params_set)."""
-        message, _ = self._command(motion_type, attrs, params, modify=False)
+        message, _, _ = self.command(motion_type, attrs, params, modify=False)
         return message
 
     def modify(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
                params: MotionParams | None = None) -> Message:
         """mpiMotionModify."""
-        message, _ = self._command(motion_type, attrs, params, modify=True)
+        message, _, _ = self.command(motion_type, attrs, params, modify=True)
         return message
 
     def command(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
                 modify: bool) -> tuple[Message, str, int]:
         """Start or modify; returns (message, detail, serial of the move it made or changed)."""
+        if MotionAttr.NO_WAIT in attrs:
+            message, detail = self._command_no_wait(motion_type, attrs, params, modify)
+            return message, detail, 0  # nothing to follow: the call did not wait for the move
         message, detail = self._command(motion_type, attrs, params, modify)
+        if message.ok and attrs & (MotionAttr.NO_HANDSHAKE | MotionAttr.NO_WAIT):
+            self._unacknowledged = self._ctl.sample  # status reads IDLE until the next sample
         serial = self.current.serial if self.current is not None else 0
         if message in (OK, Message.MPIMotionMessageAUTO_START) and attrs & MotionAttr.APPEND:
             if self.queue:
@@ -352,14 +360,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         if open_path is not None and motion_type not in paths.STREAMED_TYPES:
             return Message.MPIMotionMessagePATH_ERROR, ("the path in progress is open (final false): append its "
                                                         "points, or close it with final true, first")
-        # MPI 000, mpiMotionModify: HOLD is impossible with a modify "even when using the AUTO_START attribute"
-        verdict = validate.check_attributes(motion_type, attrs, params, modify)
-        if not verdict.ok:
-            return verdict.message, verdict.detail
-        verdict = validate.check_params(
-            motion_type, attrs, params, len(self.axis_list), self._ctl.config.io_words,
-            self._ctl.config.motors, len(self._ctl.axes), sample_rate=self._ctl.rate,
-            append_to=open_path is not None)
+        verdict = self._check_request(motion_type, attrs, params, modify, append_to=open_path is not None)
         if not verdict.ok:
             return verdict.message, verdict.detail
         if open_path is not None:
@@ -378,7 +379,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         except PlanError as exc:
             return exc.message, exc.detail
         if move.stream is not None:
-            move.stream.low_count = self._ctl.config.frame_buffer_size // 4
+            move.stream.low_count = self._low_count(attrs, params)
         if queued:
             message = self._check_frames(list(self.queue) + ([self.current] if self.current else []) + [move])
         else:
@@ -403,6 +404,40 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         if auto_start:
             return Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)"
         return OK, ""
+
+    def _check_request(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
+                       append_to: bool) -> Verdict:
+        """The attributes and values of a start or modify (validate.py)."""
+        # MPI 000, mpiMotionModify: HOLD is impossible with a modify "even when using the AUTO_START attribute"
+        verdict = validate.check_attributes(motion_type, attrs, params, modify)
+        if not verdict.ok:
+            return verdict
+        return validate.check_params(
+            motion_type, attrs, params, len(self.axis_list), self._ctl.config.io_words,
+            self._ctl.config.motors, len(self._ctl.axes), sample_rate=self._ctl.rate,
+            append_to=append_to, frame_buffer_size=self._ctl.config.frame_buffer_size)
+
+    def _command_no_wait(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
+                         modify: bool) -> tuple[Message, str]:
+        """MPI 001 NO_WAIT: the MPI "does NOT wait for the controller to acknowledge the commanded
+        move, does NOT wait for the controller to return an error code". What the library checks
+        itself (type, attributes, values) is still answered; whatever the controller would
+        refuse (its state, a profile it cannot load) is not: the call answers OK and a refused
+        move shows only as a missing MOTION_START, as MPI 001 warns."""
+        if not self.valid or not self.axis_list:
+            return self._command(motion_type, attrs, params, modify)
+        params = self.stored_params if params is None else params
+        verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21,
+                                      append=MotionAttr.APPEND in attrs)
+        if verdict.ok:
+            append_to = MotionAttr.APPEND in attrs and self.own_state is MPIState.MOVING and self._open_path() is not None
+            verdict = self._check_request(motion_type, attrs, params, modify, append_to)
+        if not verdict.ok:
+            return verdict.message, verdict.detail
+        message, _ = self._command(motion_type, attrs, params, modify)
+        if message.ok:
+            self._unacknowledged = self._ctl.sample  # status reads IDLE until the next sample
+        return OK, "NO_WAIT: sent without waiting for the controller; MOTION_START shows whether the move began"
 
     def _state_for(self, numbers: list[int]) -> MPIState:
         """State as a command on ``numbers`` sees it (other supervisors' axes included)."""
@@ -451,6 +486,12 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
         return OK
 
+    def _low_count(self, attrs: MotionAttr, params: MotionParams) -> int:
+        """MPI 001 LOW_COUNT: the given count, else a quarter of the frame buffer (32 of 128)."""
+        if MotionAttr.LOW_COUNT in attrs:
+            return params.low_count
+        return self._ctl.config.frame_buffer_size // 4
+
     def _open_path(self) -> Move | None:
         """The path in progress, if it is open (more points are expected)."""
         move = self.current
@@ -486,15 +527,20 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         self._rebase(t)
         ends = {new.axis: self._extend_plan(move, plans[new.axis], new, nows[new.axis], t) for new in chunk.plans}
         stream.append(chunk.stream, open_=not params.final)
+        if MotionAttr.LOW_COUNT in attrs:
+            stream.low_count = params.low_count
         stream.chunks.append((chunk.serial, ends))
         return OK, ""
 
     def _extend_plan(self, move: Move, old: AxisPlan, new: AxisPlan, now: float, t: float) -> float:
         """Put ``new``'s points after ``old``'s on its axis; returns when its last one is reached."""
         outputs = [(0.0, out) for out in new.outputs] + new.timed_outputs
-        extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target)
+        axis = self._axis(new.axis)
+        values = new.feedforward[1][1:] if new.feedforward is not None else None
+        extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target,
+                                values, axis.feedforward)
         move.plans[move.plans.index(old)] = extended
-        self._axis(new.axis).extend(extended, t, self.clock)
+        axis.extend(extended, t, self.clock)
         return paths.last_point_time(extended)
 
     def _rebase(self, t: float) -> None:
@@ -627,7 +673,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         return MotionSnapshot(
             sample=self._ctl.sample,
             number=self.number,
-            state=self.state,
+            state=self._reported_state(),
             axis_numbers=tuple(self.mapped),
             axes=axes,
             done=done and self.own_state is not MPIState.MOVING,
@@ -643,6 +689,15 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             progress=self.progress(),
             latched_events=tuple(self.latched.names()),
         )
+
+    def _reported_state(self) -> MPIState:
+        """The state status reports: IDLE at the sample of a start given NO_HANDSHAKE or
+        NO_WAIT (MPI 001 remarks: "the state is reported as MPIStateIDLE until the controller
+        begins the profile execution"), the state otherwise."""
+        state = self.state
+        if self._unacknowledged == self._ctl.sample and state is MPIState.MOVING:
+            return MPIState.IDLE
+        return state
 
     def progress(self) -> float:
         """0..1 along the current move (profile time over its duration)."""

@@ -251,6 +251,10 @@ class MotionParams:
     slave_position: list[float] = field(default_factory=list)
     gear_ratio: list[float] = field(default_factory=list)
     frames: list[UserFrame] = field(default_factory=list)
+    # MPIMotionPathAttributes (MPI 001), each read only with its attribute.
+    behavior: int = 0  # BEHAVIOR
+    low_count: int = 0  # LOW_COUNT: FRAMES_LOW below this many points
+    expected_axes: int = 0  # EXPECTED_AXES: must equal the mapped axes
 
     def copy(self) -> "MotionParams":
         return copy.deepcopy(self)
@@ -282,7 +286,10 @@ class MotionParams:
              check_long("empty_count", self.empty_count),  # any value: <= 0 disables (empty_count_disabled)
              check_long("id", self.id),
              check_long("master_start", self.master_start),
-             check_long("repeat_from", self.repeat_from)),
+             check_long("repeat_from", self.repeat_from),
+             check_long("behavior", self.behavior),
+             check_long("low_count", self.low_count),
+             check_long("expected_axes", self.expected_axes)),
             _each("element_id", self.element_id, check_long),
         ]
         if uses(MotionAttr.DELAY):

@@ -19,6 +19,7 @@ path different from a point-to-point move lives here:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -88,6 +89,7 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
         # the command is put on it when the path is done, AxisPlan.evaluate).
         ends = [float(points[-1, k]) for k in range(axes)]
     element_ids = _element_ids(params, attrs, len(times[0]) if times else 0)
+    feedforward = _feedforward(motion_type, params, axes)
     plans = []
     for k, (start, segments) in enumerate(zip(starts, per_axis)):
         point_times = np.cumsum(np.asarray(times[k], dtype=float))
@@ -97,8 +99,23 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
             outputs=[out for when, out in timed if when <= 0.0], start_velocity=start.velocity,
             point_times=point_times, element_ids=element_ids,
             timed_outputs=[(when, out) for when, out in timed if when > 0.0],
+            feedforward=None if feedforward is None else _knots(0.0, math.nan, point_times, feedforward[:, k]),
         ))
     return plans, [peaks(plan.segments) for plan in plans]
+
+
+def _feedforward(motion_type: MPIMotionType, params: MotionParams, axes: int) -> np.ndarray | None:
+    """PTF/PVTF: (points, axes) feedforward values (raw DAC counts), else None."""
+    if motion_type not in FEEDFORWARD_TYPES:
+        return None
+    return np.asarray(params.feedforward, dtype=float).reshape(-1, axes)
+
+
+def _knots(begin: float, first: float, point_times: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Feedforward knots: ``first`` at ``begin`` (NaN: the value the axis holds then), each
+    value at its point's time (MPI 000, MPIMotionPTF: "When the motion reaches a specified
+    position ... the interpolated feedforward value will be equal to what is specified")."""
+    return np.concatenate([[begin], begin + point_times]), np.concatenate([[first], values])
 
 
 def _points(params: MotionParams, starts: list[PathStart], relative: bool) -> np.ndarray:
@@ -146,12 +163,14 @@ def timed_outputs(params: MotionParams, attrs: MotionAttr, point_times: np.ndarr
 
 
 def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.ndarray,
-           element_ids: tuple[int, ...], outputs: list[tuple[float, Output]], target: float) -> AxisPlan:
+           element_ids: tuple[int, ...], outputs: list[tuple[float, Output]], target: float,
+           feedforward: np.ndarray | None = None, held: float = 0.0) -> AxisPlan:
     """``plan`` with points appended (profile time ``now`` into it): the executed segments
     and points are flushed; the new ones follow the last point, or start now if the path
     has run out of points (it rests on its last point meanwhile). ``point_times``: when the
     new points are reached, from the time they begin; ``outputs``: (time from
-    the first new point's interval, output); ``target``: where the new points end."""
+    the first new point's interval, output); ``target``: where the new points end;
+    ``feedforward``: the new points' values (PTF/PVTF), ``held`` the axis' feedforward now."""
     begin = append_time(plan, now)
     kept = [s for s, end in zip(plan.segments, plan.table.end) if end > now]
     first = float(plan.table.start[len(plan.segments) - len(kept)]) if kept else begin
@@ -165,7 +184,23 @@ def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.
         point_times=np.concatenate([plan.point_times[pending], new_times]),
         element_ids=ids,
         timed_outputs=[(w, o) for w, o in plan.timed_outputs if w > now] + [(begin + w, o) for w, o in outputs],
+        feedforward=_extended_feedforward(plan, begin, point_times, feedforward, held),
     )
+
+
+def _extended_feedforward(plan: AxisPlan, begin: float, point_times: np.ndarray, values: np.ndarray | None,
+                          held: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The feedforward knots of a plan with points appended: the old ones, then the new
+    points' values (from the value reached where they begin); points without values hold
+    it. ``held``: the axis' feedforward where the old plan has none."""
+    if plan.feedforward is None and values is None:
+        return None
+    last = plan.feedforward_at(begin, held)
+    old_t, old_v = plan.feedforward if plan.feedforward is not None else (np.array([begin]), np.array([last]))
+    if values is None:
+        return old_t, old_v
+    new_t, new_v = _knots(begin, last, point_times, values)
+    return np.concatenate([old_t, new_t]), np.concatenate([old_v, new_v])
 
 
 def _pending_ids(plan: AxisPlan, pending: np.ndarray, new: tuple[int, ...], count: int) -> tuple[int, ...]:

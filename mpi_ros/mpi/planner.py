@@ -278,7 +278,8 @@ def path_starts(starts: list[AxisStart]) -> list[PathStart]:
 def _path_plans(motion_type, params, attrs, starts) -> tuple[list[AxisPlan], Stream]:
     """A path's plans (paths.py) and its streaming state; the frame buffer's low count is
     the supervisor's to set (it knows the buffer's size)."""
-    plans, peaks = compile_path(motion_type, attrs, params, path_starts(starts), A.RELATIVE in attrs)
+    relative = bool(attrs & (A.RELATIVE | A.RELATIVE_MOVE))
+    plans, peaks = compile_path(motion_type, attrs, params, path_starts(starts), relative)
     for plan in plans:
         _check_finite(plan.segments, plan.axis)
     return plans, Stream(open=not params.final, empty_count=params.empty_count, low_count=0, peaks=peaks)

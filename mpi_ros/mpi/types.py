@@ -132,6 +132,16 @@ class MotionAttr(IntFlag):
     HOLD_LESS = 1 << 20
     HOLD_GREATER = 1 << 21
     OUTPUT = 1 << 22
+    # MPIMotionPathAttrMask (MPI 001) bits that are not also MPIMotionAttr bits (ID,
+    # ELEMENT_ID, HOLD and OUTPUT mean the same in both masks and are the ones above).
+    BEHAVIOR = 1 << 24
+    RELATIVE_MOVE = 1 << 25
+    RETAIN = 1 << 26
+    EMPTY_COUNT = 1 << 27
+    LOW_COUNT = 1 << 28
+    NO_HANDSHAKE = 1 << 29
+    EXPECTED_AXES = 1 << 30
+    NO_WAIT = 1 << 31
 
     @classmethod
     def parse(cls, names) -> "MotionAttr | None":
@@ -149,6 +159,16 @@ class MotionAttr(IntFlag):
 
 
 HOLD_ATTRS = MotionAttr.HOLD | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER
+PATH_ATTRS = (
+    MotionAttr.BEHAVIOR
+    | MotionAttr.RELATIVE_MOVE
+    | MotionAttr.RETAIN
+    | MotionAttr.EMPTY_COUNT
+    | MotionAttr.LOW_COUNT
+    | MotionAttr.NO_HANDSHAKE
+    | MotionAttr.EXPECTED_AXES
+    | MotionAttr.NO_WAIT
+)
 CAM_ATTRS = (
     MotionAttr.REPEAT
     | MotionAttr.MASTER_START

@@ -17,6 +17,7 @@ from .types import (
     CAM_TYPES,
     HOLD_ATTRS,
     JERK_TYPES,
+    PATH_ATTRS,
     MODIFIABLE_TYPES,
     PATH_TYPES,
     POINT_TO_POINT_TYPES,
@@ -28,7 +29,9 @@ from .types import (
 )
 
 A = MotionAttr
-_PATH_ALLOWED = A.APPEND | A.RELATIVE | A.ID | A.ELEMENT_ID | HOLD_ATTRS | A.OUTPUT
+# MPI 000, ATTRIBUTE_INVALID lists for the point types, and the path attributes of MPI 001
+# (MPIMotionPathAttrMask, the attributes of path motion: docs/paths.md).
+_PATH_ALLOWED = A.APPEND | A.RELATIVE | A.ID | A.ELEMENT_ID | HOLD_ATTRS | A.OUTPUT | PATH_ATTRS
 # spec 000: which attributes each type may carry.
 ALLOWED_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
     MPIMotionType.PT: _PATH_ALLOWED,
@@ -101,6 +104,8 @@ def check_attributes(
     forbidden = FORBIDDEN_ATTRIBUTES.get(motion_type, A.NONE) & attrs
     if forbidden:
         return _bad(bad, f"{motion_type.name} moves may not have {forbidden.names()}")
+    if motion_type not in PATH_TYPES and attrs & PATH_ATTRS:
+        return _bad(bad, f"{(attrs & PATH_ATTRS).names()} are path attributes (MPI 001, MPIMotionPathAttrMask)")
     if motion_type not in CAM_TYPES and attrs & CAM_ATTRS:
         return _bad(bad, f"{(attrs & CAM_ATTRS).names()} are cam attributes")
     if A.NO_BACKTRACK in attrs and A.NO_BACKTRACK_HOLD in attrs:
@@ -131,13 +136,18 @@ def check_params(
     axes: int,
     sample_rate: float = 0.0,
     append_to: bool = False,
+    frame_buffer_size: int = 128,
 ) -> Verdict:
     """The request's values for a move of ``axis_count`` axes (``sample_rate``: the
-    controller's, for a path's time slices; ``append_to``: the points go to an open path)."""
+    controller's, for a path's time slices; ``append_to``: the points go to an open path;
+    ``frame_buffer_size``: the axes', for LOW_COUNT)."""
     bad = Message.MPIMessagePARAM_INVALID
     if axis_count > MAX_COORD_AXES:
         return _bad(Message.MPIMessageARG_INVALID, f"{axis_count} axes exceed MEIXmpMAX_COORD_AXES ({MAX_COORD_AXES})")
     if motion_type in STREAMED_TYPES:
+        verdict = _check_path_attributes(attrs, params, axis_count, frame_buffer_size)
+        if not verdict.ok:
+            return verdict
         return _check_path(motion_type, attrs, params, axis_count, io_words, motors, axes, sample_rate, append_to)
     velocity_type = motion_type in VELOCITY_TYPES
     per_axis = bool(attrs & (A.SYNC_START | A.SYNC_END))
@@ -214,10 +224,10 @@ def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPar
         return verdict
     if points == 0 and not append_to:
         return _bad(bad, "a path needs at least one point")
-    if params.retain:
-        # MPIMotionPoint.retain keeps executed points "for backing up on path", but the
-        # reference names no call that backs up along a path: retained points could never be
-        # used. Refused rather than accepted and ignored (docs/paths.md).
+    if params.retain or A.RETAIN in attrs:
+        # MPIMotionPoint.retain and MPI 001 RETAIN keep executed points "for backing up on
+        # path", but the reference names no call that backs up along a path: retained points
+        # could never be used. Refused rather than accepted and ignored (docs/paths.md).
         return _bad(Message.MPIMessageUNSUPPORTED, "retain: the MPI names no way to back up along a path, so "
                                                    "executed points are not kept; give retain false")
     verdict = params.validate(motion_type, attrs)
@@ -229,6 +239,25 @@ def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPar
     if A.ELEMENT_ID in attrs and len(params.element_id) not in (1, points):
         return _bad(bad, f"element_id needs 1 or {points} value(s) (one per point), got {len(params.element_id)}")
     return _check_path_shape(motion_type, params, sample_rate)
+
+
+def _check_path_attributes(attrs: MotionAttr, params: MotionParams, axis_count: int,
+                           frame_buffer_size: int) -> Verdict:
+    """The fields of MPI 001's path attributes (MPIMotionPathAttributes), read only with
+    their attribute."""
+    if A.EXPECTED_AXES in attrs and params.expected_axes != axis_count:
+        # MPI 001 EXPECTED_AXES: "checked against the number of currently mapped axes, and if
+        # they don't match an error will result": the error of a wrong axis count.
+        return _bad(Message.MPIMotionMessageAXIS_COUNT,
+                    f"expected_axes {params.expected_axes}, but the supervisor has {axis_count} axes")
+    if A.BEHAVIOR in attrs and params.behavior != 0:
+        # MPI 001 BEHAVIOR selects "a non-default behavior", but names none: 0 is the default.
+        return _bad(Message.MPIMessagePARAM_INVALID, f"behavior {params.behavior}: the MPI documents no path "
+                                                     "behaviour but the default (0)")
+    if A.LOW_COUNT in attrs and not 0 <= params.low_count <= frame_buffer_size:
+        return _bad(Message.MPIMessagePARAM_INVALID, f"low_count {params.low_count}: must be 0..{frame_buffer_size} "
+                                                     "(the frame buffer's size)")
+    return OK
 
 
 def _finite_path_data(motion_type: MPIMotionType, params: MotionParams) -> bool:

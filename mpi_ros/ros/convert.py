@@ -31,15 +31,19 @@ from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 
 
 def to_dict(msg) -> dict[str, Any]:
-    """A ROS message as a dict of plain Python values (nested messages as dicts)."""
-    out: dict[str, Any] = {}
-    for name in msg.get_fields_and_field_types():
-        out[name] = _plain(getattr(msg, name))
-    return out
+    """A ROS message as a dict of plain Python values (nested messages as dicts); also a
+    message read from a bag by the definition the bag stores (its fields are its slots)."""
+    return {name: _plain(getattr(msg, name)) for name in _fields(msg)}
+
+
+def _fields(msg) -> list[str]:
+    if hasattr(msg, "get_fields_and_field_types"):
+        return list(msg.get_fields_and_field_types())
+    return [name for name in msg.__slots__ if not name.startswith("_")]
 
 
 def _plain(value):
-    if hasattr(value, "get_fields_and_field_types"):
+    if hasattr(value, "get_fields_and_field_types") or (hasattr(value, "__slots__") and hasattr(value, "_type")):
         return to_dict(value)
     if isinstance(value, (list, tuple)):
         return [_plain(v) for v in value]
@@ -164,6 +168,7 @@ def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) ->
     msg.element_id = snap.element_id
     msg.frame_count = snap.frame_count
     msg.supervisor = snap.supervisor
+    msg.feedforward = _finite(snap.feedforward)
     return msg
 
 

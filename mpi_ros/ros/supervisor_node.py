@@ -267,9 +267,9 @@ class SupervisorNode(Node):
             return
         reply, sample = applied
         goal = TrackedGoal(key, _RosGoal(handle, action_type, server), sample=sample)
-        if reply.accepted:
+        if reply.accepted and reply.serial:
             goal.serial = reply.serial
-        else:
+        else:  # refused, or answered without a move to follow (NO_WAIT): the reply is the result
             goal.end = GoalEnd(reply.message, reply.detail, sample)
         self.runner.update(partial(self._file, goal))
 

@@ -12,7 +12,7 @@ from mpi_ros.mpi import (Controller, Hold, MotionAttr, MotionParams, MPIAction, 
                          Trajectory)
 from mpi_ros.mpi.params import MotionConfig
 from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.types import HoldType, OutputType
+from mpi_ros.mpi.types import PATH_ATTRS, HoldType, OutputType
 from mpi_ros.mpi.validate import check_attributes, check_params, check_type
 
 A = MotionAttr
@@ -78,11 +78,11 @@ def test_point_to_point_and_velocity_types_are_accepted(kind, modify):
 def test_path_types_allow_exactly_their_list(kind):
     # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "PT (PTF, PVT, PVTF, BESSEL, BSPLINE, BSPLINE2) Moves are only permitted
     # to have motion attributes from the following list: APPEND RELATIVE ID ELEMENT_ID HOLD
-    # HOLD_LESS HOLD_GREATER OUTPUT"
+    # HOLD_LESS HOLD_GREATER OUTPUT", and the path attributes of MPI 001, MPIMotionPathAttrMask
     params = full_params()
     for attr in ALL_ATTRS:
         verdict = check_attributes(kind, attr, params, modify=False)
-        if attr in PATH_ALLOWED:
+        if attr in PATH_ALLOWED or attr in PATH_ATTRS:
             assert verdict.ok, attr
         else:
             assert verdict.message is M.MPIMotionMessageATTRIBUTE_INVALID, attr
@@ -92,8 +92,15 @@ def test_spline_allows_the_list_without_append():
     # MPI 000, MPIMotionMessageATTRIBUTE_INVALID SPLINE: RELATIVE ID ELEMENT_ID HOLD HOLD_LESS HOLD_GREATER OUTPUT (no APPEND)
     params = full_params()
     assert check_attributes(T.SPLINE, A.APPEND, params, False).message is M.MPIMotionMessageATTRIBUTE_INVALID
-    for attr in PATH_ALLOWED[1:]:
+    for attr in PATH_ALLOWED[1:] + list(PATH_ATTRS):
         assert check_attributes(T.SPLINE, attr, params, False).ok
+
+
+@pytest.mark.parametrize("kind", [T.TRAPEZOIDAL, T.S_CURVE, T.VELOCITY, T.FRAME])
+def test_path_attributes_belong_to_path_moves(kind):
+    # MPI 001, MPIMotionPathAttrMask: the attributes of path motion
+    for attr in PATH_ATTRS:
+        assert check_attributes(kind, attr, full_params(), False).message is M.MPIMotionMessageATTRIBUTE_INVALID, attr
 
 
 def test_frame_allows_append_and_id_only():
