@@ -715,6 +715,12 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 fractions.append(1.0 if plan.duration <= 0.0 else min(1.0, max(0.0, axis.rel / plan.duration)))
         return min(fractions) if fractions else 0.0
 
+    @property
+    def element_id(self) -> int:
+        """The element id status shows: the current (else last) move's; a path's, of the
+        point it runs toward."""
+        return self._element_id(self.current or self.last_move)
+
     def _element_id(self, move: Move | None) -> int:
         """The move's element id; a path's, of the point its first axis runs toward."""
         if move is None:

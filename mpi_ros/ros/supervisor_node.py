@@ -541,7 +541,7 @@ def _feedback(ctl: Controller, ms, action_type, current: bool):
     fb.progress = float(ms.progress()) if current and ms.current is not None else 0.0
     move = ms.current or ms.last_move
     fb.move_id = move.id if move else 0
-    fb.element_id = move.element_id if move else 0
+    fb.element_id = ms.element_id
     return fb
 
 
