@@ -18,7 +18,7 @@ import numpy as np
 
 from .events import MPIEventType
 from .params import Hold, Output, Trajectory
-from .profiles.segment import Segment, SegmentTable
+from .profiles.segment import Segment, SegmentTable, end_time
 from .types import MotionAttr, MPIMotionType
 
 _serials = itertools.count(1)
@@ -66,14 +66,21 @@ class AxisPlan:
     # after the last; the first value is NaN until the axis fills in the one it holds (the
     # feedforward is kept from move to move: MPI 000, MPIMotionPTF).
     feedforward: tuple[np.ndarray, np.ndarray] | None = None
-    table: SegmentTable = field(init=False)
     duration: float = field(init=False)
+    _table: SegmentTable | None = field(init=False, default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.segments:
             self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
-        self.table = SegmentTable(self.segments, self.origin_time)
-        self.duration = float(self.table.end[-1])
+        self.duration = end_time(self.segments, self.origin_time)
+
+    @property
+    def table(self) -> SegmentTable:
+        """The segments as arrays. Built on first use, not with the plan: numpy on a handful of
+        segments costs more than planning them, and a modify is planned while its command waits."""
+        if self._table is None:
+            self._table = SegmentTable(self.segments, self.origin_time)
+        return self._table
 
     @property
     def is_velocity(self) -> bool:
@@ -192,9 +199,13 @@ class Move:
     plan_axes: tuple[int, ...] = field(init=False)  # the axes of its plans, in order
 
     def __post_init__(self) -> None:
-        self.plan_axes = tuple(plan.axis for plan in self.plans)
-        self.is_velocity = any(plan.is_velocity for plan in self.plans)
-        self.ends_moving = any(plan.final_velocity != 0.0 for plan in self.plans)
+        # one pass over the plans (a move is made for every start and modify)
+        axes, velocity, moving = [], False, False
+        for plan in self.plans:
+            axes.append(plan.axis)
+            velocity = velocity or plan.velocity_target is not None  # AxisPlan.is_velocity
+            moving = moving or plan.final_velocity != 0.0
+        self.plan_axes, self.is_velocity, self.ends_moving = tuple(axes), velocity, moving
 
     @property
     def axes(self) -> list[int]:
