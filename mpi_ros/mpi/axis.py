@@ -328,8 +328,8 @@ class Axis:
 
     def _piece_key(self, clock: ProfileClock | None):
         if self.plan is None or clock is None:
-            return (self.mode, None, self.rest)
-        return (self.mode, id(self.plan), self.tau_start, clock)
+            return (self.mode, None, self.rest, self._held_feedforward)
+        return (self.mode, id(self.plan), self.tau_start, clock, self._held_feedforward)
 
     def _boundary_times(self, key, clock: ProfileClock | None) -> list[float]:
         """All times at which the command polynomial changes (sorted)."""
@@ -350,13 +350,16 @@ class Axis:
         if cached is not None:
             return cached
         if self.plan is None or clock is None:
-            poly = [self.rest]
+            poly, dac = [self.rest], [self._held_feedforward]
         else:
             mid = ts + 0.5 * (te - ts) if math.isfinite(te) else ts + 1.0
-            seg_start, seg_poly = self.plan.segment_poly(clock.tau_at(mid) - self.tau_start)
+            rel = clock.tau_at(mid) - self.tau_start
+            seg_start, seg_poly = self.plan.segment_poly(rel)
             q0, q1, q2 = clock.local_quadratic(ts)
             poly = compose(seg_poly, (q0 - self.tau_start - seg_start, q1, q2))
-        forced = self.plant.prepare(poly)
+            ff_start, ff_poly = self.plan.feedforward_poly(rel, self._held_feedforward)
+            dac = compose(ff_poly, (q0 - self.tau_start - ff_start, q1, q2))
+        forced = self.plant.prepare(poly, dac)
         if len(self._cache) > 256:
             self._cache.clear()
         self._cache[("piece", key, ts)] = forced
@@ -381,7 +384,7 @@ class Axis:
         """At rest with the loop settled: every coming sample is the same."""
         if self.plan is not None or self.holding or self.mode is not CommandMode.SERVO:
             return False
-        return self.state.y == self.rest and self.state.dy == 0.0
+        return self.state.y == self.rest_position and self.state.dy == 0.0
 
     def trace(self, k0: int, k1: int, clock: ProfileClock | None) -> AxisTrace:
         """Samples k0+1 .. k1, computed from the current anchor (no state changes)."""
@@ -452,7 +455,7 @@ class Axis:
     def snap(self, t: float) -> None:
         """The rest the loop has reached by ``t`` (see :meth:`_settle_anchor`), for an axis
         computed in rows: PlantRows.snap_after says when."""
-        self.state = PlantState(t, self.rest, 0.0)
+        self.state = PlantState(t, self.rest_position, 0.0)
 
     # -- rows ------------------------------------------------------------------------
     def refresh(self, clock: ProfileClock | None) -> None:
@@ -519,12 +522,24 @@ class Axis:
         """Once the loop at rest has decayed below the quiet level, snap it exactly onto
         the command: from then on every sample is the same (the steady fast path). The
         decision depends only on the anchor and the sample time, never on batching."""
-        if anchor.y == self.rest and anchor.dy == 0.0:
+        forced = self._rest_response()
+        if anchor.y == forced.y[0] and anchor.dy == 0.0:
             return anchor
-        forced = self.plant.prepare([self.rest])
         if t - anchor.t >= self.plant.quiet_after(anchor, forced.y):
-            return PlantState(t, self.rest, 0.0)
+            return PlantState(t, forced.y[0], 0.0)
         return anchor
+
+    def _rest_response(self) -> Forced:
+        """The loop's steady response with the command at rest (and the feedforward held)."""
+        return self.plant.prepare([self.rest], [self._held_feedforward])
+
+    @property
+    def rest_position(self) -> float:
+        """Where the motor rests with the command at rest: on it, or off it by what a held
+        DAC feedforward pushes against the loop."""
+        if self._held_feedforward == 0.0:
+            return self.rest
+        return self._rest_response().y[0]
 
     # -- amplifier ---------------------------------------------------------------------
     def disable(self, t: float, clock: ProfileClock | None) -> None:

@@ -150,8 +150,21 @@ class AxisPlan:
         return float(self.table.start[i]), [seg.p, seg.v, seg.a / 2.0, seg.j / 6.0]
 
     def boundaries(self) -> np.ndarray:
-        """Relative profile times at which the command polynomial changes."""
-        return self.table.end
+        """Relative profile times at which the command polynomial (or the feedforward) changes."""
+        if self.feedforward is None:
+            return self.table.end
+        return np.union1d(self.table.end, self.feedforward[0])
+
+    def feedforward_poly(self, rel: float, held: float) -> tuple[float, list[float]]:
+        """(start time, [value, slope]) of the feedforward's linear piece at ``rel``."""
+        if self.feedforward is None:
+            return 0.0, [held]
+        times, values = self.feedforward
+        i = int(np.searchsorted(times, rel, side="right"))
+        if i == 0 or i >= len(times):  # before the first knot, or held after the last
+            return 0.0, [self.feedforward_at(rel, held)]
+        slope = (values[i] - values[i - 1]) / (times[i] - times[i - 1])
+        return float(times[i - 1]), [float(values[i - 1]), float(slope)]
 
 
 @dataclass(slots=True)

@@ -416,6 +416,9 @@ class PlantConfig:
     acceleration_feedforward: float = 0.0
     encoder_resolution: float = 1.0
     coast_time_constant: float = 0.2
+    # The motor's acceleration per DAC count of PTF/PVTF feedforward (counts/s^2 per count):
+    # a full-scale 32,767 gives about 1e6 counts/s^2 by default.
+    dac_acceleration: float = 30.0
 
     def validate(self) -> Verdict:
         return first_refusal((
@@ -425,6 +428,7 @@ class PlantConfig:
             check_magnitude("acceleration_feedforward", self.acceleration_feedforward, FEEDFORWARD_MAX),
             self._encoder_resolution(),
             check_duration("coast_time_constant", self.coast_time_constant, positive=True),
+            check_magnitude("dac_acceleration", self.dac_acceleration, MAX_ACCELERATION),
         ))
 
     def _encoder_resolution(self) -> Verdict:

@@ -88,6 +88,9 @@ class Plant:
             num=(w * w, 2.0 * z * w * config.velocity_feedforward, config.acceleration_feedforward),
             den=(w * w, 2.0 * z * w, 1.0),
         )
+        # A DAC feedforward d drives the motor directly: y'' + c y' + w^2 y = ... + K d, whose
+        # steady response to a polynomial d has the gains of K / (w^2 + c s + s^2).
+        self._dac_gains = self._taylor(num=(config.dac_acceleration,), den=(w * w, 2.0 * z * w, 1.0))
         self._resolution = config.encoder_resolution
         self._coast = config.coast_time_constant
         # M^2 = kappa I (Cayley-Hamilton: A's eigenvalues are sigma +- i q, sigma +- q, or sigma twice)
@@ -115,9 +118,13 @@ class Plant:
     # -- servo on ----------------------------------------------------------------
     def particular(self, u: list[float]) -> list[float]:
         """Polynomial particular solution for a polynomial input (coefficients, low first)."""
+        return self._particular(u, self._gains)
+
+    @staticmethod
+    def _particular(u: list[float], gains: np.ndarray) -> list[float]:
         out = [0.0] * len(u)
         deriv = list(u)
-        for g in self._gains[: len(u)]:
+        for g in gains[: len(u)]:
             for i, c in enumerate(deriv):
                 out[i] += g * c
             deriv = poly_der(deriv)
@@ -150,9 +157,12 @@ class Plant:
             table = _TABLES[key] = _FreeTable.build(self, rate)
         return table
 
-    def prepare(self, u: list[float]) -> "Forced":
-        """The loop's steady response to a polynomial input (reusable for a piece)."""
+    def prepare(self, u: list[float], dac: list[float] | None = None) -> "Forced":
+        """The loop's steady response to a polynomial command ``u`` and DAC feedforward
+        ``dac`` (PTF/PVTF; None or zero: none), reusable for a piece."""
         yp = self.particular(u)
+        if dac is not None and any(dac):
+            yp = _poly_add(yp, self._particular(dac, self._dac_gains))
         return Forced(yp, poly_der(yp))
 
     def transient(self, state: PlantState, forced: "Forced", rate: float) -> "Transient | None":
@@ -398,6 +408,12 @@ def _poly_mul(a: list[float], b: list[float]) -> list[float]:
         for j, y in enumerate(b):
             out[i + j] += x * y
     return out
+
+
+def _poly_add(a: list[float], b: list[float]) -> list[float]:
+    """a + b (coefficients, low first)."""
+    longer, shorter = (a, b) if len(a) >= len(b) else (b, a)
+    return [x + (shorter[i] if i < len(shorter) else 0.0) for i, x in enumerate(longer)]
 
 
 def compose(segment_poly: list[float], quadratic: tuple[float, float, float]) -> list[float]:

@@ -203,7 +203,8 @@ def servo_effort(axis) -> float:
     of a motor of unit inertia, which is what the simulated motor then does. Here it is
     computed as a real servo computes it, from the encoder's reading of the position (so
     it carries the encoder's quantisation: up to w^2 x resolution / 2) and the actual
-    velocity. 0 while the amplifier is off (after ABORT the motor coasts)."""
+    velocity. A PTF/PVTF feedforward adds its DAC counts times ``dac_acceleration``. 0 while
+    the amplifier is off (after ABORT the motor coasts)."""
     if not axis.amp_enabled:
         return 0.0
     cfg = axis.plant.config
@@ -211,6 +212,8 @@ def servo_effort(axis) -> float:
     effort = (w * w * (axis.cmd_p - axis.act_p)
               + 2.0 * cfg.damping * w * (cfg.velocity_feedforward * axis.cmd_v - axis.act_v)
               + cfg.acceleration_feedforward * axis.cmd_a)
+    if axis.feedforward:
+        effort += cfg.dac_acceleration * axis.feedforward
     return _finite(effort)
 
 

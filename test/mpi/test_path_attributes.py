@@ -156,3 +156,43 @@ def test_feedforward_of_appended_points_follows_on(ctl, ms):
     ctl.step(100)
     assert ctl.axis_snapshot(0).feedforward == pytest.approx(300.0)  # half way to the second
     assert ms.action(MPIAction.STOP).ok
+
+
+def _ptf_run(ctl_factory, feedforward, batch):
+    ctl = ctl_factory()
+    _, ms = ctl.create_motion(0)
+    assert ms.axis_list_set([0]).ok and ms.action(MPIAction.MAP).ok
+    assert ms.start(T.PTF, A.NONE, MotionParams(position=[200.0, 600.0], time=[0.2, 0.2],
+                                                feedforward=feedforward)).ok
+    actual = {}
+    for _ in range(3000 // batch):
+        ctl.step(batch)
+        actual[ctl.sample] = (ctl.axes[0].act_p, ctl.axes[0].act_v)
+    return ms, ctl, actual
+
+
+def test_feedforward_drives_the_servo_and_holds_it_off_the_command():
+    # MPI 000, MPIMotionPTF: feedforward "values for each PTF motion segment", in DAC counts: the
+    # motor is pushed by them (PlantConfig.dac_acceleration counts/s^2 per DAC count), so the
+    # actual position leaves the pure loop's, and a feedforward held after the move keeps the motor
+    # off the resting command by K d / w^2 (the loop has no integrator).
+    from mpi_ros.mpi import Controller
+
+    _, _, plain = _ptf_run(Controller, [0.0, 0.0], 50)
+    ms, ctl, pushed = _ptf_run(Controller, [20_000.0, 20_000.0], 50)
+    assert [plain[k] != pushed[k] for k in (100, 400, 700)] == [True] * 3  # along the path
+    axis = ctl.axes[0]
+    w = 2.0 * np.pi * axis.plant.config.bandwidth_hz
+    offset = axis.plant.config.dac_acceleration * 20_000.0 / (w * w)
+    assert axis.command_position == 600.0
+    assert axis.act_p == pytest.approx(600.0 + offset, abs=0.5)  # the encoder reads whole counts
+    assert plain[ctl.sample][0] == 600.0
+
+
+@pytest.mark.parametrize("batch", [1, 10])
+def test_feedforward_is_batching_invariant(batch):
+    from mpi_ros.mpi import Controller
+
+    _, _, reference = _ptf_run(Controller, [20_000.0, -5_000.0], 250)
+    _, _, actual = _ptf_run(Controller, [20_000.0, -5_000.0], batch)
+    assert {k: actual[k] for k in reference} == reference  # every 250th sample, 3 of them along the path
