@@ -35,10 +35,10 @@ import tarfile
 import tempfile
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
-from typing import Callable
 
 from mpi_ros.crosscheck import check_plan
 from mpi_ros.crosscheck.result import RuckigLimits
@@ -132,7 +132,7 @@ class Planner:
     s_curve: object
 
     @classmethod
-    def of(cls, name: str, package: str) -> "Planner":
+    def of(cls, name: str, package: str) -> Planner:
         planner = importlib.import_module(f"{package}.mpi.planner")
         params = importlib.import_module(f"{package}.mpi.params")
         types = importlib.import_module(f"{package}.mpi.types")

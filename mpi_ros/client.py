@@ -26,6 +26,7 @@ safe to send from another thread while spinning). :class:`Watcher` follows the w
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import re
 import threading
@@ -416,10 +417,9 @@ class _Endpoint:
         self._thread.start()
 
     def _spin(self) -> None:
-        try:
+        # ExternalShutdownException: the context was shut down under us (Ctrl-C in the owner): nothing left to serve
+        with contextlib.suppress(ExternalShutdownException):
             self._executor.spin()
-        except ExternalShutdownException:
-            pass  # the context was shut down under us (Ctrl-C in the owner): nothing left to serve
 
     def close(self) -> None:
         self._executor.shutdown(timeout_sec=2.0)

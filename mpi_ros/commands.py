@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable
+from typing import Any
 
 from . import requests as rq
 from .mpi.control import Controller
@@ -48,7 +49,7 @@ class Command:
         return json.dumps(self.request, sort_keys=True, separators=(",", ":"))
 
     @classmethod
-    def from_json(cls, operation: str, supervisor: int, axis: int, text: str) -> "Command":
+    def from_json(cls, operation: str, supervisor: int, axis: int, text: str) -> Command:
         return cls(operation, supervisor, axis, json.loads(text) if text else {})
 
 

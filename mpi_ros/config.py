@@ -10,6 +10,7 @@ same configuration builds the controller for the ROS suite, the CLI tools and re
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import math
 import sys
@@ -179,10 +180,8 @@ def _coerce(value: Any, default: Any, where: str):
         return value
     if isinstance(default, float):
         if isinstance(value, str):  # PyYAML reads 1e9 (no exponent sign) as a string
-            try:
+            with contextlib.suppress(ValueError):
                 value = float(value)
-            except ValueError:
-                pass
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ConfigError(f"{where}: expected a finite number, got {value!r}")
         return float(value)

@@ -13,8 +13,9 @@ are the structs' validators' business (mpi_ros/mpi/params.py), run by the contro
 from __future__ import annotations
 
 import numbers as _numbers
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Any, Mapping
+from typing import Any
 
 from .mpi.events import MPIEventType
 from .mpi.messages import Message

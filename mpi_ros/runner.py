@@ -20,8 +20,8 @@ import logging
 import threading
 import time
 from collections import OrderedDict, deque
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from .commands import Command, Reply, apply
 from .mpi.control import Controller

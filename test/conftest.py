@@ -18,7 +18,6 @@ from __future__ import annotations
 import os
 
 
-
 def _claim_domain() -> str:
     """A DDS domain no other test run on this machine holds: ids 1..100 (valid for every RMW on
     Linux; 0 is the default everyone uses), each claimed with an exclusive lock on a file in

@@ -31,7 +31,7 @@ from mpi_ros.mpi.types import MPIState
 def test_one_exception_class_per_message_with_the_same_name_and_code():
     expected = {m.name: m.code for m in Message if m is not Message.MPIMessageOK}
     assert {name: cls.code for name, cls in errors.ERRORS.items()} == expected
-    assert errors.CODES == {m.name: m.code for m in Message}
+    assert {m.name: m.code for m in Message} == errors.CODES
     for name in expected:
         cls = getattr(errors, name)
         assert cls.message_name == name and issubclass(cls, errors.MpiError)

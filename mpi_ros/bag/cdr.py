@@ -21,7 +21,7 @@ elements when there are none); fixed arrays as the elements alone; nested messag
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 from rosidl_parser import definition as d
 
@@ -66,7 +66,7 @@ def _message_class(slot: d.NamespacedType):
     return getattr(importlib.import_module(".".join(slot.namespaces)), slot.name)
 
 
-@lru_cache(maxsize=None)
+@cache
 def plan_of(msg_class) -> tuple:
     """The field layout of a generated message class (cached per class). Consecutive
     primitive fields become one run ("r"), laid out in advance for each start offset mod 8

@@ -27,8 +27,8 @@ from ..commands import Command as ControllerCommand
 from ..commands import Reply
 from ..config import SuiteConfig
 from ..mpi.events import MPIEventType
-from ..runner import ControllerRunner
 from ..ros import convert
+from ..runner import ControllerRunner
 from .writer import BagWriter, TopicQos
 
 COMMANDS_TOPIC = "/mpi/commands"  # with the default namespace; in general <namespace>/commands

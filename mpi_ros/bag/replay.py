@@ -26,8 +26,7 @@ from .. import config as suite_config
 from ..commands import Command, apply
 from ..ros import convert
 from .reader import BagReader
-from .recorder import (COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED,
-                       commands_topic)
+from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED, commands_topic
 
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
 STATUS_TYPES = ("mpi_ros/msg/MotionStatus", "mpi_ros/msg/AxisStatus")

@@ -14,6 +14,7 @@ redrawn in place every 0.1 s; otherwise a new table is printed every second.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 import threading
 import time
@@ -53,10 +54,8 @@ def _status(session, args: argparse.Namespace) -> int:
         return OK
     tty = sys.stdout.isatty()
     interval = args.interval if args.interval is not None else (0.1 if tty else 1.0)
-    try:
+    with contextlib.suppress(KeyboardInterrupt):  # Ctrl-C is how a live view ends
         _live(watcher, sys.stdout, tty, interval)
-    except KeyboardInterrupt:
-        pass  # Ctrl-C is how a live view ends
     return OK
 
 

@@ -25,16 +25,26 @@ zero carry that much rounding).
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from ..mpi.frames import AxisPlan
 from ..mpi.profiles.segment import Segment
 from ..mpi.types import MPIMotionType
 from .limits import check_profile, strip_waits
 from .mapping import INF, Mapping, map_point_to_point, map_velocity, peak_acceleration
-from .request import ProfileRequest, motion_type as parse_type
-from .result import (BOUND_RTOL, DURATION_RTOL, STATE_RTOL, TIME_RESOLUTION, CrossCheck, Reason, RuckigLimits,
-                     StateDifference, Verdict)
+from .request import ProfileRequest
+from .request import motion_type as parse_type
+from .result import (
+    BOUND_RTOL,
+    DURATION_RTOL,
+    STATE_RTOL,
+    TIME_RESOLUTION,
+    CrossCheck,
+    Reason,
+    RuckigLimits,
+    StateDifference,
+    Verdict,
+)
 from .sampling import end_state, max_difference
 from .solver import RuckigFailed, solve
 

@@ -22,8 +22,8 @@ deceleration, jerk as configured; lines 221-227 for the S-curve's shape):
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 from ..mpi.profiles.segment import Segment
 from .mapping import peak_acceleration, ramp_jerk, reverses

@@ -19,8 +19,8 @@ from __future__ import annotations
 import logging
 import threading
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from ..mpi.control import Controller
 from ..mpi.events import MPIEventType

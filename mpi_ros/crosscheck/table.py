@@ -9,7 +9,7 @@ Problems (DISAGREE) and mapping notes follow the table, numbered by row.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from .request import ProfileRequest
 from .result import CrossCheck, Verdict

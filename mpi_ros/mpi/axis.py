@@ -65,10 +65,10 @@ class _Derived:
     def __set_name__(self, owner: type, name: str) -> None:
         self.slot = "_" + name
 
-    def __get__(self, axis: "Axis | None", owner: type | None = None):
+    def __get__(self, axis: Axis | None, owner: type | None = None):
         return self if axis is None else getattr(axis, self.slot)
 
-    def __set__(self, axis: "Axis", value) -> None:
+    def __set__(self, axis: Axis, value) -> None:
         setattr(axis, self.slot, value)
         axis._bank.stale[axis.number] = True
 
@@ -76,7 +76,7 @@ class _Derived:
 class _Anchor(_Derived):
     """The plant anchor: moving it changes only the axis' servo rows (a lighter rebuild)."""
 
-    def __set__(self, axis: "Axis", value) -> None:
+    def __set__(self, axis: Axis, value) -> None:
         setattr(axis, self.slot, value)
         axis._bank.moved[axis.number] = True
 
@@ -87,10 +87,10 @@ class _Value:
     def __set_name__(self, owner: type, name: str) -> None:
         self.name = name
 
-    def __get__(self, axis: "Axis | None", owner: type | None = None):
+    def __get__(self, axis: Axis | None, owner: type | None = None):
         return self if axis is None else float(getattr(axis._bank, self.name)[axis.number])
 
-    def __set__(self, axis: "Axis", value: float) -> None:
+    def __set__(self, axis: Axis, value: float) -> None:
         getattr(axis._bank, self.name)[axis.number] = value
 
 
@@ -246,7 +246,7 @@ class Axis:
         if t == self.state.t:
             return
         state = self.state
-        for start, end, forced in self._pieces(state.t, t, clock):
+        for _start, end, forced in self._pieces(state.t, t, clock):
             stop = min(end, t)
             state = self._advance_piece(state, forced, stop)
             if end >= t:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -303,7 +303,7 @@ class Controller:
         while self.sample < end:
             self._advance(min(end, self.sample + longest))
 
-    def run_until(self, condition: Callable[["Controller"], bool], max_samples: int, chunk: int = 1) -> bool:
+    def run_until(self, condition: Callable[[Controller], bool], max_samples: int, chunk: int = 1) -> bool:
         """Step ``chunk`` samples at a time until ``condition`` holds (True) or
         ``max_samples`` have passed (False)."""
         limit = self.sample + max_samples

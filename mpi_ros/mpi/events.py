@@ -45,7 +45,7 @@ class MPIEventType(IntFlag):
     DONE = 1 << 25
 
     @classmethod
-    def parse(cls, names) -> "MPIEventType | None":
+    def parse(cls, names) -> MPIEventType | None:
         """Names (without prefix; ALL, NONE, MOTION and AXIS allowed) to a mask."""
         mask = cls.NONE
         for name in names:

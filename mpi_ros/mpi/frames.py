@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 
@@ -181,7 +181,7 @@ class Stream:
     # on each axis). An append is a command of its own: it ends when its points are done.
     chunks: list[tuple[int, dict[int, float]]] = field(default_factory=list)
 
-    def append(self, chunk: "Stream | None", open_: bool) -> None:
+    def append(self, chunk: Stream | None, open_: bool) -> None:
         """Points were appended (``chunk``: theirs; None: none, the path is only closed)."""
         self.open = open_
         self.low_sent = self.empty_sent = False

@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 from . import paths, validate
 from .axis import Axis, CommandMode
@@ -32,11 +33,11 @@ from .supervisor_stepping import SteppingMixin
 from .types import (
     STATE_SEVERITY,
     ActionSource,
+    HoldType,
+    IoSpace,
     MotionAttr,
     MPIMotionType,
     MPIState,
-    HoldType,
-    IoSpace,
     OutputType,
 )
 
@@ -67,7 +68,7 @@ class MoveEnd:
 
 
 class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
-    def __init__(self, controller: "Controller", number: int, config: MotionConfig):
+    def __init__(self, controller: Controller, number: int, config: MotionConfig):
         self._ctl = controller
         self.number = number
         self.valid = True
@@ -444,7 +445,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         states = [self.own_state] + [other.own_state for _, other in self._held_by_others(numbers)]
         return max(states, key=STATE_SEVERITY.__getitem__)
 
-    def _held_by_others(self, numbers: list[int]) -> list[tuple[int, "MotionSupervisor"]]:
+    def _held_by_others(self, numbers: list[int]) -> list[tuple[int, MotionSupervisor]]:
         """(axis, supervisor) for each axis of ``numbers`` in another supervisor's motion."""
         held = []
         for n in numbers:

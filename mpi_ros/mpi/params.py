@@ -14,8 +14,8 @@ from __future__ import annotations
 import copy
 import math
 import numbers
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Iterable
 
 from .events import MASK_ALL, MPIEventType
 from .messages import Message
@@ -65,7 +65,7 @@ class Verdict:
     def ok(self) -> bool:
         return self.message is Message.MPIMessageOK
 
-    def prefixed(self, prefix: str) -> "Verdict":
+    def prefixed(self, prefix: str) -> Verdict:
         """The same verdict with ``prefix`` before the field it names (for nested structs)."""
         return self if self.ok else Verdict(self.message, prefix + self.detail)
 
@@ -256,7 +256,7 @@ class MotionParams:
     low_count: int = 0  # LOW_COUNT: FRAMES_LOW below this many points
     expected_axes: int = 0  # EXPECTED_AXES: must equal the mapped axes
 
-    def copy(self) -> "MotionParams":
+    def copy(self) -> MotionParams:
         return copy.deepcopy(self)
 
     @property
@@ -346,7 +346,7 @@ class MotionConfig:
     def axis_count(self) -> int:
         return len(self.axis_numbers)
 
-    def copy(self) -> "MotionConfig":
+    def copy(self) -> MotionConfig:
         return copy.deepcopy(self)
 
     def validate(self) -> Verdict:
@@ -387,7 +387,7 @@ class AxisInPosition:
     settle_on_estop: bool = False
     settle_on_estop_cmd_eq_act: bool = False
 
-    def copy(self) -> "AxisInPosition":
+    def copy(self) -> AxisInPosition:
         return copy.deepcopy(self)
 
     def validate(self) -> Verdict:

@@ -26,11 +26,11 @@ from .events import MPIEventType
 from .frames import AxisPlan, Move, Stream
 from .messages import Message
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, MotionParams, Trajectory
+from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import point_to_point, reverses, velocity_move
 from .profiles.ramps import ProfileError, ramps_between
 from .profiles.scurve import reshape
-from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.segment import Segment, chain, scaled_profile, segment_values
 from .types import HOLD_ATTRS, MotionAttr, MPIMotionType
 

@@ -63,7 +63,7 @@ class Transient:
     m0: float  # M v
     m1: float
     decayed_after: float  # seconds past the anchor from which it is dropped (inf: never)
-    table: "_FreeTable"
+    table: _FreeTable
 
     def at(self, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Its position and velocity parts at whole ``samples``."""
@@ -149,7 +149,7 @@ class Plant:
         m0, m1 = self._apply_m(e0, e1)
         return p * e0 + q * m0, p * e1 + q * m1
 
-    def table(self, rate: float) -> "_FreeTable":
+    def table(self, rate: float) -> _FreeTable:
         """The free response of this loop at whole samples of ``rate`` (shared by identical loops)."""
         key = (self.config.bandwidth_hz, self.config.damping, self._coast, rate)
         table = _TABLES.get(key)
@@ -157,7 +157,7 @@ class Plant:
             table = _TABLES[key] = _FreeTable.build(self, rate)
         return table
 
-    def prepare(self, u: list[float], dac: list[float] | None = None) -> "Forced":
+    def prepare(self, u: list[float], dac: list[float] | None = None) -> Forced:
         """The loop's steady response to a polynomial command ``u`` and DAC feedforward
         ``dac`` (PTF/PVTF; None or zero: none), reusable for a piece."""
         yp = self.particular(u)
@@ -165,7 +165,7 @@ class Plant:
             yp = _poly_add(yp, self._particular(dac, self._dac_gains))
         return Forced(yp, poly_der(yp))
 
-    def transient(self, state: PlantState, forced: "Forced", rate: float) -> "Transient | None":
+    def transient(self, state: PlantState, forced: Forced, rate: float) -> Transient | None:
         """The decaying part of the response of a piece anchored at ``state``, reduced to
         what every whole sample needs (None: below the quiet level from the anchor on).
         The one place the anchor's free state is computed, for one axis and for rows of
@@ -187,7 +187,7 @@ class Plant:
         decayed = self._settle_after(size) if len(forced.y) == 1 else math.inf
         return Transient(k0, v0, v1, m0, m1, decayed, self.table(rate))
 
-    def response(self, state: PlantState, forced: "Forced", samples: np.ndarray,
+    def response(self, state: PlantState, forced: Forced, samples: np.ndarray,
                  rate: float) -> tuple[np.ndarray, np.ndarray]:
         """Position and velocity at whole ``samples`` (at ``rate``) from ``state``."""
         s = samples / rate - state.t
@@ -213,7 +213,7 @@ class Plant:
         size = abs(state.y - yp[0]) + abs(state.dy - dyp0) / (-self._sigma)
         return self._settle_after(size)
 
-    def advance(self, state: PlantState, forced: "Forced", t: float) -> PlantState:
+    def advance(self, state: PlantState, forced: Forced, t: float) -> PlantState:
         """State at time ``t`` (within the piece that starts at ``state.t``); scalar math."""
         s = t - state.t
         y = _poly_eval_scalar(forced.y, s)
@@ -257,7 +257,7 @@ def _first_sample(t: float, rate: float) -> int:
     return k
 
 
-_TABLES: dict[tuple[float, float, float, float], "_FreeTable"] = {}  # shared by identical loops
+_TABLES: dict[tuple[float, float, float, float], _FreeTable] = {}  # shared by identical loops
 _TABLE = 4096  # samples of free response tabulated; further ones are products of two
 _BLOCKS_WATCHED = 64  # blocks of _TABLE samples searched for an exact underflow (about 2 min at 2 kHz)
 
@@ -283,7 +283,7 @@ class _FreeTable:
         self._vanishing: float | None = None
 
     @classmethod
-    def build(cls, plant: "Plant", rate: float) -> "_FreeTable":
+    def build(cls, plant: Plant, rate: float) -> _FreeTable:
         pq = [plant._free(m / rate) for m in range(_TABLE + 1)]
         p = np.array([x for x, _ in pq])
         q = np.array([y for _, y in pq])

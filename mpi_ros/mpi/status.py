@@ -110,7 +110,7 @@ class Runs:
     mixed_runs: np.ndarray  # (len(mixed), samples)
 
     @classmethod
-    def never(cls, count: int) -> "Runs":
+    def never(cls, count: int) -> Runs:
         return cls(np.zeros(count, dtype=np.int64), np.zeros(count, dtype=bool), _NONE, _NONE)
 
     def at(self, index: int) -> np.ndarray:
@@ -168,7 +168,7 @@ class StatusRows:
     _any: dict[str, bool] = field(default_factory=dict)  # has any row the flag? (until a row changes)
 
     @classmethod
-    def empty(cls, count: int) -> "StatusRows":
+    def empty(cls, count: int) -> StatusRows:
         names = [f.name for f in fields(cls) if f.name not in ("col", "_any")]
         rows = cls(**{name: np.zeros(count, dtype=bool if name in _FLAGS else
                                      (np.int64 if name == "need" else float)) for name in names})
@@ -214,7 +214,7 @@ class StretchStatus:
     (b in :data:`BITS` order), and the settling runs to carry on from any sample."""
 
     bits: np.ndarray
-    runs: tuple["Runs | _PickedRuns", Runs, Runs]  # FINE_RUN, SETTLED_RUN, VELOCITY_RUN
+    runs: tuple[Runs | _PickedRuns, Runs, Runs]  # FINE_RUN, SETTLED_RUN, VELOCITY_RUN
     _ever: dict[int, list[bool]] = field(default_factory=dict)
 
     def ever(self, bit: int) -> list[bool]:

@@ -17,8 +17,8 @@ The arrays live in a :class:`Scratch` and are reused by the next stretch.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from .axis import Axis
 from .bank import VALUES, AxisBank, ClockColumns, CommandRows, Kind, PlantRows
 from .clock import ProfileClock
 from .plant import PlantState
+
 
 class Scratch:
     """Arrays by name, reused from stretch to stretch. A fresh array of a megabyte (32 axes

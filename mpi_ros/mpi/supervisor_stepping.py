@@ -7,7 +7,8 @@ happens, stops there, and calls :meth:`transition`.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 

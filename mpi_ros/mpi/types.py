@@ -144,7 +144,7 @@ class MotionAttr(IntFlag):
     NO_WAIT = 1 << 31
 
     @classmethod
-    def parse(cls, names) -> "MotionAttr | None":
+    def parse(cls, names) -> MotionAttr | None:
         """Attribute names (without prefix) to a mask; None if a name is unknown."""
         mask = cls.NONE
         for name in names:

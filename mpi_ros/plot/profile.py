@@ -11,8 +11,8 @@ acceleration steps and is drawn as zero between them.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 

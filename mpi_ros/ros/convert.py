@@ -90,7 +90,7 @@ def answer(response, reply):
 
 
 _default_epoch_ns = 0  # the epoch of the suite anchored last in this process
-_EPOCHS: "weakref.WeakKeyDictionary[Any, int]" = weakref.WeakKeyDictionary()
+_EPOCHS: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()
 
 
 def anchor(controller, epoch_ns: int | None = None) -> int:

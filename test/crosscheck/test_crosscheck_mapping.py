@@ -7,11 +7,18 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings, strategies as st
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from mpi_ros.crosscheck import ProfileRequest, Reason, Verdict, check_request
-from mpi_ros.crosscheck.mapping import (map_point_to_point, map_velocity, peak_acceleration, ramp_jerk,
-                                        reached_velocity, reverses)
+from mpi_ros.crosscheck.mapping import (
+    map_point_to_point,
+    map_velocity,
+    peak_acceleration,
+    ramp_jerk,
+    reached_velocity,
+    reverses,
+)
 from mpi_ros.crosscheck.result import RuckigLimits
 from mpi_ros.crosscheck.sampling import sample
 from mpi_ros.crosscheck.solver import RuckigFailed, solve

@@ -6,8 +6,7 @@ import math
 
 import pytest
 
-from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, MPIAction, MPIMotionType, MPIState,
-                         PlantConfig)
+from mpi_ros.mpi import AxisInPosition, Controller, ControllerConfig, MPIAction, MPIMotionType, MPIState, PlantConfig
 from mpi_ros.mpi.messages import Message
 
 M = Message

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 import time
 
+import numpy as np
 import pytest
 
 from mpi_ros.mpi import Controller, ControllerConfig, IoSpace, MPIAction, MPIMotionType, MPIState

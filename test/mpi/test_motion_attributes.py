@@ -6,8 +6,18 @@ from __future__ import annotations
 
 import pytest
 
-from mpi_ros.mpi import (Controller, ControllerConfig, IoSpace, MotionAttr, MotionParams, MPIMotionType, MPIState,
-                         Output, OutputType, Trajectory)
+from mpi_ros.mpi import (
+    Controller,
+    ControllerConfig,
+    IoSpace,
+    MotionAttr,
+    MotionParams,
+    MPIMotionType,
+    MPIState,
+    Output,
+    OutputType,
+    Trajectory,
+)
 from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.messages import Message
 

@@ -17,8 +17,19 @@ import re
 import numpy as np
 import pytest
 
-from mpi_ros.mpi import (Controller, ControllerConfig, IoSpace, MotionAttr, MotionParams, MPIAction, MPIMotionType,
-                         MPIState, Output, OutputType, Trajectory)
+from mpi_ros.mpi import (
+    Controller,
+    ControllerConfig,
+    IoSpace,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Output,
+    OutputType,
+    Trajectory,
+)
 from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.messages import Message
 from mpi_ros.mpi.params import UserFrame
@@ -532,7 +543,8 @@ def test_element_id_is_the_id_of_the_point_the_path_runs_toward(times):
     ctl, ms = new_supervisor(notify=E.MOTION_DONE)
     first_ids = [100 + i for i in range(len(first_times))]
     more_ids = [200 + i for i in range(len(more_times))]
-    pts = lambda count, base: np.stack([base + np.arange(1.0, count + 1), np.zeros(count)], axis=1)
+    def pts(count, base):
+        return np.stack([base + np.arange(1.0, count + 1), np.zeros(count)], axis=1)
     first = path_params(T.PT, pts(len(first_times), 0.0), first_times, final=False, empty_count=0,
                         element_id=first_ids)
     assert ms.start(T.PT, A.ELEMENT_ID, first).ok
@@ -569,7 +581,8 @@ def test_points_appended_without_element_ids_leave_the_later_ids_in_place():
     # ELEMENT_ID gives its points none, and the points appended after it with ids keep theirs
     ctl, ms = new_supervisor()
     n = int(round(EXACT_DT * RATE))
-    pts = lambda base, count: np.stack([base + np.arange(1.0, count + 1), np.zeros(count)], axis=1)
+    def pts(base, count):
+        return np.stack([base + np.arange(1.0, count + 1), np.zeros(count)], axis=1)
     first = path_params(T.PT, pts(0.0, 4), [EXACT_DT] * 4, final=False, empty_count=0, element_id=[1, 2, 3, 4])
     assert ms.start(T.PT, A.ELEMENT_ID, first).ok
     s0 = ctl.sample
@@ -626,7 +639,8 @@ def test_output_by_point_index_is_applied_as_the_segment_toward_that_point_begin
                  for i in first_indices]
     more_out = [Output(type=OutputType.OUTPUT, address=5, on_mask=1 << next(bit), point_index=i)
                 for i in more_indices]
-    pts = lambda count: np.stack([np.arange(1.0, count + 1), np.zeros(count)], axis=1)
+    def pts(count):
+        return np.stack([np.arange(1.0, count + 1), np.zeros(count)], axis=1)
     assert ctl.io_get(IoSpace.IO, 5)[1] == 0
     first = path_params(T.PT, pts(len(first_times)), first_times, final=False, empty_count=0, output=first_out)
     assert ms.start(T.PT, A.OUTPUT, first).ok

@@ -22,8 +22,17 @@ import numpy as np
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from mpi_ros.mpi import (Controller, ControllerConfig, DecelTime, MotionAttr, MotionParams, MPIAction, MPIMotionType,
-                         MPIState, Trajectory)
+from mpi_ros.mpi import (
+    Controller,
+    ControllerConfig,
+    DecelTime,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Trajectory,
+)
 from mpi_ros.mpi.messages import Message
 
 T = MPIMotionType

@@ -9,8 +9,16 @@ from __future__ import annotations
 
 import pytest
 
-from mpi_ros.mpi import (ActionSource, Controller, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState,
-                         Trajectory)
+from mpi_ros.mpi import (
+    ActionSource,
+    Controller,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Trajectory,
+)
 from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.messages import Message
 

@@ -14,8 +14,18 @@ import math
 
 import pytest
 
-from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, MotionAttr, MotionParams, MPIAction, MPIMotionType,
-                         MPIState, PlantConfig, Trajectory)
+from mpi_ros.mpi import (
+    AxisInPosition,
+    Controller,
+    ControllerConfig,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    PlantConfig,
+    Trajectory,
+)
 from mpi_ros.mpi.events import MPIEventType
 
 RATE = 2000.0

@@ -14,8 +14,20 @@ import random
 
 import pytest
 
-from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, Hold, HoldType, MotionAttr, MotionParams,
-                         MPIAction, MPIMotionType, PlantConfig, Trajectory, control)
+from mpi_ros.mpi import (
+    AxisInPosition,
+    Controller,
+    ControllerConfig,
+    Hold,
+    HoldType,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    PlantConfig,
+    Trajectory,
+    control,
+)
 from mpi_ros.mpi.plant import Plant
 
 _VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")

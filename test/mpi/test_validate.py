@@ -8,10 +8,19 @@ import math
 
 import pytest
 
-from mpi_ros.mpi import (Controller, Hold, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState, Output,
-                         Trajectory)
-from mpi_ros.mpi.params import MotionConfig
+from mpi_ros.mpi import (
+    Controller,
+    Hold,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Output,
+    Trajectory,
+)
 from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.params import MotionConfig
 from mpi_ros.mpi.types import PATH_ATTRS, HoldType, OutputType
 from mpi_ros.mpi.validate import check_attributes, check_params, check_type
 

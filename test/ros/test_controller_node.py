@@ -88,8 +88,8 @@ def test_diagnostics_go_to_error_on_e_stop(suite, client, probe, applied, drive)
 
 
 def test_clock_follows_the_controller(suite, probe, drive):
-    from rosgraph_msgs.msg import Clock
     from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from rosgraph_msgs.msg import Clock
 
     ticks = []
     probe.create_subscription(Clock, "/clock", ticks.append, QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT))

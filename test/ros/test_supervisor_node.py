@@ -302,8 +302,16 @@ def test_start_with_stored_params(suite, client, probe, service, applied, drive)
 
 
 def test_axis_list_position_frame_buffer_and_event_services(suite, probe, service):
-    from mpi_ros.srv import (AxisListEdit, AxisListGet, EventNotifyGet, EventNotifySet, EventReset,
-                             FrameBufferStatusGet, PositionGet, PositionSet)
+    from mpi_ros.srv import (
+        AxisListEdit,
+        AxisListGet,
+        EventNotifyGet,
+        EventNotifySet,
+        EventReset,
+        FrameBufferStatusGet,
+        PositionGet,
+        PositionSet,
+    )
 
     listing = service(probe, AxisListGet, "/mpi/ms0/axis_list_get", AxisListGet.Request())
     assert list(listing.axis_numbers) == [0, 1] and list(listing.mapped_axis_numbers) == [0, 1]

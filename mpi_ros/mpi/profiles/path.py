@@ -15,7 +15,7 @@ dt > 0, every value finite, as many times as positions, at least one point).
 from __future__ import annotations
 
 import enum
-from typing import Sequence
+from collections.abc import Sequence
 
 from .segment import Segment
 

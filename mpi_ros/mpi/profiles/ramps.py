@@ -13,8 +13,8 @@ acceleration for every ramp (spec 000 MPIMotionVelocity: "deceleration is ignore
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 
 class ProfileError(ValueError):

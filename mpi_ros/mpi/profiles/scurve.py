@@ -11,7 +11,7 @@ f = 0 is the trapezoid itself.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from .ramps import ProfileError, Ramp
 from .segment import Segment, segment_of

@@ -7,11 +7,11 @@ seconds of profile time with jerk ``j``. A 1-D profile is a contiguous tuple of 
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, fields
 from functools import reduce
 from itertools import chain as _chain_iterables
 from operator import add, attrgetter
-from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -38,7 +38,7 @@ class Segment:
     def end_state(self) -> tuple[float, float, float]:
         return self.state_at(self.duration)
 
-    def scaled(self, factor: float, offset: float) -> "Segment":
+    def scaled(self, factor: float, offset: float) -> Segment:
         """The segment of an axis that moves ``factor`` times this 1-D profile."""
         return segment_of(
             self.duration, offset + factor * self.p, factor * self.v, factor * self.a, factor * self.j
