@@ -114,7 +114,7 @@ def problems(case: Case, count: int, seed: int = 7) -> list[Problem]:
         positions = tuple(rng.uniform(-1e5, 1e5) for _ in range(case.axes))
         speed = rng.uniform(-velocity, velocity) if case.moving else 0.0
         out.append(Problem(velocity, acceleration, rng.uniform(1.0, 100.0), positions,
-                           tuple(p + distance * u for p, u in zip(positions, unit)),
+                           tuple(p + distance * u for p, u in zip(positions, unit, strict=True)),
                            tuple(speed * u for u in unit)))
     return out
 
@@ -142,7 +142,7 @@ class Planner:
     def request(self, problem: Problem) -> tuple:
         traj = self.trajectory(problem.velocity, problem.acceleration, problem.acceleration, problem.jerk_percent)
         params = self.params(trajectory=[traj], position=list(problem.targets))
-        starts = [self.start(n, p, v) for n, (p, v) in enumerate(zip(problem.positions, problem.velocities))]
+        starts = [self.start(n, p, v) for n, (p, v) in enumerate(zip(problem.positions, problem.velocities, strict=True))]
         return params, starts
 
     def plan(self, request: tuple):
@@ -201,10 +201,10 @@ def ruckig_input(limits: list[RuckigLimits]):
     lengths = [speed(lim) ** 2 / accel(lim) for lim in limits]
     inp = InputParameter(len(limits))
     inp.current_position = [0.0] * len(limits)
-    inp.target_position = [(lim.target_position - lim.current_position) / n for lim, n in zip(limits, lengths)]
+    inp.target_position = [(lim.target_position - lim.current_position) / n for lim, n in zip(limits, lengths, strict=True)]
     inp.target_acceleration = [0.0] * len(limits)
     for name, power in _RUCKIG_UNITS.items():
-        setattr(inp, name, [getattr(lim, name) / (n / tau ** power) for lim, n in zip(limits, lengths)])
+        setattr(inp, name, [getattr(lim, name) / (n / tau ** power) for lim, n in zip(limits, lengths, strict=True)])
     return inp, tau
 
 
@@ -292,7 +292,7 @@ def side_by_side(case: Case, count: int, rounds: int, baseline: Planner | None) 
     inputs = _ruckig_problems(case, ours, requests, found)
     if baseline:
         found.identical = all(_bits(ours.plan(new).plans) == _bits(baseline.plan(old).plans)
-                              for new, old in zip(requests, old_requests))
+                              for new, old in zip(requests, old_requests, strict=True))
     order = _timers(case, requests, inputs, baseline, old_requests, found)
     for i in range(min(100, count)):  # warm up every path
         for timer in order:

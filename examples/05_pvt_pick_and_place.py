@@ -32,7 +32,7 @@ with MotionClient(supervisor=0) as ms0:
     # 1. to the pick point (a path starts wherever the axes are)
     ms0.move([PICK, 0.0], velocity=2000.0, acceleration=20000.0, jerk_percent=50.0, timeout=30.0)
     # 2. the whole cycle as one PVT path, an element id per point
-    points, velocities, times = zip(*PATH)
+    points, velocities, times = zip(*PATH, strict=True)
     result = ms0.path(MotionType.PVT, points, times, velocities=velocities, element_ids=range(1, len(PATH) + 1))
     print(result.message, result.state_name, "at", list(result.command_position))
     print("peaks:", result.detail.split("path peaks ", 1)[-1])

@@ -102,7 +102,7 @@ class SuiteConfig:
             raise ConfigError(f"axes: {self.controller.axis_count} axes need as many in_position and plant "
                               f"settings, got {len(self.in_position)} and {len(self.plant)}")
         ctl = Controller(self.controller)
-        for n, (in_position, plant) in enumerate(zip(self.in_position, self.plant)):
+        for n, (in_position, plant) in enumerate(zip(self.in_position, self.plant, strict=True)):
             _require(plant.validate(), f"axes[{n}].plant.")
             ctl.axes[n].plant = Plant(plant)  # before the tolerances: they are checked against its encoder
             _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position",

@@ -74,7 +74,7 @@ def plan_of(msg_class) -> tuple:
     names = list(msg_class.get_fields_and_field_types())
     plan: list = []
     sizes: list[int] = []
-    for name, slot in zip(names, msg_class.SLOT_TYPES):
+    for name, slot in zip(names, msg_class.SLOT_TYPES, strict=True):
         kind, detail = _element(slot)
         if kind == "p":
             sizes.append(detail)

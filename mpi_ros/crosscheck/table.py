@@ -48,7 +48,7 @@ def format_table(entries: Sequence[tuple[ProfileRequest | None, CrossCheck | str
     lines = []
     for n, r in enumerate(rows):
         lines.append("  ".join(cell.ljust(w) if c in (1, 7, 8) else cell.rjust(w)
-                               for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
+                               for c, (cell, w) in enumerate(zip(r, widths, strict=True))).rstrip())
         if n == 0:
             lines.append("  ".join("-" * w for w in widths))
     footnotes = []

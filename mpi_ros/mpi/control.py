@@ -367,7 +367,7 @@ class Controller:
         before = self.bank.bits[:EVENT_BITS]
         # Only a bit that is on somewhere, and not on throughout after being on, can rise.
         rising = bits.any(axis=2) & ~(bits.all(axis=2) & before)
-        for rank, number in zip(*np.nonzero(rising)):
+        for rank, number in zip(*np.nonzero(rising), strict=True):
             for i in rising_edges(bool(before[rank, number]), bits[rank, number]):
                 found.append((int(i), int(number), int(rank), _EDGE_EVENTS[rank], ""))
         found += self._frame_time_limits(stop, stretch)

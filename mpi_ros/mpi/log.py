@@ -43,7 +43,7 @@ class MotionLog:
         try:
             with open(filename, "w", encoding="utf-8") as out:
                 out.write(",".join(header) + "\n")
-                for samples, state, cols in zip(self.samples, self.states, self.columns):
+                for samples, state, cols in zip(self.samples, self.states, self.columns, strict=True):
                     for i, sample in enumerate(samples):
                         values = ",".join(repr(float(x)) for x in cols[i])
                         out.write(f"{int(sample)},{state}" + (f",{values}" if values else "") + "\n")

@@ -218,10 +218,10 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         # an axis is in the state of the supervisor commanding it (IDLE without one)
         owners = [self._ctl.supervisor(a.owner) for a in axes]
         states = [o.own_state if o is not None else MPIState.IDLE for o in owners]
-        if not all(a.can_set_command(state) for a, state in zip(axes, states)):
+        if not all(a.can_set_command(state) for a, state in zip(axes, states, strict=True)):
             return Message.MPIAxisMessageCOMMAND_NOT_SET
         t = self._ctl.time
-        for axis, act, cmd in zip(axes, actual, command):
+        for axis, act, cmd in zip(axes, actual, command, strict=True):
             axis.set_actual_position(act, t)
             axis.set_command_position(cmd, t)
         return OK

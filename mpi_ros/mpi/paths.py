@@ -74,7 +74,7 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
         per_axis = _frame_segments(params, starts)
         times = [[f.time for f in params.frames[k::axes]] for k in range(axes)]
         ends = [segments[-1].end_state()[0] if segments else start.position
-                for segments, start in zip(per_axis, starts)]
+                for segments, start in zip(per_axis, starts, strict=True)]
     else:
         points = _points(params, starts, relative)
         velocities = np.asarray(params.point_velocity, dtype=float).reshape(-1, axes) if \
@@ -91,7 +91,7 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
     element_ids = _element_ids(params, attrs, len(times[0]) if times else 0)
     feedforward = _feedforward(motion_type, params, axes)
     plans = []
-    for k, (start, segments) in enumerate(zip(starts, per_axis)):
+    for k, (start, segments) in enumerate(zip(starts, per_axis, strict=True)):
         point_times = np.cumsum(np.asarray(times[k], dtype=float))
         timed = timed_outputs(params, attrs, point_times, 0.0) if k == 0 else []
         plans.append(AxisPlan(
@@ -172,7 +172,7 @@ def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.
     the first new point's interval, output); ``target``: where the new points end;
     ``feedforward``: the new points' values (PTF/PVTF), ``held`` the axis' feedforward now."""
     begin = append_time(plan, now)
-    kept = [s for s, end in zip(plan.segments, plan.table.end) if end > now]
+    kept = [s for s, end in zip(plan.segments, plan.table.end, strict=True) if end > now]
     first = float(plan.table.start[len(plan.segments) - len(kept)]) if kept else begin
     pending = plan.point_times > reached(now)
     new_times = begin + point_times

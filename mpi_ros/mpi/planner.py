@@ -82,7 +82,7 @@ def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], n
     """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
     targets = []
     relative = int(attrs) & _RELATIVE
-    for start, value in zip(starts, params.position):
+    for start, value in zip(starts, params.position, strict=True):
         if relative:
             distance = float(math.trunc(value))
             if distance != value:
@@ -167,7 +167,7 @@ def _dot(a, b) -> float:
         total = a[0] * b[0] + a[1] * b[1]
         if math.isfinite(total):
             return total + 0.0
-    return math.fsum([x * y for x, y in zip(a, b)])
+    return math.fsum([x * y for x, y in zip(a, b, strict=True)])
 
 
 def _along(vector, unit, scale: float) -> tuple[float, bool]:
@@ -176,7 +176,7 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
         return 0.0, True
     along = _dot(vector, unit)
     tolerance = 1e-9 * (1.0 + scale)
-    for x, u in zip(vector, unit):
+    for x, u in zip(vector, unit, strict=True):
         if not abs(x - along * u) <= tolerance + 1e-9 * abs(x):
             return along, False
     return along, True
@@ -189,7 +189,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
     most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
     p0 = [s.position for s in starts]
     v0 = [s.velocity for s in starts]
-    delta = [t - p for t, p in zip(targets, p0)]
+    delta = [t - p for t, p in zip(targets, p0, strict=True)]
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
     if not (math.isfinite(length) and math.isfinite(speed)):
@@ -209,7 +209,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
     accels = [s.acceleration for s in starts]
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
     line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, accel), length, final_along, traj)
-    profiles = [scaled_profile(line, u, p) for u, p in zip(unit, p0)]
+    profiles = [scaled_profile(line, u, p) for u, p in zip(unit, p0, strict=True)]
     return profiles, [_scaled(traj, abs(u)) for u in unit], ""
 
 
@@ -224,11 +224,11 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     heading = [v / speed for v in v0]
     stop = _stop_profile(motion_type, speed, traj)
     stopped_after = stop[-1].end_state()[0] if stop else 0.0
-    rest = [p + h * stopped_after for p, h in zip(p0, heading)]
-    go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest)]
+    rest = [p + h * stopped_after for p, h in zip(p0, heading, strict=True)]
+    go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest, strict=True)]
     go, limits, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
-    profiles = [scaled_profile(stop, h, p) + tail for h, p, tail in zip(heading, p0, go)]
-    limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits)]
+    profiles = [scaled_profile(stop, h, p) + tail for h, p, tail in zip(heading, p0, go, strict=True)]
+    limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits, strict=True)]
     return profiles, limits, STOP_THEN_LINE
 
 
@@ -244,7 +244,7 @@ def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[
     durations = [sum(s.duration for s in prof) for prof in profiles]
     longest = max(durations, default=0.0)
     out = []
-    for prof, start, target, duration in zip(profiles, starts, targets, durations):
+    for prof, start, target, duration in zip(profiles, starts, targets, durations, strict=True):
         pad = longest - duration
         if A.SYNC_END in attrs and start.velocity == 0.0:
             prof = _wait(start.position, pad) + prof
@@ -328,7 +328,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     if bits & _SYNC:
         profiles = [
             _scalar_profile(motion_type, start, target, final, traj)
-            for start, target, final, traj in zip(starts, targets, finals, params.trajectory)
+            for start, target, final, traj in zip(starts, targets, finals, params.trajectory, strict=True)
         ]
         profiles = _sync(profiles, starts, targets, attrs)
         limits = list(params.trajectory)
@@ -338,7 +338,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     else:
         profiles, limits, composite = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
     plans = []
-    for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles)):
+    for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise PlanError(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
@@ -362,7 +362,7 @@ def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> l
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     trajs = params.trajectory if len(params.trajectory) == len(starts) else params.trajectory * len(starts)
     plans = []
-    for i, (start, traj) in enumerate(zip(starts, trajs)):
+    for i, (start, traj) in enumerate(zip(starts, trajs, strict=True)):
         delay = params.delay[i] if A.DELAY in attrs else 0.0
         cruise = limit if traj.velocity != 0.0 else 0.0
         if motion_type is MPIMotionType.VELOCITY_JERK:

@@ -76,7 +76,7 @@ FINE_RUN, SETTLED_RUN, VELOCITY_RUN = range(3)
 
 def bits_of(column: np.ndarray) -> AxisStatusBits:
     """The bits of one axis from a column of an array in :data:`BITS` order."""
-    return AxisStatusBits(**dict(zip(BITS, (bool(b) for b in column))))
+    return AxisStatusBits(**dict(zip(BITS, (bool(b) for b in column), strict=True)))
 
 
 def column_of(bits: AxisStatusBits) -> list[bool]:
@@ -226,7 +226,7 @@ class StretchStatus:
 
     def counters_at(self, index: int, out: np.ndarray) -> None:
         """``out`` = the (3, axes) settling counters at stretch sample ``index``."""
-        for row, runs in zip(out, self.runs):
+        for row, runs in zip(out, self.runs, strict=True):
             row[:] = runs.at(index)
 
 

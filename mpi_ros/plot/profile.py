@@ -82,7 +82,7 @@ def plot_profile(request: ProfileRequest, output: str | Path, sample_rate: float
 
     fig, rows = plt.subplots(4, 1, figsize=(10, 10), sharex=True)
     labels = ("position [counts]", "velocity [counts/s]", "acceleration [counts/s²]", "jerk [counts/s³]")
-    for k, (ax, label) in enumerate(zip(rows, labels)):
+    for k, (ax, label) in enumerate(zip(rows, labels, strict=True)):
         if k == 3:
             ax.step(ours[0], ours[4], where="post", lw=1.6, color="C0", label="controller")
         else:

@@ -124,7 +124,7 @@ class ControllerNode(Node):
     # -- periodic topics ------------------------------------------------------------------
     def _collect_axis_status(self, ctl):
         messages = [convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate, self.epoch_ns) for a in ctl.axes]
-        return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._pub_axis_status, messages)]
+        return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._pub_axis_status, messages, strict=True)]
 
     def _collect_joints(self, ctl):
         msg = convert.joint_state(ctl, self.epoch_ns)

@@ -49,7 +49,7 @@ def test_no_wait_answers_ok_for_what_the_controller_refuses(ctl, notified):
     assert message is M.MPIMessageOK and detail.startswith("NO_WAIT") and serial == 0
     ctl.step(1)
     assert events(ctl) == []  # refused (MOVING): no MOTION_START
-    assert all(abs(a.cmd_p - b) < 10.0 for a, b in zip(ctl.axes, before))
+    assert all(abs(a.cmd_p - b) < 10.0 for a, b in zip(ctl.axes, before, strict=True))
 
 
 def test_no_wait_still_answers_what_the_library_checks(ms):

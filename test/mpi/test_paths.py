@@ -77,7 +77,7 @@ def new_supervisor(config: ControllerConfig | None = None, notify: MPIEventType 
 
 def place(ctl, user=START_USER, origins=ORIGINS):
     """Axes 0 and 1 at rest at user positions ``user`` with ``origins`` (raw = user + origin)."""
-    for n, (x, origin) in enumerate(zip(user, origins)):
+    for n, (x, origin) in enumerate(zip(user, origins, strict=True)):
         assert ctl.axis_origin_set(n, origin).ok
         assert ctl.axis_command_position_set(n, x).ok and ctl.axis_actual_position_set(n, x).ok
     return np.array(user) + np.array(origins)
@@ -211,7 +211,7 @@ def test_frame_move_runs_the_user_frames_as_given():
     ctl, ms = new_supervisor()
     start = place(ctl)
     per_axis = [chain(START_USER[k], 0.0, 0.0, pieces) for k, pieces in enumerate(_frame_pieces())]
-    frames = [UserFrame(s.p, s.v, s.a, s.j, s.duration) for pair in zip(*per_axis) for s in pair]
+    frames = [UserFrame(s.p, s.v, s.a, s.j, s.duration) for pair in zip(*per_axis, strict=True) for s in pair]
     assert ms.start(T.FRAME, A.NONE, MotionParams(frames=frames)).ok
     expected = Expected([[s.scaled(1.0, ORIGINS[k]) for s in segs] for k, segs in enumerate(per_axis)])
     assert np.allclose(raw(ctl), start, rtol=0.0, atol=TOL)

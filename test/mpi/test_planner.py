@@ -36,10 +36,10 @@ def test_vector_move_is_one_profile_along_the_line():
     move, notes = compile_()
     x, y = move.plans
     assert x.duration == y.duration == pytest.approx(5000.0 / 1000.0 + 0.5 * (0.1 + 0.2))
-    for sx, sy in zip(x.segments, y.segments):
+    for sx, sy in zip(x.segments, y.segments, strict=True):
         assert sx.duration == sy.duration
         assert (sx.v * 4.0, sx.a * 4.0, sx.j * 4.0) == pytest.approx((sy.v * 3.0, sy.a * 3.0, sy.j * 3.0))
-    assert max(math.hypot(sx.v, sy.v) for sx, sy in zip(x.segments, y.segments)) == pytest.approx(1000.0)
+    assert max(math.hypot(sx.v, sy.v) for sx, sy in zip(x.segments, y.segments, strict=True)) == pytest.approx(1000.0)
     assert (x.target, y.target) == (3000.0, 4000.0) and end(x)[0] == pytest.approx(3000.0)
     assert notes.events == []
 

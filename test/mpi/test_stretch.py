@@ -114,7 +114,7 @@ def test_rows_equal_the_one_axis_code_over_a_long_cruise(compared):
     for number, start in enumerate((600.0, 600.0, -400.0, -400.0)):
         assert ctl.axis_command_position_set(number, start).ok
     ctl.step(4000)  # settled there
-    for ms, velocity in zip(supervisors, (-150.0, 90.0)):
+    for ms, velocity in zip(supervisors, (-150.0, 90.0), strict=True):
         ms.start(MPIMotionType.VELOCITY, MotionAttr.NONE,
                  MotionParams(trajectory=[Trajectory(velocity, 2000.0, 0.0, 0.0)]))
     while ctl.sample < 24_000:

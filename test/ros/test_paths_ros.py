@@ -86,7 +86,7 @@ def element_at(sample: int, ids, times) -> int | None:
     """The id of the point a path started at sample 0 runs toward at ``sample`` (None within
     a sample of a point, where either id is right)."""
     reached = 0.0
-    for element, dt in zip(ids, times):
+    for element, dt in zip(ids, times, strict=True):
         reached += dt * RATE
         if abs(sample - reached) <= 1:
             return None
@@ -120,14 +120,14 @@ def test_pvt_goal_from_send_goal_yaml_ends_ok_at_its_last_point(suite, client, a
     assert (result.message, result.state_name) == ("MPIMessageOK", "IDLE")
     assert result.detail.startswith("motion done; path peaks axis 0: |v| ")
     assert list(result.command_position) == [300.0, 0.0]  # the last point, exactly
-    assert all(abs(a - t) < 10.0 for a, t in zip(result.actual_position, [300.0, 0.0]))
+    assert all(abs(a - t) < 10.0 for a, t in zip(result.actual_position, [300.0, 0.0], strict=True))
     assert result.end_sample >= begin + 1.5 * RATE  # not before the last point's time
     # MotionStatus and AxisStatus element_id: the point being run toward (ELEMENT_ID)
     for topic in (status, axis):
         topic.wait_for(lambda m: m.sample >= begin + 1.5 * RATE - 100, "status near the last point")
         seen = [(m.sample - begin, m.element_id) for m in topic.messages if begin < m.sample < begin + 1.5 * RATE]
         expected = [(s, element_at(s, [11, 12, 13], [0.5] * 3)) for s, _ in seen]
-        assert [e for (_, e), (_, x) in zip(seen, expected) if x is not None] == [x for _, x in expected if x]
+        assert [e for (_, e), (_, x) in zip(seen, expected, strict=True) if x is not None] == [x for _, x in expected if x]
         assert {e for _, e in seen} == {11, 12, 13}
 
 
@@ -140,7 +140,7 @@ def test_pvt_feedback_element_id_follows_the_points(suite, client, applied, driv
     seen = [(fb.sample - begin, fb.element_id) for fb in feedback if fb.sample - begin < 1.5 * RATE]
     assert seen, "no feedback while the path ran"
     expected = [element_at(s, [11, 12, 13], [0.5] * 3) for s, _ in seen]
-    assert [e for (_, e), x in zip(seen, expected) if x is not None] == [x for x in expected if x is not None]
+    assert [e for (_, e), x in zip(seen, expected, strict=True) if x is not None] == [x for x in expected if x is not None]
 
 
 def test_frame_goal_runs_its_frames(suite, client, applied, drive):
@@ -285,7 +285,7 @@ def test_client_stream_keeps_a_10000_point_path_going(suite, client, events, cue
     assert "error" not in outcome, outcome
     result = outcome["result"]
     assert result.message == "MPIMessageOK" and result.state_name == "IDLE"
-    assert max(abs(p - e) for p, e in zip(result.command_position, points[-1])) < 1e-6
+    assert max(abs(p - e) for p, e in zip(result.command_position, points[-1], strict=True)) < 1e-6
     sends = [(c.operation, c.request["final"]) for _, c, _ in applied.commands]
     assert sends == [("motion_start", False)] + [("motion_modify", False)] * 98 + [("motion_modify", True)]
     assert cues  # the controller asked for points (a MotionStatus with few frames may ask first)

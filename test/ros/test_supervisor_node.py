@@ -33,7 +33,7 @@ def test_move_reaches_target_and_succeeds_with_ok(suite, client, applied, drive)
     assert goal.handle.status == GoalStatus.STATUS_SUCCEEDED
     assert (result.message, result.code, result.state_name) == ("MPIMessageOK", 0, "IDLE")
     assert list(result.command_position) == [1000.0, -250.0]  # exactly on target
-    assert all(abs(a - t) < 10.0 for a, t in zip(result.actual_position, [1000.0, -250.0]))  # positionFine
+    assert all(abs(a - t) < 10.0 for a, t in zip(result.actual_position, [1000.0, -250.0], strict=True))  # positionFine
     assert result.sample == sample and result.end_sample > sample
     # Never reported done while the axes still move: DONE needs the settled actual position.
     done_axes = suite.runner.read(lambda ctl: [ctl.axes[n].status.done for n in (0, 1)])

@@ -78,7 +78,7 @@ def assert_matches(segments: list[Segment], pieces, values: np.ndarray, times) -
     grid = np.arange(int(starts[-1] * RATE) + 1) / RATE
     mine: list[list[np.ndarray]] = [[], [], []]
     theirs: list[list[np.ndarray]] = [[], [], []]
-    for seg, piece, t0, t1 in zip(segments, pieces, starts, starts[1:]):
+    for seg, piece, t0, t1 in zip(segments, pieces, starts, starts[1:], strict=False):
         t = np.concatenate([[t0], grid[(grid >= t0) & (grid <= t1)], [t1]])
         for order, value in enumerate(seg.state_at(t - t0)):
             mine[order].append(np.broadcast_to(value, t.shape))
@@ -184,8 +184,8 @@ def test_pvt_uses_the_reference_equations_to_the_bit():
     x_start, v_start = 0.1, 0.7
     positions, velocities, times = [3.3, -2.45], [-1.9, 11.0 / 3.0], [0.37, 0.0123]
     segments = path_segments(PathKind.PVT, x_start, v_start, positions, times, velocities)
-    ends = [(x_start, v_start)] + list(zip(positions, velocities))
-    for seg, (x0, v0), (x1, v1), dt in zip(segments, ends, ends[1:], times):
+    ends = [(x_start, v_start)] + list(zip(positions, velocities, strict=True))
+    for seg, (x0, v0), (x1, v1), dt in zip(segments, ends, ends[1:], times, strict=False):
         assert (seg.duration, seg.p, seg.v) == (dt, x0, v0)
         assert seg.a == 6 * ((x1 - x0) / dt**2) - (2 * v1 + 4 * v0) / dt
         assert seg.j == -12 * ((x1 - x0) / dt**3) + 6 * ((v1 + v0) / dt**2)
@@ -197,7 +197,7 @@ def test_spline_velocity_is_the_or_form_not_the_typo():
     segments = path_segments(PathKind.SPLINE, 0.0, 0.0, positions, times)
     x, y = knot_times(times), knot_values(0.0, positions)
     acc = CubicSpline(x, y, bc_type="natural")(x, 2)
-    for i, (seg, dt) in enumerate(zip(segments, times)):
+    for i, (seg, dt) in enumerate(zip(segments, times, strict=True)):
         dx, da = y[i + 1] - y[i], acc[i + 1] - acc[i]
         assert seg.v == pytest.approx(dx / dt - (3 * acc[i] + da) * dt / 6, rel=1e-12)
         assert seg.a == pytest.approx(acc[i], abs=1e-9) and seg.j == pytest.approx(da / dt, rel=1e-9)
@@ -223,7 +223,7 @@ def test_bspline_passes_near_not_through_the_inner_points():
         table = SegmentTable(path_segments(kind, 0.0, 0.0, positions, times))
         at_points = table.evaluate(knot_times(times))[0]
         assert at_points[0] == 0.0 and at_points[-1] == pytest.approx(0.0, abs=1e-9)
-        assert all(abs(p - x) > 1.0 for p, x in zip(at_points[1:-1], positions[:-1]))
+        assert all(abs(p - x) > 1.0 for p, x in zip(at_points[1:-1], positions[:-1], strict=True))
 
 
 def test_bspline_timing_is_not_the_points_timing():
@@ -279,8 +279,8 @@ def test_paths_are_contiguous_finite_and_cover_the_times(path, kind):
         assert total_duration(segments) == sum(times)
     # which of position, velocity, acceleration are continuous at the joints
     continuous = {PathKind.PT: 1, PathKind.PVT: 2, PathKind.BESSEL: 2, PathKind.BSPLINE2: 2}.get(kind, 3)
-    for before, after in zip(segments, segments[1:]):
-        sizes = [s + n for s, n in zip(term_sizes(before, before.duration), term_sizes(after, 0.0))]
+    for before, after in zip(segments, segments[1:], strict=False):
+        sizes = [s + n for s, n in zip(term_sizes(before, before.duration), term_sizes(after, 0.0), strict=True)]
         for order in range(continuous):
             assert close(before.end_state()[order], (after.p, after.v, after.a)[order], sizes[order])
 
@@ -354,7 +354,7 @@ def test_feedforward_reaches_each_value_at_its_point_and_is_linear_between(path)
     start, _, values, times, _ = path
     segments = feedforward_segments(start, values, times)
     assert total_duration(segments) == sum(times)
-    for seg, before, value, dt in zip(segments, [start] + values, values, times):
+    for seg, before, value, dt in zip(segments, [start] + values, values, times, strict=False):
         assert (seg.duration, seg.p, seg.a, seg.j) == (dt, before, 0.0, 0.0)
         assert close(seg.end_state()[0], value, abs(before) + abs(seg.v) * dt)
         middle = seg.state_at(dt / 2)[0]

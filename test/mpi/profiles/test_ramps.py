@@ -19,7 +19,7 @@ def duration(plan):
 
 
 def contiguous(plan, v_start, v_final):
-    joints = all(a.v_end == b.v_start for a, b in zip(plan, plan[1:]))
+    joints = all(a.v_end == b.v_start for a, b in zip(plan, plan[1:], strict=False))
     return joints and plan[0].v_start == v_start and plan[-1].v_end == v_final
 
 
