@@ -142,7 +142,8 @@ class Planner:
     def request(self, problem: Problem) -> tuple:
         traj = self.trajectory(problem.velocity, problem.acceleration, problem.acceleration, problem.jerk_percent)
         params = self.params(trajectory=[traj], position=list(problem.targets))
-        starts = [self.start(n, p, v) for n, (p, v) in enumerate(zip(problem.positions, problem.velocities, strict=True))]
+        starts = [self.start(n, p, v)
+                  for n, (p, v) in enumerate(zip(problem.positions, problem.velocities, strict=True))]
         return params, starts
 
     def plan(self, request: tuple):
@@ -201,7 +202,8 @@ def ruckig_input(limits: list[RuckigLimits]):
     lengths = [speed(lim) ** 2 / accel(lim) for lim in limits]
     inp = InputParameter(len(limits))
     inp.current_position = [0.0] * len(limits)
-    inp.target_position = [(lim.target_position - lim.current_position) / n for lim, n in zip(limits, lengths, strict=True)]
+    inp.target_position = [(lim.target_position - lim.current_position) / n
+                           for lim, n in zip(limits, lengths, strict=True)]
     inp.target_acceleration = [0.0] * len(limits)
     for name, power in _RUCKIG_UNITS.items():
         setattr(inp, name, [getattr(lim, name) / (n / tau ** power) for lim, n in zip(limits, lengths, strict=True)])

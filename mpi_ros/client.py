@@ -707,9 +707,10 @@ class MotionClient(_Endpoint):
         FRAMES_LOW event arrives (the path is opened with the LOW_COUNT attribute, so the
         controller sends it when fewer than ``low_count`` points are left; at most the frame
         buffer's size, 128) or a MotionStatus shows an axis with fewer than ``low_count``
-        frames in its buffer (frame_count, which never shows more than the buffer holds). The controller E_STOPs an open path with fewer
-        than ``empty_count`` points left, so (low_count - empty_count) points must last longer
-        than a round trip to the suite. Not SPLINE: it may not be appended to.
+        frames in its buffer (frame_count, which never shows more than the buffer holds). The
+        controller E_STOPs an open path with fewer than ``empty_count`` points left, so
+        (low_count - empty_count) points must last longer than a round trip to the suite. Not
+        SPLINE: it may not be appended to.
 
         Returns the MotionStart goal's result once the whole path is done. ``timeout``: the
         longest wait for a cue or an answer (None: the client's timeout plus the path's

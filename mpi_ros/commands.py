@@ -83,8 +83,8 @@ def _motion(ctl: Controller, command: Command, modify: bool) -> Reply:
     ms = _supervisor(ctl, command)
     request = rq.motion_request(command.request)
     message, detail, serial = ms.command(request.type, request.attributes, request.params, modify)
-    return Reply(message, detail, serial if message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START) else 0,
-                 ms.state)
+    accepted = message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
+    return Reply(message, detail, serial if accepted else 0, ms.state)
 
 
 def _action(ctl: Controller, command: Command) -> Reply:

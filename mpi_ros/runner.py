@@ -158,7 +158,8 @@ class ControllerRunner:
                 self._collect_outcomes()  # periodic callbacks see the moves that have ended
             for periodic in self._periodic:
                 if periodic.next_sample <= ctl.sample:
-                    periodic.next_sample += periodic.every * max(1, (ctl.sample - periodic.next_sample) // periodic.every + 1)
+                    behind = (ctl.sample - periodic.next_sample) // periodic.every + 1
+                    periodic.next_sample += periodic.every * max(1, behind)
                     output = periodic.callback(ctl)
                     if output is not None:
                         self._outputs.append(output)

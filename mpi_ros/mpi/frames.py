@@ -189,7 +189,8 @@ class Stream:
             self.peaks = [(max(v, cv), max(a, ca)) for (v, a), (cv, ca) in zip(self.peaks, chunk.peaks, strict=True)]
 
     def describe_peaks(self, axes: Sequence[int]) -> str:
-        parts = [f"axis {n}: |v| {v:.6g} counts/s, |a| {a:.6g} counts/s^2" for n, (v, a) in zip(axes, self.peaks, strict=True)]
+        parts = [f"axis {n}: |v| {v:.6g} counts/s, |a| {a:.6g} counts/s^2"
+                 for n, (v, a) in zip(axes, self.peaks, strict=True)]
         return "path peaks " + "; ".join(parts)
 
 

@@ -25,7 +25,8 @@ class MotionLog:
     def full(self) -> bool:
         return self.count >= self.max_entries
 
-    def record(self, samples: np.ndarray, state: str, per_axis: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
+    def record(self, samples: np.ndarray, state: str,
+               per_axis: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
         room = self.max_entries - self.count
         if room <= 0 or len(samples) == 0:
             return

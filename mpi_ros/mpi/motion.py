@@ -431,7 +431,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21,
                                       append=MotionAttr.APPEND in attrs)
         if verdict.ok:
-            append_to = MotionAttr.APPEND in attrs and self.own_state is MPIState.MOVING and self._open_path() is not None
+            append_to = (MotionAttr.APPEND in attrs and self.own_state is MPIState.MOVING
+                         and self._open_path() is not None)
             verdict = self._check_request(motion_type, attrs, params, modify, append_to)
         if not verdict.ok:
             return verdict.message, verdict.detail

@@ -116,7 +116,8 @@ class ActionsMixin:
         for axis in self.axes:
             if axis.owner == self.number:
                 plan = axis.plan
-                axis.status_mode = StatusMode.VELOCITY if plan is not None and plan.is_velocity else StatusMode.POINT_TO_POINT
+                velocity = plan is not None and plan.is_velocity
+                axis.status_mode = StatusMode.VELOCITY if velocity else StatusMode.POINT_TO_POINT
         self._set_state(MPIState.MOVING, "RESUME", source)
         self._emit(MPIEventType.RESUME)
         return OK, ""

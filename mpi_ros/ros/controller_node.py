@@ -75,7 +75,8 @@ class ControllerNode(Node):
         self._pub_axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
         for k in range(count):
             self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp, k=k: self._on_config_get(k, resp))
-            self._service(AxisConfigSet, f"axis{k}/config_set", lambda req, resp, k=k: self._on_config_set(k, req, resp))
+            self._service(AxisConfigSet, f"axis{k}/config_set",
+                          lambda req, resp, k=k: self._on_config_set(k, req, resp))
             self._service(AxisPositionSet, f"axis{k}/position_set",
                           lambda req, resp, k=k: self._on_position_set(k, req, resp))
         self._service(GateSet, "gate_set", self._on_gate_set)
@@ -124,7 +125,8 @@ class ControllerNode(Node):
     # -- periodic topics ------------------------------------------------------------------
     def _collect_axis_status(self, ctl):
         messages = [convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate, self.epoch_ns) for a in ctl.axes]
-        return lambda: [convert.publish(self, pub, msg) for pub, msg in zip(self._pub_axis_status, messages, strict=True)]
+        return lambda: [convert.publish(self, pub, msg)
+                        for pub, msg in zip(self._pub_axis_status, messages, strict=True)]
 
     def _collect_joints(self, ctl):
         msg = convert.joint_state(ctl, self.epoch_ns)

@@ -190,7 +190,8 @@ def test_a_bag_with_the_configuration_topic_but_no_metadata_replays(tmp_path):
 
 
 def test_a_changed_controller_parameter_is_reported_as_a_divergence():
-    report = replay(FIXTURES / "bags" / "p2p_modify", overrides={"axes": {"defaults": {"plant": {"bandwidth_hz": 25.0}}}})
+    report = replay(FIXTURES / "bags" / "p2p_modify",
+                    overrides={"axes": {"defaults": {"plant": {"bandwidth_hz": 25.0}}}})
     assert not report.identical and report.first is not None
     # the servo model changed, so the actual position/velocity are where it shows first
     assert "actual" in report.first.field and report.first.difference > 0.0

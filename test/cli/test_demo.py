@@ -55,6 +55,7 @@ def test_demo_usage_errors(tmp_path):
     (tmp_path / "full" / "x").write_text("")
     proc = mpi_ros("demo", "--output", str(tmp_path / "full"))
     assert proc.returncode == 2
-    assert proc.stderr.strip() == f"mpi-ros demo: {tmp_path / 'full'} exists and is not an empty directory: pass --output DIR"
+    assert proc.stderr.strip() == (f"mpi-ros demo: {tmp_path / 'full'} exists and is not an empty directory: "
+                                   "pass --output DIR")
     proc = mpi_ros("demo", "--time-scale", "0")
     assert proc.returncode == 2 and "--time-scale must be > 0" in proc.stderr

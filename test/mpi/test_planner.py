@@ -89,8 +89,8 @@ def test_illegal_delay_only_while_moving():
 
 
 def test_relative_targets_and_truncation():
-    # MPI 000, MPIMotionAttrRELATIVE relative distances from the start; MPI 000, mpiMotionStart "the fractional portion is truncated
-    # and discarded"
+    # MPI 000, MPIMotionAttrRELATIVE relative distances from the start; MPI 000, mpiMotionStart "the fractional portion
+    # is truncated and discarded"
     starts = [AxisStart(0, 1000.0), AxisStart(1, -5.0)]
     move, notes = compile_(A.RELATIVE, position=(2000.0, -3.9), starts=starts)
     assert [p.target for p in move.plans] == [3000.0, -8.0]
@@ -210,8 +210,8 @@ def test_vector_modify_off_the_line_plans_each_axis():
 
 
 def test_hold_and_outputs_go_to_the_plans():
-    # MPI 000, MEIMotionAttributes, hold hold "for each axis"; MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame to toggle an output
-    # bit as a move begins" (on the first axis' frames)
+    # MPI 000, MEIMotionAttributes, hold hold "for each axis"; MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame
+    # to toggle an output bit as a move begins" (on the first axis' frames)
     holds = [Hold(type=HoldType.GATE, gate=1), Hold(type=HoldType.GATE, gate=2)]
     output = Output(type=OutputType.OUTPUT, on_mask=1)
     move, _ = compile_(A.HOLD | A.OUTPUT, hold=holds, output=[output])

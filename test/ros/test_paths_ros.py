@@ -127,7 +127,8 @@ def test_pvt_goal_from_send_goal_yaml_ends_ok_at_its_last_point(suite, client, a
         topic.wait_for(lambda m: m.sample >= begin + 1.5 * RATE - 100, "status near the last point")
         seen = [(m.sample - begin, m.element_id) for m in topic.messages if begin < m.sample < begin + 1.5 * RATE]
         expected = [(s, element_at(s, [11, 12, 13], [0.5] * 3)) for s, _ in seen]
-        assert [e for (_, e), (_, x) in zip(seen, expected, strict=True) if x is not None] == [x for _, x in expected if x]
+        assert ([e for (_, e), (_, x) in zip(seen, expected, strict=True) if x is not None]
+                == [x for _, x in expected if x])
         assert {e for _, e in seen} == {11, 12, 13}
 
 
@@ -140,7 +141,8 @@ def test_pvt_feedback_element_id_follows_the_points(suite, client, applied, driv
     seen = [(fb.sample - begin, fb.element_id) for fb in feedback if fb.sample - begin < 1.5 * RATE]
     assert seen, "no feedback while the path ran"
     expected = [element_at(s, [11, 12, 13], [0.5] * 3) for s, _ in seen]
-    assert [e for (_, e), x in zip(seen, expected, strict=True) if x is not None] == [x for x in expected if x is not None]
+    assert ([e for (_, e), x in zip(seen, expected, strict=True) if x is not None]
+            == [x for x in expected if x is not None])
 
 
 def test_frame_goal_runs_its_frames(suite, client, applied, drive):

@@ -264,7 +264,8 @@ def test_config_and_params_services_round_trip(suite, probe, service):
     from mpi_ros.srv import MotionConfigGet, MotionConfigSet, MotionParamsGet, MotionParamsSet
 
     config = service(probe, MotionConfigGet, "/mpi/ms0/config_get", MotionConfigGet.Request())
-    # MPI 000, MPIMotionDecelTime, stop decelTime defaults .5 s / .05 s; MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate 1.0, pauseFeedrate 0.0
+    # MPI 000, MPIMotionDecelTime, stop decelTime defaults .5 s / .05 s; MPI 000, MPIMotionConfig, normalFeedrate
+    # normalFeedrate 1.0, pauseFeedrate 0.0
     assert (config.config.decel_time_stop, config.config.decel_time_e_stop) == pytest.approx((0.5, 0.05))
     assert (config.config.normal_feedrate, config.config.pause_feedrate) == (1.0, 0.0)
     assert list(config.config.axis_numbers) == [0, 1]
