@@ -21,6 +21,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Generic, Self, TypeVar, overload
 
 import numpy as np
 
@@ -59,24 +60,32 @@ class CommandMode(Enum):
     COAST = "COAST"  # amplifier off (ABORT): the motor coasts
 
 
-class _Derived:
-    """An attribute the axis' rows in the bank derive from: setting it marks them stale."""
+V = TypeVar("V")
+
+
+class _Derived(Generic[V]):
+    """An attribute (of type V) the axis' rows in the bank derive from: setting it marks them
+    stale."""
 
     def __set_name__(self, owner: type, name: str) -> None:
         self.slot = "_" + name
 
-    def __get__(self, axis: Axis | None, owner: type | None = None):
+    @overload
+    def __get__(self, axis: None, owner: type | None = None) -> Self: ...
+    @overload
+    def __get__(self, axis: Axis, owner: type | None = None) -> V: ...
+    def __get__(self, axis: Axis | None, owner: type | None = None) -> Self | V:
         return self if axis is None else getattr(axis, self.slot)
 
-    def __set__(self, axis: Axis, value) -> None:
+    def __set__(self, axis: Axis, value: V) -> None:
         setattr(axis, self.slot, value)
         axis._bank.stale[axis.number] = True
 
 
-class _Anchor(_Derived):
+class _Anchor(_Derived[V]):
     """The plant anchor: moving it changes only the axis' servo rows (a lighter rebuild)."""
 
-    def __set__(self, axis: Axis, value) -> None:
+    def __set__(self, axis: Axis, value: V) -> None:
         setattr(axis, self.slot, value)
         axis._bank.moved[axis.number] = True
 
@@ -87,7 +96,11 @@ class _Value:
     def __set_name__(self, owner: type, name: str) -> None:
         self.name = name
 
-    def __get__(self, axis: Axis | None, owner: type | None = None):
+    @overload
+    def __get__(self, axis: None, owner: type | None = None) -> Self: ...
+    @overload
+    def __get__(self, axis: Axis, owner: type | None = None) -> float: ...
+    def __get__(self, axis: Axis | None, owner: type | None = None) -> Self | float:
         return self if axis is None else float(getattr(axis._bank, self.name)[axis.number])
 
     def __set__(self, axis: Axis, value: float) -> None:
@@ -96,25 +109,25 @@ class _Value:
 
 class Axis:
     # command
-    plan: AxisPlan | None = _Derived()
-    tau_start: float = _Derived()
-    rest: float = _Derived()  # raw command when no plan is loaded
-    mode: CommandMode = _Derived()
-    holding: bool = _Derived()  # a hold frame is waiting for its trigger
+    plan: _Derived[AxisPlan | None] = _Derived()
+    tau_start: _Derived[float] = _Derived()
+    rest: _Derived[float] = _Derived()  # raw command when no plan is loaded
+    mode: _Derived[CommandMode] = _Derived()
+    holding: _Derived[bool] = _Derived()  # a hold frame is waiting for its trigger
     # plant, anchored at the start of the current command piece
-    state: PlantState = _Anchor()
-    plant: Plant = _Derived()
+    state: _Anchor[PlantState] = _Anchor()
+    plant: _Derived[Plant] = _Derived()
     # status
-    status_mode: StatusMode = _Derived()
-    target: float = _Derived()
-    in_position: AxisInPosition = _Derived()  # replaced whole, never changed in place
-    # values at the current sample
-    cmd_p: float = _Value()
-    cmd_v: float = _Value()
-    cmd_a: float = _Value()
-    act_p: float = _Value()
-    act_v: float = _Value()
-    rel: float = _Value()  # profile time into the plan (nan without one)
+    status_mode: _Derived[StatusMode] = _Derived()
+    target: _Derived[float] = _Derived()
+    in_position: _Derived[AxisInPosition] = _Derived()  # replaced whole, never changed in place
+    # values at the current sample (floats)
+    cmd_p = _Value()
+    cmd_v = _Value()
+    cmd_a = _Value()
+    act_p = _Value()
+    act_v = _Value()
+    rel = _Value()  # profile time into the plan (nan without one)
 
     def __init__(self, number: int, bank: AxisBank, sample_rate: float, in_position: AxisInPosition,
                  plant: PlantConfig):
@@ -256,6 +269,7 @@ class Axis:
     def _advance_piece(self, state: PlantState, forced: Forced | None, t: float) -> PlantState:
         if self.mode is CommandMode.COAST:
             return self.plant.coast_to(state, t)
+        assert forced is not None  # only a coasting axis has no steady response (_pieces)
         return self.plant.advance(state, forced, t)
 
     def load(self, plan: AxisPlan, tau_start: float, t: float, clock: ProfileClock) -> None:
@@ -513,6 +527,7 @@ class Axis:
             rows.segment[row] = -1  # chosen where the profile time is, when the controller steps
             rows.seg_lo[row], rows.seg_hi[row] = math.inf, -math.inf
         if planned:
+            assert plan is not None  # (planned: a plan and a clock)
             rows.clock[row] = self.owner
             rows.tau_start[row] = self.tau_start
             rows.target[row] = plan.target

@@ -26,6 +26,8 @@ from .plant import _MAX_DEGREE, Forced, Plant, PlantState, Transient, _FreeTable
 from .status import BITS, StatusRows
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
     from .frames import AxisPlan
     from .stretch import Scratch
 
@@ -33,6 +35,7 @@ VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")  # an axis' values
 _MAX_TERMS = _MAX_DEGREE + 1  # coefficients of a piece's steady response
 _AT_REST = 1 << 30  # settling counters of an axis that has long been at rest
 T = TypeVar("T")
+Rows = TypeVar("Rows", bound="DataclassInstance")
 
 
 class Kind(IntEnum):
@@ -43,7 +46,8 @@ class Kind(IntEnum):
     SAMPLED = 2  # coasting, or the command follows the actual: one axis at a time (Axis.trace)
 
 
-def _arrays(cls: type[T], count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (), **fill: float) -> T:
+def _arrays(cls: type[Rows], count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (),
+            **fill: float) -> Rows:
     """An instance of the row dataclass ``cls`` with every field an array of ``count``."""
     def make(name: str) -> np.ndarray:
         if name in ints:

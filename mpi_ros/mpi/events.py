@@ -60,7 +60,8 @@ class MPIEventType(IntFlag):
         return mask
 
     def names(self) -> list[str]:
-        return [m.name for m in MPIEventType if m is not MPIEventType.NONE and m in self]
+        # (a member's name is None only for a combination, which iterating the class never gives)
+        return [m.name for m in MPIEventType if m is not MPIEventType.NONE and m in self and m.name is not None]
 
 
 MASK_MOTION = (

@@ -463,8 +463,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         last = self.queue[-1] if self.queue else self.current
         for n in self.axis_list:
             axis = self._axis(n)
-            if queued and last is not None and last.plan_for(n) is not None:
-                plan = last.plan_for(n)
+            plan = last.plan_for(n) if queued and last is not None else None
+            if plan is not None:
                 starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.origin))
             elif moving:
                 f = self.clock.feedrate(self._ctl.time)
@@ -539,6 +539,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         outputs = [(0.0, out) for out in new.outputs] + new.timed_outputs
         axis = self._axis(new.axis)
         values = new.feedforward[1][1:] if new.feedforward is not None else None
+        assert new.point_times is not None  # the plan of a path (paths.compile_path)
         extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target,
                                 values, axis.feedforward)
         move.plans[move.plans.index(old)] = extended
@@ -663,6 +664,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
     def _at_velocity_reached(self) -> None:
         """The velocity move is at velocity (the controller is at that sample): the event,
         and the outcome a goal on this move waits for."""
+        assert self.current is not None  # scan found the current move at its velocity
         self._at_velocity_sent = True
         self._emit(MPIEventType.MOTION_AT_VELOCITY)
         self._end_move(self.current, OK, "at velocity")

@@ -16,6 +16,7 @@ import math
 import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import TypeGuard
 
 from .events import MASK_ALL, MPIEventType
 from .messages import Message
@@ -82,7 +83,8 @@ def first_refusal(verdicts: Iterable[Verdict]) -> Verdict:
     return next((v for v in verdicts if not v.ok), VALID)
 
 
-def _finite_number(value: object) -> bool:
+def _finite_number(value: object) -> TypeGuard[float]:
+    """A finite real number (bool excluded): int, float, numpy's, ..."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         return False
     try:
@@ -100,7 +102,7 @@ def check_range(name: str, value: object, low: float, high: float, above_low: bo
 
 
 def check_integer(name: str, value: object, low: int, high: int) -> Verdict:
-    if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= value <= high:
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= int(value) <= high:
         return VALID
     return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {value!r}")
 

@@ -174,14 +174,16 @@ def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.
     begin = append_time(plan, now)
     kept = [s for s, end in zip(plan.segments, plan.table.end, strict=True) if end > now]
     first = float(plan.table.start[len(plan.segments) - len(kept)]) if kept else begin
-    pending = plan.point_times > reached(now)
+    old_times = plan.point_times
+    assert old_times is not None  # the plan of a path (compile_path)
+    pending = old_times > reached(now)
     new_times = begin + point_times
     shifted = [*kept, *segments]
     ids = _pending_ids(plan, pending, element_ids, len(point_times))
     return AxisPlan(
         axis=plan.axis, segments=shifted, start_position=plan.start_position, target=target,
         start_velocity=plan.start_velocity, origin_time=first,
-        point_times=np.concatenate([plan.point_times[pending], new_times]),
+        point_times=np.concatenate([old_times[pending], new_times]),
         element_ids=ids,
         timed_outputs=[(w, o) for w, o in plan.timed_outputs if w > now] + [(begin + w, o) for w, o in outputs],
         feedforward=_extended_feedforward(plan, begin, point_times, feedforward, held),

@@ -155,7 +155,8 @@ class MotionAttr(IntFlag):
         return mask
 
     def names(self) -> list[str]:
-        return [m.name for m in MotionAttr if m is not MotionAttr.NONE and m in self]
+        # (a member's name is None only for a combination, which iterating the class never gives)
+        return [m.name for m in MotionAttr if m is not MotionAttr.NONE and m in self and m.name is not None]
 
 
 HOLD_ATTRS = MotionAttr.HOLD | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER

@@ -16,8 +16,12 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from .segment import Segment
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class PathKind(enum.Enum):
@@ -33,8 +37,8 @@ class PathKind(enum.Enum):
 
 
 def path_segments(kind: PathKind, start_position: float, start_velocity: float,
-                  positions: Sequence[float], times: Sequence[float],
-                  velocities: Sequence[float] | None = None) -> list[Segment]:
+                  positions: Sequence[float] | np.ndarray, times: Sequence[float] | np.ndarray,
+                  velocities: Sequence[float] | np.ndarray | None = None) -> list[Segment]:
     """One axis' path: from (start_position, start_velocity) through the points.
 
     times[i] is dt_i, the seconds from point i-1 to point i (the first, from the start)

@@ -40,7 +40,10 @@ def _ramp_maker() -> Callable[[float, float, float], Ramp]:
     """``Ramp(duration, v_start, v_end)`` in half the time (its slots set directly, not
     through object.__setattr__ as a frozen dataclass' __init__ does), for planning."""
     new = object.__new__
-    set_duration, set_v_start, set_v_end = Ramp.duration.__set__, Ramp.v_start.__set__, Ramp.v_end.__set__
+    # The slots' member descriptors (from the class' __dict__: the type checker takes Ramp.duration
+    # for a float, as the fields of a dataclass without slots would be).
+    slots = Ramp.__dict__
+    set_duration, set_v_start, set_v_end = slots["duration"].__set__, slots["v_start"].__set__, slots["v_end"].__set__
 
     def ramp(duration: float, v_start: float, v_end: float) -> Ramp:
         made = new(Ramp)
