@@ -34,6 +34,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
+from functools import partial
 from typing import Any, Self
 
 import rclpy
@@ -489,7 +490,12 @@ class Goal:
         self._result_future = result_future
         self._progress = progress  # set by the first feedback or the result
         self._finished = threading.Event()
-        result_future.add_done_callback(lambda _f: (self._finished.set(), progress.set()))
+
+        def finished(_future: Any) -> None:
+            self._finished.set()
+            progress.set()
+
+        result_future.add_done_callback(finished)
         self.feedback = None  # the latest feedback message (MotionStart.Feedback)
 
     @property
@@ -721,8 +727,9 @@ class MotionClient(_Endpoint):
                             element_ids=element_ids)
         timeout = self._path_timeout(timeout, times)
         attrs = [_name(a) for a in attributes]
-        if len(parts) == 1:
-            return self.path(motion_type, **parts[0], attributes=attrs, empty_count=empty_count, timeout=timeout)
+        if len(parts) == 1:  # what path() does, with the timeout computed
+            goal = path_goal(motion_type, **parts[0], attributes=attrs, empty_count=empty_count)
+            return self.start(goal).wait(timeout)
         self._follow_buffer()
         cue = _BufferCue(low_count)
         self._sent(cue)
@@ -885,10 +892,10 @@ class Watcher(_Endpoint):
         """Keep the latest MotionStatus of ``supervisors`` and AxisStatus of ``axes``."""
         for n in supervisors:
             self.node.create_subscription(MotionStatus, f"{self.namespace}/ms{n}/status",
-                                          lambda msg, n=n: self._keep(self._supervisors, n, msg), STATUS_QOS)
+                                          partial(self._keep, self._supervisors, n), STATUS_QOS)
         for k in axes:
             self.node.create_subscription(AxisStatus, f"{self.namespace}/axis{k}/status",
-                                          lambda msg, k=k: self._keep(self._axes, k, msg), STATUS_QOS)
+                                          partial(self._keep, self._axes, k), STATUS_QOS)
 
     def _keep(self, table: dict[int, Any], key: int, msg: Any) -> None:
         with self._changed:

@@ -115,6 +115,7 @@ class SuiteConfig:
     def _build_supervisor(ctl: Controller, spec: SupervisorSpec, where: str) -> None:
         message, ms = ctl.create_motion(spec.number)
         _accepted(message, f"{where}.number")
+        assert ms is not None  # (created: the message was OK)
         # the axes first: mpiMotionConfigSet answers AXIS_COUNT without them (spec 000)
         _accepted(ms.axis_list_set(spec.axes), f"{where}.axes")
         _accepted(ms.config_set(spec.config), f"{where}.config", spec.config.validate())
@@ -143,7 +144,7 @@ def merge(base: dict, override: dict) -> dict:
     return _merge(base, override)
 
 
-def _merge(base: dict, override: dict) -> dict:
+def _merge(base: dict, override: dict | None) -> dict:
     out = copy.deepcopy(base)
     for key, value in (override or {}).items():
         if isinstance(value, dict) and isinstance(out.get(key), dict):
@@ -197,7 +198,7 @@ def _positive(value: float, where: str) -> None:
         raise ConfigError(f"{where}: must be > 0, got {value!r}")
 
 
-def _controller(raw: dict, axis_count: int, supervisor_count: int) -> ControllerConfig:
+def _controller(raw: dict | None, axis_count: int, supervisor_count: int) -> ControllerConfig:
     raw = dict(raw or {})
     cfg = _dataclass(ControllerConfig, {**raw, "axis_count": axis_count, "supervisor_count": supervisor_count},
                      "controller")
@@ -205,7 +206,7 @@ def _controller(raw: dict, axis_count: int, supervisor_count: int) -> Controller
     return cfg
 
 
-def _axes(raw: dict) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
+def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
     raw = raw or {}
     unknown = set(raw) - {"count", "defaults", "overrides"}
     if unknown:
@@ -245,7 +246,7 @@ def _motion_config(raw: dict, where: str) -> MotionConfig:
     return cfg
 
 
-def _supervisors(raw: list, defaults: dict, axis_count: int) -> list[SupervisorSpec]:
+def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[SupervisorSpec]:
     if not isinstance(raw, list) or not raw:
         raise ConfigError("supervisors: expected a non-empty list")
     defaults = defaults or {}
@@ -282,7 +283,7 @@ def _supervisors(raw: list, defaults: dict, axis_count: int) -> list[SupervisorS
     return specs
 
 
-def _ros(raw: dict) -> RosSettings:
+def _ros(raw: dict | None) -> RosSettings:
     ros = _dataclass(RosSettings, raw, "ros")
     for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate"):
         _positive(getattr(ros, key), f"ros.{key}")

@@ -81,7 +81,8 @@ def integer(value: Any, what: str) -> int:
         return int(value)
     try:
         if float(value).is_integer():  # nan and inf are not integers either
-            return int(value)
+            # typeshed's numbers.Real promises no __int__ (every Real has one: float, Fraction, numpy's)
+            return int(value)  # type: ignore[call-overload]
     except (TypeError, ValueError, OverflowError):
         pass
     raise _unreadable(what, "an integer", value)

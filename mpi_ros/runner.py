@@ -223,7 +223,11 @@ class ControllerRunner:
     # -- events and deferred work ----------------------------------------------------------
     def _on_event(self, event: Event) -> None:
         if self._event_listeners:
-            self._outputs.append(lambda e=event: [listener(e) for listener in self._event_listeners])
+            def notify(e: Event = event) -> None:
+                for listener in self._event_listeners:
+                    listener(e)
+
+            self._outputs.append(notify)
 
     def _deferred(self) -> None:
         """After a command or an update, the lock released: its deferred work runs now, on

@@ -141,9 +141,9 @@ def inspect(reader: BagReader) -> Recording:
     missing = []
     setup = None
     if stored is not None:
-        epoch = stored.get("stamp_epoch_ns")
+        stored_epoch = stored.get("stamp_epoch_ns")
         setup = (yaml.safe_load(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
-                 int(epoch) if epoch is not None else None, stored.get("namespace"))
+                 int(stored_epoch) if stored_epoch is not None else None, stored.get("namespace"))
     elif config_topics:
         found = next((msg for _, msg in reader.decoded(config_topics[:1])), None)
         if found is not None:

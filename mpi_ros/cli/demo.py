@@ -33,7 +33,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, TextIO, TypedDict
 
 from .console import OK, REFUSED, USAGE, UsageError, fail, positions
 
@@ -44,8 +44,18 @@ STARTUP_WAIT = 30.0  # s for the suite's process to come up on the graph
 STOP_WAIT = 30.0  # s for the suite's process to stop and write the bag
 WAIT = 60.0  # s of wall time any one step may take (at time scale 1 the longest takes ~3 s)
 
+
+class _Move(TypedDict):
+    """A point-to-point move's values (a plain dict at run time)."""
+
+    position: list[float]
+    velocity: float
+    acceleration: float
+    jerk_percent: float
+
+
 # The first move: its profile is also plotted against ruckig's.
-S_CURVE = {"position": [4000.0, 2000.0], "velocity": 2000.0, "acceleration": 10000.0, "jerk_percent": 50.0}
+S_CURVE: _Move = {"position": [4000.0, 2000.0], "velocity": 2000.0, "acceleration": 10000.0, "jerk_percent": 50.0}
 # A PVT path (it starts where the axes are): three points, positions interleaved by axis, one time per point.
 PATH = {"type": "PVT", "position": [1000.0, 1000.0, 2500.0, 500.0, 3000.0, 0.0],
         "point_velocity": [1200.0, 600.0, 1000.0, -800.0, 0.0, 0.0], "time": [1.0, 1.0, 1.0]}

@@ -50,7 +50,8 @@ def _status(session, args: argparse.Namespace) -> int:
         watcher.follow_status([], extra)
         watcher.wait_for_status(supervisors, extra, args.timeout)
     if args.once:
-        print("\n".join(render(*watcher.latest(), watcher.namespace)))
+        supervisor_statuses, axis_statuses = watcher.latest()
+        print("\n".join(render(supervisor_statuses, axis_statuses, watcher.namespace)))
         return OK
     tty = sys.stdout.isatty()
     interval = args.interval if args.interval is not None else (0.1 if tty else 1.0)

@@ -177,6 +177,7 @@ def check_profile(
             if speed > ceiling + v_tol or (v_end > velocity + v_tol and v_end > abs(seg.v) + v_tol):
                 problems.append(f"segment {k}: |v| reaches {speed!r}, above the velocity {velocity!r}")
                 break
+        assert target is not None  # a point-to-point move has one
         lowest = min(velocity_range(s)[0] for s in segments)
         highest = max(velocity_range(s)[1] for s in segments)
         reversed_ = lowest < -v_tol and highest > v_tol

@@ -138,6 +138,7 @@ class Mapping:
 
     def unlimited_jerk(self, note: str) -> Mapping:
         """The same problem with max_jerk = inf (for a bound: looser, still a lower bound)."""
+        assert self.limits is not None  # a problem ruckig was given
         limits = RuckigLimits(**{**_asdict(self.limits), "max_jerk": INF})
         return Mapping(limits, self.exact, self.reasons, self.notes + (note,), False)
 
@@ -214,7 +215,7 @@ def map_velocity(
         return Mapping(None, True, reasons, ("already at the velocity: no ramp",))
     peak = peak_acceleration(acceleration, f)
     jerk = ramp_jerk(acceleration, f, velocity - start_velocity)
-    notes = ()
+    notes: tuple[str, ...] = ()
     if 0.5 * f < TIME_RESOLUTION:
         jerk, notes = INF, (TOO_SHORT_TO_SEE,)
     limits = RuckigLimits(

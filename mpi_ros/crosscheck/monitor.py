@@ -61,7 +61,9 @@ class CrosscheckMonitor:
         if command.operation not in START_OPERATIONS or not reply.accepted or not reply.serial:
             return []
         ms = self.ctl.supervisor(command.supervisor)
-        move = _find_move(ms, reply.serial) if ms is not None else None
+        if ms is None:
+            return []
+        move = _find_move(ms, reply.serial)
         if move is None:
             return []
         return self.check_move(ms.number, move, self.ctl.sample if sample is None else sample)

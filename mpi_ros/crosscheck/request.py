@@ -38,6 +38,7 @@ class RequestInvalid(ValueError):
 
 
 def motion_type(value: Any) -> MPIMotionType:
+    kind: MPIMotionType | None
     if isinstance(value, MPIMotionType):
         kind = value
     else:

@@ -100,7 +100,7 @@ def plot_profile(request: ProfileRequest, output: str | Path, sample_rate: float
         for sign in (1.0, -1.0):
             rows[1].axhline(sign * traj.velocity, color="grey", ls=":", lw=1.0)
         rows[0].axhline(request.target, color="grey", ls=":", lw=1.0)
-        peaks = (peak_acceleration(traj.acceleration, f), peak_acceleration(traj.deceleration, f))
+        peaks: tuple[float, ...] = (peak_acceleration(traj.acceleration, f), peak_acceleration(traj.deceleration, f))
     else:
         rows[1].axhline(traj.velocity, color="grey", ls=":", lw=1.0)
         peaks = (peak_acceleration(traj.acceleration, f),)

@@ -120,13 +120,22 @@ class ControllerNode(Node):
         if not self._applied:
             return None
         messages, self._applied = self._applied, []
-        return lambda: [convert.publish(self, self._pub_commands, msg) for msg in messages]
+
+        def publish() -> None:
+            for msg in messages:
+                convert.publish(self, self._pub_commands, msg)
+
+        return publish
 
     # -- periodic topics ------------------------------------------------------------------
     def _collect_axis_status(self, ctl):
         messages = [convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate, self.epoch_ns) for a in ctl.axes]
-        return lambda: [convert.publish(self, pub, msg)
-                        for pub, msg in zip(self._pub_axis_status, messages, strict=True)]
+
+        def publish() -> None:
+            for pub, msg in zip(self._pub_axis_status, messages, strict=True):
+                convert.publish(self, pub, msg)
+
+        return publish
 
     def _collect_joints(self, ctl):
         msg = convert.joint_state(ctl, self.epoch_ns)
