@@ -616,6 +616,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             move.serial = previous.serial
             if not MotionAttr.ID & move.attributes:
                 move.id = previous.id
+            if previous.stream is not None:  # points appended to the path are replaced too
+                for serial, _ in previous.stream.chunks:
+                    self._end_serial(serial, Message.MPIMotionMessageSTOPPED, "replaced by a modify")
         self._load(move, announce=False)
 
     def _load(self, move: Move, announce: bool = True) -> None:

@@ -222,3 +222,21 @@ def test_a_held_path_takes_appended_points_and_runs_them_all_once_released(ctl, 
     assert trace[199] == pytest.approx([100.0, 0.0]) and trace[599] == pytest.approx([300.0, 50.0])
     assert trace[799] == pytest.approx([400.0, 0.0])  # the appended point, 0.1 s after the last
     assert max(abs(b[0] - a[0]) for a, b in zip(trace, trace[1:])) <= 0.5 + 1e-9  # no jump anywhere
+
+
+def test_a_modify_that_replaces_an_open_path_ends_its_appends(ctl, ms):
+    # MPI 000, mpiMotionModify: a PVT modify replaces the path in progress, the points appended to
+    # it included: their commands end (STOPPED, "replaced by a modify"), none is left waiting.
+    open_path = MotionParams(position=[100.0, 0.0], point_velocity=[0.0, 0.0], time=[0.5], final=False,
+                             empty_count=0)
+    assert ms.start(T.PVT, A.NONE, open_path).ok
+    _, _, appended = ms.command(T.PVT, A.APPEND, MotionParams(position=[200.0, 0.0], point_velocity=[0.0, 0.0],
+                                                              time=[0.5], final=False, empty_count=0), True)
+    ctl.step(100)
+    replaced = MotionParams(position=[50.0, 50.0], point_velocity=[0.0, 0.0], time=[0.2])
+    message, _, serial = ms.command(T.PVT, A.NONE, replaced, True)
+    assert message.ok and serial != appended
+    ends = {end.serial: (end.message, end.detail) for end in ms.move_ends}
+    assert ends[appended] == (M.MPIMotionMessageSTOPPED, "replaced by a modify")
+    ctl.run_until(lambda c: ms.state is MPIState.IDLE, 10_000)
+    assert [a.command_position for a in ms.axes] == [50.0, 50.0]
