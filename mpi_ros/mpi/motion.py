@@ -31,6 +31,7 @@ from .supervisor_actions import ActionsMixin
 from .supervisor_axis_list import AxisListMixin
 from .supervisor_stepping import SteppingMixin
 from .types import (
+    HOLD_ATTRS,
     STATE_SEVERITY,
     ActionSource,
     HoldType,
@@ -509,11 +510,15 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         point is reached."""
         stream = move.stream
         plans = {plan.axis: plan for plan in move.plans}
+        if attrs & HOLD_ATTRS:
+            # A hold waits before a move begins; appended points continue one in progress.
+            return Message.MPIMotionMessageATTRIBUTE_INVALID, "points appended to a path in motion cannot be held"
         if stream is None or sorted(plans) != sorted(self.axis_list):
             return Message.MPIMessagePARAM_INVALID, "the points' axes are not the axes of the open path"
         t = self._ctl.time
         tau = self.clock.tau_at(t)
-        nows = {n: tau - self._axis(n).tau_start for n in self.axis_list}
+        # Profile time into the path per axis (an axis still held has run none of it).
+        nows = {n: -math.inf if n in self._holds else tau - self._axis(n).tau_start for n in self.axis_list}
         if paths.point_count(motion_type, params, len(self.axis_list)) == 0:
             # No points: it only closes (or keeps open) the path, and is done with its last point.
             stream.append(None, open_=not params.final)
@@ -543,7 +548,11 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target,
                                 values, axis.feedforward)
         move.plans[move.plans.index(old)] = extended
-        axis.extend(extended, t, self.clock)
+        wait = self._holds.get(new.axis)
+        if wait is not None:
+            wait.plan = extended  # still held: the path begins, whole, when the hold releases
+        else:
+            axis.extend(extended, t, self.clock)
         return paths.last_point_time(extended)
 
     def _rebase(self, t: float) -> None:
@@ -610,6 +619,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             move.serial = previous.serial
             if not MotionAttr.ID & move.attributes:
                 move.id = previous.id
+            if previous.stream is not None:  # points appended to the path are replaced too
+                for serial, _ in previous.stream.chunks:
+                    self._end_serial(serial, Message.MPIMotionMessageSTOPPED, "replaced by a modify")
         self._load(move, announce=False)
 
     def _load(self, move: Move, announce: bool = True) -> None:

@@ -28,7 +28,7 @@ from .frames import AxisPlan, reached
 from .params import MotionParams, Output
 from .profiles.path import PathKind, path_segments, peaks
 from .profiles.segment import Segment
-from .types import MotionAttr, MPIMotionType
+from .types import HOLD_ATTRS, MotionAttr, MPIMotionType
 
 A = MotionAttr
 WRAP = 2.0**32  # the controller's 32-bit position register
@@ -99,6 +99,7 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
             outputs=[out for when, out in timed if when <= 0.0], start_velocity=start.velocity,
             point_times=point_times, element_ids=element_ids,
             timed_outputs=[(when, out) for when, out in timed if when > 0.0],
+            hold=params.hold[k] if attrs & HOLD_ATTRS else None,
             feedforward=None if feedforward is None else _knots(0.0, math.nan, point_times, feedforward[:, k]),
         ))
     return plans, [peaks(plan.segments) for plan in plans]

@@ -196,3 +196,47 @@ def test_feedforward_is_batching_invariant(batch):
     _, _, reference = _ptf_run(Controller, [20_000.0, -5_000.0], 250)
     _, _, actual = _ptf_run(Controller, [20_000.0, -5_000.0], batch)
     assert {k: actual[k] for k in reference} == reference  # every 250th sample, 3 of them along the path
+
+
+def test_a_held_path_takes_appended_points_and_runs_them_all_once_released(ctl, ms):
+    # MPI 001, HOLD "Prevent the move from executing until a specific trigger condition is met";
+    # points appended while it waits belong to the same path, which then runs whole.
+    from mpi_ros.mpi.params import Hold
+    from mpi_ros.mpi.types import HoldType
+
+    hold = Hold(type=HoldType.GATE, gate=3)
+    ctl.gate_set(3, True)
+    path = MotionParams(position=[100.0, 0.0, 300.0, 50.0], time=[0.1, 0.2], hold=[hold, hold], final=False,
+                        empty_count=0)
+    assert ms.start(T.PT, A.HOLD, path).ok
+    ctl.step(500)
+    assert [a.cmd_p for a in ms.axes] == [0.0, 0.0] and ms.state is MPIState.MOVING
+    assert ms.modify(T.PT, A.APPEND, MotionParams(position=[400.0, 0.0], time=[0.1])).ok
+    assert ms.modify(T.PT, A.APPEND | A.HOLD, MotionParams(position=[0.0, 0.0], time=[0.1],
+                                                           hold=[hold, hold])) is M.MPIMotionMessageATTRIBUTE_INVALID
+    assert ctl.gate_set(3, False).ok
+    trace = []
+    while ms.state is MPIState.MOVING and len(trace) < 2000:
+        ctl.step(1)
+        trace.append([a.cmd_p for a in ms.axes])
+    assert trace[199] == pytest.approx([100.0, 0.0]) and trace[599] == pytest.approx([300.0, 50.0])
+    assert trace[799] == pytest.approx([400.0, 0.0])  # the appended point, 0.1 s after the last
+    assert max(abs(b[0] - a[0]) for a, b in zip(trace, trace[1:])) <= 0.5 + 1e-9  # no jump anywhere
+
+
+def test_a_modify_that_replaces_an_open_path_ends_its_appends(ctl, ms):
+    # MPI 000, mpiMotionModify: a PVT modify replaces the path in progress, the points appended to
+    # it included: their commands end (STOPPED, "replaced by a modify"), none is left waiting.
+    open_path = MotionParams(position=[100.0, 0.0], point_velocity=[0.0, 0.0], time=[0.5], final=False,
+                             empty_count=0)
+    assert ms.start(T.PVT, A.NONE, open_path).ok
+    _, _, appended = ms.command(T.PVT, A.APPEND, MotionParams(position=[200.0, 0.0], point_velocity=[0.0, 0.0],
+                                                              time=[0.5], final=False, empty_count=0), True)
+    ctl.step(100)
+    replaced = MotionParams(position=[50.0, 50.0], point_velocity=[0.0, 0.0], time=[0.2])
+    message, _, serial = ms.command(T.PVT, A.NONE, replaced, True)
+    assert message.ok and serial != appended
+    ends = {end.serial: (end.message, end.detail) for end in ms.move_ends}
+    assert ends[appended] == (M.MPIMotionMessageSTOPPED, "replaced by a modify")
+    ctl.run_until(lambda c: ms.state is MPIState.IDLE, 10_000)
+    assert [a.command_position for a in ms.axes] == [50.0, 50.0]
