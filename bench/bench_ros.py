@@ -70,7 +70,7 @@ def e_stop_latency(context, cycles: int = 200) -> tuple[list[int], list[int]]:
             due = suite.runner.due_sample()
             future = client.call_async(MotionAction.Request(action="E_STOP"))
             done = threading.Event()
-            future.add_done_callback(lambda _f: done.set())
+            future.add_done_callback(lambda _f, done=done: done.set())
             assert done.wait(5.0), "no answer"
             latencies.append(future.result().sample - due)
             after_arrival.append(future.result().sample - arrivals[-1])

@@ -131,7 +131,8 @@ class _Storm:
                                                for i in range(1, modifies + 1)])
             self.wait(self.answers, modified)
             goals += started + modified
-            goals += self.send(n, "start", [{**STEP, "position": [BASE + 10.0 * i, BASE]} for i in range(1, appends + 1)])
+            goals += self.send(n, "start",
+                               [{**STEP, "position": [BASE + 10.0 * i, BASE]} for i in range(1, appends + 1)])
         self.wait(self.answers, goals)
         return goals
 
@@ -312,7 +313,8 @@ def main() -> None:
         context.try_shutdown()
         tmp.cleanup()
 
-    per = f"{goals} goals in flight ({args.modifies} modifies + 1 start + {args.appends} appends on each of 2 supervisors)"
+    per = (f"{goals} goals in flight ({args.modifies} modifies + 1 start + {args.appends} appends "
+           f"on each of 2 supervisors)")
     print(f"{args.rounds} storms of {per}; `mpi-ros run --time-scale 1`, default config "
           f"(feedback {feedback_rate:g} Hz to every goal, executor 32 threads).")
     print()
@@ -322,7 +324,8 @@ def main() -> None:
           f"{statistics.median(storm_e_stop) / statistics.median(idle_e_stop):.2f} |")
     print(f"| MotionAction RESUME round trip on ms1 (refused) | {_ms(idle_probe)} | {_ms(storm_probe)} | "
           f"{statistics.median(storm_probe) / statistics.median(idle_probe):.2f} |")
-    print(f"| suite CPU, share of one core ({SETTLE:g} s per round) | median {statistics.median(idle_cpu) * 100:.0f} % | "
+    print(f"| suite CPU, share of one core ({SETTLE:g} s per round) | "
+          f"median {statistics.median(idle_cpu) * 100:.0f} % | "
           f"median {statistics.median(storm_cpu) * 100:.0f} % (the storm client: "
           f"{statistics.median(client_cpu) * 100:.0f} %) | |")
     print(f"| all {goals} goals sent and answered | | median {statistics.median(accept_time):.2f} s | |")

@@ -10,6 +10,10 @@
         ms0.reset()
         print(ms0.status().state_name)
 
+Path moves: ``ms0.path(MotionType.PVT, points, times, velocities=...)`` runs one (points as
+one tuple per point, interleaved here); ``ms0.stream(...)`` streams a long one chunk by chunk
+as the controller asks for points (FRAMES_LOW, frame_count).
+
 It imports rclpy and the generated interfaces (``mpi_ros.msg/.srv/.action``) and nothing of
 the simulated controller, so it runs wherever the suite is reachable over DDS.
 
@@ -22,13 +26,15 @@ safe to send from another thread while spinning). :class:`Watcher` follows the w
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import re
 import threading
 import time
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
+from functools import partial
 from typing import Any, Self
 
 import rclpy
@@ -85,7 +91,7 @@ class MotionType(StrEnum):
 
 
 class Attribute(StrEnum):
-    """MPIMotionAttrMask names without the prefix (a goal's ``attributes``)."""
+    """MPIMotionAttrMask and MPIMotionPathAttrMask names without the prefix (a goal's ``attributes``)."""
 
     APPEND = "APPEND"
     AUTO_START = "AUTO_START"
@@ -106,6 +112,14 @@ class Attribute(StrEnum):
     HOLD_LESS = "HOLD_LESS"
     HOLD_GREATER = "HOLD_GREATER"
     OUTPUT = "OUTPUT"
+    BEHAVIOR = "BEHAVIOR"
+    RELATIVE_MOVE = "RELATIVE_MOVE"
+    RETAIN = "RETAIN"
+    EMPTY_COUNT = "EMPTY_COUNT"
+    LOW_COUNT = "LOW_COUNT"
+    NO_HANDSHAKE = "NO_HANDSHAKE"
+    EXPECTED_AXES = "EXPECTED_AXES"
+    NO_WAIT = "NO_WAIT"
 
 
 class Action(StrEnum):
@@ -316,6 +330,74 @@ def _name(value: Any) -> str:
     return str(value)  # StrEnum members print as their value
 
 
+# -- paths: per-point data -> goal fields ----------------------------------------------------------
+def interleave(rows: Iterable[Sequence[float] | float], name: str = "points") -> list[float]:
+    """Per-point tuples (one value per axis) as a goal's flat list, interleaved by axis.
+
+        interleave([(100.0, 0.0), (200.0, 50.0)]) == [100.0, 0.0, 200.0, 50.0]
+
+    A bare number is a point of one axis. Points of different lengths raise ValueError.
+    """
+    flat: list[float] = []
+    width = None
+    for i, row in enumerate(rows):
+        values = (row,) if isinstance(row, (int, float)) else tuple(row)
+        width = len(values) if width is None else width
+        if len(values) != width:
+            raise ValueError(f"{name}[{i}]: {len(values)} value(s), but {name}[0] has {width} (one per axis)")
+        flat.extend(float(v) for v in values)
+    return flat
+
+
+def path_goal(motion_type: MotionType | str, points: Iterable[Sequence[float] | float], times: Iterable[float],
+              velocities: Iterable[Sequence[float] | float] | None = None,
+              feedforward: Iterable[Sequence[float] | float] | None = None,
+              attributes: Iterable[Attribute | str] = (), element_ids: Iterable[int] | None = None,
+              **fields: Any) -> dict[str, Any]:
+    """The fields of a path goal (MotionStart or MotionModify) from per-point data.
+
+        path_goal("PVT", [(100.0, 0.0), (200.0, 0.0)], [0.5, 0.5], velocities=[(200.0, 0.0), (0.0, 0.0)])
+
+    ``times``: seconds from the previous point (the first from the start); ``velocities``
+    (PVT/PVTF) and ``feedforward`` (PTF/PVTF) per point like ``points``; ``element_ids`` one
+    per point (adds the ELEMENT_ID attribute); ``fields``: any other goal field (final, ...).
+    """
+    attrs = [_name(a) for a in attributes]
+    goal: dict[str, Any] = {"type": _name(motion_type), "attributes": attrs, "position": interleave(points),
+                            "time": [float(t) for t in times]}
+    if velocities is not None:
+        goal["point_velocity"] = interleave(velocities, "velocities")
+    if feedforward is not None:
+        goal["feedforward"] = interleave(feedforward, "feedforward")
+    if element_ids is not None:
+        goal["element_id"] = [int(i) for i in element_ids]
+        if Attribute.ELEMENT_ID not in attrs:
+            attrs.append(Attribute.ELEMENT_ID.value)
+    return {**goal, **fields}
+
+
+def path_chunks(points: Sequence[Any], times: Sequence[float], size: int,
+                **per_point: Sequence[Any] | None) -> list[dict[str, list[Any]]]:
+    """A path cut into chunks of ``size`` points: the arguments of path_goal for each.
+
+        path_chunks([(1.0,), (2.0,), (3.0,)], [0.1] * 3, 2) ==
+            [{"points": [(1.0,), (2.0,)], "times": [0.1, 0.1]}, {"points": [(3.0,)], "times": [0.1]}]
+
+    ``per_point``: velocities, feedforward, element_ids (None: not given), cut alike.
+    """
+    if size < 1:
+        raise ValueError(f"chunk must be at least 1 point, got {size}")
+    columns = {"points": list(points), "times": list(times)}
+    columns.update({key: list(values) for key, values in per_point.items() if values is not None})
+    if not columns["points"]:
+        raise ValueError("a path needs at least one point")
+    for key, values in columns.items():
+        if len(values) != len(columns["points"]):
+            raise ValueError(f"{key}: {len(values)} value(s) for {len(columns['points'])} point(s) (one per point)")
+    return [{key: values[i:i + size] for key, values in columns.items()}
+            for i in range(0, len(columns["points"]), size)]
+
+
 # -- a node that spins itself ------------------------------------------------------------------------------
 class _Endpoint:
     """A node of its own, spun by an executor in a background thread; finds the suite."""
@@ -336,10 +418,9 @@ class _Endpoint:
         self._thread.start()
 
     def _spin(self) -> None:
-        try:
+        # ExternalShutdownException: the context was shut down under us (Ctrl-C in the owner): nothing left to serve
+        with contextlib.suppress(ExternalShutdownException):
             self._executor.spin()
-        except ExternalShutdownException:
-            pass  # the context was shut down under us (Ctrl-C in the owner): nothing left to serve
 
     def close(self) -> None:
         self._executor.shutdown(timeout_sec=2.0)
@@ -409,7 +490,12 @@ class Goal:
         self._result_future = result_future
         self._progress = progress  # set by the first feedback or the result
         self._finished = threading.Event()
-        result_future.add_done_callback(lambda _f: (self._finished.set(), progress.set()))
+
+        def finished(_future: Any) -> None:
+            self._finished.set()
+            progress.set()
+
+        result_future.add_done_callback(finished)
         self.feedback = None  # the latest feedback message (MotionStart.Feedback)
 
     @property
@@ -443,6 +529,37 @@ class Goal:
         self._client._wait_future(future, timeout, "the cancel answer")
 
 
+@dataclass
+class _BufferCue:
+    """When stream() appends: on a FRAMES_LOW event of its supervisor, or on a MotionStatus
+    of the running path with an axis holding fewer than ``low_count`` frames (frame_count)
+    once a status has shown the last chunk arrive; either newer than the last chunk sent.
+    (A status published before the chunk was applied still shows the buffer low.)"""
+
+    low_count: int
+    since: int = -1  # the latest sample known when the last chunk was sent
+    frames_at_send: int = 0  # the fewest frames of an axis then
+    arrived: bool = False  # a status after the send shows more frames: the chunk is in
+
+    def sent(self, status: MotionStatus | None, frames_low_at: int) -> None:
+        self.since = max(status.sample if status is not None else -1, frames_low_at)
+        self.frames_at_send = _fewest_frames(status)
+        self.arrived = False
+
+    def low(self, status: MotionStatus | None, frames_low_at: int) -> bool:
+        if frames_low_at > self.since:
+            return True
+        if status is None or status.sample <= self.since or status.state_name != State.MOVING:
+            return False
+        frames = _fewest_frames(status)
+        self.arrived = self.arrived or frames > self.frames_at_send
+        return self.arrived and 0 < frames < self.low_count
+
+
+def _fewest_frames(status: MotionStatus | None) -> int:
+    return min((axis.frame_count for axis in status.axes), default=0) if status is not None else 0
+
+
 class MotionClient(_Endpoint):
     """One motion supervisor (``<namespace>/ms<supervisor>``): goals, actions and status."""
 
@@ -458,6 +575,8 @@ class MotionClient(_Endpoint):
         self._status: MotionStatus | None = None
         self._status_event = threading.Condition()
         self.node.create_subscription(MotionStatus, f"{prefix}/status", self._on_status, STATUS_QOS)
+        self._events: Any = None  # <namespace>/events, subscribed by the first stream()
+        self._frames_low_at = -1  # sample of this supervisor's latest FRAMES_LOW event
         self._start_spinning()
 
     def wait_for_server(self, timeout: float | None = None) -> bool:
@@ -553,6 +672,134 @@ class MotionClient(_Endpoint):
         """``goal.wait(timeout, raise_on_error)``: the result of a goal this client sent."""
         return goal.wait(timeout, raise_on_error)
 
+    # -- paths --------------------------------------------------------------------------------
+    def path(self, motion_type: MotionType | str, points: Iterable[Sequence[float] | float], times: Iterable[float],
+             velocities: Iterable[Sequence[float] | float] | None = None,
+             feedforward: Iterable[Sequence[float] | float] | None = None,
+             attributes: Iterable[Attribute | str] = (), element_ids: Iterable[int] | None = None,
+             wait: bool = True, timeout: float | None = None, **fields: Any) -> MotionResult | Goal:
+        """One path move (PT, PTF, PVT, PVTF, SPLINE, BESSEL, BSPLINE, BSPLINE2 or FRAME) from the command position.
+
+            result = ms0.path(MotionType.PVT, [(500.0, 0.0), (1000.0, 0.0)], [0.5, 0.5],
+                              velocities=[(1500.0, 0.0), (0.0, 0.0)])
+            print(result.detail)   # "motion done; path peaks axis 0: |v| ... counts/s, |a| ..."
+
+        ``points``: one tuple per point (a position per axis), interleaved here; ``times``:
+        seconds from the previous point (the first from the start); ``velocities`` (PVT/PVTF)
+        and ``feedforward`` (PTF/PVTF) per point like ``points``; ``element_ids``: one per point
+        (sets ELEMENT_ID). FRAME: no points or times, ``frames=[{...}, ...]`` interleaved by
+        axis. ``fields``: any other goal field (``final=False`` leaves the path open for
+        appends, ``empty_count``, ``id``, ...). Waits for the result (``timeout`` None: the
+        client's timeout plus the path's duration), or returns the Goal with wait=False.
+        Refused or ended early: raises the message's exception, as move() does.
+        """
+        goal = path_goal(motion_type, points, times, velocities, feedforward, attributes, element_ids, **fields)
+        running = self.start(goal)
+        return running.wait(self._path_timeout(timeout, goal["time"])) if wait else running
+
+    def stream(self, motion_type: MotionType | str, points: Sequence[Sequence[float] | float], times: Sequence[float],
+               velocities: Sequence[Sequence[float] | float] | None = None, chunk: int = 50, low_count: int = 32,
+               feedforward: Sequence[Sequence[float] | float] | None = None, element_ids: Sequence[int] | None = None,
+               attributes: Iterable[Attribute | str] = (), empty_count: int = 5,
+               timeout: float | None = None) -> MotionResult:
+        """Stream a long path, ``chunk`` points at a time, as the controller asks for them.
+
+            step = 2.0 * math.pi / 10_000  # a circle through the start (0, 0), 10,000 points 2 ms apart
+            points = [(1000.0 * math.cos(k * step) - 1000.0, 1000.0 * math.sin(k * step)) for k in range(1, 10_001)]
+            result = ms0.stream(MotionType.BESSEL, points, [0.002] * len(points), chunk=100, low_count=64)
+
+        The first chunk opens the path (MotionStart, final false); each further chunk is
+        appended (MotionModify with APPEND, the last one final true) when this supervisor's
+        FRAMES_LOW event arrives (the path is opened with the LOW_COUNT attribute, so the
+        controller sends it when fewer than ``low_count`` points are left; at most the frame
+        buffer's size, 128) or a MotionStatus shows an axis with fewer than ``low_count``
+        frames in its buffer (frame_count, which never shows more than the buffer holds). The
+        controller E_STOPs an open path with fewer than ``empty_count`` points left, so
+        (low_count - empty_count) points must last longer than a round trip to the suite. Not
+        SPLINE: it may not be appended to.
+
+        Returns the MotionStart goal's result once the whole path is done. ``timeout``: the
+        longest wait for a cue or an answer (None: the client's timeout plus the path's
+        duration). Refused, E-stopped or ended early: raises the message's exception (a path
+        left open then is E-stopped by the controller when its points run out).
+        """
+        parts = path_chunks(points, times, chunk, velocities=velocities, feedforward=feedforward,
+                            element_ids=element_ids)
+        timeout = self._path_timeout(timeout, times)
+        attrs = [_name(a) for a in attributes]
+        if len(parts) == 1:  # what path() does, with the timeout computed
+            goal = path_goal(motion_type, **parts[0], attributes=attrs, empty_count=empty_count)
+            return self.start(goal).wait(timeout)
+        self._follow_buffer()
+        cue = _BufferCue(low_count)
+        self._sent(cue)
+        # LOW_COUNT: the controller's FRAMES_LOW comes at the client's threshold.
+        open_attrs = attrs if Attribute.LOW_COUNT in attrs else [*attrs, Attribute.LOW_COUNT.value]
+        start = self._watched(self.start(path_goal(motion_type, **parts[0], attributes=open_attrs, final=False,
+                                                   empty_count=empty_count, low_count=low_count)))
+        appends: list[Goal] = []
+        append_attrs = attrs if Attribute.APPEND in attrs else [*attrs, Attribute.APPEND.value]
+        for number, part in enumerate(parts[1:], 2):
+            if not self._await_low(start, appends, cue, timeout):
+                break  # the path ended early: its goal says why
+            goal = path_goal(motion_type, **part, attributes=append_attrs, final=number == len(parts),
+                             empty_count=empty_count)
+            self._sent(cue)
+            appends.append(self._watched(self.modify(goal)))
+        result = start.wait(timeout)
+        for append in appends:
+            append.wait(timeout)
+        return result
+
+    def _path_timeout(self, timeout: float | None, times: Iterable[float]) -> float:
+        return self.timeout + sum(times) if timeout is None else timeout
+
+    def _await_low(self, start: Goal, appends: list[Goal], cue: _BufferCue, timeout: float) -> bool:
+        """Wait for the cue to append: True; False if the path's goal ended. Appends that are
+        done leave ``appends``; one the controller refused raises its message's exception."""
+        def woken() -> bool:
+            return start.done or any(goal.done for goal in appends) or cue.low(self._status, self._frames_low_at)
+
+        while True:
+            with self._status_event:
+                if not self._status_event.wait_for(woken, timeout):
+                    raise NoResponse(f"{self.prefix}: no FRAMES_LOW and no MotionStatus showing fewer than "
+                                     f"{cue.low_count} frames within {timeout:g} s")
+                low = cue.low(self._status, self._frames_low_at)
+            if start.done:
+                return False
+            for goal in [goal for goal in appends if goal.done]:
+                goal.wait(timeout)  # "points executed", or raises the message of a refused append
+                appends.remove(goal)
+            if low:
+                return True
+
+    def _sent(self, cue: _BufferCue) -> None:
+        """A chunk is about to be sent: what the client knows now is older than its points."""
+        with self._status_event:
+            cue.sent(self._status, self._frames_low_at)
+
+    def _follow_buffer(self) -> None:
+        """Subscribe (once) to <namespace>/events for this supervisor's FRAMES_LOW."""
+        if self._events is None:
+            self._events = self.node.create_subscription(MotionEvent, f"{self.namespace}/events", self._on_event,
+                                                         EVENTS_QOS)
+
+    def _on_event(self, event: MotionEvent) -> None:
+        if event.supervisor == self.supervisor and event.type == EventType.FRAMES_LOW:
+            with self._status_event:
+                self._frames_low_at = max(self._frames_low_at, event.sample)
+                self._status_event.notify_all()
+
+    def _watched(self, goal: Goal) -> Goal:
+        """``goal``, its end waking whoever waits on this client's status."""
+        def wake(_future: Any) -> None:
+            with self._status_event:
+                self._status_event.notify_all()
+
+        goal._result_future.add_done_callback(wake)
+        return goal
+
     # -- actions ----------------------------------------------------------------------------
     def action(self, name: Action | str, raise_on_error: bool = True) -> ActionReply:
         """mpiMotionAction: STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME or MAP."""
@@ -645,10 +892,10 @@ class Watcher(_Endpoint):
         """Keep the latest MotionStatus of ``supervisors`` and AxisStatus of ``axes``."""
         for n in supervisors:
             self.node.create_subscription(MotionStatus, f"{self.namespace}/ms{n}/status",
-                                          lambda msg, n=n: self._keep(self._supervisors, n, msg), STATUS_QOS)
+                                          partial(self._keep, self._supervisors, n), STATUS_QOS)
         for k in axes:
             self.node.create_subscription(AxisStatus, f"{self.namespace}/axis{k}/status",
-                                          lambda msg, k=k: self._keep(self._axes, k, msg), STATUS_QOS)
+                                          partial(self._keep, self._axes, k), STATUS_QOS)
 
     def _keep(self, table: dict[int, Any], key: int, msg: Any) -> None:
         with self._changed:

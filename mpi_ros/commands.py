@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable
+from typing import Any
 
 from . import requests as rq
 from .mpi.control import Controller
@@ -48,7 +49,7 @@ class Command:
         return json.dumps(self.request, sort_keys=True, separators=(",", ":"))
 
     @classmethod
-    def from_json(cls, operation: str, supervisor: int, axis: int, text: str) -> "Command":
+    def from_json(cls, operation: str, supervisor: int, axis: int, text: str) -> Command:
         return cls(operation, supervisor, axis, json.loads(text) if text else {})
 
 
@@ -82,8 +83,8 @@ def _motion(ctl: Controller, command: Command, modify: bool) -> Reply:
     ms = _supervisor(ctl, command)
     request = rq.motion_request(command.request)
     message, detail, serial = ms.command(request.type, request.attributes, request.params, modify)
-    return Reply(message, detail, serial if message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START) else 0,
-                 ms.state)
+    accepted = message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
+    return Reply(message, detail, serial if accepted else 0, ms.state)
 
 
 def _action(ctl: Controller, command: Command) -> Reply:

@@ -10,6 +10,7 @@ same configuration builds the controller for the ROS suite, the CLI tools and re
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import math
 import sys
@@ -101,7 +102,7 @@ class SuiteConfig:
             raise ConfigError(f"axes: {self.controller.axis_count} axes need as many in_position and plant "
                               f"settings, got {len(self.in_position)} and {len(self.plant)}")
         ctl = Controller(self.controller)
-        for n, (in_position, plant) in enumerate(zip(self.in_position, self.plant)):
+        for n, (in_position, plant) in enumerate(zip(self.in_position, self.plant, strict=True)):
             _require(plant.validate(), f"axes[{n}].plant.")
             ctl.axes[n].plant = Plant(plant)  # before the tolerances: they are checked against its encoder
             _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position",
@@ -114,6 +115,7 @@ class SuiteConfig:
     def _build_supervisor(ctl: Controller, spec: SupervisorSpec, where: str) -> None:
         message, ms = ctl.create_motion(spec.number)
         _accepted(message, f"{where}.number")
+        assert ms is not None  # (created: the message was OK)
         # the axes first: mpiMotionConfigSet answers AXIS_COUNT without them (spec 000)
         _accepted(ms.axis_list_set(spec.axes), f"{where}.axes")
         _accepted(ms.config_set(spec.config), f"{where}.config", spec.config.validate())
@@ -142,7 +144,7 @@ def merge(base: dict, override: dict) -> dict:
     return _merge(base, override)
 
 
-def _merge(base: dict, override: dict) -> dict:
+def _merge(base: dict, override: dict | None) -> dict:
     out = copy.deepcopy(base)
     for key, value in (override or {}).items():
         if isinstance(value, dict) and isinstance(out.get(key), dict):
@@ -179,10 +181,8 @@ def _coerce(value: Any, default: Any, where: str):
         return value
     if isinstance(default, float):
         if isinstance(value, str):  # PyYAML reads 1e9 (no exponent sign) as a string
-            try:
+            with contextlib.suppress(ValueError):
                 value = float(value)
-            except ValueError:
-                pass
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ConfigError(f"{where}: expected a finite number, got {value!r}")
         return float(value)
@@ -198,7 +198,7 @@ def _positive(value: float, where: str) -> None:
         raise ConfigError(f"{where}: must be > 0, got {value!r}")
 
 
-def _controller(raw: dict, axis_count: int, supervisor_count: int) -> ControllerConfig:
+def _controller(raw: dict | None, axis_count: int, supervisor_count: int) -> ControllerConfig:
     raw = dict(raw or {})
     cfg = _dataclass(ControllerConfig, {**raw, "axis_count": axis_count, "supervisor_count": supervisor_count},
                      "controller")
@@ -206,7 +206,7 @@ def _controller(raw: dict, axis_count: int, supervisor_count: int) -> Controller
     return cfg
 
 
-def _axes(raw: dict) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
+def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
     raw = raw or {}
     unknown = set(raw) - {"count", "defaults", "overrides"}
     if unknown:
@@ -246,7 +246,7 @@ def _motion_config(raw: dict, where: str) -> MotionConfig:
     return cfg
 
 
-def _supervisors(raw: list, defaults: dict, axis_count: int) -> list[SupervisorSpec]:
+def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[SupervisorSpec]:
     if not isinstance(raw, list) or not raw:
         raise ConfigError("supervisors: expected a non-empty list")
     defaults = defaults or {}
@@ -283,7 +283,7 @@ def _supervisors(raw: list, defaults: dict, axis_count: int) -> list[SupervisorS
     return specs
 
 
-def _ros(raw: dict) -> RosSettings:
+def _ros(raw: dict | None) -> RosSettings:
     ros = _dataclass(RosSettings, raw, "ros")
     for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate"):
         _positive(getattr(ros, key), f"ros.{key}")

@@ -13,8 +13,9 @@ are the structs' validators' business (mpi_ros/mpi/params.py), run by the contro
 from __future__ import annotations
 
 import numbers as _numbers
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Any, Mapping
+from typing import Any
 
 from .mpi.events import MPIEventType
 from .mpi.messages import Message
@@ -80,7 +81,8 @@ def integer(value: Any, what: str) -> int:
         return int(value)
     try:
         if float(value).is_integer():  # nan and inf are not integers either
-            return int(value)
+            # typeshed's numbers.Real promises no __int__ (every Real has one: float, Fraction, numpy's)
+            return int(value)  # type: ignore[call-overload]
     except (TypeError, ValueError, OverflowError):
         pass
     raise _unreadable(what, "an integer", value)
@@ -191,6 +193,9 @@ def motion_params(data: Any) -> MotionParams:
         slave_position=numbers(data.get("slave_position"), "slave_position"),
         gear_ratio=numbers(data.get("gear_ratio"), "gear_ratio"),
         frames=_structs(UserFrame, data.get("frames"), "frames"),
+        behavior=integer(data.get("behavior", 0), "behavior"),
+        low_count=integer(data.get("low_count", 0), "low_count"),
+        expected_axes=integer(data.get("expected_axes", 0), "expected_axes"),
     )
 
 
@@ -225,6 +230,9 @@ def params_to_dict(params: MotionParams) -> dict[str, Any]:
         "slave_position": list(params.slave_position),
         "gear_ratio": list(params.gear_ratio),
         "frames": [plain(f) for f in params.frames],
+        "behavior": params.behavior,
+        "low_count": params.low_count,
+        "expected_axes": params.expected_axes,
     }
 
 

@@ -21,8 +21,8 @@ import logging
 import threading
 import time
 from collections import OrderedDict, deque
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from .commands import Command, Reply, apply
 from .mpi.control import Controller
@@ -192,7 +192,8 @@ class ControllerRunner:
                 self._collect_outcomes()  # periodic callbacks see the moves that have ended
             for periodic in self._periodic:
                 if periodic.next_sample <= ctl.sample:
-                    periodic.next_sample += periodic.every * max(1, (ctl.sample - periodic.next_sample) // periodic.every + 1)
+                    behind = (ctl.sample - periodic.next_sample) // periodic.every + 1
+                    periodic.next_sample += periodic.every * max(1, behind)
                     output = periodic.callback(ctl)
                     if output is not None:
                         self._outputs.append(output)
@@ -256,7 +257,11 @@ class ControllerRunner:
     # -- events and deferred work ----------------------------------------------------------
     def _on_event(self, event: Event) -> None:
         if self._event_listeners:
-            self._outputs.append(lambda e=event: [listener(e) for listener in self._event_listeners])
+            def notify(e: Event = event) -> None:
+                for listener in self._event_listeners:
+                    listener(e)
+
+            self._outputs.append(notify)
 
     def _deferred(self) -> None:
         """After a command or an update, the lock released: its deferred work runs now, on

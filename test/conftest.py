@@ -9,14 +9,14 @@ Runs before any test module imports rclpy:
 Child processes started by tests inherit these variables and so join the same domain.
 
 Fixtures: `ros_context` gives a fresh, initialised rclpy Context that is shut down after the
-test; `probe` a node in it, spun by its own executor thread (subscriptions, service calls); every test also checks that rclpy's default context was shut down (and shuts it down
-if a test left it running).
+test; `probe` a node in it, spun by its own executor thread (subscriptions, service calls);
+every test also checks that rclpy's default context was shut down (and shuts it down if a test
+left it running).
 """
 
 from __future__ import annotations
 
 import os
-
 
 
 def _claim_domain() -> str:

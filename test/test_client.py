@@ -31,7 +31,7 @@ from mpi_ros.mpi.types import MPIState
 def test_one_exception_class_per_message_with_the_same_name_and_code():
     expected = {m.name: m.code for m in Message if m is not Message.MPIMessageOK}
     assert {name: cls.code for name, cls in errors.ERRORS.items()} == expected
-    assert errors.CODES == {m.name: m.code for m in Message}
+    assert {m.name: m.code for m in Message} == errors.CODES
     for name in expected:
         cls = getattr(errors, name)
         assert cls.message_name == name and issubclass(cls, errors.MpiError)
@@ -138,3 +138,219 @@ def test_client_and_errors_import_nothing_of_the_simulated_controller():
                           timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"
+
+
+# -- paths: path() and stream() against a recorder of their goals (no suite) ----------------------------
+# The controller's side is in test/ros/test_paths_ros.py; here the goals the client sends and
+# the cues it follows: this supervisor's FRAMES_LOW on /mpi/events, and a MotionStatus of the
+# running path with few frames left. Goals are recorded and ended by the test.
+import threading  # noqa: E402 - these tests were added at the end of the module
+
+
+def test_interleave_and_path_goal_build_the_goals_flat_lists():
+    from mpi_ros.client import interleave, path_goal
+
+    assert interleave([(100.0, 0.0), (200, 50.0)]) == [100.0, 0.0, 200.0, 50.0]
+    assert interleave([1.0, 2]) == [1.0, 2.0]  # a bare number: a point of one axis
+    goal = path_goal(MotionType.PVT, [(1.0, 2.0), (3.0, 4.0)], [0.5, 0.25], velocities=[(5.0, 6.0), (0.0, 0.0)],
+                     element_ids=[7, 8], final=False)
+    assert goal == {"type": "PVT", "attributes": ["ELEMENT_ID"], "position": [1.0, 2.0, 3.0, 4.0],
+                    "time": [0.5, 0.25], "point_velocity": [5.0, 6.0, 0.0, 0.0], "element_id": [7, 8],
+                    "final": False}
+    from mpi_ros.action import MotionStart
+
+    assert list(fill(MotionStart.Goal(), goal).point_velocity) == [5.0, 6.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match=r"velocities\[1\]: 1 value\(s\), but velocities\[0\] has 2"):
+        interleave([(1.0, 2.0), (3.0,)], "velocities")
+
+
+def test_path_chunks_cut_every_per_point_list_alike():
+    from mpi_ros.client import path_chunks
+
+    chunks = path_chunks([(1.0,), (2.0,), (3.0,)], [0.1, 0.2, 0.3], 2, velocities=[(4.0,), (5.0,), (6.0,)],
+                         element_ids=None)
+    assert chunks == [{"points": [(1.0,), (2.0,)], "times": [0.1, 0.2], "velocities": [(4.0,), (5.0,)]},
+                      {"points": [(3.0,)], "times": [0.3], "velocities": [(6.0,)]}]
+    for args, text in [(([(1.0,)], [0.1, 0.2], 5), "times: 2 value"), (([], [], 5), "at least one point"),
+                       (([(1.0,)], [0.1], 0), "chunk must be at least 1")]:
+        with pytest.raises(ValueError, match=text):
+            path_chunks(*args)
+
+
+class _Sent:
+    """What a recorded client sent: ``(kind, goal fields, result future)``, in order."""
+
+    def __init__(self):
+        self.goals = []
+        self.cond = threading.Condition()
+
+    def add(self, kind, goal, future):
+        with self.cond:
+            self.goals.append((kind, goal, future))
+            self.cond.notify_all()
+
+    def wait(self, count, timeout=5.0):
+        with self.cond:
+            assert self.cond.wait_for(lambda: len(self.goals) >= count, timeout), f"{len(self.goals)} goal(s) sent"
+            return self.goals[count - 1]
+
+
+def _ros_result(message="MPIMessageOK", detail="motion done", sample=10, end_sample=900, status=4):
+    result = SimpleNamespace(message=message, code=0, state_name="IDLE", actual_position=[0.0, 0.0],
+                             command_position=[0.0, 0.0], move_id=0, sample=sample, end_sample=end_sample,
+                             detail=detail)
+    return SimpleNamespace(result=result, status=status)
+
+
+@pytest.fixture
+def recorder(ros_context):
+    """A MotionClient of ms0 whose goals are recorded (``recorder.sent``), not sent."""
+    from rclpy.task import Future
+
+    from mpi_ros.client import Goal, MotionClient
+
+    class Recorder(MotionClient):
+        sent: _Sent
+
+        def start(self, goal, feedback=None):
+            return self._record("start", goal)
+
+        def modify(self, goal, feedback=None):
+            return self._record("modify", goal)
+
+        def _record(self, kind, goal):
+            future = Future()
+            running = Goal(self, SimpleNamespace(status=2), future, threading.Event())
+            self.sent.add(kind, goal, future)
+            return running
+
+    client = Recorder(0, context=ros_context, timeout=5.0, node_name="test_path_recorder")
+    client.sent = _Sent()
+    yield client
+    client.close()
+
+
+@pytest.fixture
+def cue(probe):
+    """``cue.low(sample, supervisor=0)``: a FRAMES_LOW on /mpi/events; ``cue.status(sample,
+    frames, state)``: a MotionStatus of ms0 whose axes hold ``frames`` frames."""
+    from mpi_ros.client import EVENTS_QOS, STATUS_QOS
+    from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
+
+    class Cue:
+        events = probe.create_publisher(MotionEvent, "/mpi/events", EVENTS_QOS)
+        statuses = probe.create_publisher(MotionStatus, "/mpi/ms0/status", STATUS_QOS)
+
+        def matched(self, publisher):
+            pause = threading.Event()
+            for _ in range(500):
+                if publisher.get_subscription_count() > 0:
+                    return
+                pause.wait(0.01)
+            raise AssertionError(f"nobody subscribed to {publisher.topic_name}")
+
+        def low(self, sample, supervisor=0):
+            self.matched(self.events)
+            self.events.publish(MotionEvent(sample=sample, type="FRAMES_LOW", supervisor=supervisor))
+
+        def status(self, sample, frames, state="MOVING"):
+            self.matched(self.statuses)
+            self.statuses.publish(MotionStatus(sample=sample, state_name=state,
+                                               axes=[AxisStatus(frame_count=frames), AxisStatus(frame_count=frames)]))
+
+    return Cue()
+
+
+def _stream_in_thread(client, *args, **kwargs):
+    outcome = {}
+
+    def run():
+        try:
+            outcome["result"] = client.stream(*args, **kwargs)
+        except Exception as exc:  # noqa: BLE001 - the test looks at it
+            outcome["error"] = exc
+
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+    return thread, outcome
+
+
+POINTS = [(float(k), -float(k)) for k in range(1, 8)]  # 7 points of two axes
+
+
+def test_stream_opens_the_path_then_appends_a_chunk_per_cue_the_last_final(recorder, cue):
+    thread, outcome = _stream_in_thread(recorder, MotionType.BESSEL, POINTS, [0.01] * 7, chunk=3, empty_count=7,
+                                        timeout=5.0)
+    kind, first, start = recorder.sent.wait(1)
+    assert (kind, first["type"], first["final"], first["empty_count"]) == ("start", "BESSEL", False, 7)
+    assert first["position"] == [1.0, -1.0, 2.0, -2.0, 3.0, -3.0] and first["time"] == [0.01] * 3
+    cue.low(100)
+    kind, second, _ = recorder.sent.wait(2)
+    assert (kind, second["attributes"], second["final"], second["position"]) == (
+        "modify", ["APPEND"], False, [4.0, -4.0, 5.0, -5.0, 6.0, -6.0])
+    cue.status(140, frames=128)   # a full buffer asks for nothing
+    cue.low(150, supervisor=1)    # nor does another supervisor's FRAMES_LOW
+    cue.status(160, frames=31)    # a MotionStatus with fewer than low_count frames does
+    kind, third, _ = recorder.sent.wait(3)
+    assert (kind, third["final"], third["position"], third["time"]) == ("modify", True, [7.0, -7.0], [0.01])
+    for _, _, future in recorder.sent.goals[1:]:
+        future.set_result(_ros_result(detail="points executed"))
+    start.set_result(_ros_result(detail="motion done; path peaks ..."))
+    thread.join(5.0)
+    assert outcome["result"].detail == "motion done; path peaks ..." and len(recorder.sent.goals) == 3
+
+
+def test_stream_ignores_cues_of_other_supervisors_and_of_stale_statuses(recorder, cue):
+    thread, outcome = _stream_in_thread(recorder, MotionType.PT, POINTS, [0.01] * 7, chunk=3, timeout=5.0)
+
+    def no_append_after(sample, sent):
+        recorder.wait_for(lambda s: s.sample == sample, 5.0)
+        with recorder.sent.cond:  # the stream had every message up to ``sample`` to act on
+            assert not recorder.sent.cond.wait_for(lambda: len(recorder.sent.goals) > sent, 0.2)
+
+    recorder.sent.wait(1)
+    cue.low(100, supervisor=1)
+    cue.status(110, frames=0, state="IDLE")  # from before the path began
+    cue.status(120, frames=100)
+    no_append_after(120, 1)
+    cue.status(130, frames=25)
+    assert recorder.sent.wait(2)[0] == "modify"
+    cue.status(140, frames=20)  # published before the append took effect: the buffer has not refilled
+    no_append_after(140, 2)
+    recorder.sent.goals[0][2].set_result(_ros_result("MPIMotionMessageERROR", "E_STOP by CONTROLLER"))
+    thread.join(5.0)
+    assert isinstance(outcome["error"], errors.MPIMotionMessageERROR) and len(recorder.sent.goals) == 2
+
+
+def test_stream_raises_a_refused_start_and_a_refused_append(recorder, cue):
+    thread, outcome = _stream_in_thread(recorder, MotionType.SPLINE, POINTS, [0.01] * 7, chunk=4, timeout=5.0)
+    recorder.sent.wait(1)[2].set_result(_ros_result("MPIMotionMessagePATH_ERROR", "final is false", 10, 10, 6))
+    thread.join(5.0)
+    assert isinstance(outcome["error"], errors.MPIMotionMessagePATH_ERROR) and len(recorder.sent.goals) == 1
+    recorder.sent = _Sent()
+    thread, outcome = _stream_in_thread(recorder, MotionType.PT, POINTS, [0.01] * 7, chunk=2, timeout=5.0)
+    recorder.sent.wait(1)
+    cue.low(200)
+    recorder.sent.wait(2)[2].set_result(_ros_result("MPIMessagePARAM_INVALID", "position needs ...", 210, 210, 6))
+    thread.join(5.0)
+    assert isinstance(outcome["error"], errors.MPIMessagePARAM_INVALID) and len(recorder.sent.goals) == 2
+
+
+def test_a_path_that_fits_one_chunk_is_one_final_goal(recorder):
+    thread, outcome = _stream_in_thread(recorder, MotionType.PVT, POINTS[:2], [0.5, 0.5],
+                                        velocities=[(1.0, 1.0), (0.0, 0.0)], timeout=5.0)
+    kind, goal, future = recorder.sent.wait(1)
+    assert kind == "start" and "final" not in goal and goal["point_velocity"] == [1.0, 1.0, 0.0, 0.0]
+    future.set_result(_ros_result())
+    thread.join(5.0)
+    assert outcome["result"].ok
+
+
+def test_path_sends_one_goal_and_raises_as_move_does(recorder):
+    running = recorder.path(MotionType.PT, POINTS[:2], [0.1, 0.1], attributes=["RELATIVE"], wait=False, id=3)
+    kind, goal, future = recorder.sent.wait(1)
+    assert (kind, goal["attributes"], goal["id"]) == ("start", ["RELATIVE"], 3)
+    assert goal["position"] == [1.0, -1.0, 2.0, -2.0] and goal["time"] == [0.1, 0.1]
+    future.set_result(_ros_result("MEIMotionMessageBAD_PATH_DATA", "a path value is infinite or NaN", 5, 5, 6))
+    with pytest.raises(errors.MEIMotionMessageBAD_PATH_DATA):
+        running.wait()

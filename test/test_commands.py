@@ -187,7 +187,8 @@ def _to_state(ctl, state: str) -> None:
     """Supervisor 0 (axes 0, 1) into ``state`` through commands, as a client would."""
     if state != "IDLE (new)":
         done = state == "IDLE (move done)"
-        assert apply(ctl, Command("motion_start", 0, request=GOAL if done else {**GOAL, "position": [1e5, 0.0]})).accepted
+        request = GOAL if done else {**GOAL, "position": [1e5, 0.0]}
+        assert apply(ctl, Command("motion_start", 0, request=request)).accepted
         ctl.step(400)  # at speed
         action = _ACTIONS.get(state)
         if action:

@@ -21,7 +21,8 @@ elements when there are none); fixed arrays as the elements alone; nested messag
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
+from typing import Any
 
 from rosidl_parser import definition as d
 
@@ -43,7 +44,7 @@ class Unsupported(TypeError):
 #   ("p", size)  primitive;  ("r", table) a run of primitive fields (attribute None);
 #   ("s", None) string;  ("m", plan) message;
 #   ("a", (n, element)) fixed array;  ("q", element) sequence   (element = a (kind, detail) pair)
-def _element(slot) -> tuple[str, object]:
+def _element(slot) -> tuple[str, Any]:  # (kind, its detail: a size, None, a plan, ...)
     if isinstance(slot, d.BasicType):
         try:
             return "p", _SIZES[slot.typename]
@@ -66,7 +67,7 @@ def _message_class(slot: d.NamespacedType):
     return getattr(importlib.import_module(".".join(slot.namespaces)), slot.name)
 
 
-@lru_cache(maxsize=None)
+@cache
 def plan_of(msg_class) -> tuple:
     """The field layout of a generated message class (cached per class). Consecutive
     primitive fields become one run ("r"), laid out in advance for each start offset mod 8
@@ -74,7 +75,7 @@ def plan_of(msg_class) -> tuple:
     names = list(msg_class.get_fields_and_field_types())
     plan: list = []
     sizes: list[int] = []
-    for name, slot in zip(names, msg_class.SLOT_TYPES):
+    for name, slot in zip(names, msg_class.SLOT_TYPES, strict=True):
         kind, detail = _element(slot)
         if kind == "p":
             sizes.append(detail)
@@ -152,7 +153,8 @@ def _walk(plan: tuple, msg, pos: int, gaps: list) -> int:
 def layout(msg) -> tuple[int, list[tuple[int, int]]]:
     """(length of the data after the header, alignment gaps as [start, end) offsets in it)."""
     gaps: list[tuple[int, int]] = []
-    end = _walk(plan_of(type(msg)), msg, 0, gaps)
+    msg_class: type = type(msg)  # (as type[Any], mypy finds it not Hashable for plan_of's cache)
+    end = _walk(plan_of(msg_class), msg, 0, gaps)
     return end, gaps
 
 

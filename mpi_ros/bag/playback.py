@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable
 
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy

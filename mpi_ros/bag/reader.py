@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any
 
 import yaml
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
+from mcap_ros2._dynamic import generate_dynamic
 
 from . import schema
 
@@ -21,12 +24,24 @@ class Recorded:
     log_time: int  # ns
     data: bytes  # CDR
     sequence: int = 0  # the writer's count on the topic: the order messages were written in
+    schema_text: str = ""  # the ros2msg definition the bag stores for the type ("": unknown)
 
     def decode(self):
-        """The message as its generated Python class (the package must be installed)."""
+        """The message: as its generated Python class (the package must be installed) when the
+        bag's definition of the type is the installed one; else read by the definition the bag
+        stores (a bag recorded before the type changed), with the fields it had."""
+        if self.schema_text and self.schema_text != schema.ros2msg(self.type):
+            return _recorded_decoder(self.type, self.schema_text)(self.data)
         from rclpy.serialization import deserialize_message
 
         return deserialize_message(self.data, schema.message_class(self.type))
+
+
+@lru_cache(maxsize=64)
+def _recorded_decoder(type_name: str, text: str):
+    """A decoder of ``type_name`` by the definition ``text`` (mcap_ros2's dynamic decoding:
+    objects with the definition's fields as attributes)."""
+    return generate_dynamic(type_name, text)[type_name]
 
 
 def mcap_path(path: str | Path) -> Path:
@@ -75,7 +90,8 @@ class BagReader:
         wanted = list(topics) if topics is not None else None
         with open(self.path, "rb") as stream:
             for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted, log_time_order=True):
-                yield Recorded(channel.topic, schema_.name, message.log_time, message.data, message.sequence)
+                yield Recorded(channel.topic, schema_.name, message.log_time, message.data, message.sequence,
+                               schema_.data.decode("utf-8", errors="replace"))
 
     def decoded(self, topics: Iterable[str] | None = None) -> Iterator[tuple[Recorded, Any]]:
         for recorded in self.messages(topics):

@@ -26,9 +26,10 @@ from .. import __version__
 from ..commands import Command as ControllerCommand
 from ..commands import Reply
 from ..config import SuiteConfig
+from ..mpi.control import Controller
 from ..mpi.events import MPIEventType
-from ..runner import ControllerRunner
 from ..ros import convert
+from ..runner import ControllerRunner, Output
 from .writer import BagWriter, TopicQos
 
 COMMANDS_TOPIC = "/mpi/commands"  # with the default namespace; in general <namespace>/commands
@@ -91,7 +92,7 @@ class Recorder:
         return convert.stamp_ns(sample, self.rate, self.epoch)
 
     # -- hooks (periodic collection under the runner lock, writing after it) --------------------------
-    def _collect_status(self, ctl):
+    def _collect_status(self, ctl: Controller) -> Output:
         t = self.log_time(ctl.sample)
         messages: list[tuple[str, object]] = [
             (f"{self.ns}/ms{ms.number}/status", convert.motion_status(ms.snapshot(), ctl.rate, self.epoch))
@@ -99,7 +100,12 @@ class Recorder:
         ]
         messages += [(f"{self.ns}/axis{a.number}/status",
                       convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate, self.epoch)) for a in ctl.axes]
-        return lambda: [self.writer.write(topic, msg, t) for topic, msg in messages]
+
+        def write() -> None:
+            for topic, msg in messages:
+                self.writer.write(topic, msg, t)
+
+        return write
 
     def _collect_joints(self, ctl):
         msg = convert.joint_state(ctl, self.epoch)

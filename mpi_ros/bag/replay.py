@@ -26,8 +26,7 @@ from .. import config as suite_config
 from ..commands import Command, apply
 from ..ros import convert
 from .reader import BagReader
-from .recorder import (COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED,
-                       commands_topic)
+from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED, commands_topic
 
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
 STATUS_TYPES = ("mpi_ros/msg/MotionStatus", "mpi_ros/msg/AxisStatus")
@@ -142,9 +141,9 @@ def inspect(reader: BagReader) -> Recording:
     missing = []
     setup = None
     if stored is not None:
-        epoch = stored.get("stamp_epoch_ns")
+        stored_epoch = stored.get("stamp_epoch_ns")
         setup = (yaml.safe_load(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
-                 int(epoch) if epoch is not None else None, stored.get("namespace"))
+                 int(stored_epoch) if stored_epoch is not None else None, stored.get("namespace"))
     elif config_topics:
         found = next((msg for _, msg in reader.decoded(config_topics[:1])), None)
         if found is not None:
@@ -261,7 +260,8 @@ def _compare_events(report: ReplayReport, recorded, replayed, rate: float, toler
     horizon = report.last_sample
     replayed = [convert.motion_event(e, rate, epoch or 0) for e in replayed if since <= e.sample <= horizon]
     recorded = [e for e in recorded if e.sample <= horizon]
-    for i, (old, new) in enumerate(zip(recorded, replayed)):
+    # pairs up to the shorter list: a difference in count is a divergence of its own (below)
+    for i, (old, new) in enumerate(zip(recorded, replayed, strict=False)):
         report.events += 1
         _compare(report, old.sample, f"event[{i}]", old, new, tolerance, skipped)
     if len(recorded) != len(replayed):

@@ -53,7 +53,8 @@ def load(path: str | Path) -> Scenario:
             steps.append(Step(int(entry["at"]), Command(str(entry["operation"]), int(entry.get("supervisor", -1)),
                                                         int(entry.get("axis", -1)), dict(entry.get("request") or {}))))
         except (KeyError, TypeError, ValueError) as exc:
-            raise ValueError(f"{path}: commands[{i}]: needs at, operation (and supervisor/axis/request): {exc}") from exc
+            raise ValueError(f"{path}: commands[{i}]: needs at, operation (and supervisor/axis/request): "
+                             f"{exc}") from exc
     scenario = Scenario(str(data.get("name", Path(path).stem)), int(data.get("samples", 0)),
                         dict(data.get("config") or {}), sorted(steps, key=lambda s: s.at))
     if scenario.steps and scenario.steps[-1].at > scenario.samples:

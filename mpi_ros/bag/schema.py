@@ -12,7 +12,7 @@ import importlib
 import json
 import re
 import sys
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 PRIMITIVES = {
@@ -48,7 +48,7 @@ def split(type_name: str) -> tuple[str, str]:
     return parts[0], parts[-1]
 
 
-@lru_cache(maxsize=None)
+@cache
 def msg_text(type_name: str) -> str:
     package, name = split(type_name)
     return _find(package, name, ".msg").read_text(encoding="utf-8")
@@ -71,7 +71,7 @@ def _field_types(text: str, package: str) -> list[str]:
     return found
 
 
-@lru_cache(maxsize=None)
+@cache
 def ros2msg(type_name: str) -> str:
     """The ros2msg schema text of a type ('pkg/msg/Type')."""
     package, name = split(type_name)
@@ -94,7 +94,7 @@ def ros2msg(type_name: str) -> str:
     return "\n".join(parts) + "\n"
 
 
-@lru_cache(maxsize=None)
+@cache
 def type_hash(type_name: str) -> str:
     """The RIHS01 type description hash of a type (empty if the package has none)."""
     package, name = split(type_name)

@@ -79,7 +79,7 @@ class BagWriter:
         self._closed = False
         self.custom_data: dict[str, str] = {}
 
-    def __enter__(self) -> "BagWriter":
+    def __enter__(self) -> BagWriter:
         return self
 
     def __exit__(self, *exc) -> None:

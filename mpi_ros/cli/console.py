@@ -21,7 +21,8 @@ DEFAULT_TIMEOUT = 5.0
 # What to do next when the supervisor's state refused a command.
 HINTS = {
     "MPIMotionMessageERROR": "ms{n} is in ERROR (after an E_STOP or ABORT): `mpi-ros reset` leaves it",
-    "MPIMotionMessageSTOPPING_ERROR": "ms{n} is stopping after an E_STOP or ABORT: wait for ERROR, then `mpi-ros reset`",
+    "MPIMotionMessageSTOPPING_ERROR":
+        "ms{n} is stopping after an E_STOP or ABORT: wait for ERROR, then `mpi-ros reset`",
     "MPIMotionMessageMOVING": "ms{n} is moving: wait for it, `mpi-ros modify` it or `mpi-ros stop` it",
     "MPIMotionMessageSTOPPING": "ms{n} is stopping: wait for STOPPED",
     "MPIMotionMessageSTOPPED": "ms{n} is STOPPED: `mpi-ros resume` continues the move, `mpi-ros reset` drops it",

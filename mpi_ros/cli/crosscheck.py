@@ -81,9 +81,10 @@ def run(args) -> int:
         print(f"mpi-ros crosscheck: {exc}", file=sys.stderr)
         return 2
 
+    from mpi_ros.crosscheck.result import CrossCheck
     from mpi_ros.crosscheck.table import format_table
 
-    entries = []
+    entries: list[tuple[ProfileRequest, CrossCheck | str]] = []
     for request in requests:
         try:
             entries.append((request, check_plan(request.plan(), request.type)))

@@ -5,8 +5,7 @@
 
 The tour, on supervisor 0 (axes 0 and 1): an S-curve move; a jog modified in flight
 into a move to a target; STOP and RESUME; E_STOP, a move refused in ERROR, and RESET; a
-path move (PVT) once the controller runs paths (until then the step says so and is
-skipped); back home. Each step prints the `mpi-ros` command that does the same against a
+path move (PVT) through three points; back home. Each step prints the `mpi-ros` command that does the same against a
 running suite, then the controller's answer. While it runs, `mpi-ros status` in another
 shell shows the axes move.
 
@@ -34,7 +33,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, TextIO, TypedDict
 
 from .console import OK, REFUSED, USAGE, UsageError, fail, positions
 
@@ -45,8 +44,18 @@ STARTUP_WAIT = 30.0  # s for the suite's process to come up on the graph
 STOP_WAIT = 30.0  # s for the suite's process to stop and write the bag
 WAIT = 60.0  # s of wall time any one step may take (at time scale 1 the longest takes ~3 s)
 
+
+class _Move(TypedDict):
+    """A point-to-point move's values (a plain dict at run time)."""
+
+    position: list[float]
+    velocity: float
+    acceleration: float
+    jerk_percent: float
+
+
 # The first move: its profile is also plotted against ruckig's.
-S_CURVE = {"position": [4000.0, 2000.0], "velocity": 2000.0, "acceleration": 10000.0, "jerk_percent": 50.0}
+S_CURVE: _Move = {"position": [4000.0, 2000.0], "velocity": 2000.0, "acceleration": 10000.0, "jerk_percent": 50.0}
 # A PVT path (it starts where the axes are): three points, positions interleaved by axis, one time per point.
 PATH = {"type": "PVT", "position": [1000.0, 1000.0, 2500.0, 500.0, 3000.0, 0.0],
         "point_velocity": [1200.0, 600.0, 1000.0, -800.0, 0.0, 0.0], "time": [1.0, 1.0, 1.0]}
@@ -387,9 +396,6 @@ def path_move(t: Tour) -> None:
            "mpi-ros move --goal \"{type: PVT, position: [1000, 1000, 2500, 500, 3000, 0], "
            "point_velocity: [1200, 600, 1000, -800, 0, 0], time: [1, 1, 1]}\"")
     result = t.client.start(PATH).wait(WAIT, raise_on_error=False)
-    if result.message == "MPIMessageUNSUPPORTED":
-        t.say(f"skipped: paths are not built yet (the controller answered {result.message}: {result.detail})")
-        return
     t.say(f"{result.message} (code {result.code}) {result.outcome}, state {result.state_name}, "
           f"at {positions(result.actual_position)}")
     from mpi_ros.errors import raise_for

@@ -2,7 +2,8 @@
 
   mpi-ros modify --position 500 0 --velocity 1000 --acceleration 10000
   mpi-ros modify --type VELOCITY --velocity -200 --acceleration 5000
-  mpi-ros modify --goal "{type: S_CURVE, position: [500.0, 0.0], trajectory: [{velocity: 1000.0, acceleration: 10000.0}]}"
+  mpi-ros modify --goal "{type: S_CURVE, position: [500.0, 0.0],
+                          trajectory: [{velocity: 1000.0, acceleration: 10000.0}]}"
 
 The same flags and --goal YAML as `mpi-ros move` (MotionModify has the same fields). The
 supervisor must be MOVING: while IDLE it answers MPIMotionMessageIDLE (unless the goal has

@@ -14,6 +14,7 @@ redrawn in place every 0.1 s; otherwise a new table is printed every second.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 import threading
 import time
@@ -49,14 +50,13 @@ def _status(session, args: argparse.Namespace) -> int:
         watcher.follow_status([], extra)
         watcher.wait_for_status(supervisors, extra, args.timeout)
     if args.once:
-        print("\n".join(render(*watcher.latest(), watcher.namespace)))
+        supervisor_statuses, axis_statuses = watcher.latest()
+        print("\n".join(render(supervisor_statuses, axis_statuses, watcher.namespace)))
         return OK
     tty = sys.stdout.isatty()
     interval = args.interval if args.interval is not None else (0.1 if tty else 1.0)
-    try:
+    with contextlib.suppress(KeyboardInterrupt):  # Ctrl-C is how a live view ends
         _live(watcher, sys.stdout, tty, interval)
-    except KeyboardInterrupt:
-        pass  # Ctrl-C is how a live view ends
     return OK
 
 

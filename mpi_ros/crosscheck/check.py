@@ -25,16 +25,26 @@ zero carry that much rounding).
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from ..mpi.frames import AxisPlan
 from ..mpi.profiles.segment import Segment
 from ..mpi.types import MPIMotionType
 from .limits import check_profile, strip_waits
 from .mapping import INF, Mapping, map_point_to_point, map_velocity, peak_acceleration
-from .request import ProfileRequest, motion_type as parse_type
-from .result import (BOUND_RTOL, DURATION_RTOL, STATE_RTOL, TIME_RESOLUTION, CrossCheck, Reason, RuckigLimits,
-                     StateDifference, Verdict)
+from .request import ProfileRequest
+from .request import motion_type as parse_type
+from .result import (
+    BOUND_RTOL,
+    DURATION_RTOL,
+    STATE_RTOL,
+    TIME_RESOLUTION,
+    CrossCheck,
+    Reason,
+    RuckigLimits,
+    StateDifference,
+    Verdict,
+)
 from .sampling import end_state, max_difference
 from .solver import RuckigFailed, solve
 
@@ -150,27 +160,30 @@ def _tolerance(scales: StateDifference, duration: float, segments: Sequence[Segm
 def _compare(kind, axis, mapping: Mapping, compared, duration, scales, problems, start, a0) -> CrossCheck:
     reasons = mapping.reasons
     tol = _tolerance(scales, duration, compared)
-    if mapping.limits is None:  # nothing to do for ruckig either
+    limits = mapping.limits
+    if limits is None:  # nothing to do for ruckig either
         if compared:
             problems.append(f"nothing should move, but the profile lasts {duration!r} s")
         return _result(kind, axis, mapping, duration, 0.0, problems, scales=scales, tol=tol)
     try:
-        reference = solve(mapping.limits)
+        reference = solve(limits)
     except RuckigFailed as exc:
-        if mapping.exact or not math.isfinite(mapping.limits.max_jerk):
+        if mapping.exact or not math.isfinite(limits.max_jerk):
             problems.append(f"ruckig failed: {exc}")
             return _result(kind, axis, mapping, duration, None, problems, scales=scales, tol=tol)
         # A bound stays a bound with unlimited jerk (a weaker one): ruckig failed on the jerk.
-        mapping = mapping.unlimited_jerk(f"ruckig failed with max_jerk {mapping.limits.max_jerk:.6g} ({exc}); "
+        mapping = mapping.unlimited_jerk(f"ruckig failed with max_jerk {limits.max_jerk:.6g} ({exc}); "
                                          "bound with unlimited jerk")
+        assert mapping.limits is not None  # the same problem, with unlimited jerk
+        limits = mapping.limits
         try:
-            reference = solve(mapping.limits)
+            reference = solve(limits)
         except RuckigFailed as exc2:
             problems.append(f"ruckig failed: {exc2}")
             return _result(kind, axis, mapping, duration, None, problems, scales=scales, tol=tol)
-    full_state = _full_state_duration(mapping.limits, a0) if Reason.ACCELERATION_STEP in reasons else None
+    full_state = _full_state_duration(limits, a0) if Reason.ACCELERATION_STEP in reasons else None
     ours = end_state(compared, start)
-    theirs = end_state(reference.segments, (mapping.limits.current_position, mapping.limits.current_velocity, 0.0))
+    theirs = end_state(reference.segments, (limits.current_position, limits.current_velocity, 0.0))
     final = StateDifference(abs(ours[0] - theirs[0]), abs(ours[1] - theirs[1]), abs(ours[2] - theirs[2]))
     window = tol.velocity / scales.acceleration if scales.acceleration > 0.0 else 0.0
     sampled = max_difference(compared, reference.segments, window)

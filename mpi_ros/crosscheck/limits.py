@@ -22,8 +22,8 @@ deceleration, jerk as configured; lines 221-227 for the S-curve's shape):
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 from ..mpi.profiles.segment import Segment
 from .mapping import peak_acceleration, ramp_jerk, reverses
@@ -177,6 +177,7 @@ def check_profile(
             if speed > ceiling + v_tol or (v_end > velocity + v_tol and v_end > abs(seg.v) + v_tol):
                 problems.append(f"segment {k}: |v| reaches {speed!r}, above the velocity {velocity!r}")
                 break
+        assert target is not None  # a point-to-point move has one
         lowest = min(velocity_range(s)[0] for s in segments)
         highest = max(velocity_range(s)[1] for s in segments)
         reversed_ = lowest < -v_tol and highest > v_tol

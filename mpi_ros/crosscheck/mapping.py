@@ -94,10 +94,7 @@ def reverses(distance: float, v0: float, vf: float, acceleration: float, deceler
     u0, uf, x = s * v0, s * vf, s * distance
     if uf < 0.0:
         return True
-    if uf <= u0:
-        shortest = (u0 * u0 - uf * uf) / (2.0 * deceleration)
-    else:
-        shortest = (uf * uf - u0 * u0) / (2.0 * acceleration)
+    shortest = (u0 * u0 - uf * uf) / (2.0 * deceleration) if uf <= u0 else (uf * uf - u0 * u0) / (2.0 * acceleration)
     return x < shortest
 
 
@@ -131,7 +128,7 @@ class Mapping:
     notes: tuple[str, ...]
     needs_profile_jerk: bool = False  # a bound whose max_jerk is the controller's largest jerk
 
-    def with_jerk(self, jerk: float) -> "Mapping":
+    def with_jerk(self, jerk: float) -> Mapping:
         """The bound with ``max_jerk`` set to the controller's largest ramp jerk."""
         if self.limits is None or not self.needs_profile_jerk:
             return self
@@ -139,8 +136,9 @@ class Mapping:
         return Mapping(limits, self.exact, self.reasons, self.notes, False)
 
 
-    def unlimited_jerk(self, note: str) -> "Mapping":
+    def unlimited_jerk(self, note: str) -> Mapping:
         """The same problem with max_jerk = inf (for a bound: looser, still a lower bound)."""
+        assert self.limits is not None  # a problem ruckig was given
         limits = RuckigLimits(**{**_asdict(self.limits), "max_jerk": INF})
         return Mapping(limits, self.exact, self.reasons, self.notes + (note,), False)
 
@@ -217,7 +215,7 @@ def map_velocity(
         return Mapping(None, True, reasons, ("already at the velocity: no ramp",))
     peak = peak_acceleration(acceleration, f)
     jerk = ramp_jerk(acceleration, f, velocity - start_velocity)
-    notes = ()
+    notes: tuple[str, ...] = ()
     if 0.5 * f < TIME_RESOLUTION:
         jerk, notes = INF, (TOO_SHORT_TO_SEE,)
     limits = RuckigLimits(

@@ -19,8 +19,8 @@ from __future__ import annotations
 import logging
 import threading
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from ..mpi.control import Controller
 from ..mpi.events import MPIEventType
@@ -61,7 +61,9 @@ class CrosscheckMonitor:
         if command.operation not in START_OPERATIONS or not reply.accepted or not reply.serial:
             return []
         ms = self.ctl.supervisor(command.supervisor)
-        move = _find_move(ms, reply.serial) if ms is not None else None
+        if ms is None:
+            return []
+        move = _find_move(ms, reply.serial)
         if move is None:
             return []
         return self.check_move(ms.number, move, self.ctl.sample if sample is None else sample)

@@ -17,14 +17,15 @@ a start (or, with a start velocity, a modify) of that request on a one-axis supe
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Any, Mapping
+from typing import Any
 
+from ..mpi import validate
 from ..mpi.frames import AxisPlan
 from ..mpi.params import MotionParams, Trajectory
 from ..mpi.planner import AxisStart, PlanError, compile_move
 from ..mpi.types import MotionAttr, MPIMotionType
-from ..mpi import validate
 
 SUPPORTED_TYPES = (MPIMotionType.TRAPEZOIDAL, MPIMotionType.S_CURVE, MPIMotionType.VELOCITY)
 _ALIASES = {"jerk": "jerk_percent", "jerkpercent": "jerk_percent", "v0": "start_velocity",
@@ -37,6 +38,7 @@ class RequestInvalid(ValueError):
 
 
 def motion_type(value: Any) -> MPIMotionType:
+    kind: MPIMotionType | None
     if isinstance(value, MPIMotionType):
         kind = value
     else:
@@ -73,7 +75,7 @@ class ProfileRequest:
         return self.target - self.start_position
 
     @classmethod
-    def from_mapping(cls, data: Mapping[str, Any]) -> "ProfileRequest":
+    def from_mapping(cls, data: Mapping[str, Any]) -> ProfileRequest:
         known = {f.name for f in fields(cls)}
         values: dict[str, Any] = {}
         distance = None
@@ -104,7 +106,7 @@ class ProfileRequest:
         return cls(**values)
 
     @classmethod
-    def parse(cls, text: str) -> "ProfileRequest":
+    def parse(cls, text: str) -> ProfileRequest:
         """From a YAML flow mapping or ``key=value,key=value``."""
         text = text.strip()
         if text.startswith("{"):

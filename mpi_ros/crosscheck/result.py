@@ -78,18 +78,18 @@ class StateDifference:
     velocity: float = 0.0
     acceleration: float = 0.0
 
-    def within(self, tolerance: "StateDifference") -> bool:
+    def within(self, tolerance: StateDifference) -> bool:
         return (self.position <= tolerance.position and self.velocity <= tolerance.velocity
                 and self.acceleration <= tolerance.acceleration)
 
-    def relative_to(self, scales: "StateDifference") -> "StateDifference":
+    def relative_to(self, scales: StateDifference) -> StateDifference:
         def rel(x: float, s: float) -> float:
             return x / s if s > 0.0 else (0.0 if x == 0.0 else math.inf)
 
         return StateDifference(rel(self.position, scales.position), rel(self.velocity, scales.velocity),
                                rel(self.acceleration, scales.acceleration))
 
-    def max(self, other: "StateDifference") -> "StateDifference":
+    def max(self, other: StateDifference) -> StateDifference:
         return StateDifference(max(self.position, other.position), max(self.velocity, other.velocity),
                                max(self.acceleration, other.acceleration))
 

@@ -13,7 +13,7 @@ comparison (ruckig, for one, may end its brake with a 1e-12 s correction phase).
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 

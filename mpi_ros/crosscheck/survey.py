@@ -27,7 +27,7 @@ import numpy as np
 from ..mpi.types import MPIMotionType
 from .check import check_request
 from .request import ProfileRequest, RequestInvalid
-from .result import CrossCheck, StateDifference, Verdict
+from .result import CrossCheck, Reason, StateDifference, Verdict
 
 CATEGORIES = ("TRAPEZOIDAL", "S_CURVE", "VELOCITY", "MODIFY")
 
@@ -145,7 +145,7 @@ def format_summary(stats: dict[str, CategoryStats]) -> str:
             f"{s.verdicts[Verdict.DIFFER_EXPLAINED]:>9} {s.verdicts[Verdict.DISAGREE]:>8} "
             f"{s.max_duration_relative:>10.2e} {s.max_relative.position:>9.2e} {s.max_relative.velocity:>9.2e} "
             f"{s.max_relative.acceleration:>9.2e} {s.max_tolerance_used:>8.2g} {margin:>12}")
-    reasons = Counter()
+    reasons: Counter[Reason] = Counter()
     for s in stats.values():
         reasons.update(s.reasons)
     if reasons:

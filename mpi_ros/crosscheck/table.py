@@ -9,7 +9,7 @@ Problems (DISAGREE) and mapping notes follow the table, numbered by row.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from .request import ProfileRequest
 from .result import CrossCheck, Verdict
@@ -28,12 +28,13 @@ def _small(*values: float) -> str:
     return ",".join(f"{v:.1e}" for v in values)
 
 
-def row(index: int, request: ProfileRequest, result: CrossCheck | str) -> tuple[str, ...]:
+def row(index: int, request: ProfileRequest | None, result: CrossCheck | str) -> tuple[str, ...]:
+    label = request.label() if request else "?"  # (a result always has its request)
     if isinstance(result, str):
-        return (str(index), request.label() if request else "?", "-", "-", "-", "-", "-", "REFUSED", result)
+        return (str(index), label, "-", "-", "-", "-", "-", "REFUSED", result)
     sampled = result.max_difference
     return (
-        str(index), request.label(), _num(result.controller_duration), _num(result.ruckig_duration),
+        str(index), label, _num(result.controller_duration), _num(result.ruckig_duration),
         "-" if result.ruckig_duration is None else f"{result.duration_relative:.1e}",
         _small(result.final_difference.position, result.final_difference.velocity),
         _small(sampled.position, sampled.velocity, sampled.acceleration) if result.exact else "(bound)",
@@ -43,12 +44,12 @@ def row(index: int, request: ProfileRequest, result: CrossCheck | str) -> tuple[
 
 def format_table(entries: Sequence[tuple[ProfileRequest | None, CrossCheck | str]]) -> str:
     """``entries``: (request, result or the refusal message)."""
-    rows = [HEADER] + [row(i + 1, req, res) for i, (req, res) in enumerate(entries)]
+    rows: list[tuple[str, ...]] = [HEADER] + [row(i + 1, req, res) for i, (req, res) in enumerate(entries)]
     widths = [max(len(r[c]) for r in rows) for c in range(len(HEADER))]
     lines = []
     for n, r in enumerate(rows):
         lines.append("  ".join(cell.ljust(w) if c in (1, 7, 8) else cell.rjust(w)
-                               for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
+                               for c, (cell, w) in enumerate(zip(r, widths, strict=True))).rstrip())
         if n == 0:
             lines.append("  ".join("-" * w for w in widths))
     footnotes = []

@@ -21,6 +21,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Generic, Self, TypeVar, overload
 
 import numpy as np
 
@@ -59,24 +60,32 @@ class CommandMode(Enum):
     COAST = "COAST"  # amplifier off (ABORT): the motor coasts
 
 
-class _Derived:
-    """An attribute the axis' rows in the bank derive from: setting it marks them stale."""
+V = TypeVar("V")
+
+
+class _Derived(Generic[V]):
+    """An attribute (of type V) the axis' rows in the bank derive from: setting it marks them
+    stale."""
 
     def __set_name__(self, owner: type, name: str) -> None:
         self.slot = "_" + name
 
-    def __get__(self, axis: "Axis | None", owner: type | None = None):
+    @overload
+    def __get__(self, axis: None, owner: type | None = None) -> Self: ...
+    @overload
+    def __get__(self, axis: Axis, owner: type | None = None) -> V: ...
+    def __get__(self, axis: Axis | None, owner: type | None = None) -> Self | V:
         return self if axis is None else getattr(axis, self.slot)
 
-    def __set__(self, axis: "Axis", value) -> None:
+    def __set__(self, axis: Axis, value: V) -> None:
         setattr(axis, self.slot, value)
         axis._bank.stale[axis.number] = True
 
 
-class _Anchor(_Derived):
+class _Anchor(_Derived[V]):
     """The plant anchor: moving it changes only the axis' servo rows (a lighter rebuild)."""
 
-    def __set__(self, axis: "Axis", value) -> None:
+    def __set__(self, axis: Axis, value: V) -> None:
         setattr(axis, self.slot, value)
         axis._bank.moved[axis.number] = True
 
@@ -87,34 +96,38 @@ class _Value:
     def __set_name__(self, owner: type, name: str) -> None:
         self.name = name
 
-    def __get__(self, axis: "Axis | None", owner: type | None = None):
+    @overload
+    def __get__(self, axis: None, owner: type | None = None) -> Self: ...
+    @overload
+    def __get__(self, axis: Axis, owner: type | None = None) -> float: ...
+    def __get__(self, axis: Axis | None, owner: type | None = None) -> Self | float:
         return self if axis is None else float(getattr(axis._bank, self.name)[axis.number])
 
-    def __set__(self, axis: "Axis", value: float) -> None:
+    def __set__(self, axis: Axis, value: float) -> None:
         getattr(axis._bank, self.name)[axis.number] = value
 
 
 class Axis:
     # command
-    plan: AxisPlan | None = _Derived()
-    tau_start: float = _Derived()
-    rest: float = _Derived()  # raw command when no plan is loaded
-    mode: CommandMode = _Derived()
-    holding: bool = _Derived()  # a hold frame is waiting for its trigger
+    plan: _Derived[AxisPlan | None] = _Derived()
+    tau_start: _Derived[float] = _Derived()
+    rest: _Derived[float] = _Derived()  # raw command when no plan is loaded
+    mode: _Derived[CommandMode] = _Derived()
+    holding: _Derived[bool] = _Derived()  # a hold frame is waiting for its trigger
     # plant, anchored at the start of the current command piece
-    state: PlantState = _Anchor()
-    plant: Plant = _Derived()
+    state: _Anchor[PlantState] = _Anchor()
+    plant: _Derived[Plant] = _Derived()
     # status
-    status_mode: StatusMode = _Derived()
-    target: float = _Derived()
-    in_position: AxisInPosition = _Derived()  # replaced whole, never changed in place
-    # values at the current sample
-    cmd_p: float = _Value()
-    cmd_v: float = _Value()
-    cmd_a: float = _Value()
-    act_p: float = _Value()
-    act_v: float = _Value()
-    rel: float = _Value()  # profile time into the plan (nan without one)
+    status_mode: _Derived[StatusMode] = _Derived()
+    target: _Derived[float] = _Derived()
+    in_position: _Derived[AxisInPosition] = _Derived()  # replaced whole, never changed in place
+    # values at the current sample (floats)
+    cmd_p = _Value()
+    cmd_v = _Value()
+    cmd_a = _Value()
+    act_p = _Value()
+    act_v = _Value()
+    rel = _Value()  # profile time into the plan (nan without one)
 
     def __init__(self, number: int, bank: AxisBank, sample_rate: float, in_position: AxisInPosition,
                  plant: PlantConfig):
@@ -133,6 +146,7 @@ class Axis:
         self.owner = -1
         self.move_id = 0
         self.element_id = 0
+        self._held_feedforward = 0.0  # PTF/PVTF feedforward kept from move to move
         self.state = PlantState(0.0, 0.0, 0.0)
         self._cache: dict = {}
         self.status_mode = StatusMode.POINT_TO_POINT
@@ -245,7 +259,7 @@ class Axis:
         if t == self.state.t:
             return
         state = self.state
-        for start, end, forced in self._pieces(state.t, t, clock):
+        for _start, end, forced in self._pieces(state.t, t, clock):
             stop = min(end, t)
             state = self._advance_piece(state, forced, stop)
             if end >= t:
@@ -255,20 +269,60 @@ class Axis:
     def _advance_piece(self, state: PlantState, forced: Forced | None, t: float) -> PlantState:
         if self.mode is CommandMode.COAST:
             return self.plant.coast_to(state, t)
+        assert forced is not None  # only a coasting axis has no steady response (_pieces)
         return self.plant.advance(state, forced, t)
 
     def load(self, plan: AxisPlan, tau_start: float, t: float, clock: ProfileClock) -> None:
         """Start executing ``plan`` at profile time ``tau_start`` (time ``t``)."""
         self.rebase(t, clock)
+        self._hold_feedforward()
+        plan.start_feedforward(self._held_feedforward)
         self.plan = plan
         self.tau_start = tau_start
         self.holding = False
         self.target = plan.target
         self._bank.reset_counters(self.number)
 
+    def extend(self, plan: AxisPlan, t: float, clock: ProfileClock) -> None:
+        """The path it runs, with points appended (paths.extend): the same profile up to now,
+        so it goes on from here in the same profile time, status counters and all."""
+        self.rebase(t, clock)
+        self._hold_feedforward()
+        self.plan = plan
+        self.target = plan.target
+
+    @property
+    def feedforward(self) -> float:
+        """The PTF/PVTF feedforward (raw DAC counts) now: interpolated along the plan that has
+        one, else the value the last one left (MPI 000, MPIMotionPTF: not zeroed by other moves)."""
+        plan = self.plan
+        if plan is None:
+            return self._held_feedforward
+        return plan.feedforward_at(self.rel, self._held_feedforward)
+
+    def _hold_feedforward(self) -> None:
+        """Before the plan changes: keep the feedforward it has reached."""
+        self._held_feedforward = self.feedforward
+
+    @property
+    def current_element_id(self) -> int:
+        """The element id of the point a path runs toward (ELEMENT_ID per point), else the
+        move's."""
+        return self.element_id_at(self.rel)
+
+    def element_id_at(self, rel: float) -> int:
+        """:attr:`current_element_id` at profile time ``rel`` of the plan (nan: none)."""
+        plan = self.plan
+        if plan is not None and plan.element_ids:
+            found = plan.element_at(rel if math.isfinite(rel) else -math.inf)
+            if found is not None:
+                return found
+        return self.element_id
+
     def unload(self, t: float, clock: ProfileClock | None) -> None:
         """Drop the plan; the command rests where it is now."""
         self.rebase(t, clock)
+        self._hold_feedforward()
         self.plan = None
         self.rest = self.cmd_p
         self.target = self.rest
@@ -288,8 +342,8 @@ class Axis:
 
     def _piece_key(self, clock: ProfileClock | None):
         if self.plan is None or clock is None:
-            return (self.mode, None, self.rest)
-        return (self.mode, id(self.plan), self.tau_start, clock)
+            return (self.mode, None, self.rest, self._held_feedforward)
+        return (self.mode, id(self.plan), self.tau_start, clock, self._held_feedforward)
 
     def _boundary_times(self, key, clock: ProfileClock | None) -> list[float]:
         """All times at which the command polynomial changes (sorted)."""
@@ -310,13 +364,16 @@ class Axis:
         if cached is not None:
             return cached
         if self.plan is None or clock is None:
-            poly = [self.rest]
+            poly, dac = [self.rest], [self._held_feedforward]
         else:
             mid = ts + 0.5 * (te - ts) if math.isfinite(te) else ts + 1.0
-            seg_start, seg_poly = self.plan.segment_poly(clock.tau_at(mid) - self.tau_start)
+            rel = clock.tau_at(mid) - self.tau_start
+            seg_start, seg_poly = self.plan.segment_poly(rel)
             q0, q1, q2 = clock.local_quadratic(ts)
             poly = compose(seg_poly, (q0 - self.tau_start - seg_start, q1, q2))
-        forced = self.plant.prepare(poly)
+            ff_start, ff_poly = self.plan.feedforward_poly(rel, self._held_feedforward)
+            dac = compose(ff_poly, (q0 - self.tau_start - ff_start, q1, q2))
+        forced = self.plant.prepare(poly, dac)
         if len(self._cache) > 256:
             self._cache.clear()
         self._cache[("piece", key, ts)] = forced
@@ -335,13 +392,13 @@ class Axis:
             i += 1
         if cuts[-1] <= t_to:
             cuts.append(math.inf)
-        return [(a, b, self._forced(key, a, b, clock)) for a, b in zip(cuts[:-1], cuts[1:])]
+        return [(a, b, self._forced(key, a, b, clock)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
 
     def steady(self, clock: ProfileClock | None) -> bool:
         """At rest with the loop settled: every coming sample is the same."""
         if self.plan is not None or self.holding or self.mode is not CommandMode.SERVO:
             return False
-        return self.state.y == self.rest and self.state.dy == 0.0
+        return self.state.y == self.rest_position and self.state.dy == 0.0
 
     def trace(self, k0: int, k1: int, clock: ProfileClock | None) -> AxisTrace:
         """Samples k0+1 .. k1, computed from the current anchor (no state changes)."""
@@ -412,7 +469,7 @@ class Axis:
     def snap(self, t: float) -> None:
         """The rest the loop has reached by ``t`` (see :meth:`_settle_anchor`), for an axis
         computed in rows: PlantRows.snap_after says when."""
-        self.state = PlantState(t, self.rest, 0.0)
+        self.state = PlantState(t, self.rest_position, 0.0)
 
     # -- rows ------------------------------------------------------------------------
     def refresh(self, clock: ProfileClock | None) -> None:
@@ -470,6 +527,7 @@ class Axis:
             rows.segment[row] = -1  # chosen where the profile time is, when the controller steps
             rows.seg_lo[row], rows.seg_hi[row] = math.inf, -math.inf
         if planned:
+            assert plan is not None  # (planned: a plan and a clock)
             rows.clock[row] = self.owner
             rows.tau_start[row] = self.tau_start
             rows.target[row] = plan.target
@@ -479,12 +537,24 @@ class Axis:
         """Once the loop at rest has decayed below the quiet level, snap it exactly onto
         the command: from then on every sample is the same (the steady fast path). The
         decision depends only on the anchor and the sample time, never on batching."""
-        if anchor.y == self.rest and anchor.dy == 0.0:
+        forced = self._rest_response()
+        if anchor.y == forced.y[0] and anchor.dy == 0.0:
             return anchor
-        forced = self.plant.prepare([self.rest])
         if t - anchor.t >= self.plant.quiet_after(anchor, forced.y):
-            return PlantState(t, self.rest, 0.0)
+            return PlantState(t, forced.y[0], 0.0)
         return anchor
+
+    def _rest_response(self) -> Forced:
+        """The loop's steady response with the command at rest (and the feedforward held)."""
+        return self.plant.prepare([self.rest], [self._held_feedforward])
+
+    @property
+    def rest_position(self) -> float:
+        """Where the motor rests with the command at rest: on it, or off it by what a held
+        DAC feedforward pushes against the loop."""
+        if self._held_feedforward == 0.0:
+            return self.rest
+        return self._rest_response().y[0]
 
     # -- amplifier ---------------------------------------------------------------------
     def disable(self, t: float, clock: ProfileClock | None) -> None:

@@ -14,9 +14,10 @@ operations across axes, not Python calls per axis.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, fields
 from enum import IntEnum
-from typing import TYPE_CHECKING, Callable, Hashable, TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
@@ -25,6 +26,8 @@ from .plant import _MAX_DEGREE, Forced, Plant, PlantState, Transient, _FreeTable
 from .status import BITS, StatusRows
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
     from .frames import AxisPlan
     from .stretch import Scratch
 
@@ -32,6 +35,7 @@ VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")  # an axis' values
 _MAX_TERMS = _MAX_DEGREE + 1  # coefficients of a piece's steady response
 _AT_REST = 1 << 30  # settling counters of an axis that has long been at rest
 T = TypeVar("T")
+Rows = TypeVar("Rows", bound="DataclassInstance")
 
 
 class Kind(IntEnum):
@@ -42,7 +46,8 @@ class Kind(IntEnum):
     SAMPLED = 2  # coasting, or the command follows the actual: one axis at a time (Axis.trace)
 
 
-def _arrays(cls: type[T], count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (), **fill: float) -> T:
+def _arrays(cls: type[Rows], count: int, ints: tuple[str, ...] = (), flags: tuple[str, ...] = (),
+            **fill: float) -> Rows:
     """An instance of the row dataclass ``cls`` with every field an array of ``count``."""
     def make(name: str) -> np.ndarray:
         if name in ints:
@@ -78,7 +83,7 @@ class CommandRows:
     rest: np.ndarray
 
     @classmethod
-    def empty(cls, count: int) -> "CommandRows":
+    def empty(cls, count: int) -> CommandRows:
         return _arrays(cls, count, ints=("clock", "segment"), flags=("planned", "truncated", "linear"))
 
     def set_segment(self, row: int, plan: AxisPlan, index: int) -> None:
@@ -118,7 +123,7 @@ class PlantRows:
     snap_after: np.ndarray  # at rest: seconds past the anchor from which it snaps onto the command (Axis.commit)
 
     @classmethod
-    def empty(cls, count: int) -> "PlantRows":
+    def empty(cls, count: int) -> PlantRows:
         rows = _arrays(cls, count, ints=("terms", "k0", "table"), piece_end=math.inf, snap_after=math.inf,
                        vanishing=math.inf)
         rows.steady_y = np.zeros((count, _MAX_TERMS))
@@ -182,14 +187,14 @@ class ClockRows:
     rate: np.ndarray
 
     @classmethod
-    def empty(cls, count: int) -> "ClockRows":
+    def empty(cls, count: int) -> ClockRows:
         return _arrays(cls, count, f0=1.0, f1=1.0)
 
     def set(self, number: int, clock: ProfileClock) -> None:
         self.t0[number], self.tau0[number], self.t_end[number] = clock.t0, clock.tau0, clock.t_end
         self.f0[number], self.f1[number], self.rate[number] = clock.f0, clock.f1, clock.rate
 
-    def columns(self, numbers: np.ndarray) -> "ClockColumns":
+    def columns(self, numbers: np.ndarray) -> ClockColumns:
         """Clocks ``numbers`` as (clocks, 1) columns (kept by the bank until a clock changes)."""
         t0, tau0, f0, f1 = (a[numbers, None] for a in (self.t0, self.tau0, self.f0, self.f1))
         t_end, rate = self.t_end[numbers, None], self.rate[numbers, None]

@@ -69,7 +69,7 @@ class ProfileClock:
         return f, df
 
     # -- changes ------------------------------------------------------------------
-    def ramp_to(self, t: float, target: float, duration: float) -> "ProfileClock":
+    def ramp_to(self, t: float, target: float, duration: float) -> ProfileClock:
         """A clock that continues this one and ramps linearly to ``target`` from ``t``."""
         tau, f = self.tau_at(t), self.feedrate(t)
         if duration <= 0.0 or f == target:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -186,7 +186,9 @@ class Controller:
         return Message.MPIMessageOK
 
     def frame_count(self, number: int) -> int:
-        """Frames in an axis' buffer: the rest of the move it runs and the ones queued."""
+        """Frames in an axis' buffer: the rest of the move it runs and the ones queued. A
+        path's points beyond the buffer wait in the library (MPI 001, LOW_COUNT): the buffer
+        never shows more than it holds."""
         axis = self.axes[number]
         count = 0
         if axis.plan is not None:
@@ -196,7 +198,7 @@ class Controller:
             held = owner.current.plan_for(number) if axis.holding and owner.current is not None else None
             count += held.frame_count if held is not None else 0
             count += sum(m.frame_counts.get(number, 0) for m in owner.queue)
-        return count
+        return min(count, self.config.frame_buffer_size)
 
     def axis_snapshot(self, number: int) -> AxisSnapshot:
         """mpiAxisStatus."""
@@ -225,9 +227,10 @@ class Controller:
             trajectory_complete=bits.trajectory_complete,
             amp_enabled=axis.amp_enabled,
             move_id=axis.move_id,
-            element_id=axis.element_id,
+            element_id=axis.current_element_id,
             frame_count=self.frame_count(number),
             supervisor=axis.owner,
+            feedforward=axis.feedforward,
         )
 
     # -- gates and I/O -------------------------------------------------------------------
@@ -300,7 +303,7 @@ class Controller:
         while self.sample < end:
             self._advance(min(end, self.sample + longest))
 
-    def run_until(self, condition: Callable[["Controller"], bool], max_samples: int, chunk: int = 1) -> bool:
+    def run_until(self, condition: Callable[[Controller], bool], max_samples: int, chunk: int = 1) -> bool:
         """Step ``chunk`` samples at a time until ``condition`` holds (True) or
         ``max_samples`` have passed (False)."""
         limit = self.sample + max_samples
@@ -359,19 +362,21 @@ class Controller:
 
     def _status_events(self, stop: int, stretch: Stretch, status: StretchStatus) -> None:
         """Events for status bits that turn on in samples up to ``stop``, in sample order."""
-        found: list[tuple[int, int, int, MPIEventType, str]] = []  # sample, axis, rank, type, detail
+        found: list[tuple[int, int, int, MPIEventType, str]] = []  # stretch index, axis, rank, type, detail
         bits = status.bits[:EVENT_BITS, :, : stop + 1]
         before = self.bank.bits[:EVENT_BITS]
         # Only a bit that is on somewhere, and not on throughout after being on, can rise.
         rising = bits.any(axis=2) & ~(bits.all(axis=2) & before)
-        for rank, number in zip(*np.nonzero(rising)):
+        for rank, number in zip(*np.nonzero(rising), strict=True):
             for i in rising_edges(bool(before[rank, number]), bits[rank, number]):
-                found.append((int(stretch.samples[i]), int(number), int(rank), _EDGE_EVENTS[rank], ""))
+                found.append((int(i), int(number), int(rank), _EDGE_EVENTS[rank], ""))
         found += self._frame_time_limits(stop, stretch)
-        for sample, number, _, kind, detail in sorted(found, key=lambda e: e[:3]):
+        for i, number, _, kind, detail in sorted(found, key=lambda e: e[:3]):
             axis = self.axes[number]
+            # The element id at the event's own sample (a path's changes along the stretch).
             self.emit(kind, supervisor=axis.owner, axis=number, move_id=axis.move_id,
-                      element_id=axis.element_id, detail=detail, sample=sample)
+                      element_id=axis.element_id_at(float(stretch.rel[number, i])), detail=detail,
+                      sample=int(stretch.samples[i]))
 
     def _frame_time_limits(self, stop: int, stretch: Stretch) -> list[tuple[int, int, int, MPIEventType, str]]:
         """spec 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
@@ -382,6 +387,6 @@ class Controller:
         reached = stretch.rel[rows, : stop + 1] >= command.duration[rows, None]
         found = []
         for i in np.flatnonzero(reached.any(axis=1)).tolist():
-            found.append((int(stretch.samples[np.argmax(reached[i])]), int(rows[i]), -1, MPIEventType.FRAME_TIME_LIMIT,
+            found.append((int(np.argmax(reached[i])), int(rows[i]), -1, MPIEventType.FRAME_TIME_LIMIT,
                           "a frame reached 16,384,000 samples: the axis stopped abruptly"))
         return found

@@ -45,7 +45,7 @@ class MPIEventType(IntFlag):
     DONE = 1 << 25
 
     @classmethod
-    def parse(cls, names) -> "MPIEventType | None":
+    def parse(cls, names) -> MPIEventType | None:
         """Names (without prefix; ALL, NONE, MOTION and AXIS allowed) to a mask."""
         mask = cls.NONE
         for name in names:
@@ -60,7 +60,8 @@ class MPIEventType(IntFlag):
         return mask
 
     def names(self) -> list[str]:
-        return [m.name for m in MPIEventType if m is not MPIEventType.NONE and m in self]
+        # (a member's name is None only for a combination, which iterating the class never gives)
+        return [m.name for m in MPIEventType if m is not MPIEventType.NONE and m in self and m.name is not None]
 
 
 MASK_MOTION = (

@@ -10,21 +10,31 @@ spec 000 mpiMotionStart: "Each axis has a 128 frame buffer (FIFO)".
 from __future__ import annotations
 
 import itertools
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 
 from .events import MPIEventType
 from .params import Hold, Output, Trajectory
-from .profiles.segment import Segment, SegmentTable
+from .profiles.segment import Segment, SegmentTable, end_time
 from .types import MotionAttr, MPIMotionType
 
 _serials = itertools.count(1)
+# A point's time is a sum of its dts in floating point, off the sample grid by rounding: a
+# point counts as reached from the sample within this many seconds of its time (far below
+# one sample at any rate the controller takes).
+POINT_TIME_TOLERANCE = 1e-9
 
 
 def next_serial() -> int:
     return next(_serials)
+
+
+def reached(rel):
+    """The profile time up to which points count as reached at profile time ``rel``."""
+    return rel + POINT_TIME_TOLERANCE
 
 
 @dataclass(slots=True)
@@ -45,14 +55,32 @@ class AxisPlan:
     start_velocity: float = 0.0  # velocity (profile time) the profile starts from
     start_acceleration: float = 0.0
     composite: str = ""  # why the segments are more than one profile (e.g. stop, then a new line)
-    table: SegmentTable = field(init=False)
+    # Paths (paths.py): profile time of the first segment (executed points are flushed from
+    # a streamed path), the time each point is reached, the element id while running toward
+    # each point, outputs applied at a later point (pointIndex > 0) with their times.
+    origin_time: float = 0.0
+    point_times: np.ndarray | None = None
+    element_ids: tuple[int, ...] = ()
+    timed_outputs: list[tuple[float, Output]] = field(default_factory=list)
+    # PTF/PVTF: the feedforward's knots (profile times, values), linear between them and held
+    # after the last; the first value is NaN until the axis fills in the one it holds (the
+    # feedforward is kept from move to move: MPI 000, MPIMotionPTF).
+    feedforward: tuple[np.ndarray, np.ndarray] | None = None
     duration: float = field(init=False)
+    _table: SegmentTable | None = field(init=False, default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.segments:
             self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
-        self.table = SegmentTable(self.segments)
-        self.duration = float(self.table.end[-1])
+        self.duration = end_time(self.segments, self.origin_time)
+
+    @property
+    def table(self) -> SegmentTable:
+        """The segments as arrays. Built on first use, not with the plan: numpy on a handful of
+        segments costs more than planning them, and a modify is planned while its command waits."""
+        if self._table is None:
+            self._table = SegmentTable(self.segments, self.origin_time)
+        return self._table
 
     @property
     def is_velocity(self) -> bool:
@@ -67,6 +95,35 @@ class AxisPlan:
         """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
         done = int(np.searchsorted(self.table.end, rel, side="right"))
         return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
+
+    def points_left(self, rel: float | np.ndarray) -> int | np.ndarray:
+        """Points of a path not reached by profile time ``rel`` (0 for other plans)."""
+        if self.point_times is None:
+            return 0 if np.ndim(rel) == 0 else np.zeros(np.shape(rel), dtype=np.int64)
+        return len(self.point_times) - np.searchsorted(self.point_times, reached(rel), side="right")
+
+    def element_at(self, rel: float) -> int | None:
+        """The element id of the point a path runs toward at ``rel`` (its last one once
+        there); None without per-point ids."""
+        if not self.element_ids or self.point_times is None:
+            return None
+        i = int(np.searchsorted(self.point_times, reached(rel), side="right"))
+        return self.element_ids[min(i, len(self.element_ids) - 1)]
+
+    def start_feedforward(self, held: float) -> None:
+        """The axis loads the plan holding feedforward ``held``: its feedforward starts there."""
+        if self.feedforward is not None and math.isnan(self.feedforward[1][0]):
+            self.feedforward[1][0] = held
+
+    def feedforward_at(self, rel: float, held: float) -> float:
+        """The feedforward at profile time ``rel`` (``held`` before the plan's first point, or
+        without a feedforward of its own)."""
+        if self.feedforward is None:
+            return held
+        times, values = self.feedforward
+        if not math.isfinite(rel) or rel <= times[0]:
+            return held if math.isnan(values[0]) else float(values[0])
+        return float(np.interp(rel, times, values))
 
     def evaluate(self, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, d/dtau and d2/dtau2 of the plan at relative profile times.
@@ -93,8 +150,48 @@ class AxisPlan:
         return float(self.table.start[i]), [seg.p, seg.v, seg.a / 2.0, seg.j / 6.0]
 
     def boundaries(self) -> np.ndarray:
-        """Relative profile times at which the command polynomial changes."""
-        return self.table.end
+        """Relative profile times at which the command polynomial (or the feedforward) changes."""
+        if self.feedforward is None:
+            return self.table.end
+        return np.union1d(self.table.end, self.feedforward[0])
+
+    def feedforward_poly(self, rel: float, held: float) -> tuple[float, list[float]]:
+        """(start time, [value, slope]) of the feedforward's linear piece at ``rel``."""
+        if self.feedforward is None:
+            return 0.0, [held]
+        times, values = self.feedforward
+        i = int(np.searchsorted(times, rel, side="right"))
+        if i == 0 or i >= len(times):  # before the first knot, or held after the last
+            return 0.0, [self.feedforward_at(rel, held)]
+        slope = (values[i] - values[i - 1]) / (times[i] - times[i - 1])
+        return float(times[i - 1]), [float(values[i - 1]), float(slope)]
+
+
+@dataclass(slots=True)
+class Stream:
+    """The streaming state of an open path (MPIMotionPoint, MPIMotionPathAttrMask)."""
+
+    open: bool  # final was false: more points are expected
+    empty_count: int  # E_STOP when fewer points are left while open (<= 0: disabled)
+    low_count: int  # FRAMES_LOW below this many points while open
+    low_sent: bool = False  # FRAMES_LOW sent since the buffer was last refilled
+    empty_sent: bool = False
+    peaks: list[tuple[float, float]] = field(default_factory=list)  # per axis: max |v|, max |a|
+    # Appended points not yet executed: (serial of the append, profile time of its last point
+    # on each axis). An append is a command of its own: it ends when its points are done.
+    chunks: list[tuple[int, dict[int, float]]] = field(default_factory=list)
+
+    def append(self, chunk: Stream | None, open_: bool) -> None:
+        """Points were appended (``chunk``: theirs; None: none, the path is only closed)."""
+        self.open = open_
+        self.low_sent = self.empty_sent = False
+        if chunk is not None:
+            self.peaks = [(max(v, cv), max(a, ca)) for (v, a), (cv, ca) in zip(self.peaks, chunk.peaks, strict=True)]
+
+    def describe_peaks(self, axes: Sequence[int]) -> str:
+        parts = [f"axis {n}: |v| {v:.6g} counts/s, |a| {a:.6g} counts/s^2"
+                 for n, (v, a) in zip(axes, self.peaks, strict=True)]
+        return "path peaks " + "; ".join(parts)
 
 
 @dataclass(slots=True)
@@ -109,19 +206,29 @@ class Move:
     element_id: int = 0
     event_mask: MPIEventType = MPIEventType.NONE
     serial: int = field(default_factory=next_serial)
+    stream: Stream | None = None  # a path move: its streaming state
     # Facts the controller asks every stretch (a move's plans never change once compiled).
     is_velocity: bool = field(init=False)  # a VELOCITY move
     ends_moving: bool = field(init=False)  # FINAL_VEL: the axes go on at their final velocity
     plan_axes: tuple[int, ...] = field(init=False)  # the axes of its plans, in order
 
     def __post_init__(self) -> None:
-        self.plan_axes = tuple(plan.axis for plan in self.plans)
-        self.is_velocity = any(plan.is_velocity for plan in self.plans)
-        self.ends_moving = any(plan.final_velocity != 0.0 for plan in self.plans)
+        # one pass over the plans (a move is made for every start and modify)
+        axes, velocity, moving = [], False, False
+        for plan in self.plans:
+            axes.append(plan.axis)
+            velocity = velocity or plan.velocity_target is not None  # AxisPlan.is_velocity
+            moving = moving or plan.final_velocity != 0.0
+        self.plan_axes, self.is_velocity, self.ends_moving = tuple(axes), velocity, moving
 
     @property
     def axes(self) -> list[int]:
         return [plan.axis for plan in self.plans]
+
+    def serials(self) -> set[int]:
+        """Its serial and those of the appends to it not yet done."""
+        chunks = self.stream.chunks if self.stream is not None else ()
+        return {self.serial, *(serial for serial, _ in chunks)}
 
     def plan_for(self, axis: int) -> AxisPlan | None:
         for plan in self.plans:

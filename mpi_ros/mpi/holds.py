@@ -36,8 +36,9 @@ class HoldWait:
     greater: bool  # position triggers: True for >=, False for <=
 
     @classmethod
-    def begin(cls, plan: AxisPlan, attrs: MotionAttr, sample: int, rate: float, position_now: float) -> "HoldWait":
+    def begin(cls, plan: AxisPlan, attrs: MotionAttr, sample: int, rate: float, position_now: float) -> HoldWait:
         hold = plan.hold
+        assert hold is not None  # only a held plan waits
         deadline = sample + max(1, math.ceil(hold.timeout * rate - 1e-9)) if hold.timeout > 0.0 else None
         if MotionAttr.HOLD_GREATER in attrs:
             greater = True

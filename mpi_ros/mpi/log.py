@@ -25,7 +25,8 @@ class MotionLog:
     def full(self) -> bool:
         return self.count >= self.max_entries
 
-    def record(self, samples: np.ndarray, state: str, per_axis: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
+    def record(self, samples: np.ndarray, state: str,
+               per_axis: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
         room = self.max_entries - self.count
         if room <= 0 or len(samples) == 0:
             return
@@ -43,7 +44,7 @@ class MotionLog:
         try:
             with open(filename, "w", encoding="utf-8") as out:
                 out.write(",".join(header) + "\n")
-                for samples, state, cols in zip(self.samples, self.states, self.columns):
+                for samples, state, cols in zip(self.samples, self.states, self.columns, strict=True):
                     for i, sample in enumerate(samples):
                         values = ",".join(repr(float(x)) for x in cols[i])
                         out.write(f"{int(sample)},{state}" + (f",{values}" if values else "") + "\n")

@@ -81,7 +81,7 @@ class Message(IntEnum):
         return self is Message.MPIMessageOK
 
     @classmethod
-    def from_name(cls, name: str) -> "Message":
+    def from_name(cls, name: str) -> Message:
         return cls[name]
 
 

@@ -11,20 +11,19 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from . import validate
+from . import paths, validate
 from .axis import Axis, CommandMode
 from .clock import ProfileClock
 from .events import MPIEventType
-from .frames import Move, frames_needed
+from .frames import AxisPlan, Move, frames_needed, next_serial
 from .holds import HoldWait
 from .log import MotionLog
 from .messages import STATE_MESSAGES, Message
-from .params import MotionConfig, MotionParams, check_position
+from .params import MotionConfig, MotionParams, Output, Verdict, check_position
 from .planner import AxisStart, PlanError, compile_move
 from .snapshot import FrameBufferStatus, MotionSnapshot
 from .status import StatusMode
@@ -32,13 +31,14 @@ from .supervisor_actions import ActionsMixin
 from .supervisor_axis_list import AxisListMixin
 from .supervisor_stepping import SteppingMixin
 from .types import (
+    HOLD_ATTRS,
     STATE_SEVERITY,
     ActionSource,
+    HoldType,
+    IoSpace,
     MotionAttr,
     MPIMotionType,
     MPIState,
-    HoldType,
-    IoSpace,
     OutputType,
 )
 
@@ -69,7 +69,7 @@ class MoveEnd:
 
 
 class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
-    def __init__(self, controller: "Controller", number: int, config: MotionConfig):
+    def __init__(self, controller: Controller, number: int, config: MotionConfig):
         self._ctl = controller
         self.number = number
         self.valid = True
@@ -98,6 +98,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         self.log: MotionLog | None = None
         self.action_callback: ActionCallback | None = None
         self.move_ends: list[MoveEnd] = []  # how each move ended, in order (drained by the owner)
+        # NO_HANDSHAKE / NO_WAIT (MPI 001): the sample of a start not yet acknowledged, at
+        # which status still reads IDLE ("until the controller begins the profile execution").
+        self._unacknowledged: int | None = None
 
     @property
     def clock(self) -> ProfileClock:
@@ -216,10 +219,10 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         # an axis is in the state of the supervisor commanding it (IDLE without one)
         owners = [self._ctl.supervisor(a.owner) for a in axes]
         states = [o.own_state if o is not None else MPIState.IDLE for o in owners]
-        if not all(a.can_set_command(state) for a, state in zip(axes, states)):
+        if not all(a.can_set_command(state) for a, state in zip(axes, states, strict=True)):
             return Message.MPIAxisMessageCOMMAND_NOT_SET
         t = self._ctl.time
-        for axis, act, cmd in zip(axes, actual, command):
+        for axis, act, cmd in zip(axes, actual, command, strict=True):
             axis.set_actual_position(act, t)
             axis.set_command_position(cmd, t)
         return OK
@@ -297,22 +300,30 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
     def start(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
               params: MotionParams | None = None) -> Message:
         """mpiMotionStart (params None: the parameters stored with params_set)."""
-        message, _ = self._command(motion_type, attrs, params, modify=False)
+        message, _, _ = self.command(motion_type, attrs, params, modify=False)
         return message
 
     def modify(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
                params: MotionParams | None = None) -> Message:
         """mpiMotionModify."""
-        message, _ = self._command(motion_type, attrs, params, modify=True)
+        message, _, _ = self.command(motion_type, attrs, params, modify=True)
         return message
 
     def command(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
                 modify: bool) -> tuple[Message, str, int]:
         """Start or modify; returns (message, detail, serial of the move it made or changed)."""
+        if MotionAttr.NO_WAIT in attrs:
+            message, detail = self._command_no_wait(motion_type, attrs, params, modify)
+            return message, detail, 0  # nothing to follow: the call did not wait for the move
         message, detail = self._command(motion_type, attrs, params, modify)
+        if message.ok and attrs & (MotionAttr.NO_HANDSHAKE | MotionAttr.NO_WAIT):
+            self._unacknowledged = self._ctl.sample  # status reads IDLE until the next sample
         serial = self.current.serial if self.current is not None else 0
-        if message in (OK, Message.MPIMotionMessageAUTO_START) and attrs & MotionAttr.APPEND and self.queue:
-            serial = self.queue[-1].serial
+        if message in (OK, Message.MPIMotionMessageAUTO_START) and attrs & MotionAttr.APPEND:
+            if self.queue:
+                serial = self.queue[-1].serial
+            elif self.current is not None and self.current.stream is not None and self.current.stream.chunks:
+                serial = self.current.stream.chunks[-1][0]  # the points just appended to the open path
         return message, detail, serial
 
     def _command(self, motion_type, attrs, params, modify) -> tuple[Message, str]:
@@ -323,7 +334,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             params = self.stored_params
         if not self.axis_list:
             return Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes"
-        verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21)
+        verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21,
+                                      append=MotionAttr.APPEND in attrs)
         if not verdict.ok:
             return verdict.message, verdict.detail
         state = self._state_for(self.axis_list)
@@ -346,15 +358,15 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
         elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
             return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
-        # MPI 000, mpiMotionModify: HOLD is impossible with a modify "even when using the AUTO_START attribute"
-        verdict = validate.check_attributes(motion_type, attrs, params, modify)
+        open_path = self._open_path() if append and state is MPIState.MOVING else None
+        if open_path is not None and motion_type not in paths.STREAMED_TYPES:
+            return Message.MPIMotionMessagePATH_ERROR, ("the path in progress is open (final false): append its "
+                                                        "points, or close it with final true, first")
+        verdict = self._check_request(motion_type, attrs, params, modify, append_to=open_path is not None)
         if not verdict.ok:
             return verdict.message, verdict.detail
-        verdict = validate.check_params(
-            motion_type, attrs, params, len(self.axis_list), self._ctl.config.io_words,
-            self._ctl.config.motors, len(self._ctl.axes))
-        if not verdict.ok:
-            return verdict.message, verdict.detail
+        if open_path is not None:
+            return self._append_points(open_path, motion_type, attrs, params)
         if modify and not auto_start and MotionAttr.DELAY in attrs and any(d != 0.0 for d in params.delay):
             # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
@@ -368,6 +380,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate)
         except PlanError as exc:
             return exc.message, exc.detail
+        if move.stream is not None:
+            move.stream.low_count = self._low_count(attrs, params)
         if queued:
             message = self._check_frames(list(self.queue) + ([self.current] if self.current else []) + [move])
         else:
@@ -393,12 +407,47 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             return Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)"
         return OK, ""
 
+    def _check_request(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
+                       append_to: bool) -> Verdict:
+        """The attributes and values of a start or modify (validate.py)."""
+        # MPI 000, mpiMotionModify: HOLD is impossible with a modify "even when using the AUTO_START attribute"
+        verdict = validate.check_attributes(motion_type, attrs, params, modify)
+        if not verdict.ok:
+            return verdict
+        return validate.check_params(
+            motion_type, attrs, params, len(self.axis_list), self._ctl.config.io_words,
+            self._ctl.config.motors, len(self._ctl.axes), sample_rate=self._ctl.rate,
+            append_to=append_to, frame_buffer_size=self._ctl.config.frame_buffer_size)
+
+    def _command_no_wait(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
+                         modify: bool) -> tuple[Message, str]:
+        """MPI 001 NO_WAIT: the MPI "does NOT wait for the controller to acknowledge the commanded
+        move, does NOT wait for the controller to return an error code". What the library checks
+        itself (type, attributes, values) is still answered; whatever the controller would
+        refuse (its state, a profile it cannot load) is not: the call answers OK and a refused
+        move shows only as a missing MOTION_START, as MPI 001 warns."""
+        if not self.valid or not self.axis_list:
+            return self._command(motion_type, attrs, params, modify)
+        params = self.stored_params if params is None else params
+        verdict = validate.check_type(motion_type, modify, self._ctl.config.firmware_option_21,
+                                      append=MotionAttr.APPEND in attrs)
+        if verdict.ok:
+            append_to = (MotionAttr.APPEND in attrs and self.own_state is MPIState.MOVING
+                         and self._open_path() is not None)
+            verdict = self._check_request(motion_type, attrs, params, modify, append_to)
+        if not verdict.ok:
+            return verdict.message, verdict.detail
+        message, _ = self._command(motion_type, attrs, params, modify)
+        if message.ok:
+            self._unacknowledged = self._ctl.sample  # status reads IDLE until the next sample
+        return OK, "NO_WAIT: sent without waiting for the controller; MOTION_START shows whether the move began"
+
     def _state_for(self, numbers: list[int]) -> MPIState:
         """State as a command on ``numbers`` sees it (other supervisors' axes included)."""
         states = [self.own_state] + [other.own_state for _, other in self._held_by_others(numbers)]
         return max(states, key=STATE_SEVERITY.__getitem__)
 
-    def _held_by_others(self, numbers: list[int]) -> list[tuple[int, "MotionSupervisor"]]:
+    def _held_by_others(self, numbers: list[int]) -> list[tuple[int, MotionSupervisor]]:
         """(axis, supervisor) for each axis of ``numbers`` in another supervisor's motion."""
         held = []
         for n in numbers:
@@ -415,8 +464,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         last = self.queue[-1] if self.queue else self.current
         for n in self.axis_list:
             axis = self._axis(n)
-            if queued and last is not None and last.plan_for(n) is not None:
-                plan = last.plan_for(n)
+            plan = last.plan_for(n) if queued and last is not None else None
+            if plan is not None:
                 starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.origin))
             elif moving:
                 f = self.clock.feedrate(self._ctl.time)
@@ -431,11 +480,80 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         return starts
 
     def _check_frames(self, moves: list[Move]) -> Message:
+        """Do the moves fit the frame buffer? A path's points need not: the library holds
+        what does not fit and loads it as the buffer drains (MPI 001, LOW_COUNT)."""
         size = self._ctl.config.frame_buffer_size
+        loaded = [move for move in moves if move.stream is None]
         for n in self.axis_list:
-            if frames_needed(moves, n) > size:
+            if frames_needed(loaded, n) > size:
                 return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
         return OK
+
+    def _low_count(self, attrs: MotionAttr, params: MotionParams) -> int:
+        """MPI 001 LOW_COUNT: the given count, else a quarter of the frame buffer (32 of 128)."""
+        if MotionAttr.LOW_COUNT in attrs:
+            return params.low_count
+        return self._ctl.config.frame_buffer_size // 4
+
+    def _open_path(self) -> Move | None:
+        """The path in progress, if it is open (more points are expected)."""
+        move = self.current
+        if move is None or move.stream is None or not move.stream.open or self.queue:
+            return None
+        return move
+
+    def _append_points(self, move: Move, motion_type: MPIMotionType, attrs: MotionAttr,
+                       params: MotionParams) -> tuple[Message, str]:
+        """APPEND to an open path: the points follow its last point (or start now, if it ran
+        out of points), planned like a path of their own from there (docs/paths.md). The
+        append is recorded as a chunk of the path: a command whose outcome comes when its last
+        point is reached."""
+        stream = move.stream
+        plans = {plan.axis: plan for plan in move.plans}
+        if attrs & HOLD_ATTRS:
+            # A hold waits before a move begins; appended points continue one in progress.
+            return Message.MPIMotionMessageATTRIBUTE_INVALID, "points appended to a path in motion cannot be held"
+        if stream is None or sorted(plans) != sorted(self.axis_list):
+            return Message.MPIMessagePARAM_INVALID, "the points' axes are not the axes of the open path"
+        t = self._ctl.time
+        tau = self.clock.tau_at(t)
+        # Profile time into the path per axis (an axis still held has run none of it).
+        nows = {n: -math.inf if n in self._holds else tau - self._axis(n).tau_start for n in self.axis_list}
+        if paths.point_count(motion_type, params, len(self.axis_list)) == 0:
+            # No points: it only closes (or keeps open) the path, and is done with its last point.
+            stream.append(None, open_=not params.final)
+            stream.chunks.append((next_serial(), {n: paths.last_point_time(plans[n]) for n in self.axis_list}))
+            return OK, ""
+        starts = [AxisStart(n, *paths.end_state(plans[n], nows[n]), self._axis(n).origin) for n in self.axis_list]
+        try:
+            chunk, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate)
+        except PlanError as exc:
+            return exc.message, exc.detail
+        for kind, detail in notes.events:
+            self._emit(kind, detail=detail, move=move)
+        self._rebase(t)
+        ends = {new.axis: self._extend_plan(move, plans[new.axis], new, nows[new.axis], t) for new in chunk.plans}
+        stream.append(chunk.stream, open_=not params.final)
+        if MotionAttr.LOW_COUNT in attrs:
+            stream.low_count = params.low_count
+        stream.chunks.append((chunk.serial, ends))
+        return OK, ""
+
+    def _extend_plan(self, move: Move, old: AxisPlan, new: AxisPlan, now: float, t: float) -> float:
+        """Put ``new``'s points after ``old``'s on its axis; returns when its last one is reached."""
+        outputs = [(0.0, out) for out in new.outputs] + new.timed_outputs
+        axis = self._axis(new.axis)
+        values = new.feedforward[1][1:] if new.feedforward is not None else None
+        assert new.point_times is not None  # the plan of a path (paths.compile_path)
+        extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target,
+                                values, axis.feedforward)
+        move.plans[move.plans.index(old)] = extended
+        wait = self._holds.get(new.axis)
+        if wait is not None:
+            wait.plan = extended  # still held: the path begins, whole, when the hold releases
+        else:
+            axis.extend(extended, t, self.clock)
+        return paths.last_point_time(extended)
 
     def _rebase(self, t: float) -> None:
         for axis in self.axes:
@@ -443,8 +561,17 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 axis.rebase(t, self.clock)
 
     def _end_move(self, move: Move, message: Message, detail: str) -> None:
+        """Record how ``move`` ended (with the appends to it still pending)."""
+        if move.stream is not None:
+            detail = f"{detail}; {move.stream.describe_peaks(move.plan_axes)}"
+            for serial, _ in move.stream.chunks:
+                self._end_serial(serial, message, detail)
+            move.stream.chunks.clear()
+        self._end_serial(move.serial, message, detail)
+
+    def _end_serial(self, serial: int, message: Message, detail: str) -> None:
         axes = [self._axis(n) for n in self.mapped]
-        self.move_ends.append(MoveEnd(move.serial, message, self._ctl.sample, detail,
+        self.move_ends.append(MoveEnd(serial, message, self._ctl.sample, detail,
                                       tuple(a.command_position for a in axes),
                                       tuple(a.actual_position for a in axes)))
 
@@ -492,6 +619,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             move.serial = previous.serial
             if not MotionAttr.ID & move.attributes:
                 move.id = previous.id
+            if previous.stream is not None:  # points appended to the path are replaced too
+                for serial, _ in previous.stream.chunks:
+                    self._end_serial(serial, Message.MPIMotionMessageSTOPPED, "replaced by a modify")
         self._load(move, announce=False)
 
     def _load(self, move: Move, announce: bool = True) -> None:
@@ -534,15 +664,19 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
 
     def _fire_outputs(self, plan) -> None:
         for output in plan.outputs:
-            if output.type is OutputType.MOTOR:
-                self._ctl.io.apply_masks(IoSpace.MOTOR_GENERAL_IO, output.motor, output.on_mask, output.off_mask)
-            elif output.type is OutputType.OUTPUT:
-                self._ctl.io.apply_masks(IoSpace.IO, output.address, output.on_mask, output.off_mask)
+            self._fire_output(output)
+
+    def _fire_output(self, output: Output) -> None:
+        if output.type is OutputType.MOTOR:
+            self._ctl.io.apply_masks(IoSpace.MOTOR_GENERAL_IO, output.motor, output.on_mask, output.off_mask)
+        elif output.type is OutputType.OUTPUT:
+            self._ctl.io.apply_masks(IoSpace.IO, output.address, output.on_mask, output.off_mask)
 
     # ================================================================= status ====
     def _at_velocity_reached(self) -> None:
         """The velocity move is at velocity (the controller is at that sample): the event,
         and the outcome a goal on this move waits for."""
+        assert self.current is not None  # scan found the current move at its velocity
         self._at_velocity_sent = True
         self._emit(MPIEventType.MOTION_AT_VELOCITY)
         self._end_move(self.current, OK, "at velocity")
@@ -555,14 +689,14 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         return MotionSnapshot(
             sample=self._ctl.sample,
             number=self.number,
-            state=self.state,
+            state=self._reported_state(),
             axis_numbers=tuple(self.mapped),
             axes=axes,
             done=done and self.own_state is not MPIState.MOVING,
             at_target=all(a.at_target for a in axes) if axes else True,
             settled=all(a.settled for a in axes) if axes else True,
             move_id=move.id if move else 0,
-            element_id=move.element_id if move else 0,
+            element_id=self._element_id(move),
             feedrate=self.clock.feedrate(self._ctl.time),
             last_action=self.last_action,
             action_source=self.action_source.value,
@@ -571,6 +705,15 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             progress=self.progress(),
             latched_events=tuple(self.latched.names()),
         )
+
+    def _reported_state(self) -> MPIState:
+        """The state status reports: IDLE at the sample of a start given NO_HANDSHAKE or
+        NO_WAIT (MPI 001 remarks: "the state is reported as MPIStateIDLE until the controller
+        begins the profile execution"), the state otherwise."""
+        state = self.state
+        if self._unacknowledged == self._ctl.sample and state is MPIState.MOVING:
+            return MPIState.IDLE
+        return state
 
     def progress(self) -> float:
         """0..1 along the current move (profile time over its duration)."""
@@ -588,11 +731,27 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 fractions.append(1.0 if plan.duration <= 0.0 else min(1.0, max(0.0, axis.rel / plan.duration)))
         return min(fractions) if fractions else 0.0
 
+    @property
+    def element_id(self) -> int:
+        """The element id status shows: the current (else last) move's; a path's, of the
+        point it runs toward."""
+        return self._element_id(self.current or self.last_move)
+
+    def _element_id(self, move: Move | None) -> int:
+        """The move's element id; a path's, of the point its first axis runs toward."""
+        if move is None:
+            return 0
+        if move.stream is not None and move.plans:
+            axis = self._axis(move.plans[0].axis)
+            if axis.plan is move.plans[0]:
+                return axis.current_element_id
+        return move.element_id
+
     # ================================================================= events ====
     def _emit(self, kind: MPIEventType, axis: int = -1, move: Move | None = None, detail: str = "",
               sample: int | None = None) -> None:
         move = move or self.current
         self._ctl.emit(kind, supervisor=self.number, axis=axis,
-                       move_id=move.id if move else 0, element_id=move.element_id if move else 0,
+                       move_id=move.id if move else 0, element_id=self._element_id(move),
                        detail=detail, extra_mask=move.event_mask if move else MPIEventType.NONE,
                        sample=sample)

@@ -14,8 +14,9 @@ from __future__ import annotations
 import copy
 import math
 import numbers
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Iterable
+from typing import TypeGuard
 
 from .events import MASK_ALL, MPIEventType
 from .messages import Message
@@ -65,7 +66,7 @@ class Verdict:
     def ok(self) -> bool:
         return self.message is Message.MPIMessageOK
 
-    def prefixed(self, prefix: str) -> "Verdict":
+    def prefixed(self, prefix: str) -> Verdict:
         """The same verdict with ``prefix`` before the field it names (for nested structs)."""
         return self if self.ok else Verdict(self.message, prefix + self.detail)
 
@@ -82,7 +83,8 @@ def first_refusal(verdicts: Iterable[Verdict]) -> Verdict:
     return next((v for v in verdicts if not v.ok), VALID)
 
 
-def _finite_number(value: object) -> bool:
+def _finite_number(value: object) -> TypeGuard[float]:
+    """A finite real number (bool excluded): int, float, numpy's, ..."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         return False
     try:
@@ -100,7 +102,7 @@ def check_range(name: str, value: object, low: float, high: float, above_low: bo
 
 
 def check_integer(name: str, value: object, low: int, high: int) -> Verdict:
-    if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= value <= high:
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= int(value) <= high:
         return VALID
     return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {value!r}")
 
@@ -251,8 +253,12 @@ class MotionParams:
     slave_position: list[float] = field(default_factory=list)
     gear_ratio: list[float] = field(default_factory=list)
     frames: list[UserFrame] = field(default_factory=list)
+    # MPIMotionPathAttributes (MPI 001), each read only with its attribute.
+    behavior: int = 0  # BEHAVIOR
+    low_count: int = 0  # LOW_COUNT: FRAMES_LOW below this many points
+    expected_axes: int = 0  # EXPECTED_AXES: must equal the mapped axes
 
-    def copy(self) -> "MotionParams":
+    def copy(self) -> MotionParams:
         return copy.deepcopy(self)
 
     @property
@@ -282,7 +288,10 @@ class MotionParams:
              check_long("empty_count", self.empty_count),  # any value: <= 0 disables (empty_count_disabled)
              check_long("id", self.id),
              check_long("master_start", self.master_start),
-             check_long("repeat_from", self.repeat_from)),
+             check_long("repeat_from", self.repeat_from),
+             check_long("behavior", self.behavior),
+             check_long("low_count", self.low_count),
+             check_long("expected_axes", self.expected_axes)),
             _each("element_id", self.element_id, check_long),
         ]
         if uses(MotionAttr.DELAY):
@@ -339,7 +348,7 @@ class MotionConfig:
     def axis_count(self) -> int:
         return len(self.axis_numbers)
 
-    def copy(self) -> "MotionConfig":
+    def copy(self) -> MotionConfig:
         return copy.deepcopy(self)
 
     def validate(self) -> Verdict:
@@ -380,7 +389,7 @@ class AxisInPosition:
     settle_on_estop: bool = False
     settle_on_estop_cmd_eq_act: bool = False
 
-    def copy(self) -> "AxisInPosition":
+    def copy(self) -> AxisInPosition:
         return copy.deepcopy(self)
 
     def validate(self) -> Verdict:
@@ -409,6 +418,9 @@ class PlantConfig:
     acceleration_feedforward: float = 0.0
     encoder_resolution: float = 1.0
     coast_time_constant: float = 0.2
+    # The motor's acceleration per DAC count of PTF/PVTF feedforward (counts/s^2 per count):
+    # a full-scale 32,767 gives about 1e6 counts/s^2 by default.
+    dac_acceleration: float = 30.0
 
     def validate(self) -> Verdict:
         return first_refusal((
@@ -418,6 +430,7 @@ class PlantConfig:
             check_magnitude("acceleration_feedforward", self.acceleration_feedforward, FEEDFORWARD_MAX),
             self._encoder_resolution(),
             check_duration("coast_time_constant", self.coast_time_constant, positive=True),
+            check_magnitude("dac_acceleration", self.dac_acceleration, MAX_ACCELERATION),
         ))
 
     def _encoder_resolution(self) -> Verdict:

@@ -20,19 +20,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from operator import attrgetter
 
 from .events import MPIEventType
-from .frames import AxisPlan, Move
+from .frames import AxisPlan, Move, Stream
 from .messages import Message
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, MotionParams, Trajectory
+from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import point_to_point, reverses, velocity_move
 from .profiles.ramps import ProfileError, ramps_between
 from .profiles.scurve import reshape
-from .profiles.segment import Segment, chain
-from .types import MotionAttr, MPIMotionType
+from .profiles.segment import Segment, chain, scaled_profile, segment_values
+from .types import HOLD_ATTRS, MotionAttr, MPIMotionType
 
 A = MotionAttr
+# The attributes planning tests, as plain ints: IntFlag's `in` and `&` run Python code (0.2 to
+# 1 us each, a dozen per move), an int's & does not.
+_RELATIVE, _FINAL_VEL, _NO_REVERSAL, _DELAY, _OUTPUT, _ID, _ELEMENT_ID, _EVENT = map(
+    int, (A.RELATIVE, A.FINAL_VEL, A.NO_REVERSAL, A.DELAY, A.OUTPUT, A.ID, A.ELEMENT_ID, A.EVENT))
+_SYNC, _HOLDS = int(A.SYNC_START | A.SYNC_END), int(HOLD_ATTRS)
+_duration_of = attrgetter("duration")
 
 
 class PlanError(Exception):
@@ -73,8 +81,9 @@ def _truncate_id(value: int, notes: PlanNotes) -> int:
 def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
     """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
     targets = []
-    for start, value in zip(starts, params.position):
-        if A.RELATIVE in attrs:
+    relative = int(attrs) & _RELATIVE
+    for start, value in zip(starts, params.position, strict=True):
+        if relative:
             distance = float(math.trunc(value))
             if distance != value:
                 notes.events.append(
@@ -89,8 +98,9 @@ def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], n
 
 def _check_finite(segments: list[Segment], axis: int) -> None:
     """A profile that overflowed (absurd distances or limits) cannot be calculated."""
-    for seg in segments:
-        if not (seg.duration >= 0.0 and all(map(math.isfinite, (seg.duration, seg.p, seg.v, seg.a, seg.j)))):
+    for d, p, v, a, j in map(segment_values, segments):
+        # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
+        if not (d >= 0.0 and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
             raise ProfileError(f"axis {axis}: the profile cannot be calculated with these values (overflow)")
 
 
@@ -99,8 +109,12 @@ def _check_lands(segments: list[Segment], start: AxisStart, target: float) -> No
     trajectory completes, which must never be a jump (guards against overflow and any
     planning fault). Rounding grows with the positions and the distance travelled."""
     end = segments[-1].end_state()[0] if segments else start.position
-    travel = sum(max(abs(s.v), abs(s.end_state()[1])) * s.duration for s in segments)
-    scale = max(1.0, abs(target), abs(start.position), travel)
+    scale = max(1.0, abs(target), abs(start.position))
+    if math.isfinite(end) and abs(end - target) <= 1e-9 * scale:
+        return  # on target without the travel, which can only widen the tolerance
+    # each segment's end velocity as Segment.state_at computes it, without a call per segment
+    travel = sum([max(abs(v), abs(v + t * (a + t * j / 2.0))) * t for t, _, v, a, j in map(segment_values, segments)])
+    scale = max(scale, travel)
     if not math.isfinite(end) or abs(end - target) > 1e-9 * scale:
         raise ProfileError(f"axis {start.axis}: the profile cannot be calculated with these values")
 
@@ -109,6 +123,8 @@ def _cap_frames(segments: list[Segment], sample_rate: float, axis: int, notes: P
     """Cut the plan at the first frame longer than 16,384,000 samples."""
     _check_finite(segments, axis)
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
+    if not segments or max(map(_duration_of, segments)) <= limit:  # (finite: checked) the usual case
+        return segments, False
     for i, seg in enumerate(segments):
         if seg.duration > limit:
             notes.events.append(
@@ -144,14 +160,26 @@ def _scaled(traj: Trajectory, share: float) -> Trajectory:
 
 
 def _dot(a, b) -> float:
-    return math.fsum(x * y for x, y in zip(a, b))
+    """The exactly rounded dot product (math.fsum of the products)."""
+    if len(a) == 2:
+        # Two products: their sum is already exactly rounded, as fsum's is. fsum answers +0.0 for
+        # a zero sum (hence + 0.0) and raises for inf - inf or an overflow (hence fsum there).
+        total = a[0] * b[0] + a[1] * b[1]
+        if math.isfinite(total):
+            return total + 0.0
+    return math.fsum([x * y for x, y in zip(a, b, strict=True)])
 
 
 def _along(vector, unit, scale: float) -> tuple[float, bool]:
     """The component of ``vector`` along ``unit``, and whether ``vector`` lies on that line."""
+    if not any(vector):  # at rest (or no final velocity): what the calculation gives, without it
+        return 0.0, True
     along = _dot(vector, unit)
     tolerance = 1e-9 * (1.0 + scale)
-    return along, all(abs(x - along * u) <= tolerance + 1e-9 * abs(x) for x, u in zip(vector, unit))
+    for x, u in zip(vector, unit, strict=True):
+        if not abs(x - along * u) <= tolerance + 1e-9 * abs(x):
+            return along, False
+    return along, True
 
 
 def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[list[Segment]], list[Trajectory], str]:
@@ -161,7 +189,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
     most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
     p0 = [s.position for s in starts]
     v0 = [s.velocity for s in starts]
-    delta = [t - p for t, p in zip(targets, p0)]
+    delta = [t - p for t, p in zip(targets, p0, strict=True)]
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
     if not (math.isfinite(length) and math.isfinite(speed)):
@@ -178,9 +206,10 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
         raise PlanError(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
-    accel = _dot([s.acceleration for s in starts], unit)
+    accels = [s.acceleration for s in starts]
+    accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
     line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, accel), length, final_along, traj)
-    profiles = [[seg.scaled(u, p) for seg in line] for u, p in zip(unit, p0)]
+    profiles = [scaled_profile(line, u, p) for u, p in zip(unit, p0, strict=True)]
     return profiles, [_scaled(traj, abs(u)) for u in unit], ""
 
 
@@ -195,11 +224,11 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     heading = [v / speed for v in v0]
     stop = _stop_profile(motion_type, speed, traj)
     stopped_after = stop[-1].end_state()[0] if stop else 0.0
-    rest = [p + h * stopped_after for p, h in zip(p0, heading)]
-    go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest)]
+    rest = [p + h * stopped_after for p, h in zip(p0, heading, strict=True)]
+    go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest, strict=True)]
     go, limits, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
-    profiles = [[seg.scaled(h, p) for seg in stop] + tail for h, p, tail in zip(heading, p0, go)]
-    limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits)]
+    profiles = [scaled_profile(stop, h, p) + tail for h, p, tail in zip(heading, p0, go, strict=True)]
+    limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits, strict=True)]
     return profiles, limits, STOP_THEN_LINE
 
 
@@ -215,7 +244,7 @@ def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[
     durations = [sum(s.duration for s in prof) for prof in profiles]
     longest = max(durations, default=0.0)
     out = []
-    for prof, start, target, duration in zip(profiles, starts, targets, durations):
+    for prof, start, target, duration in zip(profiles, starts, targets, durations, strict=True):
         pad = longest - duration
         if A.SYNC_END in attrs and start.velocity == 0.0:
             prof = _wait(start.position, pad) + prof
@@ -243,12 +272,15 @@ def compile_move(
     """
     notes = PlanNotes()
     moving = any(s.velocity != 0.0 for s in starts)
-    if A.DELAY in attrs and moving and any(d != 0.0 for d in params.delay):
+    if int(attrs) & _DELAY and moving and any(d != 0.0 for d in params.delay):
         raise PlanError(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
-    if attrs & (A.HOLD | A.HOLD_LESS | A.HOLD_GREATER) and moving:
+    if int(attrs) & _HOLDS and moving:
         raise PlanError(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
+    stream = None
     try:
-        if motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
+        if motion_type in STREAMED_TYPES:
+            plans, stream = _path_plans(motion_type, params, attrs, starts)
+        elif motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
             plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
@@ -259,27 +291,44 @@ def compile_move(
         type=motion_type,
         attributes=attrs,
         plans=plans,
-        id=_truncate_id(params.id, notes) if A.ID in attrs else 0,
-        element_id=int(params.element_id[0]) if A.ELEMENT_ID in attrs and params.element_id else 0,
-        event_mask=params.event_mask if A.EVENT in attrs else MPIEventType.NONE,
+        id=_truncate_id(params.id, notes) if int(attrs) & _ID else 0,
+        element_id=int(params.element_id[0]) if int(attrs) & _ELEMENT_ID and params.element_id else 0,
+        event_mask=params.event_mask if int(attrs) & _EVENT else MPIEventType.NONE,
+        stream=stream,
     )
     return move, notes
 
 
+def path_starts(starts: list[AxisStart]) -> list[PathStart]:
+    return [PathStart(s.axis, s.position, s.velocity, s.origin) for s in starts]
+
+
+def _path_plans(motion_type, params, attrs, starts) -> tuple[list[AxisPlan], Stream]:
+    """A path's plans (paths.py) and its streaming state; the frame buffer's low count is
+    the supervisor's to set (it knows the buffer's size)."""
+    relative = bool(attrs & (A.RELATIVE | A.RELATIVE_MOVE))
+    plans, peaks = compile_path(motion_type, attrs, params, path_starts(starts), relative)
+    for plan in plans:
+        _check_finite(plan.segments, plan.axis)
+    return plans, Stream(open=not params.final, empty_count=params.empty_count, low_count=0, peaks=peaks)
+
+
 def _holds_and_outputs(params: MotionParams, attrs: MotionAttr, index: int):
-    hold = params.hold[index] if attrs & (A.HOLD | A.HOLD_LESS | A.HOLD_GREATER) else None
-    outputs = list(params.output) if A.OUTPUT in attrs and index == 0 else []
+    bits = int(attrs)
+    hold = params.hold[index] if bits & _HOLDS else None
+    outputs = list(params.output) if bits & _OUTPUT and index == 0 else []
     return hold, outputs
 
 
 def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
+    bits = int(attrs)
     targets = _targets(params, attrs, starts, notes)
-    finals = list(params.final_velocity) if A.FINAL_VEL in attrs else [0.0] * len(starts)
+    finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
-    if attrs & (A.SYNC_START | A.SYNC_END):
+    if bits & _SYNC:
         profiles = [
             _scalar_profile(motion_type, start, target, final, traj)
-            for start, target, final, traj in zip(starts, targets, finals, params.trajectory)
+            for start, target, final, traj in zip(starts, targets, finals, params.trajectory, strict=True)
         ]
         profiles = _sync(profiles, starts, targets, attrs)
         limits = list(params.trajectory)
@@ -289,19 +338,18 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     else:
         profiles, limits, composite = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
     plans = []
-    for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles)):
-        if A.NO_REVERSAL in attrs and reverses(prof, start.velocity):
+    for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
+        if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise PlanError(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
-        if A.DELAY in attrs:
+        if bits & _DELAY:
             prof = _wait(start.position, params.delay[i]) + prof
         _check_lands(prof, start, target)
         prof, truncated = _cap_frames(prof, sample_rate, start.axis, notes)
-        end = prof[-1].end_state() if prof else (target, final, 0.0)
         hold, outputs = _holds_and_outputs(params, attrs, i)
         plans.append(AxisPlan(
             axis=start.axis, segments=prof, start_position=start.position,
-            target=end[0] if truncated else target,
+            target=prof[-1].end_state()[0] if truncated else target,  # truncated: where the cut plan ends
             final_velocity=0.0 if truncated else final,
             hold=hold, outputs=outputs, truncated=truncated,
             limits=limits[i], start_velocity=start.velocity, start_acceleration=start.acceleration,
@@ -314,7 +362,7 @@ def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> l
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     trajs = params.trajectory if len(params.trajectory) == len(starts) else params.trajectory * len(starts)
     plans = []
-    for i, (start, traj) in enumerate(zip(starts, trajs)):
+    for i, (start, traj) in enumerate(zip(starts, trajs, strict=True)):
         delay = params.delay[i] if A.DELAY in attrs else 0.0
         cruise = limit if traj.velocity != 0.0 else 0.0
         if motion_type is MPIMotionType.VELOCITY_JERK:

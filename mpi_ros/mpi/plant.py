@@ -63,7 +63,7 @@ class Transient:
     m0: float  # M v
     m1: float
     decayed_after: float  # seconds past the anchor from which it is dropped (inf: never)
-    table: "_FreeTable"
+    table: _FreeTable
 
     def at(self, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Its position and velocity parts at whole ``samples``."""
@@ -88,6 +88,9 @@ class Plant:
             num=(w * w, 2.0 * z * w * config.velocity_feedforward, config.acceleration_feedforward),
             den=(w * w, 2.0 * z * w, 1.0),
         )
+        # A DAC feedforward d drives the motor directly: y'' + c y' + w^2 y = ... + K d, whose
+        # steady response to a polynomial d has the gains of K / (w^2 + c s + s^2).
+        self._dac_gains = self._taylor(num=(config.dac_acceleration,), den=(w * w, 2.0 * z * w, 1.0))
         self._resolution = config.encoder_resolution
         self._coast = config.coast_time_constant
         # M^2 = kappa I (Cayley-Hamilton: A's eigenvalues are sigma +- i q, sigma +- q, or sigma twice)
@@ -115,9 +118,13 @@ class Plant:
     # -- servo on ----------------------------------------------------------------
     def particular(self, u: list[float]) -> list[float]:
         """Polynomial particular solution for a polynomial input (coefficients, low first)."""
+        return self._particular(u, self._gains)
+
+    @staticmethod
+    def _particular(u: list[float], gains: np.ndarray) -> list[float]:
         out = [0.0] * len(u)
         deriv = list(u)
-        for g in self._gains[: len(u)]:
+        for g in gains[: len(u)]:
             for i, c in enumerate(deriv):
                 out[i] += g * c
             deriv = poly_der(deriv)
@@ -142,7 +149,7 @@ class Plant:
         m0, m1 = self._apply_m(e0, e1)
         return p * e0 + q * m0, p * e1 + q * m1
 
-    def table(self, rate: float) -> "_FreeTable":
+    def table(self, rate: float) -> _FreeTable:
         """The free response of this loop at whole samples of ``rate`` (shared by identical loops)."""
         key = (self.config.bandwidth_hz, self.config.damping, self._coast, rate)
         table = _TABLES.get(key)
@@ -150,12 +157,15 @@ class Plant:
             table = _TABLES[key] = _FreeTable.build(self, rate)
         return table
 
-    def prepare(self, u: list[float]) -> "Forced":
-        """The loop's steady response to a polynomial input (reusable for a piece)."""
+    def prepare(self, u: list[float], dac: list[float] | None = None) -> Forced:
+        """The loop's steady response to a polynomial command ``u`` and DAC feedforward
+        ``dac`` (PTF/PVTF; None or zero: none), reusable for a piece."""
         yp = self.particular(u)
+        if dac is not None and any(dac):
+            yp = _poly_add(yp, self._particular(dac, self._dac_gains))
         return Forced(yp, poly_der(yp))
 
-    def transient(self, state: PlantState, forced: "Forced", rate: float) -> "Transient | None":
+    def transient(self, state: PlantState, forced: Forced, rate: float) -> Transient | None:
         """The decaying part of the response of a piece anchored at ``state``, reduced to
         what every whole sample needs (None: below the quiet level from the anchor on).
         The one place the anchor's free state is computed, for one axis and for rows of
@@ -177,7 +187,7 @@ class Plant:
         decayed = self._settle_after(size) if len(forced.y) == 1 else math.inf
         return Transient(k0, v0, v1, m0, m1, decayed, self.table(rate))
 
-    def response(self, state: PlantState, forced: "Forced", samples: np.ndarray,
+    def response(self, state: PlantState, forced: Forced, samples: np.ndarray,
                  rate: float) -> tuple[np.ndarray, np.ndarray]:
         """Position and velocity at whole ``samples`` (at ``rate``) from ``state``."""
         s = samples / rate - state.t
@@ -203,7 +213,7 @@ class Plant:
         size = abs(state.y - yp[0]) + abs(state.dy - dyp0) / (-self._sigma)
         return self._settle_after(size)
 
-    def advance(self, state: PlantState, forced: "Forced", t: float) -> PlantState:
+    def advance(self, state: PlantState, forced: Forced, t: float) -> PlantState:
         """State at time ``t`` (within the piece that starts at ``state.t``); scalar math."""
         s = t - state.t
         y = _poly_eval_scalar(forced.y, s)
@@ -247,7 +257,7 @@ def _first_sample(t: float, rate: float) -> int:
     return k
 
 
-_TABLES: dict[tuple[float, float, float, float], "_FreeTable"] = {}  # shared by identical loops
+_TABLES: dict[tuple[float, float, float, float], _FreeTable] = {}  # shared by identical loops
 _TABLE = 4096  # samples of free response tabulated; further ones are products of two
 _BLOCKS_WATCHED = 64  # blocks of _TABLE samples searched for an exact underflow (about 2 min at 2 kHz)
 
@@ -273,7 +283,7 @@ class _FreeTable:
         self._vanishing: float | None = None
 
     @classmethod
-    def build(cls, plant: "Plant", rate: float) -> "_FreeTable":
+    def build(cls, plant: Plant, rate: float) -> _FreeTable:
         pq = [plant._free(m / rate) for m in range(_TABLE + 1)]
         p = np.array([x for x, _ in pq])
         q = np.array([y for _, y in pq])
@@ -398,6 +408,12 @@ def _poly_mul(a: list[float], b: list[float]) -> list[float]:
         for j, y in enumerate(b):
             out[i + j] += x * y
     return out
+
+
+def _poly_add(a: list[float], b: list[float]) -> list[float]:
+    """a + b (coefficients, low first)."""
+    longer, shorter = (a, b) if len(a) >= len(b) else (b, a)
+    return [x + (shorter[i] if i < len(shorter) else 0.0) for i, x in enumerate(longer)]
 
 
 def compose(segment_poly: list[float], quadratic: tuple[float, float, float]) -> list[float]:

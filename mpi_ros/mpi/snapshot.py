@@ -32,6 +32,7 @@ class AxisSnapshot:
     element_id: int
     frame_count: int
     supervisor: int
+    feedforward: float = 0.0  # PTF/PVTF feedforward (raw DAC counts)
 
 
 @dataclass(frozen=True, slots=True)

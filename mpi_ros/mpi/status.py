@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 from enum import Enum
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -76,7 +76,7 @@ FINE_RUN, SETTLED_RUN, VELOCITY_RUN = range(3)
 
 def bits_of(column: np.ndarray) -> AxisStatusBits:
     """The bits of one axis from a column of an array in :data:`BITS` order."""
-    return AxisStatusBits(**dict(zip(BITS, (bool(b) for b in column))))
+    return AxisStatusBits(**dict(zip(BITS, (bool(b) for b in column), strict=True)))
 
 
 def column_of(bits: AxisStatusBits) -> list[bool]:
@@ -110,7 +110,7 @@ class Runs:
     mixed_runs: np.ndarray  # (len(mixed), samples)
 
     @classmethod
-    def never(cls, count: int) -> "Runs":
+    def never(cls, count: int) -> Runs:
         return cls(np.zeros(count, dtype=np.int64), np.zeros(count, dtype=bool), _NONE, _NONE)
 
     def at(self, index: int) -> np.ndarray:
@@ -128,7 +128,9 @@ def settle(criterion: np.ndarray | None, carry: np.ndarray, need: np.ndarray, ou
         out[...] = False
         return Runs.never(len(carry))
     n = criterion.shape[1]
-    every = criterion.all(axis=1)
+    # criterion is 2-D, so this is an array; numpy's stubs cannot tell it from a 1-D array's
+    # scalar (np.bool | NDArray[np.bool])
+    every: np.ndarray = criterion.all(axis=1)  # type: ignore[assignment]
     # A row that holds throughout has run carry + i + 1 at sample i: on from i = need - 1 - carry.
     first = np.where(every, need - 1 - carry, n)
     np.greater_equal(np.arange(n), first[:, None], out=out)
@@ -168,10 +170,11 @@ class StatusRows:
     _any: dict[str, bool] = field(default_factory=dict)  # has any row the flag? (until a row changes)
 
     @classmethod
-    def empty(cls, count: int) -> "StatusRows":
+    def empty(cls, count: int) -> StatusRows:
         names = [f.name for f in fields(cls) if f.name not in ("col", "_any")]
-        rows = cls(**{name: np.zeros(count, dtype=bool if name in _FLAGS else
-                                     (np.int64 if name == "need" else float)) for name in names})
+        arrays: dict[str, Any] = {name: np.zeros(count, dtype=bool if name in _FLAGS else
+                                                 (np.int64 if name == "need" else float)) for name in names}
+        rows = cls(**arrays)
         rows.col = {name: getattr(rows, name)[:, None] for name in names}
         return rows
 
@@ -214,7 +217,7 @@ class StretchStatus:
     (b in :data:`BITS` order), and the settling runs to carry on from any sample."""
 
     bits: np.ndarray
-    runs: tuple["Runs | _PickedRuns", Runs, Runs]  # FINE_RUN, SETTLED_RUN, VELOCITY_RUN
+    runs: tuple[Runs | _PickedRuns, Runs, Runs]  # FINE_RUN, SETTLED_RUN, VELOCITY_RUN
     _ever: dict[int, list[bool]] = field(default_factory=dict)
 
     def ever(self, bit: int) -> list[bool]:
@@ -226,7 +229,7 @@ class StretchStatus:
 
     def counters_at(self, index: int, out: np.ndarray) -> None:
         """``out`` = the (3, axes) settling counters at stretch sample ``index``."""
-        for row, runs in zip(out, self.runs):
+        for row, runs in zip(out, self.runs, strict=True):
             row[:] = runs.at(index)
 
 
@@ -266,11 +269,12 @@ def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scr
         at_rest &= velocity_ok
         at_rest &= ~col["abort"]
     settled_runs = settle(at_rest, counters[SETTLED_RUN], rows.need, bits[SETTLED])
-    fine_runs = _in_position(trace, rows, tc, complete, velocity_ok, counters, bits, work)
+    in_position_runs = _in_position(trace, rows, tc, complete, velocity_ok, counters, bits, work)
+    fine_runs: Runs | _PickedRuns = in_position_runs
     if rows.any("settle_on"):
         # After a stop with settling on, IN_FINE is the note-1 criterion.
         np.copyto(bits[IN_FINE], bits[SETTLED], where=rows.col["settle_on"])
-        fine_runs = _PickedRuns(rows.settle_on, settled_runs, fine_runs)
+        fine_runs = _PickedRuns(rows.settle_on, settled_runs, in_position_runs)
     velocity_runs = _at_velocity(trace, rows, tc, velocity_ok, counters, bits, work)
     # AT_TARGET: "TRUE when command = target" (002's table), at rest there; an axis of a
     # SYNC_START move that arrives early is at its target while the others still move.
@@ -302,13 +306,13 @@ def _in_position(trace: Stretch, rows: StatusRows, tc: np.ndarray, complete: boo
     coarse_possible = complete or rows.any("point_to_point")
     distance = work.absolute_difference(col["target"], trace.act_p) if coarse_possible else None
     fine = None
-    if complete:
+    if complete and distance is not None:  # (complete: coarse is possible, there is a distance)
         fine = np.less(distance, col["fine"], out=work.flag("fine"))
         fine &= tc
         fine &= velocity_ok
         fine &= col["moving"]
     runs = settle(fine, counters[FINE_RUN], rows.need, bits[IN_FINE])
-    if coarse_possible:
+    if distance is not None:  # coarse_possible
         coarse = np.less(distance, col["coarse"], out=bits[IN_COARSE])
         coarse &= col["moving"]
         coarse &= np.logical_or(tc, ~col["velocity"], out=work.flag("complete_or_not_velocity"))

@@ -17,8 +17,8 @@ The arrays live in a :class:`Scratch` and are reused by the next stretch.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from .axis import Axis
 from .bank import VALUES, AxisBank, ClockColumns, CommandRows, Kind, PlantRows
 from .clock import ProfileClock
 from .plant import PlantState
+
 
 class Scratch:
     """Arrays by name, reused from stretch to stretch. A fresh array of a megabyte (32 axes
@@ -109,7 +110,8 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
     t = samples / rate
     values = scratch.take("values", (len(VALUES), bank.count, len(samples)))
-    out = Stretch(samples, t, *values, values=values, scratch=scratch)
+    cmd_p, cmd_v, cmd_a, act_p, act_v, rel = values  # bank.VALUES order
+    out = Stretch(samples, t, cmd_p, cmd_v, cmd_a, act_p, act_v, rel, values=values, scratch=scratch)
     _steady(bank, bank.of_kind(Kind.STEADY), out)
     rows = bank.of_kind(Kind.PIECE)
     if len(rows):
@@ -449,6 +451,6 @@ def _read(resolution: np.ndarray, y: np.ndarray, into: np.ndarray | None) -> np.
         return out
     out = np.broadcast_to(y, (len(resolution), y.shape[1])).copy()
     counted = np.flatnonzero(resolution > 0.0)
-    step = resolution[counted, None]
-    out[counted] = np.floor(out[counted] / step + 0.5) * step
+    steps = resolution[counted, None]
+    out[counted] = np.floor(out[counted] / steps + 0.5) * steps
     return out

@@ -7,12 +7,20 @@ the supervisor's feedrate (clock.py); ABORT turns the amplifiers off.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from .axis import CommandMode
 from .events import MPIEventType
 from .messages import STATE_MESSAGES, Message
 from .status import StatusMode
 from .types import ActionSource, MPIAction, MPIMotionType, MPIState
+
+if TYPE_CHECKING:
+    from .axis import Axis
+    from .clock import ProfileClock
+    from .control import Controller
+    from .frames import Move
+    from .params import MotionConfig
 
 OK = Message.MPIMessageOK
 # Actions that act on another supervisor's motion on shared axes (all but MAP).
@@ -25,6 +33,36 @@ _OWN_STATES = {MPIAction.STOP: (MPIState.MOVING,), MPIAction.RESUME: (MPIState.S
 
 class ActionsMixin:
     """The actions of MotionSupervisor."""
+
+    if TYPE_CHECKING:
+        # What this mixin uses of MotionSupervisor (motion.py) and AxisListMixin: declarations
+        # for the type checker only.
+        _ctl: Controller
+        number: int
+        valid: bool
+        axis_list: list[int]
+        mapped: list[int]
+        config: MotionConfig
+        own_state: MPIState
+        current: Move | None
+        clock: ProfileClock
+        _stop_end: float
+        _abort_after_stop: bool
+        _error_at: int | None
+        _aborted: bool
+
+        @property
+        def axes(self) -> list[Axis]: ...
+        @property
+        def state(self) -> MPIState: ...
+        def _clock_of(self, axis: Axis) -> ProfileClock | None: ...
+        def _emit(self, kind: MPIEventType, axis: int = -1, move: Move | None = None, detail: str = "",
+                  sample: int | None = None) -> None: ...
+        def _set_state(self, state: MPIState, action: str, source: ActionSource) -> None: ...
+        def _rebase(self, t: float) -> None: ...
+        def _drop_pending(self, message: Message, detail: str) -> None: ...
+        def _notify_action(self, motion_type: MPIMotionType, action: str) -> None: ...
+        def _map(self) -> Message: ...
 
     def action(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Message:
         """mpiMotionAction."""
@@ -69,7 +107,7 @@ class ActionsMixin:
             return handler(source)
         if any(forwarded):
             return OK, "acted on the motion of the supervisor sharing its axes"
-        return self._refuse(())
+        return self._refusal(self.state)
 
     @property
     def _handlers(self):
@@ -90,6 +128,11 @@ class ActionsMixin:
         state = self.state
         if (self.own_state if own else state) in allowed:
             return None
+        return self._refusal(state)
+
+    @staticmethod
+    def _refusal(state: MPIState) -> tuple[Message, str]:
+        """The message of ``state``, which refuses an action."""
         return STATE_MESSAGES[state.name], f"supervisor is {state.name}"
 
     def _stop(self, source: ActionSource) -> tuple[Message, str]:
@@ -116,12 +159,13 @@ class ActionsMixin:
         for axis in self.axes:
             if axis.owner == self.number:
                 plan = axis.plan
-                axis.status_mode = StatusMode.VELOCITY if plan is not None and plan.is_velocity else StatusMode.POINT_TO_POINT
+                velocity = plan is not None and plan.is_velocity
+                axis.status_mode = StatusMode.VELOCITY if velocity else StatusMode.POINT_TO_POINT
         self._set_state(MPIState.MOVING, "RESUME", source)
         self._emit(MPIEventType.RESUME)
         return OK, ""
 
-    def _e_stop(self, source: ActionSource, then_abort: bool = False) -> tuple[Message, str]:
+    def _e_stop(self, source: ActionSource, then_abort: bool = False, reason: str = "") -> tuple[Message, str]:
         self._map_if_unmapped()
         t = self._ctl.time
         if self.own_state is MPIState.ERROR:
@@ -142,7 +186,7 @@ class ActionsMixin:
             if axis.in_position.settle_on_estop_cmd_eq_act and axis.amp_enabled:
                 axis.follow_actual(t, self.clock)
         self._set_state(MPIState.STOPPING_ERROR, "E_STOP_ABORT" if then_abort else "E_STOP", source)
-        self._emit(MPIEventType.E_STOP)
+        self._emit(MPIEventType.E_STOP, detail=reason)
         return OK, ""
 
     def _e_stop_abort(self, source: ActionSource) -> tuple[Message, str]:

@@ -3,9 +3,18 @@ the host holds it, and the mapping written to the controller (MEIActionMAP)."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .messages import Message
 from .params import MAX_COORD_AXES
 from .types import MPIState
+
+if TYPE_CHECKING:
+    from .axis import Axis
+    from .control import Controller
+    from .frames import Move
+    from .params import MotionConfig
+    from .types import ActionSource
 
 OK = Message.MPIMessageOK
 
@@ -14,6 +23,24 @@ class AxisListMixin:
     """mpiMotionAxisAppend/Insert/Remove/ListSet/ListGet/Count/Index/First/Next/... of
     MotionSupervisor (which provides ``axis_list``, ``mapped``, ``config``, ``valid``,
     ``own_state``, ``_axis`` and ``_state_message``)."""
+
+    if TYPE_CHECKING:
+        # What this mixin uses of MotionSupervisor (motion.py): declarations for the type
+        # checker only.
+        _ctl: Controller
+        valid: bool
+        axis_list: list[int]
+        mapped: list[int]
+        config: MotionConfig
+        own_state: MPIState
+        action_source: ActionSource
+        current: Move | None
+
+        def _axis(self, number: int) -> Axis: ...
+        def _state_message(self) -> Message: ...
+        def _set_state(self, state: MPIState, action: str, source: ActionSource) -> None: ...
+        def _rebase(self, t: float) -> None: ...
+        def _drop_pending(self, message: Message, detail: str) -> None: ...
 
     def _check_axis(self, number: int) -> Message:
         if not 0 <= number < len(self._ctl.axes):

@@ -7,18 +7,26 @@ happens, stops there, and calls :meth:`transition`.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .axis import Axis, CommandMode
 from .events import MPIEventType
+from .frames import reached
 from .holds import HoldWait
 from .messages import Message
 from .status import AT_VELOCITY, DONE, StatusMode
-from .types import HoldType, MPIState
+from .types import ActionSource, HoldType, MPIState
 
 if TYPE_CHECKING:
+    from collections import deque
+
+    from .clock import ProfileClock
+    from .control import Controller
+    from .frames import AxisPlan, Move, Stream
+    from .params import Hold, Output
     from .status import StretchStatus
     from .stretch import Stretch
 
@@ -28,19 +36,57 @@ OK = Message.MPIMessageOK
 class SteppingMixin:
     """The transitions of MotionSupervisor."""
 
+    if TYPE_CHECKING:
+        # What this mixin uses of MotionSupervisor (motion.py) and ActionsMixin: declarations
+        # for the type checker only.
+        _ctl: Controller
+        number: int
+        own_state: MPIState
+        last_action: str
+        action_source: ActionSource
+        current: Move | None
+        queue: deque[Move]
+        clock: ProfileClock
+        _stop_end: float
+        _abort_after_stop: bool
+        _error_at: int | None
+        _holds: dict[int, HoldWait]
+        # what :meth:`scan` found for :meth:`transition`: by a name, or (a name, an axis number)
+        _conditions: dict[Any, np.ndarray]
+        _at_velocity_sent: bool
+
+        @property
+        def axes(self) -> list[Axis]: ...
+        def _axis(self, number: int) -> Axis: ...
+        def _emit(self, kind: MPIEventType, axis: int = -1, move: Move | None = None, detail: str = "",
+                  sample: int | None = None) -> None: ...
+        def _set_state(self, state: MPIState, action: str, source: ActionSource) -> None: ...
+        def _rebase(self, t: float) -> None: ...
+        def _load(self, move: Move, announce: bool = True) -> None: ...
+        def _drop_pending(self, message: Message, detail: str) -> None: ...
+        def _end_move(self, move: Move, message: Message, detail: str) -> None: ...
+        def _end_serial(self, serial: int, message: Message, detail: str) -> None: ...
+        def _position_of(self, hold: Hold) -> float: ...
+        def _fire_outputs(self, plan: AxisPlan) -> None: ...
+        def _fire_output(self, output: Output) -> None: ...
+        def _at_velocity_reached(self) -> None: ...
+        def _disable_amps(self, t: float) -> None: ...
+        def _e_stop(self, source: ActionSource, then_abort: bool = False, reason: str = "") -> tuple[Message, str]: ...
+
     def scan(self, stretch: Stretch, status: StretchStatus) -> int | None:
         """The first sample of a stretch (stretch.Stretch, status.StretchStatus) at which a
         transition of this supervisor happens, or None.
 
         The conditions are kept until :meth:`transition` applies them.
         """
-        self._conditions = conditions = {}
+        conditions: dict[Any, np.ndarray] = {}
+        self._conditions = conditions
         state = self.own_state
         if self._holds and state in (MPIState.MOVING, MPIState.STOPPED):
             for axis_number, wait in self._holds.items():
                 conditions[("hold", axis_number)] = self._hold_trigger(wait, stretch)
         if state is MPIState.MOVING and self.current is not None and not self._holds:
-            self._scan_move(stretch, status, conditions)
+            self._scan_move(self.current, stretch, status, conditions)
         if state is MPIState.STOPPING:
             conditions["stopped"] = self._stop_complete(stretch.t, status, lambda a: a.in_position.settle_on_stop)
         elif state is MPIState.STOPPING_ERROR:
@@ -51,9 +97,13 @@ class SteppingMixin:
         firsts = [int(np.argmax(fired)) for fired in conditions.values() if fired.any()]
         return min(firsts) if firsts else None
 
-    def _scan_move(self, stretch: Stretch, status: StretchStatus, conditions: dict) -> None:
-        """A move done; a velocity move at its velocity."""
-        move = self.current
+    def _scan_move(self, move: Move, stretch: Stretch, status: StretchStatus, conditions: dict) -> None:
+        """A move done; a velocity move at its velocity; a path's outputs and buffer (``move``:
+        the current one)."""
+        if move.stream is not None:
+            self._scan_path(move, move.stream, stretch, conditions)
+            if move.stream.open:
+                return  # an open path is never done: more points are expected
         # A move that ends moving (FINAL_VEL) is never DONE: the next appended move takes
         # over at its trajectory's end; with none, the axes go on at the final velocity
         # (MOVING) until a modify, an append or a stop.
@@ -62,29 +112,54 @@ class SteppingMixin:
                 conditions["move_done"] = np.logical_and.reduce(
                     [stretch.rel[plan.axis] >= plan.duration for plan in move.plans])
         else:
-            self._all_axes(conditions, "move_done", status, DONE)
+            self._all_axes(move, conditions, "move_done", status, DONE)
         if move.is_velocity and not self._at_velocity_sent:
             # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
-            self._all_axes(conditions, "at_velocity", status, AT_VELOCITY)
+            self._all_axes(move, conditions, "at_velocity", status, AT_VELOCITY)
 
-    def _all_axes(self, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
-        """``conditions[key]``: per sample, is ``bit`` set on every axis of the current move?
-        (left out where it never is: an axis without it anywhere in the stretch)"""
+    def _scan_path(self, move: Move, stream: Stream, stretch: Stretch, conditions: dict) -> None:
+        """Outputs due at a later point; while the path is open, the points left in the
+        buffer: FRAMES_LOW below lowCount, FRAMES_EMPTY at none, and the E_STOP of MPI 000,
+        MPIMotionPoint, emptyCount ("If the number of points in the buffer is below
+        emptyCount, an E_STOP action will occur"; <= 0 disables, MotionParams.empty_count_disabled).
+        ``move``: the current one, a path; ``stream``: its streaming state."""
+        left = None
+        for plan in move.plans:
+            axis = self._axis(plan.axis)
+            if axis.plan is not plan:
+                continue
+            rel = np.nan_to_num(stretch.rel[plan.axis], nan=-np.inf)
+            if plan.timed_outputs:
+                conditions[("output", plan.axis)] = reached(rel) >= min(when for when, _ in plan.timed_outputs)
+            counts = plan.points_left(rel)
+            left = counts if left is None else np.minimum(left, counts)
+            if stream.chunks and plan.axis in stream.chunks[0][1]:
+                done = reached(rel) >= stream.chunks[0][1][plan.axis]
+                conditions["chunk"] = done & conditions.get("chunk", True)
+        if left is None or not stream.open:
+            return
+        if not stream.low_sent:
+            conditions["frames_low"] = left < stream.low_count
+        if not stream.empty_sent:
+            conditions["frames_empty"] = left == 0
+        if stream.empty_count > 0:
+            conditions["starving"] = left < stream.empty_count
+
+    def _all_axes(self, move: Move, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
+        """``conditions[key]``: per sample, is ``bit`` set on every axis of ``move`` (the current
+        one)? (left out where it never is: an axis without it anywhere in the stretch)"""
         ever = status.ever(bit)
-        axes = self.current.plan_axes
+        axes = move.plan_axes
         for number in axes:
             if not ever[number]:
                 return
         conditions[key] = np.logical_and.reduce(status.bits[bit, list(axes)], axis=0)
 
-    def _ends_moving(self) -> bool:
-        """The current move ends at its target with a velocity (FINAL_VEL)."""
-        return self.current is not None and self.current.ends_moving
-
     def cruising(self) -> bool:
         """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
-        return self._ends_moving() and all(
-            self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in self.current.plans)
+        move = self.current  # ends_moving: it ends at its target with a velocity (FINAL_VEL)
+        return move is not None and move.ends_moving and all(
+            self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in move.plans)
 
     def _stop_complete(self, t: np.ndarray, status: StretchStatus, settle: Callable[[Axis], bool]) -> np.ndarray:
         ready = t >= self._stop_end - 1e-12
@@ -112,6 +187,12 @@ class SteppingMixin:
                 wait = self._holds.get(key[1])
                 if wait is not None:
                     self._release(key[1], wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
+            elif key[0] == "output":
+                self._due_outputs(key[1])
+            elif key in ("frames_low", "frames_empty", "starving"):
+                self._buffer_event(key)
+            elif key == "chunk":
+                self._chunk_done()
             elif key == "move_done":
                 self._move_done()
             elif key == "at_velocity":
@@ -120,6 +201,41 @@ class SteppingMixin:
                 self._set_state(MPIState.STOPPED, self.last_action, self.action_source)
             elif key == "error":
                 self._stop_on_error_complete()
+
+    def _due_outputs(self, axis_number: int) -> None:
+        """Apply the outputs whose point the path has reached (the controller is there)."""
+        axis = self._axis(axis_number)
+        plan = axis.plan
+        if plan is None or self.current is None or plan not in self.current.plans:
+            return
+        now = reached(axis.rel)
+        due = [out for when, out in plan.timed_outputs if when <= now]
+        plan.timed_outputs = [(when, out) for when, out in plan.timed_outputs if when > now]
+        for out in due:
+            self._fire_output(out)
+
+    def _chunk_done(self) -> None:
+        """The last point of the oldest pending append is reached: that append is done."""
+        move = self.current
+        assert move is not None and move.stream is not None  # scan found it on the current path
+        chunks = move.stream.chunks
+        if chunks:
+            serial, _ = chunks.pop(0)
+            self._end_serial(serial, OK, "points executed")
+
+    def _buffer_event(self, key: str) -> None:
+        move = self.current
+        assert move is not None and move.stream is not None  # scan found it on the current path
+        stream = move.stream
+        if key == "frames_low" and not stream.low_sent:
+            stream.low_sent = True
+            self._emit(MPIEventType.FRAMES_LOW, detail=f"fewer than {stream.low_count} points left: append more")
+        elif key == "frames_empty" and not stream.empty_sent:
+            stream.empty_sent = True
+            self._emit(MPIEventType.FRAMES_EMPTY, detail="no points left; the path rests on its last point")
+        elif key == "starving" and self.own_state is MPIState.MOVING:
+            self._e_stop(ActionSource.CONTROLLER, reason=f"fewer than emptyCount = {stream.empty_count} points left "
+                                                          "while more are expected (final false)")
 
     def _stop_on_error_complete(self) -> None:
         """E_STOP (or ABORT) has run its course: disable what must be, enter ERROR."""
@@ -143,6 +259,7 @@ class SteppingMixin:
 
     def _move_done(self) -> None:
         move = self.current
+        assert move is not None  # scan found the current move done
         self._emit(MPIEventType.MOTION_DONE, move=move)
         self._end_move(move, OK, "motion done")
         self.current = None

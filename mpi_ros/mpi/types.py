@@ -132,9 +132,19 @@ class MotionAttr(IntFlag):
     HOLD_LESS = 1 << 20
     HOLD_GREATER = 1 << 21
     OUTPUT = 1 << 22
+    # MPIMotionPathAttrMask (MPI 001) bits that are not also MPIMotionAttr bits (ID,
+    # ELEMENT_ID, HOLD and OUTPUT mean the same in both masks and are the ones above).
+    BEHAVIOR = 1 << 24
+    RELATIVE_MOVE = 1 << 25
+    RETAIN = 1 << 26
+    EMPTY_COUNT = 1 << 27
+    LOW_COUNT = 1 << 28
+    NO_HANDSHAKE = 1 << 29
+    EXPECTED_AXES = 1 << 30
+    NO_WAIT = 1 << 31
 
     @classmethod
-    def parse(cls, names) -> "MotionAttr | None":
+    def parse(cls, names) -> MotionAttr | None:
         """Attribute names (without prefix) to a mask; None if a name is unknown."""
         mask = cls.NONE
         for name in names:
@@ -145,10 +155,21 @@ class MotionAttr(IntFlag):
         return mask
 
     def names(self) -> list[str]:
-        return [m.name for m in MotionAttr if m is not MotionAttr.NONE and m in self]
+        # (a member's name is None only for a combination, which iterating the class never gives)
+        return [m.name for m in MotionAttr if m is not MotionAttr.NONE and m in self and m.name is not None]
 
 
 HOLD_ATTRS = MotionAttr.HOLD | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER
+PATH_ATTRS = (
+    MotionAttr.BEHAVIOR
+    | MotionAttr.RELATIVE_MOVE
+    | MotionAttr.RETAIN
+    | MotionAttr.EMPTY_COUNT
+    | MotionAttr.LOW_COUNT
+    | MotionAttr.NO_HANDSHAKE
+    | MotionAttr.EXPECTED_AXES
+    | MotionAttr.NO_WAIT
+)
 CAM_ATTRS = (
     MotionAttr.REPEAT
     | MotionAttr.MASTER_START

@@ -8,6 +8,8 @@ failing check wins and nothing is changed.
 
 from __future__ import annotations
 
+import math
+
 from .messages import Message
 from .params import MAX_COORD_AXES, MAX_GATES, Hold, MotionParams, Output, Verdict
 from .types import (
@@ -16,6 +18,8 @@ from .types import (
     HOLD_ATTRS,
     JERK_TYPES,
     MODIFIABLE_TYPES,
+    PATH_ATTRS,
+    PATH_TYPES,
     POINT_TO_POINT_TYPES,
     VELOCITY_TYPES,
     HoldType,
@@ -25,7 +29,9 @@ from .types import (
 )
 
 A = MotionAttr
-_PATH_ALLOWED = A.APPEND | A.RELATIVE | A.ID | A.ELEMENT_ID | HOLD_ATTRS | A.OUTPUT
+# MPI 000, ATTRIBUTE_INVALID lists for the point types, and the path attributes of MPI 001
+# (MPIMotionPathAttrMask, the attributes of path motion: docs/paths.md).
+_PATH_ALLOWED = A.APPEND | A.RELATIVE | A.ID | A.ELEMENT_ID | HOLD_ATTRS | A.OUTPUT | PATH_ATTRS
 # spec 000: which attributes each type may carry.
 ALLOWED_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
     MPIMotionType.PT: _PATH_ALLOWED,
@@ -47,9 +53,14 @@ FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
 # mpiMotionStart is visibly incomplete: it leaves out VELOCITY and FRAME, which the same
 # reference documents as supported, so it does not exclude the cams either.)
 SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID}
-# Types this simulator executes today; the rest answer UNSUPPORTED "not simulated yet" (the
-# path types, FRAME and the cams are built in their own issues).
-EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES
+# Types this simulator executes today; the cams answer UNSUPPORTED "not simulated yet" (built
+# in their own issue).
+STREAMED_TYPES = PATH_TYPES | {MPIMotionType.FRAME}
+EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES | STREAMED_TYPES
+# The most values one path request may carry (positions, or frames, over all its axes): a
+# bound on the memory and planning time a single request can claim. A longer path is
+# streamed in requests (APPEND), as the controller's frame buffer is fed anyway.
+MAX_PATH_VALUES = 1 << 20
 
 
 OK = Verdict(Message.MPIMessageOK)
@@ -60,8 +71,12 @@ def _bad(message: Message, detail: str) -> Verdict:
 
 
 def check_type(
-    motion_type: MPIMotionType, modify: bool, firmware_option_21: bool
+    motion_type: MPIMotionType, modify: bool, firmware_option_21: bool, append: bool = False
 ) -> Verdict:
+    """Is the type known, supported and (for a modify) modifiable? A modify with APPEND adds
+    points to a path and changes nothing of the motion in progress, so it is open to every
+    type that may carry APPEND (docs/paths.md), not only to the types MPI 000, mpiMotionModify
+    lists as modifiable."""
     if motion_type is MPIMotionType.INVALID:
         return _bad(Message.MPIMotionMessageTYPE_INVALID, "motion type INVALID")
     if motion_type in JERK_TYPES and not firmware_option_21:
@@ -71,7 +86,8 @@ def check_type(
         )
     if motion_type not in SUPPORTED_TYPES:
         return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} is not supported by the controller")
-    if modify and motion_type not in MODIFIABLE_TYPES:
+    appendable = append and A.APPEND & ALLOWED_ATTRIBUTES.get(motion_type, A.NONE)
+    if modify and motion_type not in MODIFIABLE_TYPES and not appendable:
         return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} moves cannot be modified")
     if motion_type not in EXECUTED_TYPES:
         return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} motion is not simulated yet")
@@ -88,6 +104,8 @@ def check_attributes(
     forbidden = FORBIDDEN_ATTRIBUTES.get(motion_type, A.NONE) & attrs
     if forbidden:
         return _bad(bad, f"{motion_type.name} moves may not have {forbidden.names()}")
+    if motion_type not in PATH_TYPES and attrs & PATH_ATTRS:
+        return _bad(bad, f"{(attrs & PATH_ATTRS).names()} are path attributes (MPI 001, MPIMotionPathAttrMask)")
     if motion_type not in CAM_TYPES and attrs & CAM_ATTRS:
         return _bad(bad, f"{(attrs & CAM_ATTRS).names()} are cam attributes")
     if A.NO_BACKTRACK in attrs and A.NO_BACKTRACK_HOLD in attrs:
@@ -116,10 +134,21 @@ def check_params(
     io_words: int,
     motors: int,
     axes: int,
+    sample_rate: float = 0.0,
+    append_to: bool = False,
+    frame_buffer_size: int = 128,
 ) -> Verdict:
+    """The request's values for a move of ``axis_count`` axes (``sample_rate``: the
+    controller's, for a path's time slices; ``append_to``: the points go to an open path;
+    ``frame_buffer_size``: the axes', for LOW_COUNT)."""
     bad = Message.MPIMessagePARAM_INVALID
     if axis_count > MAX_COORD_AXES:
         return _bad(Message.MPIMessageARG_INVALID, f"{axis_count} axes exceed MEIXmpMAX_COORD_AXES ({MAX_COORD_AXES})")
+    if motion_type in STREAMED_TYPES:
+        verdict = _check_path_attributes(attrs, params, axis_count, frame_buffer_size)
+        if not verdict.ok:
+            return verdict
+        return _check_path(motion_type, attrs, params, axis_count, io_words, motors, axes, sample_rate, append_to)
     velocity_type = motion_type in VELOCITY_TYPES
     per_axis = bool(attrs & (A.SYNC_START | A.SYNC_END))
     counts = {axis_count} if per_axis else ({1, axis_count} if velocity_type else {1})
@@ -136,6 +165,14 @@ def check_params(
         verdict = _check_trajectory(motion_type, traj)
         if not verdict.ok:
             return verdict
+    return _check_attribute_data(attrs, params, axis_count, io_words, motors, axes, points=1)
+
+
+def _check_attribute_data(attrs: MotionAttr, params: MotionParams, axis_count: int, io_words: int, motors: int,
+                          axes: int, points: int) -> Verdict:
+    """The arrays the attributes read, for a move of ``points`` points (1 for a
+    point-to-point or velocity move)."""
+    bad = Message.MPIMessagePARAM_INVALID
     for name, attr, values in (
         ("delay", A.DELAY, params.delay),
         ("final_velocity", A.FINAL_VEL, params.final_velocity),
@@ -153,13 +190,117 @@ def check_params(
             verdict = _check_output(output, io_words, motors)
             if not verdict.ok:
                 return verdict
-            if motion_type in EXECUTED_TYPES and output.point_index != 0:
+            if not 0 <= output.point_index < max(points, 1):
                 # MEIMotionAttrOutput.pointIndex picks a point "when multiple point motion is
                 # used"; a point-to-point or velocity move has one, index 0.
-                return _bad(bad, f"output point_index {output.point_index}: a {motion_type.name} move has "
-                                 "one point (index 0)")
+                return _bad(bad, f"output point_index {output.point_index}: the move has {points} point(s) "
+                                 f"(index 0..{max(points, 1) - 1})")
     if A.ELEMENT_ID in attrs and not params.element_id:
         return _bad(bad, "ELEMENT_ID attribute specified and element_id is empty")
+    return OK
+
+
+def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, axis_count: int,
+                io_words: int, motors: int, axes: int, sample_rate: float, append_to: bool) -> Verdict:
+    """A path or FRAME request (MPI 000, MPIMotionPT .. MEIMotionFrame, MPIMotionPoint).
+
+    Order: non-finite data first (MEIMotionMessageBAD_PATH_DATA: "If any of the motion
+    parameters passed to the MPI for path motion are infinite or NAN ... will not load the
+    move"), then the arrays' lengths and ranges (MPIMessagePARAM_INVALID: "The length of the
+    array must be equal to pointCount multiplied by the number of axes"), then the path
+    itself (MPIMotionMessagePATH_ERROR: "when the final point is not specified or the time
+    slice is less than one controller sample")."""
+    if not _finite_path_data(motion_type, params):
+        return _bad(Message.MEIMotionMessageBAD_PATH_DATA, "a path value is infinite or NaN")
+    bad = Message.MPIMessagePARAM_INVALID
+    frame_type = motion_type is MPIMotionType.FRAME
+    values = len(params.frames) if frame_type else len(params.position)
+    if values > MAX_PATH_VALUES:
+        return _bad(bad, f"{values} values in one request: at most {MAX_PATH_VALUES}; stream longer paths "
+                         "with APPEND")
+    points = len(params.frames) // axis_count if frame_type else len(params.time)
+    verdict = _path_lengths(motion_type, params, axis_count, points)
+    if not verdict.ok:
+        return verdict
+    if points == 0 and not append_to:
+        return _bad(bad, "a path needs at least one point")
+    if params.retain or A.RETAIN in attrs:
+        # MPIMotionPoint.retain and MPI 001 RETAIN keep executed points "for backing up on
+        # path", but the reference names no call that backs up along a path: retained points
+        # could never be used. Refused rather than accepted and ignored (docs/paths.md).
+        return _bad(Message.MPIMessageUNSUPPORTED, "retain: the MPI names no way to back up along a path, so "
+                                                   "executed points are not kept; give retain false")
+    verdict = params.validate(motion_type, attrs)
+    if not verdict.ok:
+        return verdict
+    verdict = _check_attribute_data(attrs, params, axis_count, io_words, motors, axes, points)
+    if not verdict.ok:
+        return verdict
+    if A.ELEMENT_ID in attrs and len(params.element_id) not in (1, points):
+        return _bad(bad, f"element_id needs 1 or {points} value(s) (one per point), got {len(params.element_id)}")
+    return _check_path_shape(motion_type, params, sample_rate)
+
+
+def _check_path_attributes(attrs: MotionAttr, params: MotionParams, axis_count: int,
+                           frame_buffer_size: int) -> Verdict:
+    """The fields of MPI 001's path attributes (MPIMotionPathAttributes), read only with
+    their attribute."""
+    if A.EXPECTED_AXES in attrs and params.expected_axes != axis_count:
+        # MPI 001 EXPECTED_AXES: "checked against the number of currently mapped axes, and if
+        # they don't match an error will result": the error of a wrong axis count.
+        return _bad(Message.MPIMotionMessageAXIS_COUNT,
+                    f"expected_axes {params.expected_axes}, but the supervisor has {axis_count} axes")
+    if A.BEHAVIOR in attrs and params.behavior != 0:
+        # MPI 001 BEHAVIOR selects "a non-default behavior", but names none: 0 is the default.
+        return _bad(Message.MPIMessagePARAM_INVALID, f"behavior {params.behavior}: the MPI documents no path "
+                                                     "behaviour but the default (0)")
+    if A.LOW_COUNT in attrs and not 0 <= params.low_count <= frame_buffer_size:
+        return _bad(Message.MPIMessagePARAM_INVALID, f"low_count {params.low_count}: must be 0..{frame_buffer_size} "
+                                                     "(the frame buffer's size)")
+    return OK
+
+
+def _finite_path_data(motion_type: MPIMotionType, params: MotionParams) -> bool:
+    arrays = [params.position, params.time, params.point_velocity, params.feedforward]
+    arrays += [[f.position, f.velocity, f.acceleration, f.jerk, f.time] for f in params.frames]
+    return all(_finite(x) for values in arrays for x in values)
+
+
+def _finite(value: object) -> bool:
+    try:
+        return math.isfinite(value)  # type: ignore[arg-type]
+    except (TypeError, OverflowError):
+        return True  # not a number at all: the range checks answer it (PARAM_INVALID)
+
+
+def _path_lengths(motion_type: MPIMotionType, params: MotionParams, axis_count: int, points: int) -> Verdict:
+    bad = Message.MPIMessagePARAM_INVALID
+    if motion_type is MPIMotionType.FRAME:
+        if len(params.frames) % axis_count:
+            return _bad(bad, f"frames needs a multiple of {axis_count} (frames per axis, interleaved by axis), "
+                             f"got {len(params.frames)}")
+        return OK
+    arrays = [("position", params.position)]
+    if motion_type in (MPIMotionType.PVT, MPIMotionType.PVTF):
+        arrays.append(("point_velocity", params.point_velocity))
+    if motion_type in (MPIMotionType.PTF, MPIMotionType.PVTF):
+        arrays.append(("feedforward", params.feedforward))
+    for name, values in arrays:
+        if len(values) != points * axis_count:
+            return _bad(bad, f"{name} needs pointCount x axes = {points} x {axis_count} value(s) (one time per "
+                             f"point), got {len(values)}")
+    return OK
+
+
+def _check_path_shape(motion_type: MPIMotionType, params: MotionParams, sample_rate: float) -> Verdict:
+    bad = Message.MPIMotionMessagePATH_ERROR
+    if not params.final and not A.APPEND & ALLOWED_ATTRIBUTES[motion_type]:
+        return _bad(bad, f"final is false, but no points can be appended to a {motion_type.name} path "
+                         "(it may not carry APPEND): give the final point")
+    slices = [f.time for f in params.frames] if motion_type is MPIMotionType.FRAME else list(params.time)
+    if sample_rate > 0.0 and slices and min(slices) < (1.0 - 1e-9) / sample_rate:
+        return _bad(bad, f"a time slice of {min(slices)!r} s is less than one controller sample "
+                         f"({1.0 / sample_rate!r} s)")
     return OK
 
 

@@ -40,7 +40,7 @@ def _series(reader: BagReader):
 
 
 def _state_bands(ax, states: list[tuple[float, str]]) -> None:
-    for (t0, name), (t1, _) in zip(states, states[1:] + [states[-1]]):
+    for (t0, name), (t1, _) in zip(states, states[1:] + [states[-1]], strict=True):
         ax.axvspan(t0, t1 if t1 > t0 else t0, color=STATE_COLOURS.get(name, "#eeeeee"), lw=0)
 
 
@@ -70,7 +70,7 @@ def plot_bag(path: str | Path, output: str | Path, axes_wanted: list[int] | None
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         ax.legend(loc="upper right", fontsize=7, ncol=2)
-    for ax, (number, history) in zip(state_axes, sorted(states.items())):
+    for ax, (number, history) in zip(state_axes, sorted(states.items()), strict=True):
         _state_bands(ax, history)
         ax.set_yticks([])
         ax.set_ylabel(f"ms{number} state")

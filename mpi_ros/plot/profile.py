@@ -11,8 +11,8 @@ acceleration steps and is drawn as zero between them.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -82,7 +82,7 @@ def plot_profile(request: ProfileRequest, output: str | Path, sample_rate: float
 
     fig, rows = plt.subplots(4, 1, figsize=(10, 10), sharex=True)
     labels = ("position [counts]", "velocity [counts/s]", "acceleration [counts/s²]", "jerk [counts/s³]")
-    for k, (ax, label) in enumerate(zip(rows, labels)):
+    for k, (ax, label) in enumerate(zip(rows, labels, strict=True)):
         if k == 3:
             ax.step(ours[0], ours[4], where="post", lw=1.6, color="C0", label="controller")
         else:
@@ -100,7 +100,7 @@ def plot_profile(request: ProfileRequest, output: str | Path, sample_rate: float
         for sign in (1.0, -1.0):
             rows[1].axhline(sign * traj.velocity, color="grey", ls=":", lw=1.0)
         rows[0].axhline(request.target, color="grey", ls=":", lw=1.0)
-        peaks = (peak_acceleration(traj.acceleration, f), peak_acceleration(traj.deceleration, f))
+        peaks: tuple[float, ...] = (peak_acceleration(traj.acceleration, f), peak_acceleration(traj.deceleration, f))
     else:
         rows[1].axhline(traj.velocity, color="grey", ls=":", lw=1.0)
         peaks = (peak_acceleration(traj.acceleration, f),)

@@ -80,7 +80,8 @@ class ControllerNode(Node):
         self._pub_axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
         for k in range(count):
             self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp, k=k: self._on_config_get(k, resp))
-            self._service(AxisConfigSet, f"axis{k}/config_set", lambda req, resp, k=k: self._on_config_set(k, req, resp))
+            self._service(AxisConfigSet, f"axis{k}/config_set",
+                          lambda req, resp, k=k: self._on_config_set(k, req, resp))
             self._service(AxisPositionSet, f"axis{k}/position_set",
                           lambda req, resp, k=k: self._on_position_set(k, req, resp))
         self._service(GateSet, "gate_set", self._on_gate_set)
@@ -124,7 +125,12 @@ class ControllerNode(Node):
         if not self._applied:
             return None
         messages, self._applied = self._applied, []
-        return lambda: [convert.publish(self, self._pub_commands, msg) for msg in messages]
+
+        def publish() -> None:
+            for msg in messages:
+                convert.publish(self, self._pub_commands, msg)
+
+        return publish
 
     # -- periodic topics ------------------------------------------------------------------
     def _collect_axis_status(self, ctl):

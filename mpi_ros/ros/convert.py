@@ -31,15 +31,19 @@ from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 
 
 def to_dict(msg) -> dict[str, Any]:
-    """A ROS message as a dict of plain Python values (nested messages as dicts)."""
-    out: dict[str, Any] = {}
-    for name in msg.get_fields_and_field_types():
-        out[name] = _plain(getattr(msg, name))
-    return out
+    """A ROS message as a dict of plain Python values (nested messages as dicts); also a
+    message read from a bag by the definition the bag stores (its fields are its slots)."""
+    return {name: _plain(getattr(msg, name)) for name in _fields(msg)}
+
+
+def _fields(msg) -> list[str]:
+    if hasattr(msg, "get_fields_and_field_types"):
+        return list(msg.get_fields_and_field_types())
+    return [name for name in msg.__slots__ if not name.startswith("_")]
 
 
 def _plain(value):
-    if hasattr(value, "get_fields_and_field_types"):
+    if hasattr(value, "get_fields_and_field_types") or (hasattr(value, "__slots__") and hasattr(value, "_type")):
         return to_dict(value)
     if isinstance(value, (list, tuple)):
         return [_plain(v) for v in value]
@@ -86,7 +90,7 @@ def answer(response, reply):
 
 
 _default_epoch_ns = 0  # the epoch of the suite anchored last in this process
-_EPOCHS: "weakref.WeakKeyDictionary[Any, int]" = weakref.WeakKeyDictionary()
+_EPOCHS: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()
 
 
 def anchor(controller, epoch_ns: int | None = None) -> int:
@@ -164,6 +168,7 @@ def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) ->
     msg.element_id = snap.element_id
     msg.frame_count = snap.frame_count
     msg.supervisor = snap.supervisor
+    msg.feedforward = _finite(snap.feedforward)
     return msg
 
 
@@ -198,17 +203,21 @@ def servo_effort(axis) -> float:
     of a motor of unit inertia, which is what the simulated motor then does. Here it is
     computed as a real servo computes it, from the encoder's reading of the position (so
     it carries the encoder's quantisation: up to w^2 x resolution / 2) and the actual
-    velocity. 0 while the amplifier is off (after ABORT the motor coasts)."""
+    velocity. A PTF/PVTF feedforward adds its DAC counts times ``dac_acceleration``. 0 while
+    the amplifier is off (after ABORT the motor coasts)."""
     if not axis.amp_enabled:
         return 0.0
-    return _effort(axis.plant.config, axis.cmd_p - axis.act_p, axis.cmd_v, axis.act_v, axis.cmd_a)
+    return _effort(axis.plant.config, axis.cmd_p - axis.act_p, axis.cmd_v, axis.act_v, axis.cmd_a,
+                   axis.feedforward)
 
 
-def _effort(cfg, error: float, cmd_v: float, act_v: float, cmd_a: float) -> float:
+def _effort(cfg, error: float, cmd_v: float, act_v: float, cmd_a: float, feedforward: float) -> float:
     w = 2.0 * math.pi * cfg.bandwidth_hz
     effort = (w * w * error
               + 2.0 * cfg.damping * w * (cfg.velocity_feedforward * cmd_v - act_v)
               + cfg.acceleration_feedforward * cmd_a)
+    if feedforward:
+        effort += cfg.dac_acceleration * feedforward
     return _finite(effort)
 
 
@@ -223,7 +232,8 @@ def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
     axes = [snapshots[a.number] for a in ctl.axes]
     # snapshot values are the axis' own: position_error is cmd_p - act_p, as servo_effort reads it
     effort = [_effort(a.plant.config, s.position_error, s.command_velocity, s.actual_velocity,
-                      s.command_acceleration) if s.amp_enabled else 0.0 for a, s in zip(ctl.axes, axes)]
+                      s.command_acceleration, s.feedforward) if s.amp_enabled else 0.0
+              for a, s in zip(ctl.axes, axes, strict=True)]
     return [float(s.actual_position) for s in axes], [float(s.actual_velocity) for s in axes], effort
 
 

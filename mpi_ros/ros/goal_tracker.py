@@ -62,9 +62,9 @@ def outcome_since(outcomes: Sequence[MoveEnd], since: int) -> GoalEnd | None:
 
 def pending_serials(ms) -> set[int]:
     """The serials of the supervisor's current and queued moves."""
-    pending = {move.serial for move in ms.queue}
+    pending = {serial for move in ms.queue for serial in move.serials()}
     if ms.current is not None:
-        pending.add(ms.current.serial)
+        pending |= ms.current.serials()
     return pending
 
 

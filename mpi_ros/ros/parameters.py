@@ -101,7 +101,8 @@ def _read(reader: Node, name: str, default):
     return _typed(name, reader.declare_parameter(name, default, loose).value)
 
 
-def resolve(context: Context | None, config_path: str | None, time_scale: float) -> tuple[suite_config.SuiteConfig, float]:
+def resolve(context: Context | None, config_path: str | None,
+            time_scale: float) -> tuple[suite_config.SuiteConfig, float]:
     """The configuration and time scale in effect, parameter overrides applied."""
     reader = Node(NODE_NAME, namespace=_namespace(config_path), context=context)
     try:

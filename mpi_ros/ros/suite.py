@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import threading
 
 from rclpy.context import Context
@@ -70,10 +71,8 @@ class Suite:
     def spin(self) -> None:
         from rclpy.executors import ExternalShutdownException
 
-        try:
+        with contextlib.suppress(ExternalShutdownException):
             self.executor.spin()
-        except ExternalShutdownException:
-            pass
 
     def shutdown(self) -> None:
         """Stop goals, the clock and the executor; destroy the nodes."""

@@ -20,8 +20,10 @@ from __future__ import annotations
 import threading
 import traceback
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
+from typing import Any
 
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
@@ -108,12 +110,13 @@ class _GoalServer(ActionServer):
     callbacks are synchronous: nothing awaits while the lock is held.
     """
 
-    def __init__(self, *args, after_cancel, **kwargs):
+    def __init__(self, *args: Any, after_cancel: Callable[[], None], **kwargs: Any) -> None:
         self._taken: deque[dict] = deque()
         self._in_order = threading.Lock()
         self._after_cancel = after_cancel
         self.goal_id: bytes | None = None  # the goal request being handled (for the goal callback)
-        self.applied: dict[bytes, object] = {}  # goal id -> its command's (reply, sample), or the error
+        # goal id -> its command's (reply, sample), or the error
+        self.applied: dict[bytes, tuple[Reply, int] | Exception] = {}
         super().__init__(*args, **kwargs)
 
     def take_data(self):
@@ -206,7 +209,7 @@ class SupervisorNode(Node):
         runner.add_periodic(settings.feedback_rate, self._collect_feedback)
         runner.on_change(self._review)
 
-    def _action_server(self, action_type, name: str, operation: str) -> ActionServer:
+    def _action_server(self, action_type, name: str, operation: str) -> _GoalServer:
         return _GoalServer(self, action_type, f"~/{name}", _never_executed,
                            goal_callback=lambda goal: self._on_goal(goal, action_type, operation),
                            handle_accepted_callback=lambda handle: self._accept(handle, action_type),
@@ -251,11 +254,13 @@ class SupervisorNode(Node):
         if self._shutting_down:
             return GoalResponse.REJECT
         server = self._servers[action_type]
+        goal_id = server.goal_id
+        assert goal_id is not None  # set while the server handles the goal request that calls this
         try:
             command = Command(operation, self.number, request=convert.to_dict(goal_msg))
-            server.applied[server.goal_id] = self.runner.submit(command)
+            server.applied[goal_id] = self.runner.submit(command)
         except Exception as exc:  # noqa: BLE001 - not swallowed: the goal is aborted with it (_accept)
-            server.applied[server.goal_id] = exc
+            server.applied[goal_id] = exc
         return GoalResponse.ACCEPT
 
     def _accept(self, handle: ServerGoalHandle, action_type) -> None:
@@ -270,9 +275,9 @@ class SupervisorNode(Node):
             return
         reply, sample = applied
         goal = TrackedGoal(key, _RosGoal(handle, action_type, server), sample=sample)
-        if reply.accepted:
+        if reply.accepted and reply.serial:
             goal.serial = reply.serial
-        else:
+        else:  # refused, or answered without a move to follow (NO_WAIT): the reply is the result
             goal.end = GoalEnd(reply.message, reply.detail, sample)
         self.runner.update(partial(self._file, goal))
 
@@ -393,6 +398,7 @@ class SupervisorNode(Node):
         """Hand an ended goal back to rclpy: its execute callback, scheduled now on the
         executor, sets the terminal state and returns the result without waiting."""
         ros = goal.payload
+        assert goal.end is not None  # an ended goal
         finish = partial(self._finish, goal, _result(ros.action_type, goal.end, goal.sample, facts))
         with self._transitions:
             if ros.executing:
@@ -410,6 +416,7 @@ class SupervisorNode(Node):
     def _finish(self, goal: TrackedGoal, result, handle: ServerGoalHandle):
         """The goal's execute callback (executor thread): terminal state and result."""
         try:
+            assert goal.end is not None  # an ended goal
             if goal.end.succeeded:
                 handle.succeed()  # done (or at velocity) before a cancel's STOP took effect
             elif goal.serial is not None and handle.is_cancel_requested:
@@ -544,7 +551,7 @@ def _feedback(ctl: Controller, ms, action_type, current: bool):
     fb.progress = float(ms.progress()) if current and ms.current is not None else 0.0
     move = ms.current or ms.last_move
     fb.move_id = move.id if move else 0
-    fb.element_id = move.element_id if move else 0
+    fb.element_id = ms.element_id
     return fb
 
 

@@ -102,8 +102,8 @@ def _args(*argv: str) -> argparse.Namespace:
 
 
 def test_goal_from_flags():
-    goal = goal_from_args(_args("-p", "1000", "-250.5", "-v", "500", "-a", "5000", "-j", "50", "--attribute", "relative",
-                                "--id", "7"))
+    goal = goal_from_args(_args("-p", "1000", "-250.5", "-v", "500", "-a", "5000", "-j", "50",
+                                "--attribute", "relative", "--id", "7"))
     assert goal == {"type": "S_CURVE", "position": [1000.0, -250.5],
                     "trajectory": [{"velocity": 500.0, "acceleration": 5000.0, "jerk_percent": 50.0,
                                     "deceleration": 5000.0}],

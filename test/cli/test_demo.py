@@ -38,9 +38,7 @@ def test_demo_tours_records_and_plots(tmp_path):
     assert "RESET: MPIMessageOK (code 0), state IDLE" in _step(text, 7)
     path = _step(text, 8)
     assert "PVT" in path
-    # until the controller runs paths, the step says so; then it must move
-    assert ("skipped: paths are not built yet (the controller answered MPIMessageUNSUPPORTED" in path
-            or "MPIMessageOK (code 0) DONE" in path)
+    assert "MPIMessageOK (code 0) DONE, state IDLE, at [3000.0, 0.0]" in path
     assert "MPIMessageOK (code 0) DONE: motion done, state IDLE, at [0.0, 0.0]\n\nbag:" in _step(text, 9)
 
     lines = text.rstrip().splitlines()
@@ -57,6 +55,7 @@ def test_demo_usage_errors(tmp_path):
     (tmp_path / "full" / "x").write_text("")
     proc = mpi_ros("demo", "--output", str(tmp_path / "full"))
     assert proc.returncode == 2
-    assert proc.stderr.strip() == f"mpi-ros demo: {tmp_path / 'full'} exists and is not an empty directory: pass --output DIR"
+    assert proc.stderr.strip() == (f"mpi-ros demo: {tmp_path / 'full'} exists and is not an empty directory: "
+                                   "pass --output DIR")
     proc = mpi_ros("demo", "--time-scale", "0")
     assert proc.returncode == 2 and "--time-scale must be > 0" in proc.stderr

@@ -7,11 +7,18 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings, strategies as st
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from mpi_ros.crosscheck import ProfileRequest, Reason, Verdict, check_request
-from mpi_ros.crosscheck.mapping import (map_point_to_point, map_velocity, peak_acceleration, ramp_jerk,
-                                        reached_velocity, reverses)
+from mpi_ros.crosscheck.mapping import (
+    map_point_to_point,
+    map_velocity,
+    peak_acceleration,
+    ramp_jerk,
+    reached_velocity,
+    reverses,
+)
 from mpi_ros.crosscheck.result import RuckigLimits
 from mpi_ros.crosscheck.sampling import sample
 from mpi_ros.crosscheck.solver import RuckigFailed, solve
@@ -126,7 +133,7 @@ def test_solver_segments_match_ruckigs_own_sampling():
     assert profile.duration == pytest.approx(trajectory.duration, rel=1e-12)
     times = np.linspace(0.0, profile.duration, 57)
     p, v, a, _ = sample(profile.segments, times)
-    for t, pi, vi, ai in zip(times, p, v, a):
+    for t, pi, vi, ai in zip(times, p, v, a, strict=True):
         (rp,), (rv,), (ra,) = trajectory.at_time(float(t))
         assert pi == pytest.approx(rp, abs=1e-7) and vi == pytest.approx(rv, abs=1e-7)
         assert ai == pytest.approx(ra, abs=1e-5)

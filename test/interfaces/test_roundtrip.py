@@ -118,7 +118,7 @@ def fields(cls) -> list[str]:
 def build(cls, seed: int = 1):
     """An instance of cls with every field set to a non-default value."""
     msg = cls()
-    for i, (field, slot_type) in enumerate(zip(fields(cls), cls.SLOT_TYPES)):
+    for i, (field, slot_type) in enumerate(zip(fields(cls), cls.SLOT_TYPES, strict=True)):
         default = getattr(msg, field)
         scalar_default = default if isinstance(default, (bool, int, float, str)) else None
         setattr(msg, field, value_for(slot_type, seed * 7 + i, scalar_default))

@@ -6,8 +6,7 @@ import math
 
 import pytest
 
-from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, MPIAction, MPIMotionType, MPIState,
-                         PlantConfig)
+from mpi_ros.mpi import AxisInPosition, Controller, ControllerConfig, MPIAction, MPIMotionType, MPIState, PlantConfig
 from mpi_ros.mpi.messages import Message
 
 M = Message
@@ -46,8 +45,8 @@ def test_the_encoder_reads_whole_counts(ctl, ms, params):
 
 
 def test_origin_offsets_every_reported_position(ctl, ms, params, run_to):
-    # MPI 002, Configuration and Information Methods, <u>mpiAxisOriginGet</u> mpiAxisOriginGet/Set; axis.py: "Positions seen by users are raw positions minus
-    # the origin"
+    # MPI 002, Configuration and Information Methods, <u>mpiAxisOriginGet</u> mpiAxisOriginGet/Set; axis.py: "Positions
+    # seen by users are raw positions minus the origin"
     assert ctl.axis_origin_set(0, 100.0).ok
     assert ctl.axes[0].command_position == -100.0
     ms.start(T.TRAPEZOIDAL, params=params((500.0, 0.0)))
@@ -64,7 +63,8 @@ def test_origin_must_be_finite(ctl):
 
 
 def test_actual_position_set_moves_the_reading_not_the_command(ctl, ms):
-    # MPI 002, Configuration and Information Methods, <u>mpiAxisActualPositionSet</u> mpiAxisActualPositionSet "Set actual position"
+    # MPI 002, Configuration and Information Methods, <u>mpiAxisActualPositionSet</u> mpiAxisActualPositionSet "Set
+    # actual position"
     assert ctl.axis_actual_position_set(0, 250.0).ok
     axis = ctl.axes[0]
     assert axis.actual_position == 250.0 and axis.command_position == 0.0
@@ -91,9 +91,9 @@ def test_command_not_set_while_moving_stopping_or_stopped(ctl, ms, bring, state)
 
 
 def test_command_not_set_while_the_command_follows_the_actual(ctl, params):
-    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET "disableAction ... CMD_EQ_ACT and the motor's Amp Enable is disabled"; MPI 002, mpiAxisValidate, return values
-    # "the command position is continually set to the actual position"; here: an E_STOP with
-    # settleOnEstopCmdEqAct (MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct)
+    # MPI 002, MPIAxisMessageCOMMAND_NOT_SET "disableAction ... CMD_EQ_ACT and the motor's Amp Enable is disabled";
+    # MPI 002, mpiAxisValidate, return values "the command position is continually set to the actual position"; here: an
+    # E_STOP with settleOnEstopCmdEqAct (MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct)
     ctl = Controller(in_position=AxisInPosition(settle_on_estop_cmd_eq_act=True))
     _, ms = ctl.create_motion(0)
     ms.axis_list_set([0])

@@ -12,8 +12,17 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mpi_ros.mpi import (AxisInPosition, Controller, Hold, HoldType, MotionAttr, MotionParams, MPIAction,
-                         MPIMotionType, Trajectory)
+from mpi_ros.mpi import (
+    AxisInPosition,
+    Controller,
+    Hold,
+    HoldType,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    Trajectory,
+)
 
 SAMPLES = 3000
 TRAJ = Trajectory(3000.0, 30000.0, 20000.0, 40.0)

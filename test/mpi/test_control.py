@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 import time
 
+import numpy as np
 import pytest
 
 from mpi_ros.mpi import Controller, ControllerConfig, IoSpace, MPIAction, MPIMotionType, MPIState
@@ -40,8 +39,8 @@ def test_create_selects_the_next_unused_supervisor():
 
 @pytest.mark.parametrize("number", [-2, 2, 100])
 def test_create_out_of_range(number):
-    # MPI 000, MPIMotionMessageMOTION_INVALID MOTION_INVALID "if the motion supervisor number is less than zero or greater
-    # than or equal to MEIXmpMAX_MSs"; MPI 000, mpiMotionCreate, return values MPIHandleVOID
+    # MPI 000, MPIMotionMessageMOTION_INVALID MOTION_INVALID "if the motion supervisor number is less than zero or
+    # greater than or equal to MEIXmpMAX_MSs"; MPI 000, mpiMotionCreate, return values MPIHandleVOID
     assert Controller().create_motion(number) == (M.MPIMotionMessageMOTION_INVALID, None)
 
 
@@ -53,8 +52,8 @@ def test_create_twice_the_same_number():
 
 
 def test_validate_after_create_and_delete(ctl, ms):
-    # MPI 000, mpiMotionValidate "Always call mpiMotionValidate after creating"; MPI 000, mpiMotionDelete delete "invalidates its
-    # handle"; MPI 000, mpiMotionDelete "does not delete any of the Axis objects"
+    # MPI 000, mpiMotionValidate "Always call mpiMotionValidate after creating"; MPI 000, mpiMotionDelete delete
+    # "invalidates its handle"; MPI 000, mpiMotionDelete "does not delete any of the Axis objects"
     assert ms.validate().ok
     assert ctl.delete_motion(ms).ok
     assert ms.validate() is M.MPIMessageHANDLE_INVALID

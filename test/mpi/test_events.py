@@ -65,7 +65,8 @@ def test_motion_done_for_each_appended_move(ctl, ms, params, run_to):
 
 
 def test_motion_at_velocity(ctl, ms, params):
-    # MPI 002, MPIAxisInPosition, velocity "a velocity move is complete and an MPIEventTypeMOTION_AT_VELOCITY event is generated"
+    # MPI 002, MPIAxisInPosition, velocity "a velocity move is complete and an MPIEventTypeMOTION_AT_VELOCITY event is
+    # generated"
     ms.start(T.VELOCITY, MotionAttr.ID, params((), velocity=500.0, id=5))
     ctl.step(2000)
     at_velocity = of(ctl.drain_events(), E.MOTION_AT_VELOCITY)
@@ -74,8 +75,8 @@ def test_motion_at_velocity(ctl, ms, params):
 
 
 def test_notify_mask_none_disables_notification_but_events_latch(ctl, ms, params, run_to):
-    # MPI 000, mpiMotionEventNotifySet, remarks "disable host notification of all events: set eventmask to MPIEventTypeNONE";
-    # MPI 000, mpiMotionEventReset events are latched until mpiMotionEventReset
+    # MPI 000, mpiMotionEventNotifySet, remarks "disable host notification of all events: set eventmask to
+    # MPIEventTypeNONE"; MPI 000, mpiMotionEventReset events are latched until mpiMotionEventReset
     assert ms.event_notify_set(E.NONE).ok
     assert ms.event_notify_get() == (ms.validate(), E.NONE)
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 0.0)))
@@ -150,8 +151,8 @@ def test_shared_axes_send_motion_events_to_both_supervisors(ctl, params):
 
 
 def test_shared_axis_state_and_only_one_commander(ctl, params):
-    # MPI 000, Motion Objects, introduction "only one Motion Supervisor can command motion to an axis at a time"; MPI 000, mpiMotionAxisAppend the
-    # status "is derived from each axis' status"
+    # MPI 000, Motion Objects, introduction "only one Motion Supervisor can command motion to an axis at a time";
+    # MPI 000, mpiMotionAxisAppend the status "is derived from each axis' status"
     a, b = sharing_axis_1(ctl)
     assert a.start(T.TRAPEZOIDAL, params=params((3000.0, 3000.0))).ok
     assert b.state is MPIState.MOVING

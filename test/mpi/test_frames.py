@@ -92,8 +92,8 @@ def test_frame_count_decreases_as_the_move_runs(ctl, ms, params):
 
 
 def test_trapezoid_frames():
-    # MPI 000, Diagram of mpiMotionStart "Number of frames/point vary with type of move (1frame/point for trapezoidal, to
-    # 8 frames/point for S-curve)": here a trapezoid is accel, cruise, decel + the final frame
+    # MPI 000, Diagram of mpiMotionStart "Number of frames/point vary with type of move (1frame/point for trapezoidal,
+    # to 8 frames/point for S-curve)": here a trapezoid is accel, cruise, decel + the final frame
     plan = AxisPlan(0, [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.9, 50.0, 1e3, 0.0, 0.0),
                         Segment(0.1, 950.0, 1e3, -1e4, 0.0)], 0.0, 1000.0)
     assert plan.frame_count == 4 and plan.duration == pytest.approx(1.1)
@@ -101,7 +101,8 @@ def test_trapezoid_frames():
 
 
 def test_plan_evaluation_ends_exactly_on_target():
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, AT_TARGET AT_TARGET "TRUE when command = target": the command is the target exactly
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, AT_TARGET AT_TARGET "TRUE when
+    # command = target": the command is the target exactly
     seg = [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.1, 50.0, 1e3, -1e4, 0.0)]
     plan = AxisPlan(0, seg, 0.0, 100.0 + 1e-9)  # rounding in the segments is absorbed at the end
     p, v, a = plan.evaluate(np.array([0.05, plan.duration, plan.duration + 1.0]))

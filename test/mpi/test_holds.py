@@ -55,7 +55,8 @@ def test_gate_get(ctl):
     assert ctl.gate_get(5) == (M.MPIMessageOK, False)
     ctl.gate_set(5, True)
     assert ctl.gate_get(5) == (M.MPIMessageOK, True)
-    assert ctl.gate_set(32, True) is M.MPIMessagePARAM_INVALID  # MPI 000, MEIMotionAttrHoldSource, gate "between 0 and 31"
+    # MPI 000, MEIMotionAttrHoldSource, gate "between 0 and 31"
+    assert ctl.gate_set(32, True) is M.MPIMessagePARAM_INVALID
 
 
 def test_input_hold_matches_mask_and_pattern(ctl, ms, params):
@@ -75,8 +76,9 @@ def test_input_hold_matches_mask_and_pattern(ctl, ms, params):
 @pytest.mark.parametrize("kind,space", [(HoldType.MOTOR_GENERAL_IO, IoSpace.MOTOR_GENERAL_IO),
                                         (HoldType.MOTOR_DEDICATED_IO, IoSpace.MOTOR_DEDICATED_IO)])
 def test_motor_io_hold(ctl, ms, params, kind, space):
-    # MPI 000, MEIMotionAttrHoldTypeMOTOR_GENERAL_IO "Motion hold input triggers from a General IO bit"; MPI 000, MEIMotionAttrHoldTypeMOTOR_DEDICATED_IO "... from a
-    # Dedicated I/O bit"; MPI 000, MEIMotionAttrHoldSource, motor.number motor.number, mask, pattern; MPI 000, MEIMotionAttrHOLD
+    # MPI 000, MEIMotionAttrHoldTypeMOTOR_GENERAL_IO "Motion hold input triggers from a General IO bit"; MPI 000,
+    # MEIMotionAttrHoldTypeMOTOR_DEDICATED_IO "... from a Dedicated I/O bit"; MPI 000, MEIMotionAttrHoldSource,
+    # motor.number motor.number, mask, pattern; MPI 000, MEIMotionAttrHOLD
     held_start(ms, params, Hold(type=kind, number=2, mask=0x10, pattern=0x10))
     ctl.io_set(space, 1, 0x10)  # another motor
     assert still(ctl)
@@ -86,8 +88,9 @@ def test_motor_io_hold(ctl, ms, params, kind, space):
 
 
 def test_user_address_hold(ctl, ms, params):
-    # MPI 000, MEIMotionAttrHoldTypeUSER_ADDRESS "Motion hold input trigger from a user specifiable controller memory address";
-    # MPI 000, MEIMotionAttrHoldSource, user.address address, mask, pattern (DESIGN.md: address = an I/O word index)
+    # MPI 000, MEIMotionAttrHoldTypeUSER_ADDRESS "Motion hold input trigger from a user specifiable controller memory
+    # address"; MPI 000, MEIMotionAttrHoldSource, user.address address, mask, pattern (DESIGN.md: address = an I/O word
+    # index)
     held_start(ms, params, Hold(type=HoldType.USER_ADDRESS, address=60, mask=-1, pattern=7))
     assert still(ctl)
     ctl.io_set(IoSpace.IO, 60, 7)
@@ -115,8 +118,9 @@ def leader_and_follower(ctl, params, hold, attrs):
 
 @pytest.mark.parametrize("kind", [HoldType.AXIS_POSITION_COMMAND, HoldType.AXIS_POSITION_ACTUAL])
 def test_axis_position_hold_greater(ctl, params, kind):
-    # MPI 000, MEIMotionAttrHOLD_GREATER HOLD_GREATER "greater than or equal hold logic"; MPI 000, MEIMotionAttrHoldTypeAXIS_POSITION_ACTUAL trigger from an
-    # axis's actual / command position; MPI 000, MEIMotionAttrHoldSource, axis.number axis.number, axis.position
+    # MPI 000, MEIMotionAttrHOLD_GREATER HOLD_GREATER "greater than or equal hold logic"; MPI 000,
+    # MEIMotionAttrHoldTypeAXIS_POSITION_ACTUAL trigger from an axis's actual / command position; MPI 000,
+    # MEIMotionAttrHoldSource, axis.number axis.number, axis.position
     hold = Hold(type=kind, number=0, position=400.0)
     lead, follow = leader_and_follower(ctl, params, hold, A.HOLD | A.HOLD_GREATER)
     watched = ctl.axes[0]

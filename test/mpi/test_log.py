@@ -13,8 +13,8 @@ T = MPIMotionType
 
 
 def test_log_records_every_sample_up_to_max_entries(ctl, ms, params):
-    # MPI 000, meiMotionLogOpen "meiMotionLogOpen allocates a memory buffer for motion logging"; MPI 000, meiMotionLogOpen, maxEntries
-    # maxEntries "The maximum number of log entries"
+    # MPI 000, meiMotionLogOpen "meiMotionLogOpen allocates a memory buffer for motion logging"; MPI 000,
+    # meiMotionLogOpen, maxEntries maxEntries "The maximum number of log entries"
     assert ms.log_open(500).ok
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 100.0)))
     commands = []

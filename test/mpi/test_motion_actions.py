@@ -48,7 +48,7 @@ def test_stop_decelerates_to_zero_over_the_stop_time(params):
     rows = record(ctl, ms, 1000)
     speeds = [np.hypot(r[3], r[6]) for r in rows]
     assert speeds[-1] == 0.0 and speeds[-2] > 0.0  # zero exactly at 0.5 s
-    assert all(b <= a for a, b in zip(speeds, speeds[1:]))  # never speeds up while stopping
+    assert all(b <= a for a, b in zip(speeds, speeds[1:], strict=False))  # never speeds up while stopping
     assert ms.state is MPIState.STOPPED and ms.snapshot().feedrate == 0.0
 
 
@@ -224,8 +224,8 @@ def test_velocity_move_stops_and_resumes(params):
 
 
 def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
-    # MPI 000, MPIMotionConfig, pauseFeedrate pauseFeedrate "the feed speed rate for the Stop action": with 0.5 the axes still
-    # move when STOPPED; DESIGN.md "A new start from STOPPED discards the pending profile": the new
+    # MPI 000, MPIMotionConfig, pauseFeedrate pauseFeedrate "the feed speed rate for the Stop action": with 0.5 the axes
+    # still move when STOPPED; DESIGN.md "A new start from STOPPED discards the pending profile": the new
     # move must start from the velocity the axes have (limits never exceeded)
     ctl, ms = two_axes()
     config = ms.config_get()[1]
@@ -315,15 +315,17 @@ def test_append_behind_a_cruising_final_velocity_move_continues_without_a_jump(p
 
 
 def test_a_move_that_starts_in_motion_cannot_wait(params):
-    # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "non-zero delay value ... while in motion" and MPI 000, mpiMotionModify "It is
-    # impossible to use the HOLD attributes with mpiMotionModify": a move appended behind one that
-    # ends moving (FINAL_VEL) starts in motion too, and a wait would stop the axes dead.
+    # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "non-zero delay value ... while in motion" and MPI 000,
+    # mpiMotionModify "It is impossible to use the HOLD attributes with mpiMotionModify": a move appended behind one
+    # that ends moving (FINAL_VEL) starts in motion too, and a wait would stop the axes dead.
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
     delayed = params((2000.0, 0.0), delay=[0.1, 0.1])
-    assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.DELAY, delayed) is Message.MPIMotionMessageILLEGAL_DELAY
+    message = ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.DELAY, delayed)
+    assert message is Message.MPIMotionMessageILLEGAL_DELAY
     hold = Hold(type=HoldType.GATE, gate=1)
     held = params((2000.0, 0.0), hold=[hold, hold])
-    assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.HOLD, held) is Message.MPIMotionMessageATTRIBUTE_INVALID
+    message = ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.HOLD, held)
+    assert message is Message.MPIMotionMessageATTRIBUTE_INVALID
     assert not ms.queue  # nothing changed
     assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((2000.0, 0.0))).ok

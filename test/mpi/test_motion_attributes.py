@@ -6,8 +6,18 @@ from __future__ import annotations
 
 import pytest
 
-from mpi_ros.mpi import (Controller, ControllerConfig, IoSpace, MotionAttr, MotionParams, MPIMotionType, MPIState,
-                         Output, OutputType, Trajectory)
+from mpi_ros.mpi import (
+    Controller,
+    ControllerConfig,
+    IoSpace,
+    MotionAttr,
+    MotionParams,
+    MPIMotionType,
+    MPIState,
+    Output,
+    OutputType,
+    Trajectory,
+)
 from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.messages import Message
 
@@ -61,7 +71,8 @@ def test_append_with_modify(ctl, ms, params):
 
 
 def test_append_velocity_move_after_a_point_to_point(ctl, ms, params):
-    # MPI 000, Move Types: PT, PVT, Bessel, Bspline, Bspline2, S-Curve, Trapezoidal, Velocity, Frame APPEND move types include Velocity
+    # MPI 000, Move Types: PT, PVT, Bessel, Bspline, Bspline2, S-Curve, Trapezoidal, Velocity, Frame APPEND move types
+    # include Velocity
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     assert ms.start(T.VELOCITY, A.APPEND, params((), velocity=-300.0)).ok
     ctl.step(6000)
@@ -74,7 +85,8 @@ def test_auto_start_after_the_move_finished(ctl, ms, params):
     # previous motion is done"; MPI 000, MPIMotionMessageAUTO_START answers MPIMotionMessageAUTO_START ("not an error")
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     run_idle(ctl, ms)
-    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is M.MPIMotionMessageIDLE  # MPI 000, MPIMotionAttrAUTO_START
+    # MPI 000, MPIMotionAttrAUTO_START
+    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is M.MPIMotionMessageIDLE
     assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, params((0.0, 50.0))) is M.MPIMotionMessageAUTO_START
     run_idle(ctl, ms)
     assert [a.command_position for a in ms.axes] == [0.0, 50.0]
@@ -107,8 +119,8 @@ def test_delay_on_auto_start_is_used(ctl, ms, params):
 
 
 def test_illegal_delay_on_modify_in_motion(ctl, ms, params, bring):
-    # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "Returned if a motion modify is called with a non-zero delay value
-    # and the MPIMotionAttrDELAY attribute is set while in motion"
+    # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "Returned if a motion modify is called with a non-zero delay
+    # value and the MPIMotionAttrDELAY attribute is set while in motion"
     bring(MPIState.MOVING)
     assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.0, 0.1])) is M.MPIMotionMessageILLEGAL_DELAY
     assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.0, 0.0])).ok  # zero is legal
@@ -266,7 +278,8 @@ def test_final_velocity_then_appended_move_keeps_the_speed(ctl, ms, params):
 
 
 def test_final_velocity_above_the_velocity_is_a_profile_error(ms, params):
-    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "The motion profile is not possible with the specified constraints"
+    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "The motion profile is not possible with the specified
+    # constraints"
     message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[1500.0, 0.0]))
     assert message is M.MPIMotionMessagePROFILE_ERROR
 
@@ -279,8 +292,9 @@ def test_vector_final_velocity_off_the_line_is_param_invalid(ms, params):
 
 # ------------------------------------------------------------------ NO_REVERSAL ----
 def test_no_reversal_refuses_a_modify_behind_the_motion(ctl, ms, params, bring):
-    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "returned by mpiMotionModify when the NO_REVERSAL attribute mask
-    # is specified, but the specified target position is in the reverse direction"; MPI 000, MEIMotionAttrNO_REVERSAL
+    # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "returned by mpiMotionModify when the NO_REVERSAL attribute
+    # mask is specified, but the specified target position is in the reverse direction"; MPI 000,
+    # MEIMotionAttrNO_REVERSAL
     bring(MPIState.MOVING)
     where = ctl.axes[0].command_position
     assert ms.modify(T.TRAPEZOIDAL, A.NO_REVERSAL, params((where - 100.0, 0.0))) is M.MPIMotionMessagePROFILE_ERROR
@@ -300,8 +314,9 @@ def test_no_reversal_refuses_a_target_too_close_to_stop(ctl, ms, params, bring):
 
 # ------------------------------------------------------------------ OUTPUT ----
 def test_output_bits_as_the_move_begins(ctl, ms, params):
-    # MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame to toggle an output bit as a move begins"; MPI 000, MEIMotionAttrOutput, offMask
-    # offMask "bits to be turned OFF", onMask "bits to be turned ON"; MPI 000, MEIMotionAttrOutputTypeOUTPUT type OUTPUT
+    # MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame to toggle an output bit as a move begins"; MPI 000,
+    # MEIMotionAttrOutput, offMask offMask "bits to be turned OFF", onMask "bits to be turned ON"; MPI 000,
+    # MEIMotionAttrOutputTypeOUTPUT type OUTPUT
     ctl.io_set(IoSpace.IO, 3, 0b1010)
     out = Output(type=OutputType.OUTPUT, address=3, on_mask=0b0101, off_mask=0b1000)
     assert ms.start(T.TRAPEZOIDAL, A.OUTPUT, params((100.0, 0.0), output=[out])).ok
@@ -309,7 +324,8 @@ def test_output_bits_as_the_move_begins(ctl, ms, params):
 
 
 def test_motor_output(ctl, ms, params):
-    # MPI 000, MEIMotionAttrOutputTypeMOTOR type MOTOR "configures a motor's output bit(s)"; MPI 000, MEIMotionAttrOutput, motor motor number
+    # MPI 000, MEIMotionAttrOutputTypeMOTOR type MOTOR "configures a motor's output bit(s)"; MPI 000,
+    # MEIMotionAttrOutput, motor motor number
     out = Output(type=OutputType.MOTOR, motor=2, on_mask=0x100)
     ms.start(T.TRAPEZOIDAL, A.OUTPUT, params((100.0, 0.0), output=[out]))
     assert ctl.io_get(IoSpace.MOTOR_GENERAL_IO, 2)[1] == 0x100

@@ -23,7 +23,8 @@ def empty(big):
 
 
 def test_append_builds_the_list_in_order(empty):
-    # MPI 000, mpiMotionAxisAppend mpiMotionAxisAppend appends an Axis; MPI 000, mpiMotionAxisListGet ListGet writes the list
+    # MPI 000, mpiMotionAxisAppend mpiMotionAxisAppend appends an Axis; MPI 000, mpiMotionAxisListGet ListGet writes the
+    # list
     for n in (3, 1, 2):
         assert empty.axis_append(n).ok
     assert empty.axis_list_get() == (M.MPIMessageOK, [3, 1, 2])
@@ -45,8 +46,8 @@ def test_append_an_invalid_axis(empty, number):
 
 
 def test_append_past_max_coord_axes(empty):
-    # MPI 000, mpiMotionAxisAppend, return values MPIMessageUNSUPPORTED "The list already contains the maximum number of elements
-    # (MEIXmpMAX_COORD_AXES)" = 8
+    # MPI 000, mpiMotionAxisAppend, return values MPIMessageUNSUPPORTED "The list already contains the maximum number of
+    # elements (MEIXmpMAX_COORD_AXES)" = 8
     for n in range(8):
         assert empty.axis_append(n).ok
     assert empty.axis_append(8) is M.MPIMessageUNSUPPORTED
@@ -84,8 +85,8 @@ def test_insert_after_an_axis_not_on_the_list(empty):
 
 
 def test_remove_an_axis_not_on_the_list(big, empty):
-    # MPI 000, MPIMotionMessageAXIS_NOT_FOUND AXIS_NOT_FOUND "returned from mpiMotionAxisRemove if the axis that is being
-    # removed is not a member of the motion object"
+    # MPI 000, MPIMotionMessageAXIS_NOT_FOUND AXIS_NOT_FOUND "returned from mpiMotionAxisRemove if the axis that is
+    # being removed is not a member of the motion object"
     empty.axis_list_set([1])
     empty.action(MPIAction.MAP)
     assert empty.axis_remove(2) is M.MPIMotionMessageAXIS_NOT_FOUND
@@ -93,11 +94,12 @@ def test_remove_an_axis_not_on_the_list(big, empty):
 
 
 def test_remove_an_axis_not_mapped(empty):
-    # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS NOT_MAPPED_TO_MS "returned by ... mpiMotionAxisRemove when an axis is associated
-    # with a motion object, but not mapped to a motion supervisor"
+    # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS NOT_MAPPED_TO_MS "returned by ... mpiMotionAxisRemove when an axis is
+    # associated with a motion object, but not mapped to a motion supervisor"
     empty.axis_list_set([1, 2])
     assert empty.axis_remove(1) is M.MPIAxisMessageNOT_MAPPED_TO_MS
-    assert empty.action(MPIAction.MAP).ok  # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS "To correct this problem, map the axes"
+    # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS "To correct this problem, map the axes"
+    assert empty.action(MPIAction.MAP).ok
     assert empty.axis_remove(1).ok
     assert empty.axis_list_get()[1] == [2]
 
@@ -115,7 +117,8 @@ def test_what_maps_the_axes(big, empty, mapper):
         big.step(100)
     else:
         assert empty.event_notify_set(empty.notify_mask).ok
-    assert empty.config_get()[1].axis_numbers == [1]  # MPI 000, MEIMotionConfig, axisNumber the mapping on the controller
+    # MPI 000, MEIMotionConfig, axisNumber the mapping on the controller
+    assert empty.config_get()[1].axis_numbers == [1]
     assert empty.axis_remove(1).ok
 
 
@@ -143,7 +146,8 @@ def test_list_set_with_duplicates(empty):
 
 
 def test_list_set_while_moving_is_refused(ctl, ms, bring):
-    # MPI 000, Motion Objects, introduction "Motion Supervisor to axis maps should NOT be changed when the axes are moving"
+    # MPI 000, Motion Objects, introduction "Motion Supervisor to axis maps should NOT be changed when the axes are
+    # moving"
     bring(MPIState.MOVING)
     assert ms.axis_list_set([0]) is M.MPIMotionMessageMOVING
     assert ms.axis_remove(1) is M.MPIMotionMessageMOVING
@@ -160,8 +164,9 @@ def test_axis_by_index(empty):
 
 
 def test_first_next_last_previous(empty):
-    # MPI 000, mpiMotionAxisFirst First, MPI 000, mpiMotionAxisNext Next, MPI 000, mpiMotionAxisLast Last, MPI 000, mpiMotionAxisPrevious Previous iterate the list;
-    # MPI 000, mpiMotionAxisNext, return values MPIHandleVOID after the last axis
+    # MPI 000, mpiMotionAxisFirst First, MPI 000, mpiMotionAxisNext Next, MPI 000, mpiMotionAxisLast Last, MPI 000,
+    # mpiMotionAxisPrevious Previous iterate the list; MPI 000, mpiMotionAxisNext, return values MPIHandleVOID after the
+    # last axis
     empty.axis_list_set([4, 6, 8])
     forward, (message, axis) = [], empty.axis_first()
     while axis is not None:
@@ -176,7 +181,8 @@ def test_first_next_last_previous(empty):
 
 
 def test_first_and_last_of_an_empty_list(empty):
-    # MPI 000, mpiMotionAxisFirst, return values, MPI 000, mpiMotionAxisLast, return values MPIHandleVOID "if motion is empty"
+    # MPI 000, mpiMotionAxisFirst, return values, MPI 000, mpiMotionAxisLast, return values MPIHandleVOID "if motion is
+    # empty"
     assert empty.axis_first() == (M.MPIMessageOK, None)
     assert empty.axis_last() == (M.MPIMessageOK, None)
 
@@ -189,15 +195,17 @@ def test_next_of_an_axis_not_on_the_list(empty):
 
 
 def test_index_of_an_axis(empty):
-    # MPI 000, mpiMotionAxisIndex "returns the position of axis on the list"; MPI 000, mpiMotionAxisIndex, return values -1 if not found
+    # MPI 000, mpiMotionAxisIndex "returns the position of axis on the list"; MPI 000, mpiMotionAxisIndex, return values
+    # -1 if not found
     empty.axis_list_set([4, 6])
     assert empty.axis_index(6) == 1
     assert empty.axis_index(5) == -1
 
 
 def test_an_invalid_handle_everywhere(big, empty):
-    # MPI 000, mpiMotionAxisCount, return values count -1 "if motion is invalid"; MPI 000, mpiMotionAxisIndex, return values index -1; MPI 000, mpiMotionAxis, return values MPIHandleVOID;
-    # MPI 000, mpiMotionAxisAppend, return values HANDLE_INVALID
+    # MPI 000, mpiMotionAxisCount, return values count -1 "if motion is invalid"; MPI 000, mpiMotionAxisIndex, return
+    # values index -1; MPI 000, mpiMotionAxis, return values MPIHandleVOID; MPI 000, mpiMotionAxisAppend, return values
+    # HANDLE_INVALID
     empty.axis_list_set([4])
     empty.action(MPIAction.MAP)
     assert big.delete_motion(empty).ok

@@ -14,22 +14,23 @@ T = MPIMotionType
 
 
 def test_decel_time_defaults(ms):
-    # MPI 000, MPIMotionDecelTime, stop stop "The default value is .5 seconds"; MPI 000, MPIMotionDecelTime, eStop eStop "The default value is
-    # .05 seconds"
+    # MPI 000, MPIMotionDecelTime, stop stop "The default value is .5 seconds"; MPI 000, MPIMotionDecelTime, eStop eStop
+    # "The default value is .05 seconds"
     config = ms.config_get()[1]
     assert config.decel_time.stop == 0.5 and config.decel_time.e_stop == 0.05
 
 
 def test_feedrate_defaults(ms):
-    # MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate "The default value is 1.0 (100%)"; MPI 000, MPIMotionConfig, pauseFeedrate pauseFeedrate "The
-    # default value is 0.0"
+    # MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate "The default value is 1.0 (100%)"; MPI 000,
+    # MPIMotionConfig, pauseFeedrate pauseFeedrate "The default value is 0.0"
     config = ms.config_get()[1]
     assert config.normal_feedrate == 1.0 and config.pause_feedrate == 0.0
 
 
 def test_mei_config_fields(ms):
-    # MPI 000, MEIMotionConfig, userLabel userLabel (16 characters, not used by the controller); MPI 000, MEIMotionConfig, axisCount
-    # axisCount/axisNumber = the current mapping; MPI 000, MEIMotionConfig, blendLimit blendLimit
+    # MPI 000, MEIMotionConfig, userLabel userLabel (16 characters, not used by the controller); MPI 000,
+    # MEIMotionConfig, axisCount axisCount/axisNumber = the current mapping; MPI 000, MEIMotionConfig, blendLimit
+    # blendLimit
     config = ms.config_get()[1]
     assert config.user_label == "" and config.axis_numbers == [0, 1] and config.axis_count == 2
     config.user_label = "x" * 16
@@ -64,8 +65,8 @@ def test_config_set_cannot_change_the_mapping(ms):
     lambda c: setattr(c, "user_label", "x" * 17),
 ])
 def test_config_set_refuses_bad_values(ms, change):
-    # MPI 000, MEIMotionConfig, userLabel userLabel 16 characters; MPI 000, MEIMotionConfig, blendLimit blendLimit from -1.0 to 1.0; the times are
-    # durations and the feedrates fractions (DESIGN.md: bad input changes nothing)
+    # MPI 000, MEIMotionConfig, userLabel userLabel 16 characters; MPI 000, MEIMotionConfig, blendLimit blendLimit from
+    # -1.0 to 1.0; the times are durations and the feedrates fractions (DESIGN.md: bad input changes nothing)
     config = ms.config_get()[1]
     change(config)
     assert ms.config_set(config) is M.MPIMessagePARAM_INVALID
@@ -101,8 +102,8 @@ def test_normal_feedrate_scales_the_speed(ctl, ms, params):
 
 
 def test_normal_feedrate_change_while_moving_ramps(ctl, ms, params):
-    # MPI 000, mpiMotionConfigGet, sample code sample modifyFeedrate: the feedrate is changed with ConfigSet while moving;
-    # motion.py: "a new normal feedrate applies on the fly (ramped over the stop time while moving)"
+    # MPI 000, mpiMotionConfigGet, sample code sample modifyFeedrate: the feedrate is changed with ConfigSet while
+    # moving; motion.py: "a new normal feedrate applies on the fly (ramped over the stop time while moving)"
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(1000)
     config = ms.config_get()[1]
@@ -147,7 +148,8 @@ def test_start_with_null_params_uses_the_stored_ones(ctl, ms, params, run_to):
 
 
 def test_start_with_null_params_and_nothing_stored(ms):
-    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID / MPI 000, MPIMessagePARAM_INVALID: no usable parameters -> refused, nothing moves
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID / MPI 000, MPIMessagePARAM_INVALID: no usable parameters -> refused,
+    # nothing moves
     assert ms.start(T.TRAPEZOIDAL, params=None) is M.MPIMessagePARAM_INVALID
     assert ms.state is MPIState.IDLE
 
@@ -203,8 +205,9 @@ def test_params_set_while_moving_that_the_move_refuses_changes_nothing(ctl, ms, 
 
 # ------------------------------------------------------------------ frame buffer status ----
 def test_frame_buffer_status(ctl, ms, params, run_to):
-    # MPI 000, meiMotionFrameBufferStatus "gets a Motion object (motion) frame buffer status"; MPI 000, MEIMotionFrameBufferStatus, size size "the size of
-    # the controller's frame buffer"; MPI 000, MEIMotionFrameBufferStatus, frameCount frameCount "the number of frames in the buffer"
+    # MPI 000, meiMotionFrameBufferStatus "gets a Motion object (motion) frame buffer status"; MPI 000,
+    # MEIMotionFrameBufferStatus, size size "the size of the controller's frame buffer"; MPI 000,
+    # MEIMotionFrameBufferStatus, frameCount frameCount "the number of frames in the buffer"
     message, status = ms.frame_buffer_status()
     assert message.ok and [(s.axis, s.size) for s in status] == [(0, 128), (1, 128)]
     ms.start(T.S_CURVE, params=params((5000.0, 0.0), jerk_percent=50.0))
@@ -219,8 +222,8 @@ def test_frame_buffer_status(ctl, ms, params, run_to):
 # ------------------------------------------------------------------ action callback ----
 def test_action_callback_sees_every_action(ctl, ms, params):
     # MPI 000, meiMotionActionFunction "the callback function is called whenever the MPI writes to the action variable"
-    # (start, modify, stop, abort, reset ...); MPI 000, MEIMotionActionFunction, motion it receives the motion, the motion type
-    # and the action
+    # (start, modify, stop, abort, reset ...); MPI 000, MEIMotionActionFunction, motion it receives the motion, the
+    # motion type and the action
     calls = []
     assert ms.action_function(lambda motion, kind, action: calls.append((motion.number, kind, action))) is None
     ms.start(T.S_CURVE, params=params((100_000.0, 0.0)))

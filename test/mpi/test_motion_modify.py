@@ -53,7 +53,8 @@ def test_modify_to_a_farther_target(params, kind, jerk_percent):
 @pytest.mark.parametrize("kind,jerk_percent", [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0)])
 def test_modify_to_a_target_behind_reverses(params, kind, jerk_percent):
     # issue 3: "Modify on the fly from the current position, velocity and acceleration (including
-    # reversal)"; MPI 000, MPIMotionMessagePROFILE_ERROR (a target "in the reverse direction" is legal without NO_REVERSAL)
+    # reversal)"; MPI 000, MPIMotionMessagePROFILE_ERROR (a target "in the reverse direction" is legal without
+    # NO_REVERSAL)
     ctl, ms = rig()
     ms.start(kind, params=params((5000.0,), jerk_percent=jerk_percent))
     ctl.step(1000)
@@ -123,8 +124,8 @@ def test_s_curve_jerk_modify_keeps_the_acceleration(params):
 
 
 def test_velocity_modify_changes_speed_and_direction(params):
-    # MPI 000, mpiMotionModify VELOCITY moves can be modified; MPI 000, MPIMotionVelocity the acceleration is used for every ramp
-    # ("deceleration is ignored")
+    # MPI 000, mpiMotionModify VELOCITY moves can be modified; MPI 000, MPIMotionVelocity the acceleration is used for
+    # every ramp ("deceleration is ignored")
     ctl, ms = rig()
     ms.start(T.VELOCITY, params=params((), velocity=500.0, acceleration=5000.0, deceleration=1.0))
     ctl.step(1000)
@@ -159,7 +160,8 @@ def test_a_velocity_modify_reaches_its_velocity_at_the_end_of_its_own_ramp(param
 
 
 def test_velocity_modify_to_zero_ends_the_move(params):
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, DONE DONE after the velocity move is over; a velocity of zero ends the motion
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, DONE DONE after the velocity
+    # move is over; a velocity of zero ends the motion
     ctl, ms = rig()
     ms.start(T.VELOCITY, params=params((), velocity=500.0))
     ctl.step(500)

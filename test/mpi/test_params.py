@@ -364,7 +364,8 @@ _HIGH = dict(
     in_position=AxisInPosition(position_fine=MAX_POSITION, position_coarse=LONG_MAX, velocity=3.4e38,
                                settling_time=MAX_DURATION, settle_on_stop=True, settle_on_estop=True),
     plant=PlantConfig(bandwidth_hz=SAMPLE_RATE_MAX / 2, damping=1.0, velocity_feedforward=10.0,
-                      acceleration_feedforward=10.0, encoder_resolution=MAX_POSITION / 4, coast_time_constant=MAX_DURATION),
+                      acceleration_feedforward=10.0, encoder_resolution=MAX_POSITION / 4,
+                      coast_time_constant=MAX_DURATION),
     motion_config=MotionConfig(DecelTime(MAX_DURATION, MAX_DURATION), normal_feedrate=FEEDRATE_MAX,
                                pause_feedrate=FEEDRATE_MAX, blend_limit=1.0),
 )

@@ -36,10 +36,10 @@ def test_vector_move_is_one_profile_along_the_line():
     move, notes = compile_()
     x, y = move.plans
     assert x.duration == y.duration == pytest.approx(5000.0 / 1000.0 + 0.5 * (0.1 + 0.2))
-    for sx, sy in zip(x.segments, y.segments):
+    for sx, sy in zip(x.segments, y.segments, strict=True):
         assert sx.duration == sy.duration
         assert (sx.v * 4.0, sx.a * 4.0, sx.j * 4.0) == pytest.approx((sy.v * 3.0, sy.a * 3.0, sy.j * 3.0))
-    assert max(math.hypot(sx.v, sy.v) for sx, sy in zip(x.segments, y.segments)) == pytest.approx(1000.0)
+    assert max(math.hypot(sx.v, sy.v) for sx, sy in zip(x.segments, y.segments, strict=True)) == pytest.approx(1000.0)
     assert (x.target, y.target) == (3000.0, 4000.0) and end(x)[0] == pytest.approx(3000.0)
     assert notes.events == []
 
@@ -89,8 +89,8 @@ def test_illegal_delay_only_while_moving():
 
 
 def test_relative_targets_and_truncation():
-    # MPI 000, MPIMotionAttrRELATIVE relative distances from the start; MPI 000, mpiMotionStart "the fractional portion is truncated
-    # and discarded"
+    # MPI 000, MPIMotionAttrRELATIVE relative distances from the start; MPI 000, mpiMotionStart "the fractional portion
+    # is truncated and discarded"
     starts = [AxisStart(0, 1000.0), AxisStart(1, -5.0)]
     move, notes = compile_(A.RELATIVE, position=(2000.0, -3.9), starts=starts)
     assert [p.target for p in move.plans] == [3000.0, -8.0]
@@ -210,8 +210,8 @@ def test_vector_modify_off_the_line_plans_each_axis():
 
 
 def test_hold_and_outputs_go_to_the_plans():
-    # MPI 000, MEIMotionAttributes, hold hold "for each axis"; MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame to toggle an output
-    # bit as a move begins" (on the first axis' frames)
+    # MPI 000, MEIMotionAttributes, hold hold "for each axis"; MPI 000, MEIMotionAttrOUTPUT OUTPUT "configures a frame
+    # to toggle an output bit as a move begins" (on the first axis' frames)
     holds = [Hold(type=HoldType.GATE, gate=1), Hold(type=HoldType.GATE, gate=2)]
     output = Output(type=OutputType.OUTPUT, on_mask=1)
     move, _ = compile_(A.HOLD | A.OUTPUT, hold=holds, output=[output])

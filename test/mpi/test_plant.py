@@ -32,7 +32,7 @@ def test_tabulated_response_equals_the_closed_form_far_beyond_the_table(damping)
     forced = plant.prepare([100.0, 20.0])  # a ramp command
     samples = np.array([3, 4, 5, 4099, 4100, 9000, 60001], dtype=np.int64)
     y, dy = plant.response(state, forced, samples, RATE)
-    for k, yk, dyk in zip(samples, y, dy):
+    for k, yk, dyk in zip(samples, y, dy, strict=True):
         want_y, want_dy = closed_form(plant, state, forced, k / RATE)
         assert yk == pytest.approx(want_y, rel=1e-9, abs=1e-9)
         assert dyk == pytest.approx(want_dy, rel=1e-9, abs=1e-9)
@@ -52,7 +52,7 @@ def test_coasting_decays_like_the_exponential():
     state = PlantState(t=2.00031, y=1.0, dy=100.0)
     samples = np.array([4001, 4002, 9000, 20000], dtype=np.int64)
     y, dy = plant.coast(state, samples, RATE)
-    for k, yk, dyk in zip(samples, y, dy):
+    for k, yk, dyk in zip(samples, y, dy, strict=True):
         decay = math.exp(-(k / RATE - state.t) / 0.5)
         assert dyk == pytest.approx(100.0 * decay, rel=1e-12)
         assert yk == pytest.approx(1.0 + 100.0 * 0.5 * (1.0 - decay), rel=1e-12)

@@ -22,8 +22,17 @@ import numpy as np
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from mpi_ros.mpi import (Controller, ControllerConfig, DecelTime, MotionAttr, MotionParams, MPIAction, MPIMotionType,
-                         MPIState, Trajectory)
+from mpi_ros.mpi import (
+    Controller,
+    ControllerConfig,
+    DecelTime,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Trajectory,
+)
 from mpi_ros.mpi.messages import Message
 
 T = MPIMotionType
@@ -96,8 +105,8 @@ def speeding_up(seg, v_max: float):
 
 
 def check_segment_limits(plan, v_max: float, up: float, down: float) -> None:
-    """The same limits from the planned constant-jerk segments (MPI 000, Streaming Point Motion Type Calculations: the extremes of the
-    acceleration are at the segment ends)."""
+    """The same limits from the planned constant-jerk segments (MPI 000, Streaming Point Motion Type
+    Calculations: the extremes of the acceleration are at the segment ends)."""
     for seg in plan.segments:
         p1, v1, a1 = seg.end_state()
         assert all(math.isfinite(x) for x in (seg.p, seg.v, seg.a, seg.j, p1, v1, a1))
@@ -111,7 +120,8 @@ def check_segment_limits(plan, v_max: float, up: float, down: float) -> None:
 @given(kind=st.sampled_from([T.TRAPEZOIDAL, T.S_CURVE]), data=st.data(), distance=distances)
 def test_point_to_point_limits_and_target(kind, data, distance):
     # DESIGN.md quality bar: "limits never exceeded (|v| <= velocity, |a| <= acceleration/
-    # deceleration, jerk as configured, within float tolerance)"; MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, AT_TARGET "command = target"
+    # deceleration, jerk as configured, within float tolerance)"; MPI 002, Configuration of IN_POSITION and DONE Events
+    # after STOP or E-STOP Events, AT_TARGET "command = target"
     traj = data.draw(trajectories(kind))
     ctl, ms = rig()
     assert ms.start(kind, params=MotionParams(trajectory=[traj], position=[distance])).ok
@@ -224,7 +234,8 @@ def test_velocity_moves(first, second, acc, dec, jerk, when):
        e_stop=st.floats(0.001, 0.2), when=st.floats(0.0, 0.9), distance=distances)
 def test_stop_and_e_stop_reach_zero_within_their_time(kind, data, action, stop, e_stop, when, distance):
     # MPI 000, MPIActionSTOP STOP "decelerates the axis (or axes) to a stop in the time specified by the stop
-    # time"; MPI 000, MPIActionE_STOP E_STOP likewise in the eStop time; MPI 000, MPIMotionDecelTime, stop MPIMotionDecelTime
+    # time"; MPI 000, MPIActionE_STOP E_STOP likewise in the eStop time; MPI 000, MPIMotionDecelTime, stop
+    # MPIMotionDecelTime
     traj = data.draw(trajectories(kind if kind is not T.VELOCITY else T.S_CURVE))
     ctl, ms = rig()
     config = ms.config_get()[1]

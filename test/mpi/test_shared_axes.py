@@ -201,7 +201,8 @@ def test_cell_from_the_supervisor_sharing_an_axis(state, name, message, after):
 SHARED_REFUSALS = [c for c in SHARED if c[2] is not Message.MPIMessageOK]
 
 
-@pytest.mark.parametrize("state,name,message,after", SHARED_REFUSALS, ids=[f"{c[0].name}-{c[1]}" for c in SHARED_REFUSALS])
+@pytest.mark.parametrize("state,name,message,after", SHARED_REFUSALS,
+                         ids=[f"{c[0].name}-{c[1]}" for c in SHARED_REFUSALS])
 def test_refused_cell_from_the_sharing_supervisor_changes_nothing(state, name, message, after):
     # docs/state-machine.md: '"msg X" = refused with MPIMotionMessageX, nothing changes', on shared axes too
     ctl_a, a, _ = shared_in(state)

@@ -9,8 +9,16 @@ from __future__ import annotations
 
 import pytest
 
-from mpi_ros.mpi import (ActionSource, Controller, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState,
-                         Trajectory)
+from mpi_ros.mpi import (
+    ActionSource,
+    Controller,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Trajectory,
+)
 from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.messages import Message
 
@@ -41,7 +49,8 @@ CELLS = [
     # IDLE
     (S.IDLE, "start", OK, S.MOVING),  # MPI 000, mpiMotionStart start changes IDLE to MOVING
     (S.IDLE, "modify", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE IDLE "returned from mpiMotionModify when IDLE"
-    (S.IDLE, "STOP", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE "also returned ... when a STOP ... in the IDLE state"
+    (S.IDLE, "STOP", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE "also returned ... when a STOP ... in the IDLE
+                                     # state"
     (S.IDLE, "RESUME", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE "... or RESUME is commanded when ... IDLE"
     (S.IDLE, "RESET", OK, S.IDLE),  # docs/state-machine.md: RESET in IDLE "OK, no change"
     (S.IDLE, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction E_STOP -> STOPPING_ERROR -> ERROR
@@ -49,20 +58,25 @@ CELLS = [
     (S.IDLE, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
     (S.IDLE, "MAP", OK, S.IDLE),  # MPI 000, MEIActionMAP MAP writes the axis mapping
     # MOVING
-    (S.MOVING, "start", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING MOVING "returned from mpiMotionStart when MOVING"
+    (S.MOVING, "start", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING MOVING "returned from mpiMotionStart when
+                                            # MOVING"
     (S.MOVING, "modify", OK, S.MOVING),  # MPI 000, mpiMotionModify modify "if motion is in progress (MPIStateMOVING)"
     (S.MOVING, "STOP", OK, S.STOPPING),  # MPI 000, MPIActionSTOP STOP: MOVING -> STOPPING
-    (S.MOVING, "RESUME", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING "when a RESUME ... is commanded ... MOVING"
+    (S.MOVING, "RESUME", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING "when a RESUME ... is commanded ...
+                                             # MOVING"
     (S.MOVING, "RESET", MOVING, S.MOVING),  # MPI 000, MPIMotionMessageMOVING "... or RESET is commanded ... MOVING"
     (S.MOVING, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
     (S.MOVING, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
     (S.MOVING, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction, 921
-    (S.MOVING, "MAP", MOVING, S.MOVING),  # MPI 000, Motion Objects, introduction maps "should NOT be changed when the axes are moving"
+    (S.MOVING, "MAP", MOVING, S.MOVING),  # MPI 000, Motion Objects, introduction maps "should NOT be changed when the
+                                          # axes are moving"
     # STOPPING
-    (S.STOPPING, "start", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING STOPPING from start "in the STOPPING state"
+    (S.STOPPING, "start", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING STOPPING from start "in the
+                                                  # STOPPING state"
     (S.STOPPING, "modify", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING "... or mpiMotionModify"
     (S.STOPPING, "STOP", STOPPING, S.STOPPING),  # docs/state-machine.md: STOP in STOPPING "msg STOPPING"
-    (S.STOPPING, "RESUME", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING "RESUME or RESET ... STOPPING state"
+    (S.STOPPING, "RESUME", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING "RESUME or RESET ... STOPPING
+                                                   # state"
     (S.STOPPING, "RESET", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING
     (S.STOPPING, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction; DESIGN.md never refused
     (S.STOPPING, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
@@ -71,7 +85,8 @@ CELLS = [
     # STOPPED
     (S.STOPPED, "start", OK, S.MOVING),  # DESIGN.md: "A new start from STOPPED discards the pending profile"
     (S.STOPPED, "modify", STOPPED, S.STOPPED),  # docs/state-machine.md: modify in STOPPED "msg STOPPED"
-    (S.STOPPED, "STOP", STOPPED, S.STOPPED),  # MPI 000, MPIMotionMessageSTOPPED STOPPED "when a STOP ... already STOPPED"
+    (S.STOPPED, "STOP", STOPPED, S.STOPPED),  # MPI 000, MPIMotionMessageSTOPPED STOPPED "when a STOP ... already
+                                              # STOPPED"
     (S.STOPPED, "RESUME", OK, S.MOVING),  # MPI 000, MPIActionRESUME RESUME continues a motion stopped by STOP
     (S.STOPPED, "RESET", OK, S.IDLE),  # docs/state-machine.md: RESET in STOPPED "OK, to IDLE, pending dropped"
     (S.STOPPED, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
@@ -79,17 +94,21 @@ CELLS = [
     (S.STOPPED, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
     (S.STOPPED, "MAP", OK, S.STOPPED),  # docs/state-machine.md: MAP in STOPPED "OK"
     # STOPPING_ERROR
-    (S.STOPPING_ERROR, "start", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR from mpiMotionStart
-    (S.STOPPING_ERROR, "modify", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR "... or mpiMotionModify"
+    (S.STOPPING_ERROR, "start", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR from
+                                                                    # mpiMotionStart
+    (S.STOPPING_ERROR, "modify", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR "... or
+                                                                     # mpiMotionModify"
     (S.STOPPING_ERROR, "STOP", STOPPING_ERROR, S.STOPPING_ERROR),  # docs/state-machine.md
-    (S.STOPPING_ERROR, "RESUME", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR "RESUME or RESET"
+    (S.STOPPING_ERROR, "RESUME", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR "RESUME
+                                                                     # or RESET"
     (S.STOPPING_ERROR, "RESET", STOPPING_ERROR, S.STOPPING_ERROR),  # MPI 000, MPIMotionMessageSTOPPING_ERROR
     (S.STOPPING_ERROR, "E_STOP", OK, S.STOPPING_ERROR),  # docs/state-machine.md: safety actions "OK"
     (S.STOPPING_ERROR, "ABORT", OK, S.STOPPING_ERROR),  # docs/state-machine.md
     (S.STOPPING_ERROR, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # docs/state-machine.md
     (S.STOPPING_ERROR, "MAP", STOPPING_ERROR, S.STOPPING_ERROR),  # docs/state-machine.md: "msg STOPPING_ERROR"
     # ERROR
-    (S.ERROR, "start", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR ERROR from start "in an error state"; MPI 000, MPIMotionMessageERROR
+    (S.ERROR, "start", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR ERROR from start "in an error state"; MPI 000,
+                                         # MPIMotionMessageERROR
     (S.ERROR, "modify", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR "... or mpiMotionModify"
     (S.ERROR, "STOP", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR "when a STOP or RESUME is commanded ... ERROR"
     (S.ERROR, "RESUME", ERROR, S.ERROR),  # MPI 000, MPIMotionMessageERROR
@@ -149,8 +168,8 @@ def test_safety_actions_end_in_error(state, action, prepared):
 
 
 def test_modify_auto_start_in_idle_starts_and_answers_auto_start(prepared):
-    # MPI 000, MPIMotionMessageAUTO_START AUTO_START "returned from mpiMotionModify when the AUTO_START attribute mask was
-    # specified and the motion was commanded while the motion supervisor is in the IDLE state";
+    # MPI 000, MPIMotionMessageAUTO_START AUTO_START "returned from mpiMotionModify when the AUTO_START attribute mask
+    # was specified and the motion was commanded while the motion supervisor is in the IDLE state";
     # MPI 000, MPIMotionAttrAUTO_START "converts a mpiMotionModify(...) call to a mpiMotionStart(...)"
     ctl, ms = prepared(S.IDLE)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is Message.MPIMotionMessageAUTO_START
@@ -279,8 +298,8 @@ def test_reset_in_error_returns_to_idle_and_allows_a_start(prepared):
 
 @pytest.mark.parametrize("action", ["STOP", "E_STOP", "ABORT", "E_STOP_ABORT", "RESET", "RESUME", "MAP"])
 def test_actions_without_axes_answer_no_axes_mapped(action):
-    # MPI 000, MEIMotionMessageNO_AXES_MAPPED NO_AXES_MAPPED "returned by mpiMotionStart, mpiMotionModify or mpiMotionAction
-    # if there are no axes mapped to the motion object"
+    # MPI 000, MEIMotionMessageNO_AXES_MAPPED NO_AXES_MAPPED "returned by mpiMotionStart, mpiMotionModify or
+    # mpiMotionAction if there are no axes mapped to the motion object"
     ctl = Controller()
     _, ms = ctl.create_motion(0)
     assert ms.action(MPIAction[action]) is Message.MEIMotionMessageNO_AXES_MAPPED

@@ -1,6 +1,9 @@
 """Axis status bits (mpi_ros/mpi/status.py) exactly as the two tables at the end of spec 002
-(MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events) with NOTE 1-3 (MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events) say, settleOnStop/settleOnEstop (MPI 002, MPIAxisInPosition, settleOnStop,
-MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events) and settleOnEstopCmdEqAct (MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct).
+(MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events) with NOTE 1-3
+(MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events) say,
+settleOnStop/settleOnEstop (MPI 002, MPIAxisInPosition, settleOnStop, MPI 002, Configuration of
+IN_POSITION and DONE Events after STOP or E-STOP Events) and settleOnEstopCmdEqAct (MPI 002,
+MPIAxisInPosition, settleOnEstopCmdEqAct).
 
 The tests step one sample at a time and recompute each bit from its definition (the
 criteria and how many consecutive samples they held), next to the controller's answer.
@@ -14,8 +17,18 @@ import math
 
 import pytest
 
-from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, MotionAttr, MotionParams, MPIAction, MPIMotionType,
-                         MPIState, PlantConfig, Trajectory)
+from mpi_ros.mpi import (
+    AxisInPosition,
+    Controller,
+    ControllerConfig,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    PlantConfig,
+    Trajectory,
+)
 from mpi_ros.mpi.events import MPIEventType
 
 RATE = 2000.0
@@ -56,11 +69,13 @@ class Run:
 
 
 def test_bits_after_a_point_to_point_move_follow_note_3():
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION (settleOn* FALSE table, column "After S-curve or Trapezoidal Move"):
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION (settleOn*
+    # FALSE table, column "After S-curve or Trapezoidal Move"):
     # IN_FINE_POSITION per note 3, IN_COARSE_POSITION "Based on target distance", AT_TARGET "TRUE
     # when command = target", DONE "TRUE if both TC and IN_FINE_POSITION are true".
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events NOTE 3: TC, |target - actual| < fine, |command velocity - actual velocity|
-    # < velocity tolerance, "satisfied for a duration specified by the settling time parameter".
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events NOTE 3: TC, |target - actual| <
+    # fine, |command velocity - actual velocity| < velocity tolerance, "satisfied for a duration specified by the
+    # settling time parameter".
     tol = AxisInPosition(position_fine=5.0, position_coarse=200, velocity=50.0, settling_time=0.02)
     ctl, ms, axis = rig(tol)
     target, k0 = 2000.0, ctl.sample
@@ -84,8 +99,9 @@ def test_bits_after_a_point_to_point_move_follow_note_3():
 
 
 def test_velocity_tolerance_delays_in_fine_position():
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events "|command velocity - actual velocity| < velocity tolerance"; MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events "the default
-    # setting for velocity tolerance so large that this criteria is ignored"
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events "|command velocity - actual
+    # velocity| < velocity tolerance"; MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events
+    # "the default setting for velocity tolerance so large that this criteria is ignored"
     def fine_sample(velocity_tolerance):
         ctl, ms, axis = rig(AxisInPosition(position_fine=30.0, velocity=velocity_tolerance, settling_time=0.0))
         ms.start(MPIMotionType.TRAPEZOIDAL, params=trapezoid(1000.0))
@@ -99,8 +115,8 @@ def test_velocity_tolerance_delays_in_fine_position():
 
 
 def test_settling_time_zero_sets_in_fine_at_the_first_sample():
-    # MPI 002, MPIAxisInPosition, settlingTime settlingTime "Duration in seconds that an axis must satisfy the positionFine
-    # and/or velocity tolerance, before the respective status flag is set"
+    # MPI 002, MPIAxisInPosition, settlingTime settlingTime "Duration in seconds that an axis must satisfy the
+    # positionFine and/or velocity tolerance, before the respective status flag is set"
     def first(settling_time):
         ctl, ms, axis = rig(AxisInPosition(position_fine=5.0, settling_time=settling_time))
         ms.start(MPIMotionType.TRAPEZOIDAL, params=trapezoid(1000.0))
@@ -112,8 +128,8 @@ def test_settling_time_zero_sets_in_fine_at_the_first_sample():
 
 
 def test_bits_during_a_velocity_move_are_false():
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION column "During Velocity Move": IN_FINE_POSITION, IN_COARSE_POSITION,
-    # AT_TARGET and DONE are FALSE
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION column "During
+    # Velocity Move": IN_FINE_POSITION, IN_COARSE_POSITION, AT_TARGET and DONE are FALSE
     ctl, ms, axis = rig(AxisInPosition(position_coarse=10**9))
     ms.start(MPIMotionType.VELOCITY, params=MotionParams(trajectory=[Trajectory(500.0, 5000.0)]))
     for _ in range(60):
@@ -124,8 +140,8 @@ def test_bits_during_a_velocity_move_are_false():
 
 
 def test_at_velocity_after_the_ramp_within_tolerance_for_the_settling_time():
-    # MPI 002, MPIAxisInPosition, velocity velocity tolerance: "from the final move velocity at which the controller sets
-    # the at velocity status flag"; MPI 002, MPIAxisInPosition, settlingTime held for the settling time
+    # MPI 002, MPIAxisInPosition, velocity velocity tolerance: "from the final move velocity at which the controller
+    # sets the at velocity status flag"; MPI 002, MPIAxisInPosition, settlingTime held for the settling time
     tol = AxisInPosition(velocity=20.0, settling_time=0.01)
     ctl, ms, axis = rig(tol)
     k0 = ctl.sample
@@ -154,9 +170,11 @@ def stop_then_watch(action, tol, samples=3000):
 
 @pytest.mark.parametrize("action", [MPIAction.STOP, MPIAction.E_STOP])
 def test_after_stop_without_settle_done_is_command_velocity_zero(action):
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION (settleOnStop/settleOnEstop = FALSE, column "After STOP (E-STOP)"):
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION
+    # (settleOnStop/settleOnEstop = FALSE, column "After STOP (E-STOP)"):
     # IN_FINE_POSITION FALSE, IN_COARSE_POSITION FALSE, AT_TARGET FALSE, DONE "TRUE when command
-    # velocity = 0"; MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events "DONE to be based solely on command velocity"
+    # velocity = 0"; MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events "DONE to be based
+    # solely on command velocity"
     _, _, _, rows = stop_then_watch(action, AxisInPosition(position_fine=5.0, position_coarse=10**9))
     for _, _, cmd_v, _, _, _, bits in rows:
         assert not (bits.in_fine_position or bits.in_coarse_position or bits.at_target)
@@ -166,10 +184,11 @@ def test_after_stop_without_settle_done_is_command_velocity_zero(action):
 
 @pytest.mark.parametrize("action,flag", [(MPIAction.STOP, "settle_on_stop"), (MPIAction.E_STOP, "settle_on_estop")])
 def test_after_stop_with_settle_in_fine_follows_note_1(action, flag):
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION (settleOn* = TRUE, "After STOP (E-STOP)"): IN_FINE_POSITION "Based on
-    # position error (see note 1)", DONE "Same as IN_FINE_POSITION", IN_COARSE/AT_TARGET FALSE.
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events NOTE 1: trajectory complete, |command - actual| < fine, |target velocity -
-    # actual velocity| < velocity tolerance, held for the settling time.
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION (settleOn* =
+    # TRUE, "After STOP (E-STOP)"): IN_FINE_POSITION "Based on position error (see note 1)", DONE "Same as
+    # IN_FINE_POSITION", IN_COARSE/AT_TARGET FALSE.
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events NOTE 1: trajectory complete,
+    # |command - actual| < fine, |target velocity - actual velocity| < velocity tolerance, held for the settling time.
     tol = AxisInPosition(position_fine=5.0, velocity=20.0, settling_time=0.02, **{flag: True})
     _, _, _, rows = stop_then_watch(action, tol)
     run = Run()
@@ -187,8 +206,8 @@ def test_after_stop_with_settle_in_fine_follows_note_1(action, flag):
     (MPIAction.E_STOP, "settle_on_estop", MPIState.ERROR, 0.05),
 ])
 def test_settle_on_stop_keeps_the_state_until_settled(action, flag, state, decel):
-    # MPI 002, MPIAxisInPosition, settleOnStop settleOnStop: "the axis will stay in an MPIStateSTOPPING state until: 1. The
-    # settling criteria are satisfied AND 2. The stop duration ... has elapsed"; "If settleOnStop
+    # MPI 002, MPIAxisInPosition, settleOnStop settleOnStop: "the axis will stay in an MPIStateSTOPPING state until: 1.
+    # The settling criteria are satisfied AND 2. The stop duration ... has elapsed"; "If settleOnStop
     # = FALSE, the axis will stay in an MPIStateSTOPPING state only until the stop duration"
     # MPI 002, MPIAxisInPosition, settleOnEstop the same for settleOnEstop and MPIStateSTOPPING_ERROR
     def arrival(settle):
@@ -204,8 +223,9 @@ def test_settle_on_stop_keeps_the_state_until_settled(action, flag, state, decel
 
 
 def test_after_abort_only_done_is_true():
-    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION and MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION, column "After ABORT": IN_FINE_POSITION, IN_COARSE_POSITION,
-    # AT_TARGET FALSE; DONE TRUE (with either settle setting)
+    # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION and MPI 002,
+    # Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION, column "After ABORT":
+    # IN_FINE_POSITION, IN_COARSE_POSITION, AT_TARGET FALSE; DONE TRUE (with either settle setting)
     for settle in (False, True):
         tol = AxisInPosition(position_coarse=10**9, settle_on_stop=settle, settle_on_estop=settle)
         _, ms, _, rows = stop_then_watch(MPIAction.ABORT, tol, samples=2000)
@@ -216,10 +236,10 @@ def test_after_abort_only_done_is_true():
 
 
 def test_settle_on_estop_cmd_eq_act_command_follows_previous_actual():
-    # MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct settleOnEstopCmdEqAct: "During an Estop, Cmd Eq Act action, the command position
-    # is set equal to the actual position from the previous servo sample"; MPI 002, MPIAxisInPosition "for the amount
-    # of time that the Axis' Motion Supervisor Estop time"; MPI 002, MPIAxisInPosition "After the Estop time elapses,
-    # the axis' motors will disable the amplifiers."
+    # MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct settleOnEstopCmdEqAct: "During an Estop, Cmd Eq Act action, the
+    # command position is set equal to the actual position from the previous servo sample"; MPI 002, MPIAxisInPosition
+    # "for the amount of time that the Axis' Motion Supervisor Estop time"; MPI 002, MPIAxisInPosition "After the Estop
+    # time elapses, the axis' motors will disable the amplifiers."
     ctl, ms, axis = rig(AxisInPosition(settle_on_estop_cmd_eq_act=True))
     ms.start(MPIMotionType.TRAPEZOIDAL, params=trapezoid(50_000.0))
     ctl.step(1000)
@@ -238,8 +258,8 @@ def test_settle_on_estop_cmd_eq_act_command_follows_previous_actual():
 
 
 def test_without_cmd_eq_act_e_stop_ramps_the_command():
-    # MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct "During normal motion, there is no difference" / E_STOP otherwise decelerates
-    # the command (MPI 000, MPIActionE_STOP): the command does not copy the actual position
+    # MPI 002, MPIAxisInPosition, settleOnEstopCmdEqAct "During normal motion, there is no difference" / E_STOP
+    # otherwise decelerates the command (MPI 000, MPIActionE_STOP): the command does not copy the actual position
     ctl, ms, axis = rig(AxisInPosition())
     ms.start(MPIMotionType.TRAPEZOIDAL, params=trapezoid(50_000.0))
     ctl.step(1000)
@@ -252,7 +272,8 @@ def test_without_cmd_eq_act_e_stop_ramps_the_command():
 
 
 def test_settled_event_when_the_axis_rests_on_its_command():
-    # MPI 002, MPIAxisInPosition, positionFine positionFine is "used as part of the Axis settling criteria to determine ...
+    # MPI 002, MPIAxisInPosition, positionFine positionFine is "used as part of the Axis settling criteria to determine
+    # ...
     # when MPIEventTypeMOTION_DONE and MEIEventTypeSETTLED events are generated"
     ctl, ms, axis = rig(AxisInPosition(position_fine=5.0, settling_time=0.01))
     ms.start(MPIMotionType.TRAPEZOIDAL, params=trapezoid(1000.0))

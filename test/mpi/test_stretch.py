@@ -14,8 +14,20 @@ import random
 
 import pytest
 
-from mpi_ros.mpi import (AxisInPosition, Controller, ControllerConfig, Hold, HoldType, MotionAttr, MotionParams,
-                         MPIAction, MPIMotionType, PlantConfig, Trajectory, control)
+from mpi_ros.mpi import (
+    AxisInPosition,
+    Controller,
+    ControllerConfig,
+    Hold,
+    HoldType,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    PlantConfig,
+    Trajectory,
+    control,
+)
 from mpi_ros.mpi.plant import Plant
 
 _VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")
@@ -102,7 +114,7 @@ def test_rows_equal_the_one_axis_code_over_a_long_cruise(compared):
     for number, start in enumerate((600.0, 600.0, -400.0, -400.0)):
         assert ctl.axis_command_position_set(number, start).ok
     ctl.step(4000)  # settled there
-    for ms, velocity in zip(supervisors, (-150.0, 90.0)):
+    for ms, velocity in zip(supervisors, (-150.0, 90.0), strict=True):
         ms.start(MPIMotionType.VELOCITY, MotionAttr.NONE,
                  MotionParams(trajectory=[Trajectory(velocity, 2000.0, 0.0, 0.0)]))
     while ctl.sample < 24_000:

@@ -75,6 +75,6 @@ def test_modifiable_types_are_the_spec_list(kind):
 
 def test_jerk_types_are_the_firmware_option_types():
     # MPI 000, MPIMotionType S_CURVE_JERK and VELOCITY_JERK are only available with firmware option 21
-    assert JERK_TYPES == {MPIMotionType.S_CURVE_JERK, MPIMotionType.VELOCITY_JERK}
+    assert {MPIMotionType.S_CURVE_JERK, MPIMotionType.VELOCITY_JERK} == JERK_TYPES
     for kind in (MPIMotionType.PTF, MPIMotionType.SPLINE, MPIMotionType.FRAME, MPIMotionType.CAM_LINEAR):
         assert kind not in MODIFIABLE_TYPES

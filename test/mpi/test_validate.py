@@ -1,5 +1,6 @@
 """Validation of start/modify (mpi_ros/mpi/validate.py): spec 000's return table
-(MPI 000, Returns for mpiMotionStart and mpiMotionModify), the ATTRIBUTE_INVALID causes (MPI 000, MPIMotionMessageATTRIBUTE_INVALID) and DESIGN.md's array rules.
+(MPI 000, Returns for mpiMotionStart and mpiMotionModify), the ATTRIBUTE_INVALID causes
+(MPI 000, MPIMotionMessageATTRIBUTE_INVALID) and DESIGN.md's array rules.
 A refused command answers the spec's message and changes nothing."""
 
 from __future__ import annotations
@@ -8,11 +9,20 @@ import math
 
 import pytest
 
-from mpi_ros.mpi import (Controller, Hold, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState, Output,
-                         Trajectory)
-from mpi_ros.mpi.params import MotionConfig
+from mpi_ros.mpi import (
+    Controller,
+    Hold,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Output,
+    Trajectory,
+)
 from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.types import HoldType, OutputType
+from mpi_ros.mpi.params import MotionConfig
+from mpi_ros.mpi.types import PATH_ATTRS, HoldType, OutputType
 from mpi_ros.mpi.validate import check_attributes, check_params, check_type
 
 A = MotionAttr
@@ -44,8 +54,8 @@ def test_type_invalid():
 @pytest.mark.parametrize("kind", [T.S_CURVE_JERK, T.VELOCITY_JERK])
 @pytest.mark.parametrize("modify", [False, True])
 def test_jerk_types_without_firmware_option_21_are_not_supported(kind, modify):
-    # MPI 000, MPIMotionMessagePROFILE_NOT_SUPPORTED PROFILE_NOT_SUPPORTED "returned by mpiMotionStart or mpiMotionModify when an
-    # S_CURVE_JERK or VELOCITY_JERK motion type is commanded, but not supported by the firmware"
+    # MPI 000, MPIMotionMessagePROFILE_NOT_SUPPORTED PROFILE_NOT_SUPPORTED "returned by mpiMotionStart or
+    # mpiMotionModify when an S_CURVE_JERK or VELOCITY_JERK motion type is commanded, but not supported by the firmware"
     assert check_type(kind, modify, False).message is M.MPIMotionMessagePROFILE_NOT_SUPPORTED
     # DESIGN.md: "on by configuration"
     assert check_type(kind, modify, True).ok
@@ -76,24 +86,32 @@ def test_point_to_point_and_velocity_types_are_accepted(kind, modify):
 # ------------------------------------------------------------------ attributes ----
 @pytest.mark.parametrize("kind", [T.PT, T.PTF, T.PVT, T.PVTF, T.BESSEL, T.BSPLINE, T.BSPLINE2])
 def test_path_types_allow_exactly_their_list(kind):
-    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "PT (PTF, PVT, PVTF, BESSEL, BSPLINE, BSPLINE2) Moves are only permitted
-    # to have motion attributes from the following list: APPEND RELATIVE ID ELEMENT_ID HOLD
-    # HOLD_LESS HOLD_GREATER OUTPUT"
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "PT (PTF, PVT, PVTF, BESSEL, BSPLINE, BSPLINE2) Moves are only
+    # permitted to have motion attributes from the following list: APPEND RELATIVE ID ELEMENT_ID HOLD
+    # HOLD_LESS HOLD_GREATER OUTPUT", and the path attributes of MPI 001, MPIMotionPathAttrMask
     params = full_params()
     for attr in ALL_ATTRS:
         verdict = check_attributes(kind, attr, params, modify=False)
-        if attr in PATH_ALLOWED:
+        if attr in PATH_ALLOWED or attr in PATH_ATTRS:
             assert verdict.ok, attr
         else:
             assert verdict.message is M.MPIMotionMessageATTRIBUTE_INVALID, attr
 
 
 def test_spline_allows_the_list_without_append():
-    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID SPLINE: RELATIVE ID ELEMENT_ID HOLD HOLD_LESS HOLD_GREATER OUTPUT (no APPEND)
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID SPLINE: RELATIVE ID ELEMENT_ID HOLD HOLD_LESS HOLD_GREATER OUTPUT (no
+    # APPEND)
     params = full_params()
     assert check_attributes(T.SPLINE, A.APPEND, params, False).message is M.MPIMotionMessageATTRIBUTE_INVALID
-    for attr in PATH_ALLOWED[1:]:
+    for attr in PATH_ALLOWED[1:] + list(PATH_ATTRS):
         assert check_attributes(T.SPLINE, attr, params, False).ok
+
+
+@pytest.mark.parametrize("kind", [T.TRAPEZOIDAL, T.S_CURVE, T.VELOCITY, T.FRAME])
+def test_path_attributes_belong_to_path_moves(kind):
+    # MPI 001, MPIMotionPathAttrMask: the attributes of path motion
+    for attr in PATH_ATTRS:
+        assert check_attributes(kind, attr, full_params(), False).message is M.MPIMotionMessageATTRIBUTE_INVALID, attr
 
 
 def test_frame_allows_append_and_id_only():
@@ -114,7 +132,8 @@ def test_velocity_moves_refuse_sync_final_vel_no_reversal(kind, attr):
 
 @pytest.mark.parametrize("attr", [A.APPEND, A.AUTO_START, A.DELAY, A.ID, A.RELATIVE, A.EVENT, A.OUTPUT, A.HOLD])
 def test_velocity_moves_allow_the_other_attributes(attr):
-    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID only SYNC_END/SYNC_START/FINAL_VEL/NO_REVERSAL are forbidden for VELOCITY
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID only SYNC_END/SYNC_START/FINAL_VEL/NO_REVERSAL are forbidden for
+    # VELOCITY
     assert check_attributes(T.VELOCITY, attr, full_params(), False).ok
 
 
@@ -125,7 +144,8 @@ def test_cam_attributes_on_a_point_to_point_move(attr):
 
 
 def test_no_backtrack_and_no_backtrack_hold_exclude_each_other():
-    # MPI 000, MPIMotionAttrREPEAT_NO_BACKTRACK "This attribute cannot be specified with the MPIMotionAttrNO_BACKTRACK attribute"
+    # MPI 000, MPIMotionAttrREPEAT_NO_BACKTRACK "This attribute cannot be specified with the MPIMotionAttrNO_BACKTRACK
+    # attribute"
     verdict = check_attributes(T.CAM_LINEAR, A.NO_BACKTRACK | A.NO_BACKTRACK_HOLD, full_params(), False)
     assert verdict.message is M.MPIMotionMessageATTRIBUTE_INVALID
     assert check_attributes(T.CAM_LINEAR, A.NO_BACKTRACK, full_params(), False).ok
@@ -148,8 +168,8 @@ def test_attribute_with_null_data_is_attribute_invalid(attr, field):
 
 @pytest.mark.parametrize("attr", [A.HOLD, A.HOLD_LESS, A.HOLD_GREATER])
 def test_hold_attributes_are_not_permitted_on_modify(attr):
-    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "HOLD, HOLD_LESS, and HOLD_GREATER are not permitted during motion modifies";
-    # MPI 000, MEIMotionAttrHOLD
+    # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "HOLD, HOLD_LESS, and HOLD_GREATER are not permitted during motion
+    # modifies"; MPI 000, MEIMotionAttrHOLD
     assert check_attributes(T.TRAPEZOIDAL, attr, full_params(), True).message is M.MPIMotionMessageATTRIBUTE_INVALID
     assert check_attributes(T.TRAPEZOIDAL, attr, full_params(), False).ok
 
@@ -175,8 +195,8 @@ def test_arg_invalid_past_max_coord_axes():
 
 
 def test_one_trajectory_without_sync():
-    # MPI 000, MPIMotionAttrMaskNO_BACKTRACK_HOLD, remarks "if neither SYNC_START nor SYNC_END are specified, then only one MPITrajectory
-    # structure will be used"; DESIGN.md: anything else is MPIMessagePARAM_INVALID
+    # MPI 000, MPIMotionAttrMaskNO_BACKTRACK_HOLD, remarks "if neither SYNC_START nor SYNC_END are specified, then only
+    # one MPITrajectory structure will be used"; DESIGN.md: anything else is MPIMessagePARAM_INVALID
     assert params_verdict(p2p(trajectory=[TRAJ])).ok
     assert params_verdict(p2p(trajectory=[TRAJ, TRAJ])).message is M.MPIMessagePARAM_INVALID
     assert params_verdict(p2p(trajectory=[])).message is M.MPIMessagePARAM_INVALID
@@ -221,7 +241,8 @@ def test_velocity_move_velocity_may_be_negative_or_zero():
 
 @pytest.mark.parametrize("jerk_percent,ok", [(0.0, True), (100.0, True), (-0.1, False), (100.1, False)])
 def test_jerk_percent_within_0_and_100(jerk_percent, ok):
-    # MPI 000, MPIMotionSCurve S-curve parameters are velocity, acceleration, deceleration and jerkPercent (a percentage)
+    # MPI 000, MPIMotionSCurve S-curve parameters are velocity, acceleration, deceleration and jerkPercent (a
+    # percentage)
     traj = Trajectory(1000.0, 10_000.0, 10_000.0, jerk_percent)
     assert params_verdict(p2p(trajectory=[traj]), kind=T.S_CURVE).ok is ok
 
@@ -263,7 +284,8 @@ def test_per_axis_attribute_arrays(attr, field, value):
     (Hold(type=HoldType.INPUT, address=64), False),  # DESIGN.md: address = index of an I/O word
     (Hold(type=HoldType.MOTOR_GENERAL_IO, number=3), True),
     (Hold(type=HoldType.MOTOR_DEDICATED_IO, number=4), False),
-    (Hold(type=HoldType.AXIS_POSITION_ACTUAL, number=4), False),  # MPI 000, MEIMotionAttrHoldSource, axis.number an axis's number
+    (Hold(type=HoldType.AXIS_POSITION_ACTUAL, number=4), False),  # MPI 000, MEIMotionAttrHoldSource, axis.number an
+                                                                  # axis's number
     (Hold(type=HoldType.AXIS_POSITION_COMMAND, number=3, position=5.0), True),
     (Hold(type=HoldType.INVALID), False),
     (Hold(type=HoldType.GATE, timeout=-1.0), False),
@@ -329,8 +351,8 @@ def test_empty_count_past_a_c_long_is_param_invalid():
 
 # ------------------------------------------------------------------ through the supervisor ----
 def test_start_with_no_axes_answers_axis_count(ctl):
-    # MPI 000, MPIMotionMessageAXIS_COUNT MPIMotionMessageAXIS_COUNT "if the motion object has no axes"; MPI 000, MPIMotionMessageAXIS_COUNT;
-    # MPI 000, mpiMotionStart "There must be at least one Axis in the coordinate system"
+    # MPI 000, MPIMotionMessageAXIS_COUNT MPIMotionMessageAXIS_COUNT "if the motion object has no axes"; MPI 000,
+    # MPIMotionMessageAXIS_COUNT; MPI 000, mpiMotionStart "There must be at least one Axis in the coordinate system"
     _, ms = ctl.create_motion(0)
     assert ms.start(T.TRAPEZOIDAL, params=p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT
     assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT

@@ -88,11 +88,12 @@ def test_diagnostics_go_to_error_on_e_stop(suite, client, probe, applied, drive)
 
 
 def test_clock_follows_the_controller(suite, probe, drive):
-    from rosgraph_msgs.msg import Clock
     from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from rosgraph_msgs.msg import Clock
 
     ticks = []
-    probe.create_subscription(Clock, "/clock", ticks.append, QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT))
+    probe.create_subscription(Clock, "/clock", ticks.append,
+                              QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT))
     drive(lambda: len(ticks) >= 3, chunk=20)
     stamps = [t.clock.sec * 1_000_000_000 + t.clock.nanosec for t in ticks[:3]]
     period = round(1e9 / suite.config.ros.clock_rate)
@@ -138,7 +139,8 @@ def test_gate_holds_a_move_until_it_opens(suite, client, probe, service, applied
     applied.wait(2)
     suite.runner.step(2000)
     # MPI 000, MEIMotionAttrHOLD "the motion will be held until a call to mpiControlGateSet() with closed=FALSE"
-    assert suite.runner.read(lambda ctl: (ctl.axes[0].command_position, ctl.supervisor(0).state.name)) == (0.0, "MOVING")
+    held = suite.runner.read(lambda ctl: (ctl.axes[0].command_position, ctl.supervisor(0).state.name))
+    assert held == (0.0, "MOVING")
     service(probe, GateSet, "/mpi/gate_set", GateSet.Request(gate=7, closed=False))
     drive(lambda: goal.done)
     assert list(goal.wait().command_position) == [300.0, 0.0]
@@ -157,4 +159,5 @@ def test_io_services_and_an_input_hold(suite, client, probe, service, applied, d
     assert service(probe, IoGet, "/mpi/io_get", IoGet.Request(space="IO", index=3)).value == 0x6
     drive(lambda: goal.done)
     assert goal.wait().message == "MPIMessageOK"
-    assert service(probe, IoGet, "/mpi/io_get", IoGet.Request(space="TAPE", index=0)).message == "MPIMessagePARAM_INVALID"
+    refused = service(probe, IoGet, "/mpi/io_get", IoGet.Request(space="TAPE", index=0))
+    assert refused.message == "MPIMessagePARAM_INVALID"

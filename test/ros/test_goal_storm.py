@@ -121,7 +121,7 @@ class GoalSender:
     def wait_status(self, indices, status: int, timeout: float = WAIT) -> None:
         """Until the action servers publish every goal of ``indices`` in ``status``."""
         handles = self.wait_answers(indices)
-        ids = [(self._server_of[i], bytes(h.goal_id.uuid)) for i, h in zip(indices, handles)]
+        ids = [(self._server_of[i], bytes(h.goal_id.uuid)) for i, h in zip(indices, handles, strict=True)]
 
         def seen() -> list[int]:
             return [self._statuses.get(key, {}).get(uuid, GoalStatus.STATUS_UNKNOWN) for key, uuid in ids]

@@ -74,7 +74,7 @@ def test_each_parameter_has_its_own_descriptor_with_type_range_and_description()
         node = Node("controller", namespace="/param_test", context=context)
         parameters.show(node, config.load(), 1.0)
         names = sorted(parameters.SPECS)
-        descriptors = dict(zip(names, node.describe_parameters(names)))
+        descriptors = dict(zip(names, node.describe_parameters(names), strict=True))
         values = {name: node.get_parameter(name).value for name in names}
         node.destroy_node()
     finally:

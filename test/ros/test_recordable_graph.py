@@ -204,6 +204,7 @@ def test_each_parameter_has_its_own_descriptor(suite, probe, service):
     assert by_name["config"].type == ParameterType.PARAMETER_STRING
     assert by_name["crosscheck"].type == ParameterType.PARAMETER_BOOL
     assert by_name["status_rate"].type == ParameterType.PARAMETER_DOUBLE
-    assert by_name["status_rate"].floating_point_range and by_name["status_rate"].floating_point_range[0].to_value == 1000.0
+    status_range = by_name["status_rate"].floating_point_range
+    assert status_range and status_range[0].to_value == 1000.0
     assert len({d.description for d in described}) == len(names)  # not one shared text
     assert all(d.read_only for d in described)

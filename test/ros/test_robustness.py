@@ -107,7 +107,7 @@ def test_fuzzed_goals_through_the_action_server(suite, client, drive):
     ]
     for goal in weird:
         running = client.start(goal)
-        drive(lambda: running.done)  # a valid one (names are case-insensitive) runs to its end
+        drive(lambda running=running: running.done)  # a valid one (names are case-insensitive) runs to its end
         assert running.wait(raise_on_error=False).message in Message.__members__
     assert suite.runner.read(lambda ctl: _finite_state(ctl))
 

@@ -33,7 +33,7 @@ def test_move_reaches_target_and_succeeds_with_ok(suite, client, applied, drive)
     assert goal.handle.status == GoalStatus.STATUS_SUCCEEDED
     assert (result.message, result.code, result.state_name) == ("MPIMessageOK", 0, "IDLE")
     assert list(result.command_position) == [1000.0, -250.0]  # exactly on target
-    assert all(abs(a - t) < 10.0 for a, t in zip(result.actual_position, [1000.0, -250.0]))  # positionFine
+    assert all(abs(a - t) < 10.0 for a, t in zip(result.actual_position, [1000.0, -250.0], strict=True))  # positionFine
     assert result.sample == sample and result.end_sample > sample
     # Never reported done while the axes still move: DONE needs the settled actual position.
     done_axes = suite.runner.read(lambda ctl: [ctl.axes[n].status.done for n in (0, 1)])
@@ -264,7 +264,8 @@ def test_config_and_params_services_round_trip(suite, probe, service):
     from mpi_ros.srv import MotionConfigGet, MotionConfigSet, MotionParamsGet, MotionParamsSet
 
     config = service(probe, MotionConfigGet, "/mpi/ms0/config_get", MotionConfigGet.Request())
-    # MPI 000, MPIMotionDecelTime, stop decelTime defaults .5 s / .05 s; MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate 1.0, pauseFeedrate 0.0
+    # MPI 000, MPIMotionDecelTime, stop decelTime defaults .5 s / .05 s; MPI 000, MPIMotionConfig, normalFeedrate
+    # normalFeedrate 1.0, pauseFeedrate 0.0
     assert (config.config.decel_time_stop, config.config.decel_time_e_stop) == pytest.approx((0.5, 0.05))
     assert (config.config.normal_feedrate, config.config.pause_feedrate) == (1.0, 0.0)
     assert list(config.config.axis_numbers) == [0, 1]
@@ -302,8 +303,16 @@ def test_start_with_stored_params(suite, client, probe, service, applied, drive)
 
 
 def test_axis_list_position_frame_buffer_and_event_services(suite, probe, service):
-    from mpi_ros.srv import (AxisListEdit, AxisListGet, EventNotifyGet, EventNotifySet, EventReset,
-                             FrameBufferStatusGet, PositionGet, PositionSet)
+    from mpi_ros.srv import (
+        AxisListEdit,
+        AxisListGet,
+        EventNotifyGet,
+        EventNotifySet,
+        EventReset,
+        FrameBufferStatusGet,
+        PositionGet,
+        PositionSet,
+    )
 
     listing = service(probe, AxisListGet, "/mpi/ms0/axis_list_get", AxisListGet.Request())
     assert list(listing.axis_numbers) == [0, 1] and list(listing.mapped_axis_numbers) == [0, 1]

@@ -13,6 +13,7 @@ acceleration for every ramp (spec 000 MPIMotionVelocity: "deceleration is ignore
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 
@@ -35,9 +36,26 @@ class Ramp:
         return 0.5 * (self.v_start + self.v_end) * self.duration
 
 
-def _ramp_rate(v_from: float, v_to: float, accel: float, decel: float) -> float:
-    """Rate of a ramp that does not cross zero."""
-    return accel if abs(v_to) > abs(v_from) else decel
+def _ramp_maker() -> Callable[[float, float, float], Ramp]:
+    """``Ramp(duration, v_start, v_end)`` in half the time (its slots set directly, not
+    through object.__setattr__ as a frozen dataclass' __init__ does), for planning."""
+    new = object.__new__
+    # The slots' member descriptors (from the class' __dict__: the type checker takes Ramp.duration
+    # for a float, as the fields of a dataclass without slots would be).
+    slots = Ramp.__dict__
+    set_duration, set_v_start, set_v_end = slots["duration"].__set__, slots["v_start"].__set__, slots["v_end"].__set__
+
+    def ramp(duration: float, v_start: float, v_end: float) -> Ramp:
+        made = new(Ramp)
+        set_duration(made, duration)
+        set_v_start(made, v_start)
+        set_v_end(made, v_end)
+        return made
+
+    return ramp
+
+
+_ramp = _ramp_maker()
 
 
 def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> list[Ramp]:
@@ -46,30 +64,35 @@ def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> lis
         return []
     if v_from * v_to < 0.0:
         return ramps_between(v_from, 0.0, accel, decel) + ramps_between(0.0, v_to, accel, decel)
-    rate = _ramp_rate(v_from, v_to, accel, decel)
-    return [Ramp(abs(v_to - v_from) / rate, v_from, v_to)]
+    rate = accel if abs(v_to) > abs(v_from) else decel  # the ramp does not cross zero
+    return [_ramp(abs(v_to - v_from) / rate, v_from, v_to)]
 
 
 def _ramp_time(v_from: float, v_to: float, accel: float, decel: float) -> float:
     return sum(r.duration for r in ramps_between(v_from, v_to, accel, decel))
 
 
-def _first_ramp_coefficients(u0: float, w: float, accel: float, decel: float) -> tuple[float, float]:
-    """Distance of the ramp u0 -> w as alpha*w^2 + beta (directional coordinates)."""
+def _total_time(peak: float, cruise: float, v_start: float, v_final: float, accel: float, decel: float) -> float:
+    """Duration of the plan v_start -> peak, cruise, peak -> v_final."""
+    return _ramp_time(v_start, peak, accel, decel) + cruise + _ramp_time(peak, v_final, accel, decel)
+
+
+def _coefficients(u0: float, uf: float, w: float, accel: float, decel: float) -> tuple[float, float]:
+    """Distance of the ramps u0 -> w -> uf as alpha*w^2 + beta (directional coordinates), on
+    the piece of w that contains ``w``: the first ramp's alpha and beta plus the last's."""
     if u0 < 0.0:
-        return 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * decel)
-    if w >= u0:
-        return 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * accel)
-    return -1.0 / (2.0 * decel), u0 * u0 / (2.0 * decel)
-
-
-def _last_ramp_coefficients(w: float, uf: float, accel: float, decel: float) -> tuple[float, float]:
-    """Distance of the ramp w -> uf as alpha*w^2 + beta (directional coordinates)."""
+        a1, b1 = 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * decel)
+    elif w >= u0:
+        a1, b1 = 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * accel)
+    else:
+        a1, b1 = -1.0 / (2.0 * decel), u0 * u0 / (2.0 * decel)
     if uf < 0.0:
-        return 1.0 / (2.0 * decel), -uf * uf / (2.0 * accel)
-    if w >= uf:
-        return 1.0 / (2.0 * decel), -uf * uf / (2.0 * decel)
-    return -1.0 / (2.0 * accel), uf * uf / (2.0 * accel)
+        a2, b2 = 1.0 / (2.0 * decel), -uf * uf / (2.0 * accel)
+    elif w >= uf:
+        a2, b2 = 1.0 / (2.0 * decel), -uf * uf / (2.0 * decel)
+    else:
+        a2, b2 = -1.0 / (2.0 * accel), uf * uf / (2.0 * accel)
+    return a1 + a2, b1 + b2
 
 
 def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float, decel: float):
@@ -81,33 +104,34 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
     piecewise alpha*w^2 + beta with breakpoints at u0 and uf; the fastest profile uses
     the largest w with F(w) <= x and cruises at w for the rest.
     """
-
-    def coefficients(w_mid: float) -> tuple[float, float]:
-        a1, b1 = _first_ramp_coefficients(u0, w_mid, accel, decel)
-        a2, b2 = _last_ramp_coefficients(w_mid, uf, accel, decel)
-        return a1 + a2, b1 + b2
-
-    def distance(w: float, w_mid: float) -> float:
-        alpha, beta = coefficients(w_mid)
-        return alpha * w * w + beta
-
-    points = sorted({0.0, vmax} | {u for u in (u0, uf) if 0.0 < u < vmax})
     tolerance = 1e-12 * max(1.0, abs(x))
+    if u0 == 0.0 and uf == 0.0 and x + tolerance < 0.0 and 1.0 / (2.0 * accel) + 1.0 / (2.0 * decel) < math.inf:
+        # From rest to rest, away from the target: F(w) = alpha*w^2 with a finite alpha is 0 at
+        # w = 0 and grows, so the scan below would find every breakpoint overshooting.
+        return None
+    if 0.0 < u0 < vmax or 0.0 < uf < vmax:
+        points = [0.0, *sorted({u for u in (u0, uf) if 0.0 < u < vmax}), vmax]  # the breakpoints, ascending
+    else:
+        points = [0.0, vmax]
+    top = len(points) - 1
+    piece = -1
     # Scan the breakpoints from the top: the first one that does not overshoot bounds w.
-    for i in range(len(points) - 1, -1, -1):
+    for i in range(top, -1, -1):
+        # F at a breakpoint is that of the piece above it (below it at vmax): the top two
+        # breakpoints share a piece, whose coefficients are calculated once
+        k = min(i, top - 1)
+        if k != piece:
+            piece = k
+            alpha, beta = _coefficients(u0, uf, 0.5 * (points[k] + points[k + 1]), accel, decel)
         lo = points[i]
-        upper_mid = 0.5 * (lo + points[i + 1]) if i + 1 < len(points) else lo
-        lower_mid = 0.5 * (points[i - 1] + lo) if i > 0 else lo
-        f_lo = distance(lo, upper_mid if i + 1 < len(points) else lower_mid)
+        f_lo = alpha * lo * lo + beta
         if f_lo > x + tolerance:
             continue
-        if i == len(points) - 1:  # even the top speed leaves distance: cruise at vmax
+        if i == top:  # even the top speed leaves distance: cruise at vmax
             cruise = (x - f_lo) / vmax if vmax > 0.0 else 0.0
             return vmax, max(0.0, cruise)
-        hi = points[i + 1]
-        alpha, beta = coefficients(upper_mid)
         w = math.sqrt(max(0.0, (x - beta) / alpha)) if alpha > 0.0 else lo
-        return min(max(w, lo), hi), 0.0
+        return min(max(w, lo), points[i + 1]), 0.0
     return None
 
 
@@ -129,41 +153,37 @@ def plan_point_to_point(
         raise ProfileError("velocity, acceleration and deceleration must be positive")
     if abs(v_final) > vmax * (1.0 + 1e-12):
         raise ProfileError("final velocity exceeds the trajectory velocity")
-    best = None
+    found = []
     for direction in (1.0, -1.0):
-        found = _peak_in_direction(
+        peak_cruise = _peak_in_direction(
             direction * distance, direction * v_start, direction * v_final, vmax, accel, decel
         )
-        if found is None:
-            continue
-        w, cruise = found
-        peak = direction * w
-        total = (
-            _ramp_time(v_start, peak, accel, decel)
-            + cruise
-            + _ramp_time(peak, v_final, accel, decel)
-        )
-        if best is None or total < best[0] - 1e-15:
-            best = (total, peak, cruise)
-    if best is None:
+        if peak_cruise is not None:
+            found.append((direction * peak_cruise[0], peak_cruise[1]))
+    if not found:
         raise ProfileError("no profile reaches the target")
-    _, peak, cruise = best
+    peak, cruise = found[0]
+    # Both directions reach the target: the other only if it is faster. The times are
+    # needed for this comparison alone, so they are not calculated otherwise.
+    if len(found) == 2 and _total_time(*found[1], v_start, v_final, accel, decel) < _total_time(
+            peak, cruise, v_start, v_final, accel, decel) - 1e-15:
+        peak, cruise = found[1]
     plan = ramps_between(v_start, peak, accel, decel)
     if cruise > 0.0:
-        plan.append(Ramp(cruise, peak, peak))
+        plan.append(_ramp(cruise, peak, peak))
     plan += ramps_between(peak, v_final, accel, decel)
     return _absorb_rounding(plan, distance)
 
 
 def _absorb_rounding(plan: list[Ramp], distance: float) -> list[Ramp]:
     """Let the cruise (if any) absorb the last rounding error of the distance."""
-    error = distance - sum(r.distance for r in plan)
+    # each ramp's distance as Ramp.distance calculates it, without a call per ramp
+    error = distance - sum([0.5 * (r.v_start + r.v_end) * r.duration for r in plan])
     if not math.isfinite(error):
         raise ProfileError("the profile cannot be calculated with these values (overflow)")
     for i, ramp in enumerate(plan):
-        if ramp.is_cruise and ramp.v_start != 0.0:
-            duration = max(0.0, ramp.duration + error / ramp.v_start)
-            plan[i] = Ramp(duration, ramp.v_start, ramp.v_end)
+        if ramp.v_start == ramp.v_end and ramp.v_start != 0.0:  # a cruise (Ramp.is_cruise)
+            plan[i] = _ramp(max(0.0, ramp.duration + error / ramp.v_start), ramp.v_start, ramp.v_end)
             break
     return plan
 

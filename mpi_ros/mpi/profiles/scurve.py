@@ -11,27 +11,27 @@ f = 0 is the trapezoid itself.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from .ramps import ProfileError, Ramp
-from .segment import Segment
+from .segment import Segment, segment_of
 
 
 def ramp_pieces(ramp: Ramp, fraction: float) -> list[tuple[float, float, float]]:
     """(duration, start acceleration, jerk) pieces of one ramp or cruise."""
-    dv = ramp.v_end - ramp.v_start
-    trapezoid = [(ramp.duration, dv / ramp.duration if ramp.duration > 0.0 else 0.0, 0.0)]
-    jerk_time = 0.5 * fraction * ramp.duration
-    # a cruise, f = 0, or jerk phases too short to represent (tiny jerkPercent, or a ramp of ~1e-324 s)
-    if ramp.is_cruise or jerk_time <= 0.0:
-        return trapezoid
-    flat_time = (1.0 - fraction) * ramp.duration
-    peak = dv / (ramp.duration * (1.0 - 0.5 * fraction))
-    jerk = peak / jerk_time
-    if not math.isfinite(jerk):
-        # jerkPercent so small (~1e-308) that the jerk overflows: it would make the positions NaN.
-        return trapezoid
-    return [(jerk_time, 0.0, jerk), (flat_time, peak, 0.0), (jerk_time, peak, -jerk)]
+    duration, v_start, v_end = ramp.duration, ramp.v_start, ramp.v_end
+    dv = v_end - v_start
+    jerk_time = 0.5 * fraction * duration
+    # The S-curve's three pieces, unless this is a cruise, f = 0, the jerk phases are too short
+    # to represent (tiny jerkPercent, or a ramp of ~1e-324 s), or the jerk overflows (jerkPercent
+    # ~1e-308: the positions would be NaN). Then the trapezoid's ramp.
+    if not (v_start == v_end or jerk_time <= 0.0):
+        flat_time = (1.0 - fraction) * duration
+        peak = dv / (duration * (1.0 - 0.5 * fraction))
+        jerk = peak / jerk_time
+        if math.isfinite(jerk):
+            return [(jerk_time, 0.0, jerk), (flat_time, peak, 0.0), (jerk_time, peak, -jerk)]
+    return [(duration, dv / duration if duration > 0.0 else 0.0, 0.0)]
 
 
 def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segment]:
@@ -41,13 +41,15 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
         raise ProfileError("jerkPercent must be within 0..100")
     fraction = jerk_percent / 100.0
     segments: list[Segment] = []
+    append = segments.append
     p = p0
     for ramp in plan:
         v = ramp.v_start
-        for duration, accel, jerk in ramp_pieces(ramp, fraction):
-            if duration <= 0.0:
+        for t, a, j in ramp_pieces(ramp, fraction):
+            if t <= 0.0:
                 continue
-            seg = Segment(duration, p, v, accel, jerk)
-            segments.append(seg)
-            p, v, _ = seg.end_state()
+            append(segment_of(t, p, v, a, j))
+            # Where the segment ends, as Segment.end_state computes it (the same operations in
+            # the same order), without the method calls: the next piece starts there.
+            p, v = p + t * (v + t * (a / 2.0 + t * j / 6.0)), v + t * (a + t * j / 2.0)
     return segments

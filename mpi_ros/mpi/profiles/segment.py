@@ -7,14 +7,20 @@ seconds of profile time with jerk ``j``. A 1-D profile is a contiguous tuple of 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, fields
+from functools import reduce
+from itertools import chain as _chain_iterables
+from operator import add, attrgetter
 
 import numpy as np
 
 
 @dataclass(frozen=True, slots=True)
 class Segment:
+    """Planning builds many: :func:`segment_of` makes them faster than ``Segment(...)`` (keep
+    it in step if this class ever validates its fields)."""
+
     duration: float
     p: float
     v: float
@@ -32,11 +38,44 @@ class Segment:
     def end_state(self) -> tuple[float, float, float]:
         return self.state_at(self.duration)
 
-    def scaled(self, factor: float, offset: float) -> "Segment":
+    def scaled(self, factor: float, offset: float) -> Segment:
         """The segment of an axis that moves ``factor`` times this 1-D profile."""
-        return Segment(
+        return segment_of(
             self.duration, offset + factor * self.p, factor * self.v, factor * self.a, factor * self.j
         )
+
+
+def _segment_maker() -> Callable[[float, float, float, float, float], Segment]:
+    """``Segment(duration, p, v, a, j)`` in half the time: a frozen dataclass' __init__ sets
+    each field through object.__setattr__; this sets the slots directly. Planning makes a
+    segment per constant-jerk piece of every axis, and a modify is planned while its command
+    waits for its sample."""
+    new = object.__new__
+    set_duration, set_p, set_v, set_a, set_j = (getattr(Segment, f.name).__set__ for f in fields(Segment))
+
+    def segment_of(duration: float, p: float, v: float, a: float, j: float) -> Segment:
+        seg = new(Segment)
+        set_duration(seg, duration)
+        set_p(seg, p)
+        set_v(seg, v)
+        set_a(seg, a)
+        set_j(seg, j)
+        return seg
+
+    return segment_of
+
+
+segment_of = _segment_maker()
+# (duration, p, v, a, j) of a segment in one C call, for the loops over every segment
+segment_values: Callable[[Segment], tuple[float, float, float, float, float]] = attrgetter(
+    *(f.name for f in fields(Segment)))
+
+
+def scaled_profile(segments: Iterable[Segment], factor: float, offset: float) -> list[Segment]:
+    """``[seg.scaled(factor, offset) for seg in segments]``: the same operations, without a
+    method call per segment (a vector move scales its profile for every axis)."""
+    return [segment_of(d, offset + factor * p, factor * v, factor * a, factor * j)
+            for d, p, v, a, j in map(segment_values, segments)]
 
 
 def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]]) -> list[Segment]:
@@ -50,7 +89,7 @@ def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]])
     for duration, jerk in moves:
         if duration <= 0.0:
             continue
-        seg = Segment(duration, p, v, a, jerk)
+        seg = segment_of(duration, p, v, a, jerk)
         out.append(seg)
         p, v, a = seg.end_state()
     return out
@@ -58,6 +97,15 @@ def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]])
 
 def total_duration(segments: Sequence[Segment]) -> float:
     return float(sum(s.duration for s in segments))
+
+
+_duration_of = attrgetter("duration")
+
+
+def end_time(segments: Sequence[Segment], t0: float = 0.0) -> float:
+    """``SegmentTable(segments, t0).end[-1]`` without the arrays: the same additions in the
+    same order as the table's cumulative sum (``segments`` must not be empty)."""
+    return t0 + reduce(add, map(_duration_of, segments))
 
 
 def end_state(segments: Sequence[Segment], start: tuple[float, float, float]) -> tuple[float, float, float]:
@@ -70,13 +118,12 @@ class SegmentTable:
     __slots__ = ("start", "end", "p", "v", "a", "j", "count")
 
     def __init__(self, segments: Sequence[Segment], t0: float = 0.0):
-        d = np.array([s.duration for s in segments], dtype=float)
+        # One array of every segment's fields in a row (np.fromiter: five np.array calls on
+        # lists cost several times more for a few segments), whose columns are the fields.
+        values = np.fromiter(_chain_iterables.from_iterable(map(segment_values, segments)), float, 5 * len(segments))
+        d, self.p, self.v, self.a, self.j = values.reshape(-1, 5).T
         self.end = t0 + np.cumsum(d)
         self.start = self.end - d
-        self.p = np.array([s.p for s in segments], dtype=float)
-        self.v = np.array([s.v for s in segments], dtype=float)
-        self.a = np.array([s.a for s in segments], dtype=float)
-        self.j = np.array([s.j for s in segments], dtype=float)
         self.count = len(segments)
 
     def index(self, t: np.ndarray) -> np.ndarray:

@@ -19,12 +19,13 @@ def duration(plan):
 
 
 def contiguous(plan, v_start, v_final):
-    joints = all(a.v_end == b.v_start for a, b in zip(plan, plan[1:]))
+    joints = all(a.v_end == b.v_start for a, b in zip(plan, plan[1:], strict=False))
     return joints and plan[0].v_start == v_start and plan[-1].v_end == v_final
 
 
 def test_long_move_is_accel_cruise_decel():
-    # MPI 000, MPIMotionTypeTRAPEZOIDAL TRAPEZOIDAL "specified by acceleration, velocity, deceleration and final position"
+    # MPI 000, MPIMotionTypeTRAPEZOIDAL TRAPEZOIDAL "specified by acceleration, velocity, deceleration and final
+    # position"
     plan = plan_point_to_point(10_000.0, 0.0, 0.0, 1000.0, 10_000.0, 5_000.0)
     assert [(r.v_start, r.v_end) for r in plan] == [(0.0, 1000.0), (1000.0, 1000.0), (1000.0, 0.0)]
     assert [r.duration for r in plan] == pytest.approx([0.1, 10.0 - 0.05 - 0.1, 0.2])

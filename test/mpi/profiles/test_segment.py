@@ -28,7 +28,7 @@ def test_table_evaluates_like_the_segments():
     table = SegmentTable(segments)
     t = np.linspace(0.0, total_duration(segments), 997)
     p, v, a, _ = table.evaluate(t)
-    for ti, pi, vi, ai in zip(t[::50], p[::50], v[::50], a[::50]):
+    for ti, pi, vi, ai in zip(t[::50], p[::50], v[::50], a[::50], strict=True):
         i = min(int(np.searchsorted(table.end, ti, side="right")), len(segments) - 1)
         expected = segments[i].state_at(ti - table.start[i])
         assert (pi, vi, ai) == pytest.approx(expected)
