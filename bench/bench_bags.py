@@ -130,7 +130,7 @@ def write_read_rows(count: int, rounds: int) -> list[str]:
             label = "zstd" if compress else "none"
             bags = []
             for how in ("write", "write_raw"):
-                def run(how=how, compress=compress):
+                def run(how=how, compress=compress, label=label):
                     directory = Path(tmp) / f"{how}_{label}_{time.perf_counter_ns()}"
                     with BagWriter(directory, compress=compress) as bag:
                         if how == "write":
@@ -147,7 +147,7 @@ def write_read_rows(count: int, rounds: int) -> list[str]:
                             f"{payload / wall:.1f} | {size:.1f} MB |")
             for how in ("messages", "decoded"):
                 reader = BagReader(bags[0])
-                wall, read = _best(lambda how=how: sum(1 for _ in getattr(reader, how)()), rounds)
+                wall, read = _best(lambda how=how, reader=reader: sum(1 for _ in getattr(reader, how)()), rounds)
                 assert read == count, (read, count)
                 rows.append(f"| BagReader.{how} | {label} | {wall:.2f} s | {count / wall:,.0f} | "
                             f"{payload / wall:.1f} | |")

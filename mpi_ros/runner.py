@@ -154,10 +154,11 @@ class ControllerRunner:
     def _until_next_stop(self, period: float) -> float:
         """Seconds until the next periodic stop is due (at most ``period``): the clock thread
         wakes as it becomes due, steps to it and publishes at once."""
-        if not self._periodic:
+        scale = self.time_scale
+        if not self._periodic or self._anchor_wall is None or not scale:  # manual or as fast as possible
             return period
         ahead = min(p.next_sample for p in self._periodic) - self._anchor_sample
-        due_at = self._anchor_wall + ahead / (self.time_scale * self.ctl.rate)
+        due_at = self._anchor_wall + ahead / (scale * self.ctl.rate)
         # a little late rather than early: early, the sample due would still be the one before
         return min(period, max(0.0, due_at - time.monotonic() + _WAKE_MARGIN))
 

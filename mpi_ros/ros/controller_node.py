@@ -138,7 +138,7 @@ class ControllerNode(Node):
         # same bytes, a third of the work); the snapshots are the supervisors' (snapshots.py)
         encode = wire.axis_status if wire.AVAILABLE else convert.axis_status
         messages = [encode(self._snapshots.axis(ctl, a.number), ctl.rate, self.epoch_ns) for a in ctl.axes]
-        return lambda: convert.publish_all(self, zip(self._pub_axis_status, messages))
+        return lambda: convert.publish_all(self, zip(self._pub_axis_status, messages, strict=True))
 
     def _collect_joints(self, ctl):
         if not wire.AVAILABLE:

@@ -16,7 +16,8 @@ import array
 import math
 import time
 import weakref
-from typing import Any, Iterable, Mapping
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 from builtin_interfaces.msg import Time

@@ -22,7 +22,7 @@ from ..mpi.control import Controller
 from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 from ..runner import ControllerRunner
 
-_SHARED: "weakref.WeakKeyDictionary[ControllerRunner, SampleSnapshots]" = weakref.WeakKeyDictionary()
+_SHARED: weakref.WeakKeyDictionary[ControllerRunner, SampleSnapshots] = weakref.WeakKeyDictionary()
 
 
 class SampleSnapshots:

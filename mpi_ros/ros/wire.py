@@ -27,11 +27,13 @@ from __future__ import annotations
 
 import math
 import struct
-from functools import lru_cache
-from typing import Sequence
+from collections.abc import Sequence
+from functools import cache, lru_cache
+from typing import Any
+
+from sensor_msgs.msg import JointState
 
 from mpi_ros.msg import AxisStatus, MotionStatus
-from sensor_msgs.msg import JointState
 
 from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 from . import convert
@@ -91,7 +93,7 @@ class _Layout:
         return struct.Struct(self.fmt)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _axis_layout(start: int, name_length: int) -> struct.Struct:
     """A whole AxisStatus starting at ``start`` (mod 8) with a state name of that length."""
     layout = _Layout(start).add("i", 4).add("I", 4).add("Q", 8).add("i", 4).add("B", 1).string(name_length)
@@ -99,14 +101,14 @@ def _axis_layout(start: int, name_length: int) -> struct.Struct:
     return (layout.add("d", 8) if FEEDFORWARD else layout).struct()
 
 
-@lru_cache(maxsize=None)
+@cache
 def _motion_head(name_length: int, axes: int) -> struct.Struct:
     """A MotionStatus from its stamp to the count of its axes (it starts the data: at 0)."""
     layout = _Layout(0).add("i", 4).add("I", 4).add("Q", 8).add("i", 4).add("B", 1).string(name_length)
     return layout.add("I", 4).add("i", 4, axes).add("I", 4).struct()
 
 
-@lru_cache(maxsize=None)
+@cache
 def _motion_tail(start: int, last_action: int, action_source: int, motion_type: int) -> struct.Struct:
     """A MotionStatus after its axes, from ``start`` (mod 8), with strings of those lengths."""
     layout = _Layout(start).add("?", 1, 3).add("i", 4, 2).add("d", 8)
@@ -123,7 +125,7 @@ def _joint_names(names: tuple[str, ...]) -> bytes:
     return layout.struct().pack(1, b"", len(encoded), *(x for name in encoded for x in (len(name) + 1, name)))
 
 
-@lru_cache(maxsize=None)
+@cache
 def _joint_values(start: int, count: int) -> struct.Struct:
     """A JointState's position, velocity and effort (``count`` each), from ``start`` (mod 8)."""
     layout = _Layout(start)
@@ -144,7 +146,7 @@ def _finite(x: float) -> float:
 def _axis(out: bytearray, snap: AxisSnapshot, rate: float, epoch_ns: int | None) -> None:
     name = snap.state.name.encode("utf-8")
     layout = _axis_layout((len(out) - len(HEADER)) % 8, len(name))
-    values = (
+    values: tuple[Any, ...] = (
         *_time(snap.sample, rate, epoch_ns), snap.sample, snap.number, int(snap.state), len(name) + 1, name,
         _finite(snap.command_position), _finite(snap.actual_position), _finite(snap.position_error),
         float(snap.target_position), _finite(snap.origin), _finite(snap.command_velocity),

@@ -15,7 +15,6 @@ from mpi_ros import config
 from mpi_ros.bag import cdr
 from mpi_ros.mpi import MotionAttr, MotionParams, MPIAction, MPIMotionType, Trajectory
 from mpi_ros.mpi.types import MPIState
-from mpi_ros.msg import AxisStatus, MotionStatus
 from mpi_ros.ros import convert, wire
 
 EPOCH = 1_795_000_000_123_456_789
@@ -60,9 +59,8 @@ def test_the_installed_interfaces_have_the_layout_the_encoder_packs():
 
 @pytest.mark.parametrize("epoch", [EPOCH, 0])
 def test_axis_and_motion_status_bytes_equal_the_canonical_cdr_of_convert(epoch):
-    ctl = _controller()
     seen_states = set()
-    for ctl in _moving_states(ctl):
+    for ctl in _moving_states(_controller()):
         for axis in ctl.axes:
             snap = ctl.axis_snapshot(axis.number)
             msg = convert.axis_status(snap, ctl.rate, epoch)
@@ -99,10 +97,10 @@ def test_edge_values_are_packed_as_convert_sets_them():
 
 
 def test_joint_state_bytes_equal_the_canonical_cdr_of_convert_from_the_axes_or_their_snapshots():
-    ctl = _controller()
-    names = convert.joint_names(ctl)
-    ctl.axes[4].origin = 12.5  # positions are reported minus the origin
-    for step, ctl in enumerate(_moving_states(ctl)):
+    start = _controller()
+    names = convert.joint_names(start)
+    start.axes[4].origin = 12.5  # positions are reported minus the origin
+    for step, ctl in enumerate(_moving_states(start)):
         if step == 40:
             ctl.supervisors[1].action(MPIAction.ABORT)  # amplifier off: no effort
         expected = cdr.serialize(convert.joint_state(ctl, EPOCH))
@@ -115,8 +113,8 @@ def test_joint_state_bytes_equal_the_canonical_cdr_of_convert_from_the_axes_or_t
 
 def test_snapshots_are_read_once_a_sample_and_read_again_after_a_command():
     from mpi_ros.commands import Command
-    from mpi_ros.runner import ControllerRunner
     from mpi_ros.ros.snapshots import shared
+    from mpi_ros.runner import ControllerRunner
 
     ctl = _controller(axes=8)  # axes 6 and 7: no supervisor maps them
     runner = ControllerRunner(ctl, time_scale=None)
