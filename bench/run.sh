@@ -41,6 +41,14 @@ cd "$repo/bench"
     echo
     "$py" -P bench_bags.py
     echo
+    echo "## Path motion: planning, and a stream in the controller (bench/bench_paths.py)"
+    echo
+    "$py" -P bench_paths.py
+    echo
+    echo "## A 100,000-point path streamed through ROS (bench/bench_stream.py)"
+    echo
+    "$py" -P bench_stream.py
+    echo
     echo "## E_STOP with hundreds of goals in flight (bench/goal_storm.py)"
     echo
     "$py" -P goal_storm.py
