@@ -5,6 +5,11 @@ with the ROS interfaces' field names). :func:`apply` carries it out on a control
 answers a :class:`Reply`. The ROS nodes, the Python client and replay all go through
 here, so a recording of commands with the samples they took effect at reproduces a run.
 
+Size: a request larger than params.MAX_REQUEST_VALUES array elements or
+params.MAX_REQUEST_TEXT characters is refused (MPIMessagePARAM_INVALID, "request too
+large: ...") before any of it is read, and recorded compacted (:meth:`Command.to_json`),
+so input refused for its size costs a bounded time and leaves nothing large behind.
+
 Errors: a request that cannot be read (:class:`mpi_ros.requests.RequestError`) is the
 user's and answers its message (MPIMessagePARAM_INVALID unless named). Any other
 exception is a bug of this package, not of the request: it is logged with its traceback
@@ -16,14 +21,14 @@ from __future__ import annotations
 
 import json
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 from . import requests as rq
 from .mpi.control import Controller
 from .mpi.messages import Message
-from .mpi.params import Verdict, check_position, check_settling_reachable, first_refusal
+from .mpi.params import Verdict, check_position, check_settling_reachable, first_refusal, shown
 from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
 
 MOTION_START = "motion_start"
@@ -46,7 +51,17 @@ class Command:
     request: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> str:
-        return json.dumps(self.request, sort_keys=True, separators=(",", ":"))
+        """The request as JSON: what the commands topic and recordings carry, and replay reads.
+
+        A request too large to be read (requests.check_size: apply refuses it before reading
+        any of it) is recorded compacted (requests.compact): its long arrays and strings are
+        replaced by their sizes, which replayed are refused again with the same message.
+        Recorded whole, a refused goal of 1,000,000 values would keep megabytes in the
+        commands topic's history (1000 messages deep, kept for late joiners)."""
+        request = self.request
+        if isinstance(request, Mapping) and not rq.request_size(request).ok:
+            request = rq.compact(request)
+        return json.dumps(request, sort_keys=True, separators=(",", ":"))
 
     @classmethod
     def from_json(cls, operation: str, supervisor: int, axis: int, text: str) -> Command:
@@ -93,7 +108,8 @@ def _action(ctl: Controller, command: Command) -> Reply:
     action = MPIAction.__members__.get(name)
     if action is None or action is MPIAction.NONE:
         return Reply(Message.MPIMessagePARAM_INVALID,
-                     f"unknown action {name!r} (STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME, MAP)", state=ms.state)
+                     f"unknown action {shown(name)} (STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME, MAP)",
+                     state=ms.state)
     source = ActionSource.CONTROLLER if command.request.get("source") == "CONTROLLER" else ActionSource.USER
     message, detail = ms.action_detail(action, source)
     return Reply(message, detail, state=ms.state)
@@ -119,11 +135,22 @@ def _params_set(ctl: Controller, command: Command) -> Reply:
 
 
 def _axis_list_set(ctl: Controller, command: Command) -> Reply:
+    """mpiMotionAxisListSet, then (``map``, the default) MEIActionMAP: all or nothing, so a
+    refused MAP leaves the axis list as it was (a refusal changes nothing)."""
     ms = _supervisor(ctl, command)
-    message = ms.axis_list_set(rq.integers(command.request.get("axis_numbers", []), "axis_numbers"))
-    if message.ok and rq.boolean(command.request.get("map", True), "map"):
-        message = ms.action(MPIAction.MAP)
-    return Reply(message, state=ms.state, value=list(ms.axis_list))
+    numbers = rq.integers(command.request.get("axis_numbers", []), "axis_numbers")
+    mapping = rq.boolean(command.request.get("map", True), "map")
+    if mapping and not numbers:
+        return Reply(Message.MEIMotionMessageNO_AXES_MAPPED, "map true with an empty axis list: nothing to map "
+                     "(map false empties the list)", state=ms.state, value=list(ms.axis_list))
+    previous = list(ms.axis_list)
+    message = ms.axis_list_set(numbers)
+    detail = ""
+    if message.ok and mapping:
+        message, detail = ms.action_detail(MPIAction.MAP)
+        if not message.ok:
+            ms.axis_list_set(previous)  # valid a moment ago, in the same state
+    return Reply(message, detail, state=ms.state, value=list(ms.axis_list))
 
 
 def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
@@ -137,7 +164,7 @@ def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
     elif operation == "REMOVE":
         message = ms.axis_remove(axis)
     else:
-        return Reply(Message.MPIMessagePARAM_INVALID, f"unknown operation {operation!r} (APPEND, INSERT, REMOVE)",
+        return Reply(Message.MPIMessagePARAM_INVALID, f"unknown operation {shown(operation)} (APPEND, INSERT, REMOVE)",
                      value=list(ms.axis_list))
     return Reply(message, state=ms.state, value=list(ms.axis_list))
 
@@ -174,7 +201,7 @@ def io_space(name) -> IoSpace:
         return IoSpace(str(name).strip().upper())
     except ValueError as exc:
         raise rq.RequestError(Message.MPIMessagePARAM_INVALID,
-                              f"unknown I/O space {name!r} (IO, MOTOR_GENERAL_IO, MOTOR_DEDICATED_IO)") from exc
+                              f"unknown I/O space {shown(name)} (IO, MOTOR_GENERAL_IO, MOTOR_DEDICATED_IO)") from exc
 
 
 def _io_set(ctl: Controller, command: Command) -> Reply:
@@ -201,7 +228,7 @@ def _axis_position_set(ctl: Controller, command: Command) -> Reply:
         "ORIGIN": ctl.axis_origin_set,
     }.get(which)
     if setter is None:
-        return Reply(Message.MPIMessagePARAM_INVALID, f"unknown position {which!r} (COMMAND, ACTUAL, ORIGIN)")
+        return Reply(Message.MPIMessagePARAM_INVALID, f"unknown position {shown(which)} (COMMAND, ACTUAL, ORIGIN)")
     message = setter(command.axis, value)  # the axis checks the range with params.check_position
     return Reply(message, _refusal_detail(message, check_position("value", value)))
 
@@ -228,18 +255,27 @@ def apply(ctl: Controller, command: Command) -> Reply:
     """Carry out ``command`` at the controller's current sample."""
     handler = OPERATIONS.get(command.operation)
     if handler is None:
-        return Reply(Message.MPIMessageUNSUPPORTED, f"unknown operation {command.operation!r}")
+        return Reply(Message.MPIMessageUNSUPPORTED, f"unknown operation {shown(command.operation)}")
     try:
         if command.request is None:  # no request: every field takes its default
             command = replace(command, request={})
         rq.mapping(command.request, "request")
+        rq.check_size(command.request)  # before reading any of it
         return handler(ctl, command)
     except rq.RequestError as exc:
         return Reply(exc.message, exc.detail, state=_state(ctl, command))
     except Exception as exc:  # noqa: BLE001 - a bug, not the request: logged in full, answered, the node stays up
-        _log.exception("internal error applying %s (supervisor %s, axis %s, request %r)",
-                       command.operation, command.supervisor, command.axis, command.request)
+        _log.exception("internal error applying %s (supervisor %s, axis %s, request %s)",
+                       command.operation, command.supervisor, command.axis, _logged(command.request))
         return Reply(INTERNAL_ERROR, f"{INTERNAL_DETAIL}: {type(exc).__name__}: {exc}", state=_state(ctl, command))
+
+
+def _logged(request: Any) -> str:
+    """A request for the log: compacted (long arrays and strings as their sizes)."""
+    try:
+        return repr(rq.compact(request))
+    except Exception:  # noqa: BLE001 - the log line must not fail in turn
+        return shown(request)
 
 
 def _state(ctl: Controller, command: Command) -> MPIState:

@@ -8,6 +8,12 @@ Parsing only checks that a request can be read (a mapping where one is expected,
 number where a number is): anything else raises :class:`RequestError`, the only error
 the command layer answers as the user's (MPIMessagePARAM_INVALID unless named). Ranges
 are the structs' validators' business (mpi_ros/mpi/params.py), run by the controller.
+
+Size: before any of it is read, a request must be small enough (:func:`check_size`: at
+most params.MAX_REQUEST_VALUES array elements and params.MAX_REQUEST_TEXT characters of
+text in all). A request refused for its size is recorded compacted (:func:`compact`): its
+long arrays and strings are replaced by markers that count as their sizes, so the record
+stays small and is refused again, with the same message, when it is replayed.
 """
 
 from __future__ import annotations
@@ -19,7 +25,19 @@ from typing import Any
 
 from .mpi.events import MPIEventType
 from .mpi.messages import Message
-from .mpi.params import AxisInPosition, DecelTime, Hold, MotionConfig, MotionParams, Output, Trajectory, UserFrame
+from .mpi.params import (
+    MAX_REQUEST_TEXT,
+    MAX_REQUEST_VALUES,
+    AxisInPosition,
+    DecelTime,
+    Hold,
+    MotionConfig,
+    MotionParams,
+    Output,
+    Trajectory,
+    UserFrame,
+    shown,
+)
 from .mpi.types import HoldType, MotionAttr, MPIMotionType, OutputType
 
 
@@ -40,7 +58,122 @@ class MotionRequest:
 
 
 def _unreadable(what: str, expected: str, value: Any) -> RequestError:
-    return RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: {expected} expected, got {value!r}")
+    return RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: {expected} expected, got {shown(value)}")
+
+
+# -- size ----------------------------------------------------------------------------------------
+# A compacted record puts one of these mappings where a long array or string was: {OMITTED_VALUES:
+# n, OMITTED_TEXT: c} counts as n array elements and c characters (either key may be left out).
+OMITTED_VALUES = "omitted_values"
+OMITTED_TEXT = "omitted_characters"
+_MARKER_KEYS = frozenset((OMITTED_VALUES, OMITTED_TEXT))
+_COMPACT_ELEMENTS = 32  # a compacted record keeps arrays up to this long ...
+_COMPACT_TEXT = 256  # ... and strings up to this long
+_LEAVES = (int, float, bool, type(None))
+
+
+@dataclass(frozen=True, slots=True)
+class RequestSize:
+    """How much a request carries: array elements (over every array, nested ones too) and
+    characters of text (over every string; mapping keys are field names and not counted),
+    with the longest array and the longest string (where, how long)."""
+
+    values: int = 0
+    text: int = 0
+    longest_array: tuple[str, int] = ("", 0)
+    longest_text: tuple[str, int] = ("", 0)
+
+    @property
+    def ok(self) -> bool:
+        return self.values <= MAX_REQUEST_VALUES and self.text <= MAX_REQUEST_TEXT
+
+    def refusal(self) -> RequestError:
+        """The answer to a request of this size, when it is not ``ok``."""
+        if self.values > MAX_REQUEST_VALUES:
+            where, count = self.longest_array
+            return RequestError(Message.MPIMessagePARAM_INVALID,
+                                f"request too large: {self.values:,} array elements ({where} has {count:,}); at most "
+                                f"{MAX_REQUEST_VALUES:,} in one request (params.MAX_REQUEST_VALUES): stream a longer "
+                                "path in parts (APPEND)")
+        where, count = self.longest_text
+        return RequestError(Message.MPIMessagePARAM_INVALID,
+                            f"request too large: {self.text:,} characters of text ({where} has {count:,}); at most "
+                            f"{MAX_REQUEST_TEXT:,} in one request (params.MAX_REQUEST_TEXT)")
+
+
+def _marker(value: Mapping) -> tuple[int, int] | None:
+    """(values, characters) of a compacted record's marker; None if ``value`` is not one."""
+    if not value or not set(value) <= _MARKER_KEYS:
+        return None
+    counts = [value.get(OMITTED_VALUES, 0), value.get(OMITTED_TEXT, 0)]
+    if not all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in counts):
+        return None
+    return counts[0], counts[1]
+
+
+def _longer(found: tuple[str, int], where: str, count: int) -> tuple[str, int]:
+    # the longest; among equals the first name in order (the same whatever the mapping's order)
+    return (where, count) if count > found[1] or (count == found[1] and count and where < found[0]) else found
+
+
+def request_size(data: Any, where: str = "request") -> RequestSize:
+    """The size of ``data`` (a request, or any part of one).
+
+    Walks the request once, without recursion (no nesting depth can overflow the stack). The
+    elements of an array longer than MAX_REQUEST_VALUES are not looked at: its length alone
+    refuses the request."""
+    values = text = 0
+    longest_array = longest_text = ("", 0)
+    stack = [(where, data)]
+    while stack:
+        here, value = stack.pop()
+        if isinstance(value, str):
+            text += len(value)
+            longest_text = _longer(longest_text, here, len(value))
+        elif isinstance(value, (list, tuple)):
+            values += len(value)
+            longest_array = _longer(longest_array, here, len(value))
+            if len(value) <= MAX_REQUEST_VALUES:
+                stack.extend((f"{here}[{i}]", item) for i, item in enumerate(value) if not isinstance(item, _LEAVES))
+        elif isinstance(value, Mapping):
+            marker = _marker(value)
+            if marker is not None:
+                values += marker[0]
+                text += marker[1]
+                longest_array = _longer(longest_array, here, marker[0])
+                longest_text = _longer(longest_text, here, marker[1])
+            else:
+                prefix = "" if here == "request" else f"{here}."
+                stack.extend((f"{prefix}{key}", item) for key, item in value.items() if not isinstance(item, _LEAVES))
+    return RequestSize(values, text, longest_array, longest_text)
+
+
+def check_size(data: Any) -> None:
+    """Raise RequestError (MPIMessagePARAM_INVALID, naming the longest array or string) if
+    the request is too large to be read (see :class:`RequestSize`)."""
+    size = request_size(data)
+    if not size.ok:
+        # raised as made: an exception held in a local of this frame would make a cycle
+        # (exception -> traceback -> frame -> exception) that keeps the request until the
+        # cyclic garbage collector runs
+        raise size.refusal()
+
+
+def compact(data: Any) -> Any:
+    """``data`` with every array longer than 32 elements and every string longer than 256
+    characters replaced by a marker of its size ({"omitted_values": n, "omitted_characters":
+    c}): what a record keeps of a request refused for its size. Its size, as
+    :func:`request_size` counts it, is the request's, so replayed it is refused again."""
+    if isinstance(data, str):
+        return {OMITTED_TEXT: len(data)} if len(data) > _COMPACT_TEXT else data
+    if isinstance(data, (list, tuple)):
+        if len(data) > _COMPACT_ELEMENTS:
+            size = request_size(data)
+            return {key: count for key, count in ((OMITTED_VALUES, size.values), (OMITTED_TEXT, size.text)) if count}
+        return [compact(item) for item in data]
+    if isinstance(data, Mapping) and _marker(data) is None:
+        return {key: compact(item) for key, item in data.items()}
+    return data
 
 
 def mapping(data: Any, what: str) -> Mapping[str, Any]:
@@ -104,18 +237,24 @@ def text(value: Any, what: str) -> str:
 
 
 def numbers(values: Any, what: str) -> list[float]:
-    return [number(v, f"{what}[{i}]") for i, v in enumerate(sequence(values, what))]
+    values = sequence(values, what)
+    if all(type(v) is float for v in values):  # what the ROS edge gives: read as is, no name per element
+        return values
+    return [number(v, f"{what}[{i}]") for i, v in enumerate(values)]
 
 
 def integers(values: Any, what: str) -> list[int]:
-    return [integer(v, f"{what}[{i}]") for i, v in enumerate(sequence(values, what))]
+    values = sequence(values, what)
+    if all(type(v) is int for v in values):
+        return values
+    return [integer(v, f"{what}[{i}]") for i, v in enumerate(values)]
 
 
 def enum_by_name(enum, name: Any, what: str, message: Message = Message.MPIMessagePARAM_INVALID):
     key = str(name).strip().upper()
     member = enum.__members__.get(key)
     if member is None:
-        raise RequestError(message, f"unknown {what} {name!r}")
+        raise RequestError(message, f"unknown {what} {shown(name)}")
     return member
 
 
@@ -123,7 +262,7 @@ def event_mask(names: Any, what: str) -> MPIEventType:
     values = sequence(names, what)
     mask = MPIEventType.parse(values)
     if mask is None:
-        raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown event type in {values}")
+        raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown event type in {shown(values)}")
     return mask
 
 
@@ -138,7 +277,7 @@ def _struct(cls, data: Any, what: str, enum_fields: dict | None = None):
     known = {f.name for f in fields(cls)}
     for key, value in mapping(data, what).items():
         if key not in known:
-            raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown field {key!r}")
+            raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown field {shown(key)}")
         if key in enum_fields:
             enum, message = enum_fields[key]
             kwargs[key] = enum.NONE if value in ("", None) else enum_by_name(enum, value, f"{what} type", message)
@@ -159,7 +298,7 @@ def motion_request(data: Any) -> MotionRequest:
     names = sequence(data.get("attributes"), "attributes")
     attributes = MotionAttr.parse(names)
     if attributes is None:
-        raise RequestError(Message.MPIMotionMessageTYPE_INVALID, f"unknown attribute in {names}")
+        raise RequestError(Message.MPIMotionMessageTYPE_INVALID, f"unknown attribute in {shown(names)}")
     if boolean(data.get("use_stored_params", False), "use_stored_params"):
         return MotionRequest(motion_type, attributes, None)
     return MotionRequest(motion_type, attributes, motion_params(data))
@@ -246,7 +385,7 @@ def motion_config(data: Any) -> MotionConfig:
     data = mapping(data, "config")
     unknown = sorted(str(key) for key in data if key not in _CONFIG_FIELDS)
     if unknown:
-        raise RequestError(Message.MPIMessagePARAM_INVALID, f"config: unknown field {unknown[0]!r}")
+        raise RequestError(Message.MPIMessagePARAM_INVALID, f"config: unknown field {shown(unknown[0])}")
     value = {key: number(data.get(key, 0.0), key) for key in _CONFIG_NUMBERS}
     return MotionConfig(
         decel_time=DecelTime(value["decel_time_stop"], value["decel_time_e_stop"]),

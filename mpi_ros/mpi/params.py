@@ -14,6 +14,7 @@ from __future__ import annotations
 import copy
 import math
 import numbers
+import reprlib
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import TypeGuard
@@ -52,6 +53,16 @@ FEEDFORWARD_MAX = 10.0
 MAX_OBJECTS = 1024  # axes, supervisors and motors of one controller
 FRAME_BUFFER_MIN, FRAME_BUFFER_MAX = 16, 65_536  # frames per axis
 IO_WORDS_MAX = 65_536
+# The size of one request (a goal or a service request; docs/hostile-input.md). A request is
+# read only if it carries at most MAX_REQUEST_VALUES array elements over all its arrays (a
+# path's positions, times, velocities ... together) and MAX_REQUEST_TEXT characters over all
+# its strings; a larger one is refused with MPIMessagePARAM_INVALID before any of its values
+# is read or kept (mpi_ros/requests.py, check_size). It bounds what one request may cost: the
+# time the controller is held planning it, the memory it claims, and what the commands topic
+# and recordings keep of it. A longer path is streamed in parts (APPEND), as a frame buffer
+# (at most FRAME_BUFFER_MAX frames per axis) is fed anyway.
+MAX_REQUEST_VALUES = 1 << 16
+MAX_REQUEST_TEXT = 1 << 14
 
 
 # -- the outcome of a check -------------------------------------------------------------------
@@ -72,6 +83,20 @@ class Verdict:
 
 
 VALID = Verdict(Message.MPIMessageOK)
+
+
+_SHOWN = reprlib.Repr()
+_SHOWN.maxstring = _SHOWN.maxother = 80
+_SHOWN.maxlist = _SHOWN.maxtuple = _SHOWN.maxdict = _SHOWN.maxset = 8
+
+
+def shown(value: object) -> str:
+    """``repr(value)`` cut short (a long string, list or number shows its ends): what a
+    refusal quotes of the value it refuses, so an answer never carries a 100 kB string back."""
+    try:
+        return _SHOWN.repr(value)
+    except Exception:  # noqa: BLE001 - a repr that fails (an int beyond str's digit limit) shows its type
+        return f"<{type(value).__name__}>"
 
 
 def refuse(detail: str, message: Message = Message.MPIMessagePARAM_INVALID) -> Verdict:
@@ -98,13 +123,13 @@ def check_range(name: str, value: object, low: float, high: float, above_low: bo
     if _finite_number(value) and low <= value <= high and not (above_low and value == low):
         return VALID
     lower = f"> {low:g}" if above_low else f">= {low:g}"
-    return refuse(f"{name}: must be a finite number {lower} and <= {high:g}, got {value!r}")
+    return refuse(f"{name}: must be a finite number {lower} and <= {high:g}, got {shown(value)}")
 
 
 def check_integer(name: str, value: object, low: int, high: int) -> Verdict:
     if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= int(value) <= high:
         return VALID
-    return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {value!r}")
+    return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {shown(value)}")
 
 
 def check_long(name: str, value: object) -> Verdict:
@@ -113,13 +138,13 @@ def check_long(name: str, value: object) -> Verdict:
 
 
 def check_bool(name: str, value: object) -> Verdict:
-    return VALID if isinstance(value, bool) else refuse(f"{name}: must be true or false, got {value!r}")
+    return VALID if isinstance(value, bool) else refuse(f"{name}: must be true or false, got {shown(value)}")
 
 
 def check_magnitude(name: str, value: object, limit: float) -> Verdict:
     if _finite_number(value) and abs(value) <= limit:
         return VALID
-    return refuse(f"{name}: must be a finite number of magnitude <= {limit:g}, got {value!r}")
+    return refuse(f"{name}: must be a finite number of magnitude <= {limit:g}, got {shown(value)}")
 
 
 def check_position(name: str, value: object) -> Verdict:
@@ -373,7 +398,7 @@ class MotionConfig:
         if isinstance(self.user_label, str) and len(self.user_label) <= USER_LABEL_MAX:
             return VALID
         return refuse(f"user_label: at most {USER_LABEL_MAX} characters (MEIObjectLabelCharMAX), "
-                      f"got {self.user_label!r}")
+                      f"got {shown(self.user_label)}")
 
 
 @dataclass(slots=True)
@@ -447,7 +472,7 @@ def check_settling_reachable(in_position: AxisInPosition, plant: PlantConfig) ->
     if plant.encoder_resolution / 2.0 < in_position.position_fine:
         return VALID
     return refuse(f"position_fine: must be above half the encoder resolution "
-                  f"({plant.encoder_resolution:g} counts), got {in_position.position_fine!r}")
+                  f"({plant.encoder_resolution:g} counts), got {shown(in_position.position_fine)}")
 
 
 @dataclass(slots=True)

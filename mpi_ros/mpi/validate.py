@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 from .messages import Message
-from .params import MAX_COORD_AXES, MAX_GATES, Hold, MotionParams, Output, Verdict
+from .params import MAX_COORD_AXES, MAX_GATES, MAX_REQUEST_VALUES, Hold, MotionParams, Output, Verdict
 from .types import (
     CAM_ATTRS,
     CAM_TYPES,
@@ -58,9 +58,11 @@ SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID}
 STREAMED_TYPES = PATH_TYPES | {MPIMotionType.FRAME}
 EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES | STREAMED_TYPES
 # The most values one path request may carry (positions, or frames, over all its axes): a
-# bound on the memory and planning time a single request can claim. A longer path is
-# streamed in requests (APPEND), as the controller's frame buffer is fed anyway.
-MAX_PATH_VALUES = 1 << 20
+# bound on the memory and planning time a single request can claim (1 << 20 took 5 s to
+# plan, holding the controller). A longer path is streamed in requests (APPEND), as the
+# controller's frame buffer is fed anyway. The same bound as a request's arrays in all
+# (params.MAX_REQUEST_VALUES), which the command layer checks before reading a request.
+MAX_PATH_VALUES = MAX_REQUEST_VALUES
 
 
 OK = Verdict(Message.MPIMessageOK)

@@ -258,6 +258,7 @@ class SupervisorNode(Node):
         assert goal_id is not None  # set while the server handles the goal request that calls this
         try:
             command = Command(operation, self.number, request=convert.to_dict(goal_msg))
+            convert.release(goal_msg)  # read once; rclpy would keep it until the result expires
             server.applied[goal_id] = self.runner.submit(command)
         except Exception as exc:  # noqa: BLE001 - not swallowed: the goal is aborted with it (_accept)
             server.applied[goal_id] = exc
