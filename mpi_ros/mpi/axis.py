@@ -25,11 +25,12 @@ from typing import Generic, Self, TypeVar, overload
 
 import numpy as np
 
+from . import masters
 from .bank import AxisBank, Kind
 from .clock import ProfileClock
 from .frames import AxisPlan
 from .messages import Message
-from .params import AxisInPosition, PlantConfig, check_position
+from .params import AxisInPosition, AxisMaster, PlantConfig, check_position
 from .plant import Forced, Plant, PlantState, compose
 from .status import AxisStatusBits, StatusMode, bits_of, column_of
 from .types import MPIState
@@ -135,6 +136,7 @@ class Axis:
         self._bank = bank
         self.rate = sample_rate
         self.in_position = in_position.copy()
+        self.master = AxisMaster()  # MPIAxisConfig.master and masterCorrection (cams)
         self.plant = Plant(plant)
         self.origin = 0.0
         self.enabled = True  # an enabled axis (MPIMessageOBJECT_NOT_ENABLED otherwise)
@@ -223,6 +225,17 @@ class Axis:
         if state in (MPIState.MOVING, MPIState.STOPPING, MPIState.STOPPED, MPIState.STOPPING_ERROR):
             return False
         return self.command_at_rest and not self.holding and self.mode is not CommandMode.FOLLOW_ACTUAL
+
+    @property
+    def camming(self) -> bool:
+        """A cam's slave: its command follows a master position sample by sample (cams.py)."""
+        plan = self.plan
+        return plan is not None and plan.cam is not None
+
+    def cam_reads(self) -> set[int]:
+        """The axes whose values at a sample this cam slave's master position reads."""
+        plan = self.plan
+        return masters.reads(plan.cam.master) if plan is not None and plan.cam is not None else set()
 
     @property
     def command_at_rest(self) -> bool:
@@ -400,10 +413,15 @@ class Axis:
             return False
         return self.state.y == self.rest_position and self.state.dy == 0.0
 
-    def trace(self, k0: int, k1: int, clock: ProfileClock | None) -> AxisTrace:
-        """Samples k0+1 .. k1, computed from the current anchor (no state changes)."""
+    def trace(self, k0: int, k1: int, clock: ProfileClock | None,
+              cam: tuple[np.ndarray, np.ndarray] | None = None) -> AxisTrace:
+        """Samples k0+1 .. k1, computed from the current anchor (no state changes but a
+        cam's progress, kept aside until :meth:`keep_anchor`). ``cam``: a cam slave's master
+        position and feedrate ratio at each of the samples."""
         samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
         t = samples / self.rate
+        if cam is not None and self.camming and self.mode is CommandMode.SERVO:
+            return self._trace_cam(samples, t, *cam)
         if self.steady(clock):
             n = len(t)
             zero = np.zeros(n)
@@ -438,6 +456,35 @@ class Axis:
             anchors.append(state)
         return y, dy, anchors
 
+    def _trace_cam(self, samples: np.ndarray, t: np.ndarray, master: np.ndarray, scale: np.ndarray) -> AxisTrace:
+        """A cam's slave: the command from the cam at each sample's master position, its
+        velocity and acceleration as the differences from sample to sample, the loop stepped
+        sample by sample with the command linear in between (Plant.sample_step)."""
+        plan = self.plan
+        assert plan is not None and plan.cam is not None  # (camming)
+        cmd_p = plan.cam.follow(t, master, scale)
+        cmd_v = (cmd_p - np.concatenate(([self.cmd_p], cmd_p[:-1]))) * self.rate
+        cmd_a = (cmd_v - np.concatenate(([self.cmd_v], cmd_v[:-1]))) * self.rate
+        y, dy, anchors = self._trace_steps(t, cmd_p)
+        assert plan.cam.pending is not None  # (follow keeps the progress)
+        return AxisTrace(samples, t, cmd_p, cmd_v, cmd_a, self.plant.read(y), dy, plan.cam.pending[1].u, anchors)
+
+    def _trace_steps(self, t: np.ndarray, cmd_p: np.ndarray):
+        """The loop driven by a command known at each sample, linear in between, from the
+        anchor (at the sample before the first: a cam's slave is anchored every sample)."""
+        (a0, a1, a2, a3, a4), (b0, b1, b2, b3, b4) = self.plant.sample_step(self.rate)
+        feedforward = self._held_feedforward
+        state = self.state
+        y, dy, p0 = state.y, state.dy, self.cmd_p
+        ys, dys = np.empty_like(t), np.empty_like(t)
+        anchors = [state]
+        for k, (tk, p1) in enumerate(zip(t.tolist(), cmd_p.tolist(), strict=True)):
+            y, dy = (a0 * y + a1 * dy + a2 * p0 + a3 * p1 + a4 * feedforward,
+                     b0 * y + b1 * dy + b2 * p0 + b3 * p1 + b4 * feedforward)
+            ys[k], dys[k], p0 = y, dy, p1
+            anchors.append(PlantState(tk, y, dy))
+        return ys, dys, anchors
+
     def _trace_follow(self, t: np.ndarray):
         """settleOnEstopCmdEqAct: each sample the command is the previous actual."""
         y = np.empty_like(t)
@@ -455,6 +502,9 @@ class Axis:
     def keep_anchor(self, anchors: list[PlantState], t: float) -> None:
         """After a stretch traced here (:meth:`trace`): the plant anchor in force at time ``t``
         of it (the controller keeps the values)."""
+        plan = self.plan
+        if plan is not None and plan.cam is not None:
+            plan.cam.commit(t)
         anchor = self.state
         for candidate in anchors:
             if candidate.t <= t:
@@ -488,7 +538,7 @@ class Axis:
         bank.moved[row] = False
         if self.steady(clock):
             bank.kind[row] = Kind.STEADY
-        elif self.mode is CommandMode.SERVO:
+        elif self.mode is CommandMode.SERVO and not self.camming:
             bank.kind[row] = Kind.PIECE
             self._write_piece(clock)
         else:

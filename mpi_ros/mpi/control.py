@@ -25,11 +25,15 @@ from .events import Event, MPIEventType
 from .io import IoImage
 from .messages import STATE_MESSAGES, Message
 from .motion import MotionSupervisor
+from .masters import SecondaryInputs, Sources
 from .params import (
     AxisInPosition,
+    AxisMaster,
     ControllerConfig,
     MotionConfig,
     PlantConfig,
+    SecondaryFeedback,
+    Verdict,
     check_position,
     check_settling_reachable,
 )
@@ -73,6 +77,7 @@ class Controller:
             for n in range(self.config.axis_count)
         ]
         self.io = IoImage(self.config.io_words, self.config.motors)
+        self.secondary = SecondaryInputs(self.config.motors)  # the motors' second encoder inputs (cams)
         self.motion_defaults = motion_config or MotionConfig()
         self._supervisors: dict[int, MotionSupervisor] = {}
         self.events: deque[Event] = deque()
@@ -184,6 +189,48 @@ class Controller:
             return verdict.message
         axis.in_position = in_position.copy()
         return Message.MPIMessageOK
+
+    def axis_master_check(self, number: int, master: AxisMaster) -> Verdict:
+        """The one AxisMaster validator, against this controller's axes, motors and I/O words."""
+        if not 0 <= number < len(self.axes):
+            return Verdict(Message.MPIAxisMessageAXIS_INVALID, f"no axis {number}")
+        return master.validate(len(self.axes), self.config.motors, self.config.io_words)
+
+    def axis_master_set(self, number: int, master: AxisMaster) -> Message:
+        """mpiAxisConfigSet (master, masterCorrection): used by the next cam the axis runs (a
+        running cam keeps the master it started with: docs/cams.md)."""
+        verdict = self.axis_master_check(number, master)
+        if not verdict.ok:
+            return verdict.message
+        self.axes[number].master = master.copy()
+        return Message.MPIMessageOK
+
+    def secondary_feedback_set(self, motor: int, feedback: SecondaryFeedback) -> Message:
+        """Drive a motor's secondary feedback input (MOTOR_FEEDBACK_SECONDARY masters): from the
+        next sample it reads ``feedback.position`` and moves at ``feedback.velocity``."""
+        if not 0 <= motor < len(self.secondary):
+            return Message.MPIMessagePARAM_INVALID
+        if not feedback.validate().ok:
+            return feedback.validate().message
+        self.secondary.set(motor, feedback, self.sample)
+        return Message.MPIMessageOK
+
+    def master_sources(self, stretch: Stretch | None = None) -> Sources:
+        """Where master positions are read: over ``stretch`` (as far as it is traced), or now."""
+        if stretch is None:
+            samples = np.array([self.sample], dtype=np.int64)
+            cmd_p, act_p = self.bank.cmd_p[:, None], self.bank.act_p[:, None]
+        else:
+            samples, cmd_p, act_p = stretch.samples, stretch.cmd_p, stretch.act_p
+        return Sources(cmd_p, act_p, samples, [a.origin for a in self.axes], self.io, self.secondary, self.rate)
+
+    def _cam_inputs(self, axis: Axis, stretch: Stretch) -> tuple[np.ndarray, np.ndarray]:
+        """A cam slave's master position and feedrate ratio at each sample of ``stretch``: a
+        stop ramps its supervisor's feedrate, which scales the slave's progress (cams.py)."""
+        plan, owner = axis.plan, self.supervisor(axis.owner)
+        assert plan is not None and plan.cam is not None and owner is not None  # a camming axis
+        feedrate, _ = owner.clock.feedrates(stretch.t)
+        return self.master_sources(stretch).position(plan.cam.master), feedrate / owner.config.normal_feedrate
 
     def frame_count(self, number: int) -> int:
         """Frames in an axis' buffer: the rest of the move it runs and the ones queued. A
@@ -321,7 +368,8 @@ class Controller:
         k0 = self.sample
         self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])),
                           lambda row: self.axes[row].reanchor(self._clock(self.axes[row])))
-        stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch)
+        stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch,
+                                  self._cam_inputs)
         status = compute(stretch, self.bank.status, self.bank.runs, self._scratch)
         stop = len(stretch) - 1
         event_at = None

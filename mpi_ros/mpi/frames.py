@@ -13,6 +13,7 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,6 +21,9 @@ from .events import MPIEventType
 from .params import Hold, Output, Trajectory
 from .profiles.segment import Segment, SegmentTable, end_time
 from .types import MotionAttr, MPIMotionType
+
+if TYPE_CHECKING:
+    from .cams import CamFollow
 
 _serials = itertools.count(1)
 # A point's time is a sum of its dts in floating point, off the sample grid by rounding: a
@@ -66,13 +70,16 @@ class AxisPlan:
     # after the last; the first value is NaN until the axis fills in the one it holds (the
     # feedforward is kept from move to move: MPI 000, MPIMotionPTF).
     feedforward: tuple[np.ndarray, np.ndarray] | None = None
+    # Cams (cams.py): the slave's table, master and progress; its "profile time" is the
+    # progress along the table (status, progress and frames read it as they read time).
+    cam: CamFollow | None = None
     duration: float = field(init=False)
     _table: SegmentTable | None = field(init=False, default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.segments:
             self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
-        self.duration = end_time(self.segments, self.origin_time)
+        self.duration = end_time(self.segments, self.origin_time) if self.cam is None else self.cam.duration
 
     @property
     def table(self) -> SegmentTable:
@@ -89,10 +96,14 @@ class AxisPlan:
     @property
     def frame_count(self) -> int:
         """Frames this plan loads: its segments, the final frame, and a hold frame."""
+        if self.cam is not None:
+            return self.cam.table.frames  # the whole table stays loaded (a repeat runs it again)
         return len(self.segments) + 1 + (1 if self.hold is not None else 0)
 
     def frames_left(self, rel: float) -> int:
         """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
+        if self.cam is not None:
+            return self.frame_count
         done = int(np.searchsorted(self.table.end, rel, side="right"))
         return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
 

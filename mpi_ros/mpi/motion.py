@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from . import paths, validate
+from . import cams, paths, validate
 from .axis import Axis, CommandMode
 from .clock import ProfileClock
 from .events import MPIEventType
@@ -23,7 +23,7 @@ from .frames import AxisPlan, Move, frames_needed, next_serial
 from .holds import HoldWait
 from .log import MotionLog
 from .messages import STATE_MESSAGES, Message
-from .params import MotionConfig, MotionParams, Output, Verdict, check_position
+from .params import AxisMaster, MotionConfig, MotionParams, Output, Verdict, check_position
 from .planner import AxisStart, PlanError, compile_move
 from .snapshot import FrameBufferStatus, MotionSnapshot
 from .status import StatusMode
@@ -31,6 +31,7 @@ from .supervisor_actions import ActionsMixin
 from .supervisor_axis_list import AxisListMixin
 from .supervisor_stepping import SteppingMixin
 from .types import (
+    CAM_TYPES,
     HOLD_ATTRS,
     STATE_SEVERITY,
     ActionSource,
@@ -377,7 +378,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         queued = append and state is MPIState.MOVING and (bool(self.queue) or not self.cruising())
         starts = self._starts(queued, state, modify and not auto_start)
         try:
-            move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate)
+            move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate,
+                                       self._cam_masters() if motion_type in CAM_TYPES else None)
         except PlanError as exc:
             return exc.message, exc.detail
         if move.stream is not None:
@@ -478,6 +480,18 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 f = self.config.normal_feedrate
                 starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.origin, axis.cmd_a / (f * f)))
         return starts
+
+    def _cam_masters(self) -> list[tuple[AxisMaster, float]]:
+        """Each slave axis' master (MPIAxisConfig.master) and the master's position now, for a
+        cam on the axis list. Raises PlanError if the masters would form a loop."""
+        masters = [self._axis(n).master for n in self.axis_list]
+        running = {axis.number: axis.cam_reads() for axis in self._ctl.axes if axis.camming}
+        loop = cams.master_loop(self.axis_list, masters, running)
+        if loop:
+            raise PlanError(Message.MPIMessagePARAM_INVALID, f"{loop} (MPIAxisConfig.master): a slave cannot follow "
+                                                             "itself, directly or through other cams")
+        now = self._ctl.master_sources()
+        return [(master, float(now.position(master)[0])) for master in masters]
 
     def _check_frames(self, moves: list[Move]) -> Message:
         """Do the moves fit the frame buffer? A path's points need not: the library holds

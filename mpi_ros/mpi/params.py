@@ -21,7 +21,16 @@ from typing import TypeGuard
 
 from .events import MASK_ALL, MPIEventType
 from .messages import Message
-from .types import HOLD_ATTRS, POINT_TO_POINT_TYPES, VELOCITY_TYPES, HoldType, MotionAttr, MPIMotionType, OutputType
+from .types import (
+    HOLD_ATTRS,
+    POINT_TO_POINT_TYPES,
+    VELOCITY_TYPES,
+    AxisMasterType,
+    HoldType,
+    MotionAttr,
+    MPIMotionType,
+    OutputType,
+)
 
 MAX_COORD_AXES = 8  # MEIXmpMAX_COORD_AXES
 MAX_GATES = 32  # gate numbers 0..31 (spec 000 MEIMotionAttrHoldSource)
@@ -429,6 +438,54 @@ class AxisInPosition:
             check_bool("settle_on_estop", self.settle_on_estop),
             check_bool("settle_on_estop_cmd_eq_act", self.settle_on_estop_cmd_eq_act),
         ))
+
+
+@dataclass(slots=True)
+class AxisMaster:
+    """MPIAxisMaster with MPIAxisConfig.masterCorrection (MPI 002): where the master position a
+    cam on this axis follows comes from. ``number`` is the motor (MOTOR_FEEDBACK_*) or the axis
+    (AXIS_*), ``address`` the I/O word (ADDRESS); the other one is "Not used" (MPI 002,
+    MPIAxisMaster) and not checked. ``correction``: the axis whose command position is added
+    to the master position (masterCorrection; -1: none, docs/cams.md)."""
+
+    type: AxisMasterType = AxisMasterType.AXIS_COMMANDED_POSITION
+    number: int = 0
+    address: int = 0
+    correction: int = -1
+
+    def copy(self) -> AxisMaster:
+        return copy.deepcopy(self)
+
+    def validate(self, axes: int = MAX_OBJECTS, motors: int = MAX_OBJECTS, io_words: int = IO_WORDS_MAX) -> Verdict:
+        """Against a controller of ``axes`` axes, ``motors`` motors and ``io_words`` I/O words.
+        The primary feedback of motor n is the encoder of axis n's motor (the simulated plant),
+        so it needs an axis n; a secondary input exists for every motor."""
+        if not isinstance(self.type, AxisMasterType):
+            return refuse(f"type: must be one of {[t.name for t in AxisMasterType]}, got {shown(self.type)}")
+        bounds = {AxisMasterType.MOTOR_FEEDBACK_PRIMARY: ("number", self.number, min(axes, motors)),
+                  AxisMasterType.MOTOR_FEEDBACK_SECONDARY: ("number", self.number, motors),
+                  AxisMasterType.AXIS_COMMANDED_POSITION: ("number", self.number, axes),
+                  AxisMasterType.AXIS_ACTUAL_POSITION: ("number", self.number, axes),
+                  AxisMasterType.ADDRESS: ("address", self.address, io_words)}
+        name, value, count = bounds[self.type]
+        return first_refusal((
+            check_integer(name, value, 0, count - 1),
+            check_integer("correction", self.correction, -1, axes - 1),
+        ))
+
+
+@dataclass(slots=True)
+class SecondaryFeedback:
+    """The secondary feedback input of a motor (MPI 002, MPIAxisMasterTypeMOTOR_FEEDBACK_SECONDARY):
+    a second encoder, such as a line shaft's, that reads ``position`` when it is set and moves
+    on at ``velocity`` (docs/cams.md)."""
+
+    position: float = 0.0
+    velocity: float = 0.0
+
+    def validate(self) -> Verdict:
+        return first_refusal((check_position("position", self.position),
+                              check_magnitude("velocity", self.velocity, MAX_VELOCITY)))
 
 
 @dataclass(slots=True)

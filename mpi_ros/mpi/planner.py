@@ -22,17 +22,18 @@ import math
 from dataclasses import dataclass, field
 from operator import attrgetter
 
+from . import cams
 from .events import MPIEventType
 from .frames import AxisPlan, Move, Stream
 from .messages import Message
-from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, MotionParams, Trajectory
+from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, MotionParams, Trajectory
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import point_to_point, reverses, velocity_move
 from .profiles.ramps import ProfileError, ramps_between
 from .profiles.scurve import reshape
 from .profiles.segment import Segment, chain, scaled_profile, segment_values
-from .types import HOLD_ATTRS, MotionAttr, MPIMotionType
+from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
 
 A = MotionAttr
 # The attributes planning tests, as plain ints: IntFlag's `in` and `&` run Python code (0.2 to
@@ -261,6 +262,7 @@ def compile_move(
     params: MotionParams,
     starts: list[AxisStart],
     sample_rate: float,
+    cam_masters: list[tuple[AxisMaster, float]] | None = None,
 ) -> tuple[Move, PlanNotes]:
     """The frames of a request for the axes ``starts`` (in the supervisor's order).
 
@@ -268,7 +270,8 @@ def compile_move(
     that starts while its axes move cannot wait first: a non-zero DELAY is
     MPIMotionMessageILLEGAL_DELAY (spec 000, for a modify in motion) and a HOLD
     MPIMotionMessageATTRIBUTE_INVALID (spec 000: HOLD is not permitted in modifies); either
-    would stop the axes dead.
+    would stop the axes dead. A cam (``cam_masters``: each slave's master and its position
+    now) is planned by cams.py.
     """
     notes = PlanNotes()
     moving = any(s.velocity != 0.0 for s in starts)
@@ -278,7 +281,10 @@ def compile_move(
         raise PlanError(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
     stream = None
     try:
-        if motion_type in STREAMED_TYPES:
+        if motion_type in CAM_TYPES:
+            assert cam_masters is not None  # (the supervisor reads each slave's master)
+            plans = cams.cam_plans(motion_type, attrs, params, starts, cam_masters)
+        elif motion_type in STREAMED_TYPES:
             plans, stream = _path_plans(motion_type, params, attrs, starts)
         elif motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)

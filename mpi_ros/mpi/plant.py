@@ -93,6 +93,7 @@ class Plant:
         self._dac_gains = self._taylor(num=(config.dac_acceleration,), den=(w * w, 2.0 * z * w, 1.0))
         self._resolution = config.encoder_resolution
         self._coast = config.coast_time_constant
+        self._steps: dict = {}  # sample_step, per rate
         # M^2 = kappa I (Cayley-Hamilton: A's eigenvalues are sigma +- i q, sigma +- q, or sigma twice)
         self._kappa = {"under": -self._q * self._q, "over": self._q * self._q}.get(self._kind, 0.0)
 
@@ -225,6 +226,31 @@ class Plant:
             return PlantState(t, y, dy)
         h0, h1 = self._homogeneous_at(e0, e1, s)
         return PlantState(t, y + h0, dy + h1)
+
+    def sample_step(self, rate: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """The loop over one sample of a command that goes linearly from p0 to p1 with a constant
+        DAC feedforward d (a cam's slave: its command is known only sample by sample): rows r0,
+        r1 with y' = r0 . (y, dy, p0, p1, d) and dy' = r1 . (y, dy, p0, p1, d). The closed form
+        of :meth:`advance` for that piece, which is linear in those five values, so the rows are
+        its responses to each of them alone. Cached per rate."""
+        key = ("step", rate)
+        cached = self._steps.get(key)
+        if cached is not None:
+            return cached
+        span = 1.0 / rate
+
+        def after(y: float, dy: float, p0: float, p1: float, d: float) -> tuple[float, float]:
+            yp = self.particular([p0, (p1 - p0) * rate])
+            if d:
+                yp = _poly_add(yp, self._particular([d], self._dac_gains))
+            dyp = poly_der(yp)
+            h0, h1 = self._homogeneous_at(y - yp[0], dy - _poly_eval_scalar(dyp, 0.0), span)
+            return _poly_eval_scalar(yp, span) + h0, _poly_eval_scalar(dyp, span) + h1
+
+        columns = [after(*(1.0 if i == j else 0.0 for j in range(5))) for i in range(5)]
+        step = (tuple(c[0] for c in columns), tuple(c[1] for c in columns))
+        self._steps[key] = step
+        return step
 
     # -- servo off (ABORT) ---------------------------------------------------------
     def coast(self, state: PlantState, samples: np.ndarray, rate: float) -> tuple[np.ndarray, np.ndarray]:

@@ -104,9 +104,15 @@ class Stretch:
         return self.into(name, rows)
 
 
+# A cam slave's inputs over a stretch: its master position and feedrate ratio at each sample,
+# read from the stretch as far as it is traced (controller.py).
+CamInputs = Callable[[Axis, "Stretch"], tuple[np.ndarray, np.ndarray]]
+
+
 def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileClock | None],
-          k0: int, k1: int, rate: float, scratch: Scratch) -> Stretch:
-    """Samples k0+1 .. k1 of every axis, from the bank's (fresh) rows; changes nothing."""
+          k0: int, k1: int, rate: float, scratch: Scratch, cam_inputs: CamInputs | None = None) -> Stretch:
+    """Samples k0+1 .. k1 of every axis, from the bank's (fresh) rows; changes nothing but
+    the cam slaves' progress, kept aside until the controller commits."""
     samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
     t = samples / rate
     values = scratch.take("values", (len(VALUES), bank.count, len(samples)))
@@ -123,13 +129,30 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
         out.pieces = rows[~ending]
         if ending.any():
             _following_pieces(bank, axes, clock_of, rows[ending], out)
-    for row in bank.of_kind(Kind.SAMPLED).tolist():
+    for row in _sampled_order(bank.of_kind(Kind.SAMPLED).tolist(), axes):
         axis = axes[row]
-        one = axis.trace(k0, k1, clock_of(axis))
+        cam = cam_inputs(axis, out) if cam_inputs is not None and axis.camming else None
+        one = axis.trace(k0, k1, clock_of(axis), cam)
         out.anchors[row] = one.anchors
         for name in VALUES:
             getattr(out, name)[row] = getattr(one, name)
     return out
+
+
+def _sampled_order(rows: list[int], axes: list[Axis]) -> list[int]:
+    """The axes traced one at a time, in an order in which a cam's slave comes after every
+    axis its master position reads (a start refuses a cam whose masters would form a loop)."""
+    slaves = [row for row in rows if axes[row].camming]
+    if not slaves:
+        return rows
+    ordered = [row for row in rows if not axes[row].camming]
+    waiting = set(slaves)
+    while waiting:
+        ready = sorted(row for row in waiting if not axes[row].cam_reads() & waiting)
+        assert ready, f"cam masters form a loop among axes {sorted(waiting)}"  # refused at the start
+        ordered += ready
+        waiting -= set(ready)
+    return ordered
 
 
 def _steady(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:

@@ -262,6 +262,11 @@ class SteppingMixin:
         assert move is not None  # scan found the current move done
         self._emit(MPIEventType.MOTION_DONE, move=move)
         self._end_move(move, OK, "motion done")
+        t = self._ctl.time
+        for plan in move.plans:
+            axis = self._axis(plan.axis)
+            if plan.cam is not None and axis.plan is plan:
+                axis.unload(t, self.clock)  # at the table's end the slave rests: it follows no longer
         self.current = None
         if self.queue:
             self._load(self.queue.popleft())

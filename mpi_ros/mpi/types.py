@@ -207,3 +207,14 @@ class IoSpace(Enum):
     IO = "IO"
     MOTOR_GENERAL_IO = "MOTOR_GENERAL_IO"
     MOTOR_DEDICATED_IO = "MOTOR_DEDICATED_IO"
+
+
+class AxisMasterType(IntEnum):
+    """MPIAxisMasterType (MPI 002): the source of the master position a cam's slave axis
+    follows. The numbers are the enum's order in the reference."""
+
+    MOTOR_FEEDBACK_PRIMARY = 0
+    MOTOR_FEEDBACK_SECONDARY = 1
+    AXIS_COMMANDED_POSITION = 2
+    AXIS_ACTUAL_POSITION = 3
+    ADDRESS = 4

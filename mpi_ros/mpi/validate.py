@@ -9,6 +9,7 @@ failing check wins and nothing is changed.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from .messages import Message
 from .params import MAX_COORD_AXES, MAX_GATES, MAX_REQUEST_VALUES, Hold, MotionParams, Output, Verdict
@@ -43,6 +44,12 @@ ALLOWED_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
     MPIMotionType.BSPLINE: _PATH_ALLOWED,
     MPIMotionType.BSPLINE2: _PATH_ALLOWED,
     MPIMotionType.FRAME: A.APPEND | A.ID,
+    # The reference has no ATTRIBUTE_INVALID list for the cams: they take their own attributes
+    # (MPIMotionAttrMask: REPEAT, MASTER_START, NO_BACKTRACK, NO_BACKTRACK_HOLD), ID and EVENT,
+    # which every move may carry. A cam's slave distances are relative by definition
+    # (MPIMotionCam), and its start is MASTER_START, not a time (DELAY) or a HOLD (docs/cams.md).
+    MPIMotionType.CAM_LINEAR: CAM_ATTRS | A.ID | A.EVENT,
+    MPIMotionType.CAM_CUBIC: CAM_ATTRS | A.ID | A.EVENT,
 }
 # spec 000: "VELOCITY, VELOCITY_JERK Moves are not permitted to have the following".
 FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
@@ -53,10 +60,9 @@ FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
 # mpiMotionStart is visibly incomplete: it leaves out VELOCITY and FRAME, which the same
 # reference documents as supported, so it does not exclude the cams either.)
 SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID}
-# Types this simulator executes today; the cams answer UNSUPPORTED "not simulated yet" (built
-# in their own issue).
+# Types this simulator executes: all of them.
 STREAMED_TYPES = PATH_TYPES | {MPIMotionType.FRAME}
-EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES | STREAMED_TYPES
+EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES | STREAMED_TYPES | CAM_TYPES
 # The most values one path request may carry (positions, or frames, over all its axes): a
 # bound on the memory and planning time a single request can claim (1 << 20 took 5 s to
 # plan, holding the controller). A longer path is streamed in requests (APPEND), as the
@@ -146,6 +152,8 @@ def check_params(
     bad = Message.MPIMessagePARAM_INVALID
     if axis_count > MAX_COORD_AXES:
         return _bad(Message.MPIMessageARG_INVALID, f"{axis_count} axes exceed MEIXmpMAX_COORD_AXES ({MAX_COORD_AXES})")
+    if motion_type in CAM_TYPES:
+        return _check_cam(motion_type, attrs, params, axis_count)
     if motion_type in STREAMED_TYPES:
         verdict = _check_path_attributes(attrs, params, axis_count, frame_buffer_size)
         if not verdict.ok:
@@ -241,6 +249,42 @@ def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPar
     if A.ELEMENT_ID in attrs and len(params.element_id) not in (1, points):
         return _bad(bad, f"element_id needs 1 or {points} value(s) (one per point), got {len(params.element_id)}")
     return _check_path_shape(motion_type, params, sample_rate)
+
+
+def _check_cam(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, axis_count: int) -> Verdict:
+    """A cam (MPI 000, MPIMotionCam): pointCount segments, each with a master distance
+    (masterDistance: pointCount elements), a slave distance per axis (slavePosition) and, for
+    CAM_CUBIC, a gear ratio per axis at its end (gearRatio; a linear cam ignores it). The
+    arrays are interleaved by axis like a path's positions. Values are finite and in range
+    (MPIMessagePARAM_INVALID, as for any move's values); a master distance of zero would make a
+    segment the master never moves through, and distances of both signs a table the master
+    runs through back and forth: both refused (docs/cams.md). REPEAT's repeatFrom is "the
+    first frame that is repeated" (MPI 000, MPIMotionAttributes): one of the segments."""
+    bad = Message.MPIMessagePARAM_INVALID
+    points = len(params.master_distance)
+    if points == 0:
+        return _bad(bad, "master_distance: a cam needs at least one segment (pointCount >= 1)")
+    if points * axis_count > MAX_PATH_VALUES:
+        return _bad(bad, f"{points} segments x {axis_count} axes: at most {MAX_PATH_VALUES} values in one request")
+    arrays = [("slave_position", params.slave_position)]
+    if motion_type is MPIMotionType.CAM_CUBIC:
+        arrays.append(("gear_ratio", params.gear_ratio))
+    for name, values in arrays:
+        if len(values) != points * axis_count:
+            return _bad(bad, f"{name} needs pointCount x axes = {points} x {axis_count} value(s) (interleaved by "
+                             f"axis), got {len(values)}")
+    # "with linear cams this field is completely ignored" (MPIMotionCam, gearRatio): not read
+    read = params if motion_type is MPIMotionType.CAM_CUBIC else replace(params, gear_ratio=[])
+    verdict = read.validate(motion_type, attrs)
+    if not verdict.ok:
+        return verdict
+    if any(d == 0.0 for d in params.master_distance):
+        return _bad(bad, "master_distance: every segment's master distance must be non-zero")
+    if any(d > 0.0 for d in params.master_distance) and any(d < 0.0 for d in params.master_distance):
+        return _bad(bad, "master_distance: all of one sign (the direction of the master along the table)")
+    if A.REPEAT in attrs and not 0 <= params.repeat_from < points:
+        return _bad(bad, f"repeat_from {params.repeat_from}: must be a segment of the cam, 0..{points - 1}")
+    return OK
 
 
 def _check_path_attributes(attrs: MotionAttr, params: MotionParams, axis_count: int,

@@ -1,0 +1,246 @@
+"""Electronic cams: CAM_LINEAR and CAM_CUBIC slave axes that follow a master position.
+
+MPI 000, MPIMotionCam and the attributes REPEAT, MASTER_START, NO_BACKTRACK and
+NO_BACKTRACK_HOLD; MPI 002, MPIAxisConfig.master and masterCorrection. The slave's command is
+a function of the master's position, not of time: each sample the master position (masters.py)
+becomes a travel ``x`` along the table (from the master's position at the start, or from
+``masterStart``), the backtrack rule turns it into the slave's progress ``u``, and the table
+(profiles/cam.py) gives the slave's position at ``u``. Decisions: docs/cams.md.
+
+Progress, per sample k (x_k the master's travel, s_k the feedrate over the normal one):
+- before the cam has started (MASTER_START: the master has not reached ``masterStart``;
+  x < 0 until then) the slave waits at its start: u = x (the table is flat before 0);
+- the reference r follows the master: x itself (the master may reverse and the slave with
+  it), the forward travel alone (NO_BACKTRACK: r grows by the master's forward steps, so the
+  slave holds while the master goes back and moves as soon as it goes forward again), or
+  the furthest point reached (NO_BACKTRACK_HOLD: the slave holds until the master is back
+  where it reversed);
+- u = r + offset. The offset is the phase a stop lost: at the normal feedrate it does not
+  change (u is r plus a constant, one rounding, so no drift however long the cam runs);
+  while STOP or E_STOP ramp the feedrate, u grows by s_k times r's step and the offset
+  becomes u - r.
+- a cam without REPEAT is complete once u reaches the table's end: the slave stays there.
+All of it is arrays over a stretch (numpy); a stretch in which the feedrate changes runs the
+same recurrence sample by sample. Either way each value is computed by the same operations,
+so the result never depends on how the samples were batched.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .frames import AxisPlan
+from .masters import reads
+from .params import AxisMaster, MotionParams
+from .profiles.cam import CamTable
+from .types import MotionAttr, MPIMotionType
+
+if TYPE_CHECKING:
+    from .planner import AxisStart
+
+
+class Backtrack(Enum):
+    """What the slave does when the master reverses (MPI 000, MPIMotionAttrMask)."""
+
+    FOLLOW = "FOLLOW"  # neither attribute: the slave follows the master back
+    NO_BACKTRACK = "NO_BACKTRACK"
+    NO_BACKTRACK_HOLD = "NO_BACKTRACK_HOLD"
+
+    @classmethod
+    def of(cls, attrs: MotionAttr) -> Backtrack:
+        if MotionAttr.NO_BACKTRACK in attrs:
+            return cls.NO_BACKTRACK
+        if MotionAttr.NO_BACKTRACK_HOLD in attrs:
+            return cls.NO_BACKTRACK_HOLD
+        return cls.FOLLOW
+
+
+@dataclass(frozen=True, slots=True)
+class CamState:
+    """A slave's progress at one sample: the master's travel ``x``, the reference ``r``, the
+    offset, the progress ``u`` = r + offset, started (the master reached the start), finished
+    (the end of a non-repeating table reached)."""
+
+    x: float
+    r: float
+    offset: float
+    u: float
+    started: bool
+    finished: bool
+
+    @classmethod
+    def at_start(cls, x: float) -> CamState:
+        started = x >= 0.0
+        return cls(x, x, 0.0, x, started, False)
+
+
+@dataclass(slots=True)
+class Progress:
+    """The progress over a stretch, and the state at each of its samples (kept until the
+    controller commits one of them)."""
+
+    x: np.ndarray
+    r: np.ndarray
+    offset: np.ndarray
+    u: np.ndarray
+    started: np.ndarray
+    finished: np.ndarray
+
+    def state(self, i: int) -> CamState:
+        return CamState(float(self.x[i]), float(self.r[i]), float(self.offset[i]), float(self.u[i]),
+                        bool(self.started[i]), bool(self.finished[i]))
+
+
+def progress(mode: Backtrack, x: np.ndarray, scale: np.ndarray, state: CamState, end: float | None) -> Progress:
+    """The slave's progress at travels ``x`` with feedrate ratios ``scale``, from ``state``
+    (the sample before the first); ``end``: the travel at which the cam is complete."""
+    started = state.started | np.logical_or.accumulate(x >= 0.0)
+    pre = ~started
+    r, step = _reference(mode, x, state, started)
+    step = np.where(pre, 0.0, step)
+    if np.all(scale == 1.0):
+        offset = np.full_like(x, state.offset)
+        u = np.where(pre, x, r + state.offset)
+    else:
+        u, offset = _scaled(x, r, step, scale, pre, state)
+    finished = state.finished | (np.logical_or.accumulate(u >= end) if end is not None else False)
+    finished = np.broadcast_to(finished, x.shape)
+    if end is not None:
+        u = np.where(finished, end, u)
+    return Progress(x, r, offset, u, started, finished)
+
+
+def _reference(mode: Backtrack, x: np.ndarray, state: CamState, started: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(reference, its step at each sample) under the backtrack rule; before the start r = x."""
+    previous = np.concatenate(([state.x], x[:-1]))
+    if mode is Backtrack.FOLLOW:
+        return x, x - previous
+    if mode is Backtrack.NO_BACKTRACK_HOLD:
+        # furthest point reached; before the start x < 0, so the first x >= 0 is past all of them
+        r = np.maximum.accumulate(np.concatenate(([state.r], x)))[1:]
+        r = np.where(started, r, x)
+        return r, r - np.concatenate(([state.r], r[:-1]))
+    # NO_BACKTRACK: the forward steps, summed from the start (a cumulative sum adds one step
+    # after the other, as a sample-by-sample loop would)
+    forward = np.maximum(x - previous, 0.0)
+    first = int(np.argmax(started)) if started.any() else len(x)
+    seed = state.r if first == 0 else float(x[first - 1])
+    r = x.copy()
+    r[first:] = np.cumsum(np.concatenate(([seed], forward[first:])))[1:]
+    return r, forward
+
+
+def _scaled(x: np.ndarray, r: np.ndarray, step: np.ndarray, scale: np.ndarray, pre: np.ndarray,
+            state: CamState) -> tuple[np.ndarray, np.ndarray]:
+    """Progress while the feedrate is off its normal value somewhere in the stretch, sample by
+    sample: at the normal feedrate u = r + offset (as :func:`progress` computes it), else u
+    grows by the scaled step and the offset follows."""
+    n = len(x)
+    u = np.empty(n)
+    offset = np.empty(n)
+    u_prev, off = state.u, state.offset
+    for k in range(n):
+        if pre[k]:
+            value = float(x[k])
+        elif scale[k] == 1.0:
+            value = float(r[k]) + off
+        else:
+            value = u_prev + float(scale[k]) * float(step[k])
+            off = value - float(r[k])
+        u[k], offset[k], u_prev = value, off, value
+    return u, offset
+
+
+@dataclass(slots=True)
+class CamFollow:
+    """One slave axis' part of a cam move: its table, its master (MPIAxisConfig.master as it
+    was when the cam started), the table's direction along the master (+1 or -1), the master
+    position at travel 0, the backtrack rule, the slave's raw command at the start, and its
+    progress at the last committed sample."""
+
+    table: CamTable
+    master: AxisMaster
+    direction: float
+    origin: float
+    mode: Backtrack
+    start: float
+    state: CamState
+    pending: tuple[np.ndarray, Progress] | None = None  # the last stretch traced: (times, progress)
+
+    def travel(self, master: np.ndarray) -> np.ndarray:
+        """The master's travel along the table at master positions ``master``."""
+        return (master - self.origin) * self.direction
+
+    def follow(self, t: np.ndarray, master: np.ndarray, scale: np.ndarray) -> np.ndarray:
+        """The slave's raw command at times ``t`` where the master is at ``master``; the
+        progress is kept until :meth:`commit`."""
+        done = progress(self.mode, self.travel(master), scale, self.state, self.table.end)
+        self.pending = (t, done)
+        return self.start + self.table.position(done.u)
+
+    def commit(self, t: float) -> None:
+        """The controller keeps the stretch up to time ``t``: so does the progress."""
+        if self.pending is None:
+            return
+        times, done = self.pending
+        i = int(np.searchsorted(times, t, side="right")) - 1
+        if i >= 0:
+            self.state = done.state(i)
+        self.pending = None
+
+    @property
+    def target(self) -> float:
+        """The raw position at the table's end (a repeating cam: the end of its first pass)."""
+        return self.start + float(self.table.slave[-1])
+
+    @property
+    def duration(self) -> float:
+        """The progress at which the cam is complete: its 'trajectory complete' (inf: never)."""
+        end = self.table.end
+        return math.inf if end is None else end
+
+
+def cam_plans(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, starts: list[AxisStart],
+              masters: list[tuple[AxisMaster, float]]) -> list[AxisPlan]:
+    """The plans of a validated cam (validate._check_cam) for the slave axes ``starts``, each
+    with its master and the master's position now. Travel 0 is the master's position now, or
+    ``masterStart`` with MASTER_START; the table's direction is the sign of the master
+    distances, and a gear ratio (dS/d master position) becomes dS/d travel in it."""
+    count = len(starts)
+    direction = 1.0 if params.master_distance[0] > 0.0 else -1.0
+    distances = [abs(float(d)) for d in params.master_distance]
+    repeat_from = int(params.repeat_from) if MotionAttr.REPEAT in attrs else None
+    cubic = motion_type is MPIMotionType.CAM_CUBIC
+    plans = []
+    for j, (start, (master, now)) in enumerate(zip(starts, masters, strict=True)):
+        ratios = [direction * float(g) for g in params.gear_ratio[j::count]] if cubic else None
+        table = CamTable.build(distances, [float(s) for s in params.slave_position[j::count]], ratios, repeat_from)
+        origin = float(params.master_start) if MotionAttr.MASTER_START in attrs else now
+        follow = CamFollow(table, master.copy(), direction, origin, Backtrack.of(attrs), start.position,
+                           CamState.at_start((now - origin) * direction))
+        plans.append(AxisPlan(axis=start.axis, segments=[], start_position=start.position, target=follow.target,
+                              cam=follow))
+    return plans
+
+
+def master_loop(slaves: list[int], masters: list[AxisMaster], running: dict[int, set[int]]) -> str:
+    """Why the masters of a cam on ``slaves`` would form a loop ('' if they do not): a slave
+    would follow itself, another slave of the cam, or, through the cams running (``running``:
+    slave axis -> the axes its master reads), one of them. Each sample a slave follows its
+    master's position of the same sample, so the masters must be computed first."""
+    for slave, master in zip(slaves, masters, strict=True):
+        seen: set[int] = set()
+        todo = list(reads(master))
+        while todo:
+            axis = todo.pop()
+            if axis in slaves:
+                return f"axis {slave}: its master position reads axis {axis}, a slave of this cam"
+            if axis not in seen:
+                seen.add(axis)
+                todo += running.get(axis, set())
+    return ""
