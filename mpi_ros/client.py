@@ -47,7 +47,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
-from mpi_ros.srv import MotionAction
+from mpi_ros.srv import AxisConfigGet, AxisConfigSet, MotionAction, MotorFeedbackSecondarySet
 
 from . import errors
 from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
@@ -398,6 +398,34 @@ def path_chunks(points: Sequence[Any], times: Sequence[float], size: int,
             for i in range(0, len(columns["points"]), size)]
 
 
+def cam_goal(motion_type: MotionType | str, master_distances: Iterable[float],
+             slave_positions: Iterable[Sequence[float] | float],
+             gear_ratios: Iterable[Sequence[float] | float] | None = None, attributes: Iterable[Attribute | str] = (),
+             repeat_from: int | None = None, master_start: int | None = None, **fields: Any) -> dict[str, Any]:
+    """The fields of a cam goal (CAM_LINEAR or CAM_CUBIC; MPI 000, MPIMotionCam) per segment.
+
+        cam_goal("CAM_CUBIC", [1000.0, 1000.0], [(500.0,), (500.0,)], gear_ratios=[(0.5,), (0.0,)])
+
+    ``master_distances``: the master's travel in each segment; ``slave_positions``: the
+    distance each slave axis moves in it (a tuple per segment, one value per axis);
+    ``gear_ratios`` (CAM_CUBIC): the slave's gear ratio at the end of each segment, like
+    ``slave_positions``; ``repeat_from`` (adds REPEAT) and ``master_start`` (adds MASTER_START).
+    """
+    attrs = [_name(a) for a in attributes]
+    goal: dict[str, Any] = {"type": _name(motion_type), "attributes": attrs,
+                            "master_distance": [float(d) for d in master_distances],
+                            "slave_position": interleave(slave_positions, "slave_positions")}
+    if gear_ratios is not None:
+        goal["gear_ratio"] = interleave(gear_ratios, "gear_ratios")
+    for attribute, key, value in ((Attribute.REPEAT, "repeat_from", repeat_from),
+                                  (Attribute.MASTER_START, "master_start", master_start)):
+        if value is not None:
+            goal[key] = int(value)
+            if attribute not in attrs:
+                attrs.append(attribute.value)
+    return {**goal, **fields}
+
+
 # -- a node that spins itself ------------------------------------------------------------------------------
 class _Endpoint:
     """A node of its own, spun by an executor in a background thread; finds the suite."""
@@ -434,6 +462,32 @@ class _Endpoint:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+    # -- plumbing ------------------------------------------------------------------------
+    def _on_executor(self, call: Callable[[], Any]) -> Any:
+        """Run ``call`` on the spinning thread; returns what it returns (a future)."""
+        box: dict[str, Any] = {}
+        ready = threading.Event()
+
+        def run() -> None:
+            try:
+                box["future"] = call()
+            finally:
+                ready.set()
+
+        self._executor.create_task(run)
+        if not ready.wait(self.timeout):
+            raise NoResponse("the client's executor did not run the request")
+        if "future" not in box:
+            raise NoResponse("the request failed on the client's executor (see its log)")
+        return box["future"]
+
+    def _wait_future(self, future: Any, timeout: float | None, what: str) -> Any:
+        done = threading.Event()
+        future.add_done_callback(lambda _f: done.set())
+        if not done.wait(self.timeout if timeout is None else timeout):
+            raise NoResponse(f"no answer for {what} within the timeout")
+        return future.result()
 
     # -- the graph -------------------------------------------------------------------------
     @property
@@ -585,32 +639,6 @@ class MotionClient(_Endpoint):
         return all(wait(timeout_sec=timeout) for wait in (self._start.wait_for_server,
                                                             self._modify.wait_for_server,
                                                             self._action.wait_for_service))
-
-    # -- plumbing ------------------------------------------------------------------------
-    def _on_executor(self, call: Callable[[], Any]) -> Any:
-        """Run ``call`` on the spinning thread; returns what it returns (a future)."""
-        box: dict[str, Any] = {}
-        ready = threading.Event()
-
-        def run() -> None:
-            try:
-                box["future"] = call()
-            finally:
-                ready.set()
-
-        self._executor.create_task(run)
-        if not ready.wait(self.timeout):
-            raise NoResponse("the client's executor did not run the request")
-        if "future" not in box:
-            raise NoResponse("the request failed on the client's executor (see its log)")
-        return box["future"]
-
-    def _wait_future(self, future: Any, timeout: float | None, what: str) -> Any:
-        done = threading.Event()
-        future.add_done_callback(lambda _f: done.set())
-        if not done.wait(self.timeout if timeout is None else timeout):
-            raise NoResponse(f"no answer for {what} within the timeout")
-        return future.result()
 
     # -- goals ---------------------------------------------------------------------------
     def start(self, goal: Mapping[str, Any] | Any, feedback: Callable[[Any], None] | None = None) -> Goal:
@@ -800,6 +828,20 @@ class MotionClient(_Endpoint):
         goal._result_future.add_done_callback(wake)
         return goal
 
+    def cam(self, motion_type: MotionType | str, master_distances: Iterable[float],
+            slave_positions: Iterable[Sequence[float] | float],
+            gear_ratios: Iterable[Sequence[float] | float] | None = None, attributes: Iterable[Attribute | str] = (),
+            repeat_from: int | None = None, master_start: int | None = None, wait: bool = False,
+            timeout: float | None = None, **fields: Any) -> MotionResult | Goal:
+        """A cam (CAM_LINEAR or CAM_CUBIC) on the supervisor's axes, which follow each axis'
+        master (AxisClient.config_set); the arguments as :func:`cam_goal`. Returns the running
+        Goal (a cam ends when its master reaches the table's end, a REPEAT cam only when
+        stopped), or with wait=True its result."""
+        goal = cam_goal(motion_type, master_distances, slave_positions, gear_ratios, attributes, repeat_from,
+                        master_start, **fields)
+        running = self.start(goal)
+        return running.wait(timeout) if wait else running
+
     # -- actions ----------------------------------------------------------------------------
     def action(self, name: Action | str, raise_on_error: bool = True) -> ActionReply:
         """mpiMotionAction: STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME or MAP."""
@@ -857,6 +899,73 @@ class MotionClient(_Endpoint):
         wanted = _name(state_name)
         return self.wait_for(lambda s: s.state_name == wanted and s.sample > newer_than, timeout,
                              f"state {wanted}")
+
+
+@dataclass(frozen=True, slots=True)
+class ServiceReply:
+    """The answer of a controller service: the spec's message name and its code."""
+
+    message: str
+    code: int
+
+    @property
+    def ok(self) -> bool:
+        return self.message == "MPIMessageOK"
+
+
+class AxisClient(_Endpoint):
+    """The controller's axis services: mpiAxisConfigGet/Set (inPosition, master,
+    masterCorrection) and the motors' secondary feedback inputs that cams can follow.
+
+        with AxisClient() as axes:
+            axes.config_set(1, master={"type": "AXIS_COMMANDED_POSITION", "number": 0})
+    """
+
+    def __init__(self, namespace: str = "/mpi", context: Context | None = None, timeout: float = 10.0,
+                 node_name: str | None = None):
+        super().__init__(namespace, context, timeout, node_name or "mpi_ros_axis_client")
+        self._clients: dict[tuple[type, str], Any] = {}
+        self._start_spinning()
+
+    def _call(self, srv_type: type, name: str, request: Any, raise_on_error: bool) -> Any:
+        key = (srv_type, name)
+        if key not in self._clients:
+            self._clients[key] = self.node.create_client(srv_type, f"{self.namespace}/{name}")
+        client = self._clients[key]
+        if not client.wait_for_service(timeout_sec=self.timeout):
+            raise NoResponse(f"the controller's service {self.namespace}/{name} is not available")
+        response = self._wait_future(self._on_executor(lambda: client.call_async(request)), None, name)
+        if raise_on_error:
+            raise_for(response.message, name, ServiceReply(response.message, response.code))
+        return response
+
+    def config_get(self, axis: int) -> Any:
+        """mpiAxisConfigGet: the AxisConfigGet response (in_position, master, master_correction)."""
+        return self._call(AxisConfigGet, f"axis{axis}/config_get", AxisConfigGet.Request(), True)
+
+    def config_set(self, axis: int, in_position: Mapping[str, Any] | None = None,
+                   master: Mapping[str, Any] | None = None, master_correction: int | None = None,
+                   raise_on_error: bool = True) -> ServiceReply:
+        """mpiAxisConfigSet; what is not given stays as the axis has it (read first)."""
+        current = self.config_get(axis)
+        request = AxisConfigSet.Request(in_position=current.in_position, master=current.master,
+                                        master_correction=current.master_correction)
+        if in_position is not None:
+            fill(request.in_position, in_position, "in_position")
+        if master is not None:
+            fill(request.master, master, "master")
+        if master_correction is not None:
+            request.master_correction = int(master_correction)
+        response = self._call(AxisConfigSet, f"axis{axis}/config_set", request, raise_on_error)
+        return ServiceReply(response.message, response.code)
+
+    def secondary_feedback_set(self, motor: int, position: float, velocity: float,
+                               raise_on_error: bool = True) -> ServiceReply:
+        """Drive motor ``motor``'s secondary feedback input: from the next sample it reads
+        ``position`` and moves at ``velocity`` counts/s (a line shaft's encoder, say)."""
+        request = MotorFeedbackSecondarySet.Request(motor=motor, position=float(position), velocity=float(velocity))
+        response = self._call(MotorFeedbackSecondarySet, "motor_feedback_secondary_set", request, raise_on_error)
+        return ServiceReply(response.message, response.code)
 
 
 # -- the whole suite ----------------------------------------------------------------------------------------

@@ -211,12 +211,29 @@ def _io_set(ctl: Controller, command: Command) -> Reply:
 
 
 def _axis_config_set(ctl: Controller, command: Command) -> Reply:
-    in_position = rq.in_position(command.request.get("in_position", {}))
+    """mpiAxisConfigSet: inPosition, master and masterCorrection, all or nothing."""
+    request = command.request
+    in_position = rq.in_position(request.get("in_position", {}))
+    if not 0 <= command.axis < len(ctl.axes):
+        return Reply(ctl.axis_in_position_set(command.axis, in_position), f"no axis {command.axis}")
+    master = rq.axis_master(request.get("master"), request.get("master_correction"), ctl.axes[command.axis].master)
+    verdict = ctl.axis_master_check(command.axis, master)  # the one AxisMaster validator
+    if not verdict.ok:
+        return Reply(verdict.message, verdict.prefixed("master.").detail)
     message = ctl.axis_in_position_set(command.axis, in_position)  # validates with AxisInPosition.validate
-    checks = [in_position.validate()]
-    if 0 <= command.axis < len(ctl.axes):  # and against the axis' encoder
-        checks.append(check_settling_reachable(in_position, ctl.axes[command.axis].plant.config))
+    # (and against the axis' encoder)
+    checks = [in_position.validate(), check_settling_reachable(in_position, ctl.axes[command.axis].plant.config)]
+    if message.ok:
+        message = ctl.axis_master_set(command.axis, master)
     return Reply(message, _refusal_detail(message, first_refusal(checks)))
+
+
+def _secondary_feedback_set(ctl: Controller, command: Command) -> Reply:
+    motor, feedback = rq.secondary_feedback(command.request)
+    message = ctl.secondary_feedback_set(motor, feedback)  # validates with SecondaryFeedback.validate
+    if not 0 <= motor < len(ctl.secondary):
+        return Reply(message, f"no motor {motor} ({len(ctl.secondary)} motors)")
+    return Reply(message, _refusal_detail(message, feedback.validate()))
 
 
 def _axis_position_set(ctl: Controller, command: Command) -> Reply:
@@ -247,6 +264,7 @@ OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
     "gate_set": _gate_set,
     "io_set": _io_set,
     "axis_config_set": _axis_config_set,
+    "secondary_feedback_set": _secondary_feedback_set,
     "axis_position_set": _axis_position_set,
 }
 

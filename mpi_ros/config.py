@@ -28,16 +28,18 @@ from .mpi.params import (
     MAX_OBJECTS,
     VALID,
     AxisInPosition,
+    AxisMaster,
     ControllerConfig,
     DecelTime,
     MotionConfig,
     PlantConfig,
+    SecondaryFeedback,
     Verdict,
     check_settling_reachable,
     first_refusal,
 )
 from .mpi.plant import Plant
-from .mpi.types import MPIAction
+from .mpi.types import AxisMasterType, MPIAction
 
 
 def default_config_path() -> Path:
@@ -89,6 +91,10 @@ class SuiteConfig:
     ros: RosSettings = field(default_factory=RosSettings)
     source: str = "<defaults>"
     raw: dict = field(default_factory=dict)  # the validated mapping (recorded in bags for replay)
+    # per axis: the cam master (MPIAxisConfig.master, masterCorrection) and the secondary
+    # feedback input of the axis' motor (docs/cams.md); empty: the defaults
+    masters: list[AxisMaster] = field(default_factory=list)
+    secondary: list[SecondaryFeedback] = field(default_factory=list)
 
     @property
     def axis_count(self) -> int:
@@ -107,6 +113,12 @@ class SuiteConfig:
             ctl.axes[n].plant = Plant(plant)  # before the tolerances: they are checked against its encoder
             _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position",
                       first_refusal((in_position.validate(), check_settling_reachable(in_position, plant))))
+        for n, master in enumerate(self.masters):
+            _accepted(ctl.axis_master_set(n, master), f"axes[{n}].master", ctl.axis_master_check(n, master))
+        for n, feedback in enumerate(self.secondary):
+            if feedback == SecondaryFeedback():  # (motor n may not exist: motor_count < axes)
+                continue
+            _accepted(ctl.secondary_feedback_set(n, feedback), f"axes[{n}].secondary_feedback", feedback.validate())
         for i, spec in enumerate(self.supervisors):
             self._build_supervisor(ctl, spec, f"supervisors[{i}]")
         return ctl
@@ -206,7 +218,31 @@ def _controller(raw: dict | None, axis_count: int, supervisor_count: int) -> Con
     return cfg
 
 
-def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
+@dataclass(slots=True)
+class _AxesConfig:
+    count: int
+    in_position: list[AxisInPosition]
+    plant: list[PlantConfig]
+    masters: list[AxisMaster]
+    secondary: list[SecondaryFeedback]
+
+
+def _axis_master(raw: Any, where: str) -> AxisMaster:
+    """axes[n].master: {type: AXIS_COMMANDED_POSITION, number: 0, address: 0, correction: -1}."""
+    if raw is not None and not isinstance(raw, dict):
+        raise ConfigError(f"{where}: expected a mapping, got {type(raw).__name__}")
+    data = dict(raw or {})
+    name = data.pop("type", AxisMaster().type.name)
+    kind = AxisMasterType.__members__.get(str(name).strip().upper())
+    if kind is None:
+        raise ConfigError(f"{where}.type: expected one of {', '.join(AxisMasterType.__members__)}, got {name!r}")
+    master = _dataclass(AxisMaster, data, where)
+    master.type = kind
+    _require(master.validate(), f"{where}.")
+    return master
+
+
+def _axes(raw: dict | None) -> _AxesConfig:
     raw = raw or {}
     unknown = set(raw) - {"count", "defaults", "overrides"}
     if unknown:
@@ -218,20 +254,25 @@ def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig
     overrides = raw.get("overrides") or {}
     if not isinstance(overrides, dict):
         raise ConfigError("axes.overrides: expected a mapping of axis number -> settings")
-    in_position, plants = [], []
+    out = _AxesConfig(count, [], [], [], [])
     for n in range(count):
         merged = _merge(defaults, overrides.get(n, overrides.get(str(n), {})))
-        extra = set(merged) - {"in_position", "plant"}
+        extra = set(merged) - {"in_position", "plant", "master", "secondary_feedback"}
         if extra:
-            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: in_position, plant)")
+            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: in_position, master, plant, "
+                              "secondary_feedback)")
         ip = _dataclass(AxisInPosition, merged.get("in_position"), f"axes[{n}].in_position")
         plant = _dataclass(PlantConfig, merged.get("plant"), f"axes[{n}].plant")
         _require(ip.validate(), f"axes[{n}].in_position.")
         _require(plant.validate(), f"axes[{n}].plant.")
         _require(check_settling_reachable(ip, plant), f"axes[{n}].in_position.")
-        in_position.append(ip)
-        plants.append(plant)
-    return count, in_position, plants
+        secondary = _dataclass(SecondaryFeedback, merged.get("secondary_feedback"), f"axes[{n}].secondary_feedback")
+        _require(secondary.validate(), f"axes[{n}].secondary_feedback.")
+        out.in_position.append(ip)
+        out.plant.append(plant)
+        out.masters.append(_axis_master(merged.get("master"), f"axes[{n}].master"))
+        out.secondary.append(secondary)
+    return out
 
 
 def _motion_config(raw: dict, where: str) -> MotionConfig:
@@ -304,12 +345,13 @@ def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
     extra = set(data) - known
     if extra:
         raise ConfigError(f"{sorted(extra)[0]}: unknown top-level key (known: {', '.join(sorted(known))})")
-    count, in_position, plants = _axes(data.get("axes"))
+    axes = _axes(data.get("axes"))
     supervisors = _supervisors(data.get("supervisors", [{"number": 0, "axes": [0]}]),
-                               data.get("supervisor_defaults"), count)
+                               data.get("supervisor_defaults"), axes.count)
     supervisor_count = max(s.number for s in supervisors) + 1
-    controller = _controller(data.get("controller"), count, supervisor_count)
-    return SuiteConfig(controller, in_position, plants, supervisors, _ros(data.get("ros")), source, copy.deepcopy(data))
+    controller = _controller(data.get("controller"), axes.count, supervisor_count)
+    return SuiteConfig(controller, axes.in_position, axes.plant, supervisors, _ros(data.get("ros")), source,
+                       copy.deepcopy(data), axes.masters, axes.secondary)
 
 
 def load(path: str | Path | None = None, overrides: dict | None = None) -> SuiteConfig:

@@ -29,16 +29,18 @@ from .mpi.params import (
     MAX_REQUEST_TEXT,
     MAX_REQUEST_VALUES,
     AxisInPosition,
+    AxisMaster,
     DecelTime,
     Hold,
     MotionConfig,
     MotionParams,
     Output,
+    SecondaryFeedback,
     Trajectory,
     UserFrame,
     shown,
 )
-from .mpi.types import HoldType, MotionAttr, MPIMotionType, OutputType
+from .mpi.types import AxisMasterType, HoldType, MotionAttr, MPIMotionType, OutputType
 
 
 class RequestError(ValueError):
@@ -415,3 +417,42 @@ def in_position(data: Any) -> AxisInPosition:
 
 def in_position_to_dict(cfg: AxisInPosition) -> dict[str, Any]:
     return {key: getattr(cfg, key) for key in cfg.__slots__}
+
+
+_MASTER_FIELDS = frozenset({"type", "number", "address"})
+
+
+def axis_master(data: Any, correction: Any, current: AxisMaster) -> AxisMaster:
+    """The AxisMaster message (as a dict: type, number, address) and master_correction of an
+    AxisConfigSet request, over the axis' ``current`` master: an absent master (a request
+    recorded before the field existed) or an empty type keeps the current source, an absent
+    master_correction the current correction. Ranges are checked by the controller."""
+    master = current.copy()
+    if data is not None:
+        data = mapping(data, "master")
+        unknown = sorted(str(key) for key in data if key not in _MASTER_FIELDS)
+        if unknown:
+            raise RequestError(Message.MPIMessagePARAM_INVALID, f"master: unknown field {shown(unknown[0])}")
+        kind = text(data.get("type", ""), "master.type")
+        if kind.strip():
+            master.type = enum_by_name(AxisMasterType, kind, "master type (MOTOR_FEEDBACK_PRIMARY, "
+                                       "MOTOR_FEEDBACK_SECONDARY, AXIS_COMMANDED_POSITION, AXIS_ACTUAL_POSITION, "
+                                       "ADDRESS)")
+            master.number = integer(data.get("number", 0), "master.number")
+            master.address = integer(data.get("address", 0), "master.address")
+    if correction is not None:
+        master.correction = integer(correction, "master_correction")
+    return master
+
+
+def axis_master_to_dict(master: AxisMaster) -> dict[str, Any]:
+    """The AxisMaster message's fields (master_correction is a field of the service beside it)."""
+    return {"type": master.type.name, "number": master.number, "address": master.address}
+
+
+def secondary_feedback(data: Any) -> tuple[int, SecondaryFeedback]:
+    """A MotorFeedbackSecondarySet request (as a dict): (motor, the input's new reading)."""
+    data = mapping(data, "request")
+    return (integer(data.get("motor", -1), "motor"),
+            SecondaryFeedback(number(data.get("position", 0.0), "position"),
+                              number(data.get("velocity", 0.0), "velocity")))

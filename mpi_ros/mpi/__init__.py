@@ -36,6 +36,9 @@ Where each spec concept lives (spec = ../shared/spec; 000 motion objects, 002 ax
 |   stretch is computed from (command piece, plant anchor,  |   |
 |   status inputs, supervisors' clocks)                     |   |
 | every axis over a stretch of samples at once              | stretch.py |
+| MPIMotionCam tables (CAM_LINEAR, CAM_CUBIC, REPEAT)       | profiles/cam.py |
+| cams: progress, MASTER_START, NO_BACKTRACK(_HOLD)          | cams.py (docs/cams.md) |
+| MPIAxisMaster sources, masterCorrection, 2nd encoders     | masters.py |
 
 Start with ``Controller``: create it, ``create_motion``, ``axis_list_set``, ``start``,
 then ``step(n)`` or ``run_until(...)``. Every call answers a ``Message``.
@@ -47,6 +50,7 @@ from .messages import Message
 from .motion import MotionSupervisor
 from .params import (
     AxisInPosition,
+    AxisMaster,
     ControllerConfig,
     DecelTime,
     Hold,
@@ -54,13 +58,25 @@ from .params import (
     MotionParams,
     Output,
     PlantConfig,
+    SecondaryFeedback,
     Trajectory,
 )
-from .types import ActionSource, HoldType, IoSpace, MotionAttr, MPIAction, MPIMotionType, MPIState, OutputType
+from .types import (
+    ActionSource,
+    AxisMasterType,
+    HoldType,
+    IoSpace,
+    MotionAttr,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    OutputType,
+)
 
 __all__ = [
-    "ActionSource", "AxisInPosition", "Controller", "ControllerConfig", "DecelTime", "Event", "Hold",
+    "ActionSource", "AxisInPosition", "AxisMaster", "AxisMasterType", "Controller", "ControllerConfig", "DecelTime",
+    "Event", "Hold",
     "HoldType", "IoSpace", "Message", "MotionAttr", "MotionConfig", "MotionParams", "MotionSupervisor",
     "MPIAction", "MPIEventType", "MPIMotionType", "MPIState", "Output", "OutputType", "PlantConfig",
-    "Trajectory",
+    "SecondaryFeedback", "Trajectory",
 ]

@@ -151,6 +151,7 @@ class Axis:
         self._held_feedforward = 0.0  # PTF/PVTF feedforward kept from move to move
         self.state = PlantState(0.0, 0.0, 0.0)
         self._cache: dict = {}
+        self._sampled: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # a cam slave's last trace
         self.status_mode = StatusMode.POINT_TO_POINT
         self.target = 0.0
 
@@ -459,31 +460,34 @@ class Axis:
     def _trace_cam(self, samples: np.ndarray, t: np.ndarray, master: np.ndarray, scale: np.ndarray) -> AxisTrace:
         """A cam's slave: the command from the cam at each sample's master position, its
         velocity and acceleration as the differences from sample to sample, the loop stepped
-        sample by sample with the command linear in between (Plant.sample_step)."""
+        sample by sample with the command linear in between (Plant.sample_step). The plant
+        states are kept aside, as the cam's progress is, until :meth:`keep_anchor`."""
         plan = self.plan
         assert plan is not None and plan.cam is not None  # (camming)
         cmd_p = plan.cam.follow(t, master, scale)
         cmd_v = (cmd_p - np.concatenate(([self.cmd_p], cmd_p[:-1]))) * self.rate
         cmd_a = (cmd_v - np.concatenate(([self.cmd_v], cmd_v[:-1]))) * self.rate
-        y, dy, anchors = self._trace_steps(t, cmd_p)
+        y, dy = self._trace_steps(cmd_p)
+        self._sampled = (t, y, dy)
         assert plan.cam.pending is not None  # (follow keeps the progress)
-        return AxisTrace(samples, t, cmd_p, cmd_v, cmd_a, self.plant.read(y), dy, plan.cam.pending[1].u, anchors)
+        return AxisTrace(samples, t, cmd_p, cmd_v, cmd_a, self.plant.read(y), dy, plan.cam.pending[1].u, [self.state])
 
-    def _trace_steps(self, t: np.ndarray, cmd_p: np.ndarray):
+    def _trace_steps(self, cmd_p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The loop driven by a command known at each sample, linear in between, from the
-        anchor (at the sample before the first: a cam's slave is anchored every sample)."""
+        anchor (at the sample before the first: a cam's slave is anchored every sample). Plain
+        floats: a few multiplications per sample."""
         (a0, a1, a2, a3, a4), (b0, b1, b2, b3, b4) = self.plant.sample_step(self.rate)
         feedforward = self._held_feedforward
-        state = self.state
-        y, dy, p0 = state.y, state.dy, self.cmd_p
-        ys, dys = np.empty_like(t), np.empty_like(t)
-        anchors = [state]
-        for k, (tk, p1) in enumerate(zip(t.tolist(), cmd_p.tolist(), strict=True)):
-            y, dy = (a0 * y + a1 * dy + a2 * p0 + a3 * p1 + a4 * feedforward,
-                     b0 * y + b1 * dy + b2 * p0 + b3 * p1 + b4 * feedforward)
-            ys[k], dys[k], p0 = y, dy, p1
-            anchors.append(PlantState(tk, y, dy))
-        return ys, dys, anchors
+        y, dy, p0 = self.state.y, self.state.dy, self.cmd_p
+        a_ff, b_ff = a4 * feedforward, b4 * feedforward
+        ys, dys = [], []
+        for p1 in cmd_p.tolist():
+            y, dy = (a0 * y + a1 * dy + a2 * p0 + a3 * p1 + a_ff,
+                     b0 * y + b1 * dy + b2 * p0 + b3 * p1 + b_ff)
+            ys.append(y)
+            dys.append(dy)
+            p0 = p1
+        return np.array(ys), np.array(dys)
 
     def _trace_follow(self, t: np.ndarray):
         """settleOnEstopCmdEqAct: each sample the command is the previous actual."""
@@ -503,8 +507,14 @@ class Axis:
         """After a stretch traced here (:meth:`trace`): the plant anchor in force at time ``t``
         of it (the controller keeps the values)."""
         plan = self.plan
-        if plan is not None and plan.cam is not None:
+        if plan is not None and plan.cam is not None and self._sampled is not None:
             plan.cam.commit(t)
+            times, y, dy = self._sampled
+            i = int(np.searchsorted(times, t, side="right")) - 1
+            self._sampled = None
+            if i >= 0:
+                self.state = PlantState(float(times[i]), float(y[i]), float(dy[i]))
+            return
         anchor = self.state
         for candidate in anchors:
             if candidate.t <= t:

@@ -23,9 +23,9 @@ from .bank import AxisBank
 from .clock import ProfileClock
 from .events import Event, MPIEventType
 from .io import IoImage
+from .masters import SecondaryInputs, Sources
 from .messages import STATE_MESSAGES, Message
 from .motion import MotionSupervisor
-from .masters import SecondaryInputs, Sources
 from .params import (
     AxisInPosition,
     AxisMaster,

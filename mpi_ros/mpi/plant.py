@@ -248,7 +248,7 @@ class Plant:
             return _poly_eval_scalar(yp, span) + h0, _poly_eval_scalar(dyp, span) + h1
 
         columns = [after(*(1.0 if i == j else 0.0 for j in range(5))) for i in range(5)]
-        step = (tuple(c[0] for c in columns), tuple(c[1] for c in columns))
+        step = (tuple(float(c[0]) for c in columns), tuple(float(c[1]) for c in columns))
         self._steps[key] = step
         return step
 

@@ -3,7 +3,8 @@
 Publishes /<ns>/axis<k>/status, /<ns>/events, /joint_states, /diagnostics and /clock
 (controller time, for use_sim_time consumers); serves the axis services
 (/<ns>/axis<k>/config_get|config_set|position_set) and the control's gates and I/O
-(/<ns>/gate_set|gate_get|io_get|io_set).
+(/<ns>/gate_set|gate_get|io_get|io_set) and the motors' secondary feedback inputs that cams can
+follow (/<ns>/motor_feedback_secondary_set).
 
 For recordings any tool can make: every command the controller applied goes out on
 /<ns>/commands (mpi_ros/msg/Command, with the sample at which it took effect) and the
@@ -27,7 +28,16 @@ from sensor_msgs.msg import JointState
 
 from mpi_ros.msg import AxisStatus, MotionEvent, SuiteConfiguration
 from mpi_ros.msg import Command as CommandMsg
-from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisPositionSet, GateGet, GateSet, IoGet, IoSet
+from mpi_ros.srv import (
+    AxisConfigGet,
+    AxisConfigSet,
+    AxisPositionSet,
+    GateGet,
+    GateSet,
+    IoGet,
+    IoSet,
+    MotorFeedbackSecondarySet,
+)
 
 from .. import requests as rq
 from ..commands import Command, Reply, io_space
@@ -88,6 +98,7 @@ class ControllerNode(Node):
         self._service(GateGet, "gate_get", self._on_gate_get)
         self._service(IoSet, "io_set", self._on_io_set)
         self._service(IoGet, "io_get", self._on_io_get)
+        self._service(MotorFeedbackSecondarySet, "motor_feedback_secondary_set", self._on_secondary_set)
         self._pub_events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
         self._pub_joints = self.create_publisher(JointState, "/joint_states", 10)
         self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
@@ -208,13 +219,20 @@ class ControllerNode(Node):
 
     # -- services -------------------------------------------------------------------------
     def _on_config_get(self, k: int, response):
-        cfg = self.runner.read(lambda ctl: ctl.axes[k].in_position.copy())
+        cfg, master = self.runner.read(lambda ctl: (ctl.axes[k].in_position.copy(), ctl.axes[k].master.copy()))
         convert.fill(response.in_position, rq.in_position_to_dict(cfg))
+        convert.fill(response.master, rq.axis_master_to_dict(master))
+        response.master_correction = master.correction
         return convert.answer(response, Reply(Message.MPIMessageOK))
 
     def _on_config_set(self, k: int, request, response):
-        reply, _ = self.runner.submit(Command("axis_config_set", axis=k,
-                                              request={"in_position": convert.to_dict(request.in_position)}))
+        reply, _ = self.runner.submit(Command("axis_config_set", axis=k, request={
+            "in_position": convert.to_dict(request.in_position), "master": convert.to_dict(request.master),
+            "master_correction": request.master_correction}))
+        return convert.answer(response, reply)
+
+    def _on_secondary_set(self, request, response):
+        reply, _ = self.runner.submit(Command("secondary_feedback_set", request=convert.to_dict(request)))
         return convert.answer(response, reply)
 
     def _on_position_set(self, k: int, request, response):
