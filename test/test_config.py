@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from mpi_ros import config, requests
@@ -164,3 +166,29 @@ def test_yaml_service_and_controller_agree_on_in_position(key, values):
         by_service = apply(ctl, Command("axis_config_set", axis=0, request={"in_position": {key: value}})).accepted
         assert by_yaml is by_service, (key, value)
 
+
+
+def test_axis_master_and_secondary_feedback_from_yaml():
+    # MPI 002, MPIAxisConfig.master / masterCorrection per axis; the secondary feedback input of motor n
+    # (docs/cams.md)
+    from mpi_ros.mpi import AxisMaster, AxisMasterType, SecondaryFeedback
+
+    cfg = config.parse({"axes": {"overrides": {
+        1: {"master": {"type": "address", "address": 5, "correction": 3}},
+        2: {"secondary_feedback": {"position": 10.0, "velocity": 250.0}}}}})
+    ctl = cfg.build_controller()
+    assert ctl.axes[1].master == AxisMaster(AxisMasterType.ADDRESS, 0, 5, 3)
+    assert ctl.axes[0].master == AxisMaster()
+    assert ctl.secondary.get(2) == (0, SecondaryFeedback(10.0, 250.0))
+
+
+@pytest.mark.parametrize(("override", "words"), [
+    ({"master": {"type": "SOMEWHERE"}}, "axes[1].master.type"),
+    ({"master": {"type": "AXIS_ACTUAL_POSITION", "number": "zero"}}, "axes[1].master.number"),
+    ({"master": {"correction": -5}}, "axes[1].master.correction"),
+    ({"master": {"type": "ADDRESS", "address": 64}}, "axes[1].master.address"),
+    ({"secondary_feedback": {"velocity": 1e13}}, "axes[1].secondary_feedback.velocity"),
+])
+def test_a_bad_axis_master_names_its_key(override, words):
+    with pytest.raises(config.ConfigError, match=re.escape(words)):
+        config.parse({"axes": {"overrides": {1: override}}}).build_controller()

@@ -15,6 +15,7 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
     ("01_controller_move.py", "MOTION_DONE"),
     ("02_stop_resume_e_stop.py", "RESET: MPIMessageOK -> IDLE"),
     ("04_record_and_replay.py", "zero differences"),
+    ("07_flying_shear_cam.py", "slave speed / line speed = 1.000000 during every cut"),
 ])
 def test_example_runs(name, expect, tmp_path):
     args = [sys.executable, "-P", str(EXAMPLES / name)]

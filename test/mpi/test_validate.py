@@ -62,11 +62,11 @@ def test_jerk_types_without_firmware_option_21_are_not_supported(kind, modify):
 
 
 @pytest.mark.parametrize("kind", [T.CAM_LINEAR, T.CAM_CUBIC])
-def test_cams_answer_unsupported_because_they_are_not_simulated_yet(kind):
-    # MPI 000 documents the cams in full (MPIMotionCam, REPEAT, MASTER_START): they are supported
-    # by the controller. Until this twin simulates them, MPIMessageUNSUPPORTED says so.
-    verdict = check_type(kind, False, False)
-    assert verdict.message is M.MPIMessageUNSUPPORTED and "not simulated yet" in verdict.detail
+def test_cams_are_supported_but_cannot_be_modified(kind):
+    # MPI 000 documents the cams in full (MPIMotionCam, REPEAT, MASTER_START): supported (test_cams.py); they
+    # are not among the types mpiMotionModify can modify
+    assert check_type(kind, False, False).ok
+    assert check_type(kind, True, False).message is M.MPIMessageUNSUPPORTED
 
 
 @pytest.mark.parametrize("kind", [T.PTF, T.PVTF, T.SPLINE, T.BESSEL, T.BSPLINE, T.BSPLINE2, T.FRAME])
@@ -417,7 +417,7 @@ REFUSED = [
     ("type invalid", False, T.INVALID, A.NONE, p2p(), M.MPIMotionMessageTYPE_INVALID),
     ("jerk w/o option", False, T.S_CURVE_JERK, A.NONE, p2p(trajectory=[JERK_TRAJ]),
      M.MPIMotionMessagePROFILE_NOT_SUPPORTED),
-    ("unsupported cam", False, T.CAM_LINEAR, A.NONE, p2p(), M.MPIMessageUNSUPPORTED),
+    ("cam without segments", False, T.CAM_LINEAR, A.NONE, p2p(), M.MPIMessagePARAM_INVALID),
     ("attribute", True, T.VELOCITY, A.FINAL_VEL, p2p(final_velocity=[1.0, 1.0]),
      M.MPIMotionMessageATTRIBUTE_INVALID),
     ("param", True, T.TRAPEZOIDAL, A.NONE, p2p([1.0]), M.MPIMessagePARAM_INVALID),

@@ -182,7 +182,7 @@ def test_cancel_is_a_stop(suite, client, applied, drive):
         ({"type": "S_CURVE_JERK", "position": [1.0, 0.0], "trajectory": [{"velocity": 1.0, "acceleration": 1.0,
                                                                          "deceleration": 1.0}]},
          "MPIMotionMessagePROFILE_NOT_SUPPORTED"),
-        ({"type": "CAM_LINEAR", "position": [1.0, 0.0]}, "MPIMessageUNSUPPORTED"),
+        ({"type": "CAM_LINEAR", "position": [1.0, 0.0]}, "MPIMessagePARAM_INVALID"),  # no segments
     ],
 )
 def test_bad_goals_get_the_spec_message_and_change_nothing(suite, client, applied, goal, message):
