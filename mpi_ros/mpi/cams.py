@@ -108,9 +108,10 @@ def progress(mode: Backtrack, x: np.ndarray, scale: np.ndarray, state: CamState,
         u = np.where(pre, x, r + state.offset)
     else:
         u, offset = _scaled(x, r, step, scale, pre, state)
-    finished = state.finished | (np.logical_or.accumulate(u >= end) if end is not None else False)
-    finished = np.broadcast_to(finished, x.shape)
-    if end is not None:
+    if end is None:
+        finished = np.full(x.shape, state.finished)
+    else:
+        finished = np.logical_or.accumulate(u >= end) | state.finished
         u = np.where(finished, end, u)
     return Progress(x, r, offset, u, started, finished)
 

@@ -78,6 +78,7 @@ class Controller:
         ]
         self.io = IoImage(self.config.io_words, self.config.motors)
         self.secondary = SecondaryInputs(self.config.motors)  # the motors' second encoder inputs (cams)
+        self._sources: tuple[Stretch, Sources] | None = None  # where the cam slaves of a stretch read masters
         self.motion_defaults = motion_config or MotionConfig()
         self._supervisors: dict[int, MotionSupervisor] = {}
         self.events: deque[Event] = deque()
@@ -222,7 +223,7 @@ class Controller:
             cmd_p, act_p = self.bank.cmd_p[:, None], self.bank.act_p[:, None]
         else:
             samples, cmd_p, act_p = stretch.samples, stretch.cmd_p, stretch.act_p
-        return Sources(cmd_p, act_p, samples, [a.origin for a in self.axes], self.io, self.secondary, self.rate)
+        return Sources(cmd_p, act_p, samples, lambda n: self.axes[n].origin, self.io, self.secondary, self.rate)
 
     def _cam_inputs(self, axis: Axis, stretch: Stretch) -> tuple[np.ndarray, np.ndarray]:
         """A cam slave's master position and feedrate ratio at each sample of ``stretch``: a
@@ -230,7 +231,9 @@ class Controller:
         plan, owner = axis.plan, self.supervisor(axis.owner)
         assert plan is not None and plan.cam is not None and owner is not None  # a camming axis
         feedrate, _ = owner.clock.feedrates(stretch.t)
-        return self.master_sources(stretch).position(plan.cam.master), feedrate / owner.config.normal_feedrate
+        if self._sources is None or self._sources[0] is not stretch:  # one per stretch, for all its slaves
+            self._sources = (stretch, self.master_sources(stretch))
+        return self._sources[1].position(plan.cam.master), feedrate / owner.config.normal_feedrate
 
     def frame_count(self, number: int) -> int:
         """Frames in an axis' buffer: the rest of the move it runs and the ones queued. A

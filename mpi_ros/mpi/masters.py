@@ -16,6 +16,7 @@ sample (an axis master is traced before its slaves: stretch.py).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,13 +70,13 @@ class SecondaryInputs:
 @dataclass(frozen=True, slots=True)
 class Sources:
     """What master positions are read from: command and actual positions (raw, one row per
-    axis, one column per sample), the samples, the axes' origins, the I/O image, the
+    axis, one column per sample), the samples, each axis' origin, the I/O image, the
     secondary inputs and the sample rate."""
 
     cmd_p: np.ndarray
     act_p: np.ndarray
     samples: np.ndarray
-    origins: list[float]
+    origin: Callable[[int], float]
     io: IoImage
     secondary: SecondaryInputs
     rate: float
@@ -84,15 +85,15 @@ class Sources:
         """The master position at each sample."""
         n, kind = master.number, master.type
         if kind is M.AXIS_COMMANDED_POSITION:
-            value = self.cmd_p[n] - self.origins[n]
+            value = self.cmd_p[n] - self.origin(n)
         elif kind is M.AXIS_ACTUAL_POSITION:
-            value = self.act_p[n] - self.origins[n]
+            value = self.act_p[n] - self.origin(n)
         elif kind is M.MOTOR_FEEDBACK_PRIMARY:
-            value = self.act_p[n].copy()
+            value = self.act_p[n] + 0.0  # (a copy)
         elif kind is M.MOTOR_FEEDBACK_SECONDARY:
             value = self.secondary.at(n, self.samples, self.rate)
         else:
-            value = np.full(len(self.samples), float(self.io.words[IoSpace.IO][master.address]))
+            value = np.full(self.samples.shape, float(self.io.words[IoSpace.IO][master.address]))
         if master.correction >= 0:
-            value = value + (self.cmd_p[master.correction] - self.origins[master.correction])
-        return np.broadcast_to(value, self.samples.shape).astype(float)
+            value = value + (self.cmd_p[master.correction] - self.origin(master.correction))
+        return value

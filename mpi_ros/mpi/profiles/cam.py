@@ -70,7 +70,7 @@ class CamTable:
         period = end - first
         cycles = np.maximum(np.ceil((u - end) / period), 0.0)
         # (clipped: rounding of cycles * period must not leave the repeated part)
-        return np.where(cycles > 0.0, np.clip(u - cycles * period, first, end), u), cycles
+        return np.where(cycles > 0.0, np.minimum(np.maximum(u - cycles * period, first), end), u), cycles
 
     def position(self, u: np.ndarray) -> np.ndarray:
         """The slave's offset from its start at travels ``u`` (before the start: 0)."""
@@ -107,6 +107,6 @@ class CamTable:
     def _segment(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(segment index, fraction 0..1 into it, its length) at travels ``w`` within the table."""
         last = len(self.knots) - 2
-        i = np.clip(np.searchsorted(self.knots, w, side="right") - 1, 0, last)
+        i = np.minimum(np.maximum(np.searchsorted(self.knots, w, side="right") - 1, 0), last)
         h = self.knots[i + 1] - self.knots[i]
         return i, (w - self.knots[i]) / h, h
