@@ -21,7 +21,7 @@ from .conftest import WAIT
 CAM_YAML = """
 {type: CAM_CUBIC, attributes: [ID], id: 7,
  master_distance: [1000, 1000, 1000],
- slave_position: [500, -200, 500, 0, -1000, 200],
+ slave_position: [500, -200, 500, 0, -700, 100],
  gear_ratio: [0.5, 0, 0.5, 0, 0, 0]}
 """
 
@@ -57,21 +57,23 @@ def test_axis_config_get_and_set_carry_the_master(suite, axes, probe, service):
         axes.config_set(2, master={"type": "NOT_A_SOURCE"})
 
 
-def test_cam_goal_from_send_goal_yaml_follows_the_master_to_its_end(suite, client, client1, axes, drive):
+def test_cam_goal_from_send_goal_yaml_follows_the_master_to_its_end(suite, client, client1, axes, applied, drive):
     for axis in (2, 3):
         assert axes.config_set(axis, master={"type": "AXIS_COMMANDED_POSITION", "number": 0}).ok
     running = client1.start(yaml.safe_load(CAM_YAML))
-    assert running.wait_started(WAIT)
+    _, _, reply = applied.wait(3)
+    assert reply.message.name == "MPIMessageOK"
     client.start({"type": "VELOCITY", "trajectory": [{"velocity": 4000.0, "acceleration": 1e6}]})
-    drive(running.done, samples=20_000)
+    applied.wait(4)
+    drive(lambda: running.done, samples=20_000)
     result = running.wait()
     assert result.message == "MPIMessageOK" and result.move_id == 7
     # at the end of the table: the sums of the slave distances
     assert suite.runner.read(lambda ctl: (ctl.axes[2].command_position, ctl.axes[3].command_position)) == (
-        300.0, 0.0)
+        300.0, -100.0)
 
 
-def test_client_cam_follows_a_line_shaft_encoder_and_stops(suite, client1, axes, drive):
+def test_client_cam_follows_a_line_shaft_encoder_and_stops(suite, client1, axes, applied, drive):
     # the secondary feedback input of motor 1 runs like a line shaft; axis 2 follows it with a repeating
     # linear cam (a flying shear's cycle), until STOP
     assert axes.config_set(2, master={"type": "MOTOR_FEEDBACK_SECONDARY", "number": 1}).ok
@@ -79,14 +81,14 @@ def test_client_cam_follows_a_line_shaft_encoder_and_stops(suite, client1, axes,
     assert axes.secondary_feedback_set(1, 0.0, 2000.0).ok
     running = client1.cam(MotionType.CAM_LINEAR, [200.0, 300.0], [(100.0, 0.0), (-100.0, 0.0)], repeat_from=0,
                           attributes=["NO_BACKTRACK"])
-    assert running.wait_started(WAIT)
+    _, _, reply = applied.wait(4)
+    assert reply.message.name == "MPIMessageOK"
     start = suite.runner.ctl.sample
     drive(lambda: suite.runner.ctl.sample >= start + 1250, samples=2000, chunk=50)  # 2500 master counts: 5 cycles
-    status = client1.wait_for(lambda s: s.sample >= start + 1250)
-    assert status.state_name == "MOVING" and status.motion_type == "CAM_LINEAR"
-    assert 0.0 <= status.axes[0].command_position <= 100.0
+    state, position = suite.runner.read(lambda ctl: (ctl.supervisor(1).state.name, ctl.axes[2].command_position))
+    assert state == "MOVING" and 0.0 <= position <= 100.0
     client1.stop()
-    drive(running.done, samples=5000)
+    drive(lambda: running.done, samples=5000)
     assert running.wait(raise_on_error=False).message == "MPIMotionMessageSTOPPED"
     with pytest.raises(errors.error_for("MPIMessagePARAM_INVALID")):
         axes.secondary_feedback_set(99, 0.0, 1.0)
