@@ -39,8 +39,8 @@ def compared(monkeypatch):
     counts = {"stretches": 0, "axes": 0}
     trace = control.stretches.trace
 
-    def checked(bank, axes, clock_of, k0, k1, rate, scratch):
-        stretch = trace(bank, axes, clock_of, k0, k1, rate, scratch)
+    def checked(bank, axes, clock_of, k0, k1, rate, scratch, cam_inputs=None):
+        stretch = trace(bank, axes, clock_of, k0, k1, rate, scratch, cam_inputs)
         for axis in axes:
             one = axis.trace(k0, k1, clock_of(axis))
             for name in _VALUES:

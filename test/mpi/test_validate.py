@@ -417,7 +417,7 @@ REFUSED = [
     ("type invalid", False, T.INVALID, A.NONE, p2p(), M.MPIMotionMessageTYPE_INVALID),
     ("jerk w/o option", False, T.S_CURVE_JERK, A.NONE, p2p(trajectory=[JERK_TRAJ]),
      M.MPIMotionMessagePROFILE_NOT_SUPPORTED),
-    ("cam without segments", False, T.CAM_LINEAR, A.NONE, p2p(), M.MPIMessagePARAM_INVALID),
+    ("cam modify", True, T.CAM_LINEAR, A.NONE, p2p(), M.MPIMessageUNSUPPORTED),
     ("attribute", True, T.VELOCITY, A.FINAL_VEL, p2p(final_velocity=[1.0, 1.0]),
      M.MPIMotionMessageATTRIBUTE_INVALID),
     ("param", True, T.TRAPEZOIDAL, A.NONE, p2p([1.0]), M.MPIMessagePARAM_INVALID),

@@ -366,6 +366,12 @@ class Fuzzer:
                 velocity=self.real(1.0, 1e9), settling_time=self.real(0.0, 0.05),
                 settle_on_stop=rng.random() < 0.5, settle_on_estop=rng.random() < 0.5,
                 settle_on_estop_cmd_eq_act=rng.random() < 0.5))
+            # the cam master (MPI 002, MPIAxisMaster): any source, numbers in and out of range
+            msg.master.type = rng.choice(("", "AXIS_COMMANDED_POSITION", "AXIS_ACTUAL_POSITION", "ADDRESS",
+                                          "MOTOR_FEEDBACK_PRIMARY", "MOTOR_FEEDBACK_SECONDARY", "SIDEWAYS"))
+            msg.master.number = self.int32(0, 3, bad=0.3)
+            msg.master.address = self.int32(0, 63, bad=0.3)
+            msg.master_correction = self.int32(-1, 3, bad=0.3)
         elif choice == "axis_position_set":
             k = rng.randrange(4)
             name = f"axis{k}/position_set"
