@@ -62,9 +62,11 @@ class Backtrack(Enum):
 
 @dataclass(frozen=True, slots=True)
 class CamState:
-    """A slave's progress at one sample: the master's travel ``x``, the reference ``r``, the
-    offset, the progress ``u`` = r + offset, started (the master reached the start), finished
-    (the end of a non-repeating table reached)."""
+    """A slave's progress at one sample: the master's travel ``x`` (before the start, never
+    past it), the reference ``r``, the offset, the progress ``u`` = r + offset, started (the
+    master reached the start), finished (the end of a non-repeating table reached), and above
+    (MASTER_START with the master past ``masterStart`` when the cam started: it starts when
+    the master comes back to it)."""
 
     x: float
     r: float
@@ -72,11 +74,12 @@ class CamState:
     u: float
     started: bool
     finished: bool
+    above: bool = False
 
     @classmethod
     def at_start(cls, x: float) -> CamState:
-        started = x >= 0.0
-        return cls(x, x, 0.0, x, started, False)
+        """At the start, with the master at travel ``x`` (0 unless MASTER_START)."""
+        return cls(min(x, 0.0), min(x, 0.0), 0.0, min(x, 0.0), x == 0.0, False, x > 0.0)
 
 
 @dataclass(slots=True)
@@ -91,16 +94,20 @@ class Progress:
     started: np.ndarray
     finished: np.ndarray
 
-    def state(self, i: int) -> CamState:
+    def state(self, i: int, above: bool) -> CamState:
         return CamState(float(self.x[i]), float(self.r[i]), float(self.offset[i]), float(self.u[i]),
-                        bool(self.started[i]), bool(self.finished[i]))
+                        bool(self.started[i]), bool(self.finished[i]), above)
 
 
 def progress(mode: Backtrack, x: np.ndarray, scale: np.ndarray, state: CamState, end: float | None) -> Progress:
     """The slave's progress at travels ``x`` with feedrate ratios ``scale``, from ``state``
     (the sample before the first); ``end``: the travel at which the cam is complete."""
-    started = state.started | np.logical_or.accumulate(x >= 0.0)
+    # MASTER_START: the cam starts once the master reaches the start from the side it was on
+    # (as a HOLD's position trigger: docs/decisions.md); until then its travel counts as at
+    # most 0, so the slave waits at its start and no backtrack rule remembers a travel beyond.
+    started = state.started | np.logical_or.accumulate((x <= 0.0) if state.above else (x >= 0.0))
     pre = ~started
+    x = np.where(started, x, np.minimum(x, 0.0))
     r, step = _reference(mode, x, state, started)
     step = np.where(pre, 0.0, step)
     if np.all(scale == 1.0):
@@ -122,7 +129,7 @@ def _reference(mode: Backtrack, x: np.ndarray, state: CamState, started: np.ndar
     if mode is Backtrack.FOLLOW:
         return x, x - previous
     if mode is Backtrack.NO_BACKTRACK_HOLD:
-        # furthest point reached; before the start x < 0, so the first x >= 0 is past all of them
+        # furthest point reached; before the start x <= 0, so the first x >= 0 is past all of them
         r = np.maximum.accumulate(np.concatenate(([state.r], x)))[1:]
         r = np.where(started, r, x)
         return r, r - np.concatenate(([state.r], r[:-1]))
@@ -191,7 +198,7 @@ class CamFollow:
         times, done = self.pending
         i = int(np.searchsorted(times, t, side="right")) - 1
         if i >= 0:
-            self.state = done.state(i)
+            self.state = done.state(i, self.state.above)
         self.pending = None
 
     @property

@@ -192,6 +192,23 @@ def test_master_start_holds_the_slave_until_the_master_gets_there():
     assert ms1.state is MPIState.IDLE  # the end of the table reached at 600: DONE
 
 
+def test_master_start_behind_the_master_waits_for_it_to_come_back():
+    # docs/cams.md: the cam starts when the master reaches masterStart from the side it was on (as a HOLD's
+    # position trigger); until then the slave waits at its start, however far the master is past it
+    ctl = controller()
+    follow(ctl, AxisMaster(S.ADDRESS, address=3), axes=(1,))
+    ms1 = ctl.supervisor(1)
+    ms1.axis_list_set([1])
+    set_word(ctl, 700)
+    assert ms1.start(T.CAM_LINEAR, A.MASTER_START | A.NO_BACKTRACK_HOLD, cam([100.0], [50.0], master_start=500)).ok
+    got = []
+    for word in (800, 600, 450, 520, 480, 560):
+        set_word(ctl, word)
+        ctl.step(3)
+        got.append(command(ctl, 1))
+    assert got == [0.0, 0.0, 0.0, 10.0, 10.0, 30.0]
+
+
 # ------------------------------------------------------------------ master sources ----
 @pytest.mark.parametrize("source", list(S))
 def test_each_master_source(source):
@@ -494,3 +511,21 @@ def test_cams_are_bit_identical_however_the_samples_are_batched():
         assert other[1] == one[1]
         for sample, values in other[0].items():
             assert values == one[0][sample], sample
+
+
+def test_a_move_appended_behind_a_cam_starts_from_the_tables_end():
+    # MPIMotionAttrAPPEND: "added to the end of a previous motion profile ... begin execution after the previous
+    # profile has completed": a cam completes at its table's end (docs/cams.md)
+    ctl = controller()
+    follow(ctl, AxisMaster(S.ADDRESS, address=3), axes=(1,))
+    ms1 = ctl.supervisor(1)
+    ms1.axis_list_set([1])
+    assert ms1.start(T.CAM_LINEAR, A.NONE, cam([100.0], [40.0])).ok
+    assert ms1.start(T.TRAPEZOIDAL, A.APPEND, MotionParams(trajectory=[Trajectory(1000.0, 1e5, 1e5)],
+                                                           position=[-60.0])).ok
+    assert ms1.snapshot().moves_pending == 1
+    set_word(ctl, 100)
+    assert ctl.run_until(lambda c: ms1.state is MPIState.IDLE, 5000)
+    assert command(ctl, 1) == -60.0
+    done = [e.type for e in ctl.drain_events() if e.supervisor == 1 and e.type is MPIEventType.MOTION_DONE]
+    assert len(done) == 2
