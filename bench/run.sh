@@ -45,6 +45,10 @@ cd "$repo/bench"
     echo
     "$py" -P bench_paths.py
     echo
+    echo "## Cam slaves (bench/bench_cams.py)"
+    echo
+    "$py" -P bench_cams.py
+    echo
     echo "## A 100,000-point path streamed through ROS (bench/bench_stream.py)"
     echo
     "$py" -P bench_stream.py

@@ -12,7 +12,10 @@
 
 Path moves: ``ms0.path(MotionType.PVT, points, times, velocities=...)`` runs one (points as
 one tuple per point, interleaved here); ``ms0.stream(...)`` streams a long one chunk by chunk
-as the controller asks for points (FRAMES_LOW, frame_count).
+as the controller asks for points (FRAMES_LOW, frame_count). Cams: ``ms1.cam("CAM_CUBIC",
+master_distances, slave_positions, gear_ratios, repeat_from=0)`` (:func:`cam_goal`); each slave
+axis' master is set with :class:`AxisClient` (``config_set(axis, master={...})``), which also
+drives the motors' secondary feedback inputs (docs/cams.md).
 
 It imports rclpy and the generated interfaces (``mpi_ros.msg/.srv/.action``) and nothing of
 the simulated controller, so it runs wherever the suite is reachable over DDS.
