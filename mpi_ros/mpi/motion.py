@@ -378,8 +378,9 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         queued = append and state is MPIState.MOVING and (bool(self.queue) or not self.cruising())
         starts = self._starts(queued, state, modify and not auto_start)
         try:
-            move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate,
-                                       self._cam_masters() if motion_type in CAM_TYPES else None)
+            # (a cam also needs each slave's master; other moves are planned from the starts alone)
+            cams_of = (self._cam_masters(),) if motion_type in CAM_TYPES else ()
+            move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._ctl.rate, *cams_of)
         except PlanError as exc:
             return exc.message, exc.detail
         if move.stream is not None:
