@@ -211,8 +211,9 @@ class Controller:
         next sample it reads ``feedback.position`` and moves at ``feedback.velocity``."""
         if not 0 <= motor < len(self.secondary):
             return Message.MPIMessagePARAM_INVALID
-        if not feedback.validate().ok:
-            return feedback.validate().message
+        verdict = feedback.validate()  # the one SecondaryFeedback validator (the YAML's too)
+        if not verdict.ok:
+            return verdict.message
         self.secondary.set(motor, feedback, self.sample)
         return Message.MPIMessageOK
 
