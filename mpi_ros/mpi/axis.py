@@ -357,6 +357,10 @@ class Axis:
     def _piece_key(self, clock: ProfileClock | None):
         if self.plan is None or clock is None:
             return (self.mode, None, self.rest, self._held_feedforward)
+        # The cache keeps the plan while entries keyed by its id exist: a plan freed meanwhile
+        # could hand its id to a new one (a path extended at the same tau_start and clock) and
+        # the new one would read the old one's pieces.
+        self._cache.setdefault(("plan", id(self.plan)), self.plan)
         return (self.mode, id(self.plan), self.tau_start, clock, self._held_feedforward)
 
     def _boundary_times(self, key, clock: ProfileClock | None) -> list[float]:
