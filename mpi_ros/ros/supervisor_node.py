@@ -215,7 +215,8 @@ class SupervisorNode(Node):
                            handle_accepted_callback=lambda handle: self._accept(handle, action_type),
                            cancel_callback=self._on_cancel,
                            after_cancel=lambda: self.runner.update(self._review),
-                           callback_group=self._goal_group, **ACTION_QOS)
+                           callback_group=self._goal_group, result_timeout=self.settings.result_timeout,
+                           **ACTION_QOS)
 
     def _service(self, srv_type, name, callback):
         """A service of this supervisor: /<ns>/ms<n>/<name>."""
