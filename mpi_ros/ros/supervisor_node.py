@@ -119,6 +119,14 @@ class _GoalServer(ActionServer):
         self.applied: dict[bytes, tuple[Reply, int] | Exception] = {}
         super().__init__(*args, **kwargs)
 
+    def kept(self) -> int:
+        """Goals rclpy keeps: the unfinished ones and the ended ones until result_timeout."""
+        return len(self._goal_handles)
+
+    def unfiled(self) -> int:
+        """Goal and cancel requests taken and not yet handled, and goals applied and not yet filed."""
+        return len(self._taken) + len(self.applied)
+
     def take_data(self):
         data = super().take_data()
         requests = {key: data.pop(key) for key in ("goal", "cancel") if key in data}
@@ -208,6 +216,13 @@ class SupervisorNode(Node):
         runner.add_periodic(settings.status_rate, self._collect_status)
         runner.add_periodic(settings.feedback_rate, self._collect_feedback)
         runner.on_change(self._review)
+
+    def held(self) -> dict[str, int]:
+        """What this node holds of its goals (for /diagnostics: none of it may grow without
+        bound): goals tracked until they end, goals rclpy keeps until their result expires,
+        requests not yet filed. Runner lock held."""
+        return {"goals_tracked": len(self._book), "goals_kept": sum(s.kept() for s in self._servers.values()),
+                "requests_unfiled": sum(s.unfiled() for s in self._servers.values())}
 
     def _action_server(self, action_type, name: str, operation: str) -> _GoalServer:
         return _GoalServer(self, action_type, f"~/{name}", _never_executed,
