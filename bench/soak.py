@@ -184,8 +184,8 @@ def load(domain: str, rate: float, seconds: float, out: str, ready) -> None:
     while time.monotonic() - began < seconds:
         target = 2000.0 if tick % 2 else -2000.0
         for n in range(SUPERVISORS):
-            send(n, "modify", fill(MotionModify.Goal(), {"type": "S_CURVE", "position": [target],
-                                                         "trajectory": trajectory}))
+            send(n, "modify", fill(MotionModify.Goal(), {"type": "S_CURVE", "position": [target], "attributes": [
+                "AUTO_START"], "trajectory": trajectory}))  # a modify late enough to find the axis at rest starts
         tick += 1
         pause.wait(max(0.0, began + tick * period - time.monotonic()))  # pacing the load, not a test wait
     for n in range(SUPERVISORS):
@@ -233,11 +233,16 @@ def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout:
         topics.update({f"/mpi/axis{n}/status": SampleOrder(step) for n in range(SUPERVISORS)})
         probe = Probe(context, [(topic_type(name), name, counter) for name, counter in topics.items()])
         diagnostics = Diagnostics()
-        probe.node.create_subscription(DiagnosticArray, "/diagnostics", diagnostics.on_message, 10)
+        # A node of its own: an executor spinning the probe's node would take the status
+        # messages too, through rclpy's callbacks, and make the probe a slow reader (the suite's
+        # reliable writers then block in publish).
         from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
 
+        watcher = Node("soak_diagnostics", context=context)
+        watcher.create_subscription(DiagnosticArray, "/diagnostics", diagnostics.on_message, 10)
         executor = SingleThreadedExecutor(context=context)
-        executor.add_node(probe.node)
+        executor.add_node(watcher)
         threading.Thread(target=executor.spin, daemon=True).start()
         out = Path(tmp) / "load.json"
         spawn = multiprocessing.get_context("spawn")
@@ -265,6 +270,7 @@ def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout:
         totals = {"statuses": sum(t.count for t in topics.values()), "gaps": sum(t.gaps for t in topics.values()),
                   "missing": sum(t.missing for t in topics.values()),
                   "disorder": sum(t.disorder for t in topics.values()), "most_behind": diagnostics.most_behind,
+                  "per_topic": {name: (t.count, t.gaps, t.missing) for name, t in topics.items()},
                   "suite_exit": suite.returncode if suite.returncode != -9 else "killed after 30 s",
                   "log_errors": _errors(log_path.read_text()), **counts}
     return rows, totals
@@ -331,6 +337,7 @@ def main() -> None:
     rows, totals = soak(args.minutes, args.modify_rate, args.status_rate, args.result_timeout)
     text = report(rows, totals, args)
     print(text)
+    print("per topic (received, gaps, missing):", totals["per_topic"])
     if args.append:
         with open(REPO / "bench" / "RESULTS.md", "a", encoding="utf-8") as results:
             results.write("\n" + text)
