@@ -26,6 +26,7 @@ import argparse
 import json
 import multiprocessing
 import os
+import shutil
 import struct
 import subprocess
 import sys
@@ -155,7 +156,8 @@ def load(domain: str, rate: float, seconds: float, out: str, ready) -> None:
 
     def on_result(future) -> None:
         count("results")
-        count(f"result {future.result().result.message}")
+        response = future.result()
+        count(f"result {response.result.message or f'(none: goal status {response.status})'}")
 
     def send(n: int, kind: str, goal) -> None:
         request = services[n][kind].srv_type.Request(goal_id=UUID(uuid=list(uuid.uuid4().bytes)), goal=goal)
@@ -273,6 +275,7 @@ def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout:
                   "per_topic": {name: (t.count, t.gaps, t.missing) for name, t in topics.items()},
                   "suite_exit": suite.returncode if suite.returncode != -9 else "killed after 30 s",
                   "log_errors": _errors(log_path.read_text()), **counts}
+        shutil.copyfile(log_path, Path(tempfile.gettempdir()) / "soak-suite.log")  # for a look after the run
     return rows, totals
 
 
@@ -307,22 +310,25 @@ def report(rows: list[Minute], totals: dict, args) -> str:
         f"(2 cores, load {load_average()} at the end).",
         "",
         "| minute | suite RSS MB | suite CPU (one core) | statuses received | gaps | samples behind | "
-        "goals tracked / kept (all supervisors) | publications queued |",
+        "goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for row in rows:
         d = row.diagnostics
         tracked = sum(v for k, v in d.items() if k.endswith("goals_tracked"))
         kept = sum(v for k, v in d.items() if k.endswith("goals_kept"))
+        unfiled = sum(v for k, v in d.items() if k.endswith("requests_unfiled"))
         lines.append(f"| {row.minute} | {row.rss_mb:.0f} | {row.cpu:.0%} | {row.statuses:,} | {row.gaps} | "
-                     f"{d.get('samples_behind', '?')} | {tracked} / {kept} | {d.get('outputs_queued', '?')} |")
+                     f"{d.get('samples_behind', '?')} | {tracked} / {kept} / {unfiled} | "
+                     f"{d.get('outputs_queued', '?')} |")
     lines += ["", f"Goals: {sent:,} sent ({totals.get('ticks', 0) * SUPERVISORS / max(totals.get('seconds', 1), 1):.0f}"
               f"/s offered), {totals.get('accepted', 0):,} accepted, {totals.get('rejected', 0):,} rejected, "
               f"{totals.get('results', 0):,} results; "
               + ", ".join(f"{k[7:]} {v:,}" for k, v in sorted(totals.items()) if k.startswith("result ")) + ".",
               f"Statuses: {totals['statuses']:,} received, {totals['gaps']} gaps ({totals['missing']} status points "
               f"missing), {totals['disorder']} out of order; at most {totals['most_behind']} samples behind the wall "
-              f"clock; suite exit {totals['suite_exit']}, {totals['log_errors']} error lines in its log.", ""]
+              f"clock; suite exit {totals['suite_exit']}, {totals['log_errors']} error lines in its log (copied to "
+              "/tmp/soak-suite.log).", ""]
     return "\n".join(lines)
 
 
