@@ -91,6 +91,12 @@ def error_samples(config: AxisFaultConfig, rate: float) -> int:
     return max(0, math.ceil(config.following_error_time * rate - 1e-9)) + 1
 
 
+def _stepping_checks(config: AxisFaultConfig) -> bool:
+    """The configuration has a condition checked at every sample (the others are injected)."""
+    return (config.following_error_limit > 0.0 or config.software_limit_positive_enabled
+            or config.software_limit_negative_enabled)
+
+
 @dataclass(slots=True)
 class AxisFaults:
     """The faults of one axis: its configuration, what is latched, what is injected."""
@@ -119,6 +125,7 @@ class FaultMonitor:
         self.axes = [AxisFaults(AxisFaultConfig(encoder_fault_motor_number=n if n < ctl.config.motors else -1))
                      for n in range(len(ctl.axes))]
         self.encoder_faults: set[int] = set()  # motors whose encoder has an injected fault
+        self._watched: list[int] = []  # axes with a condition checked while stepping (limits)
         self._found: list[_Found] = []
         self._runs: dict[int, np.ndarray] = {}  # following-error runs over the last scanned stretch
 
@@ -138,6 +145,7 @@ class FaultMonitor:
         faults = self.axes[number]
         faults.config = config.copy()
         faults.error_run = 0  # a new limit counts from here
+        self._watched = [n for n, f in enumerate(self.axes) if _stepping_checks(f.config)]
         if config.encoder_fault_motor_number in self.encoder_faults:
             self._trip_encoder(number, config.encoder_fault_motor_number)
         return verdict
@@ -152,7 +160,8 @@ class FaultMonitor:
         What was found is kept for :meth:`transition`."""
         self._found = []
         self._runs = {}
-        for number, faults in enumerate(self.axes):
+        for number in self._watched:
+            faults = self.axes[number]
             config = faults.config
             if config.following_error_limit > 0.0 and Fault.LIMIT_ERROR not in faults.latched:
                 self._scan_error(number, faults, stretch)
@@ -190,9 +199,9 @@ class FaultMonitor:
 
     def commit(self, stop: int) -> None:
         """The controller keeps stretch index ``stop``: carry the following-error runs."""
-        for number, faults in enumerate(self.axes):
+        for number in self._watched:
             runs = self._runs.get(number)
-            faults.error_run = int(runs[stop]) if runs is not None else 0
+            self.axes[number].error_run = int(runs[stop]) if runs is not None else 0
 
     def transition(self, index: int) -> None:
         """Trip what :meth:`scan` found at stretch index ``index`` (the controller is there)."""

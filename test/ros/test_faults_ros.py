@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from std_srvs.srv import Trigger
 
@@ -22,6 +23,15 @@ from .test_wire import EPOCH, _controller
 
 AGGRESSIVE = {"type": "S_CURVE", "position": [20_000.0, 0.0],
               "trajectory": [{"velocity": 100_000.0, "acceleration": 5e6, "deceleration": 5e6}]}
+
+
+@pytest.fixture
+def suite_config():
+    """The default configuration with /diagnostics at 50 Hz of controller time (not 1 Hz), so
+    the tests step a few hundred samples, not thousands, to see a fault there."""
+    from mpi_ros import config
+
+    return config.load(overrides={"ros": {"diagnostics_rate": 50.0}})
 
 
 def test_axis_status_with_faults_is_packed_as_the_canonical_cdr():
@@ -73,6 +83,35 @@ def test_an_injected_amplifier_fault_shows_everywhere_and_recovers_with_reset(su
     assert (reset.message, reset.state_name, reset.detail) == ("MPIMessageOK", "IDLE", "")
     drive(lambda: status.messages and not status.messages[-1].faults and status.messages[-1].amp_enabled)
     drive(lambda: any(_healthy(a, "mpi/axis1") for a in diagnostics.messages[-1:]), samples=20_000, chunk=100)
+
+
+@pytest.mark.parametrize(("fault", "state"), [
+    ("LIMIT_ERROR", "ERROR"), ("LIMIT_SW_POSITIVE", "ERROR"), ("LIMIT_SW_NEGATIVE", "ERROR"),
+    ("AMP_FAULT", "ERROR"), ("ENCODER_FAULT", "ERROR"), ("FRAME_UNDERFLOW", "IDLE")])
+def test_each_fault_reaches_its_state_shows_in_status_and_diagnostics_and_recovers(
+        suite, probe, service, drive, fault, state):
+    """Injected on axis 3 (supervisor 1) with its default action: ABORT, E_STOP, E_STOP,
+    ABORT, ABORT (MPI 002: "this axis will abort"), NONE."""
+    events = Collector(probe, MotionEvent, "/mpi/events")
+    status = Collector(probe, AxisStatus, "/mpi/axis3/status")
+    diagnostics = Collector(probe, DiagnosticArray, "/diagnostics")
+    answer = service(probe, AxisFaultInject, "/mpi/axis3/fault_inject", AxisFaultInject.Request(fault=fault))
+    assert (answer.message, list(answer.faults)) == ("MPIMessageOK", [fault])
+    trip = next(m for m in events.wait_for(lambda ms: any(m.type == fault for m in ms)) if m.type == fault)
+    assert (trip.axis, trip.supervisor) == (3, 1) and f"{fault} " in trip.detail and "axis 3" in trip.detail
+    def shown() -> bool:
+        last = status.messages[-1] if status.messages else None
+        return (last is not None and last.state_name == state and list(last.faults) == [fault]
+                and any(_faulted(a, "mpi/axis3") for a in diagnostics.messages))
+
+    drive(shown, samples=20_000, chunk=100)
+    entry = _diagnostic(next(a for a in diagnostics.messages if _faulted(a, "mpi/axis3")), "mpi/axis3")
+    assert fault in entry.message and {v.key: v.value for v in entry.values}["faults"] == fault
+    if fault in ("AMP_FAULT", "ENCODER_FAULT"):  # conditions that hold until cleared
+        service(probe, AxisFaultInject, "/mpi/axis3/fault_inject", AxisFaultInject.Request(fault=fault, active=False))
+    reset = service(probe, MotionAction, "/mpi/ms1/action", MotionAction.Request(action="RESET"))
+    assert (reset.message, reset.state_name) == ("MPIMessageOK", "IDLE")
+    drive(lambda: status.messages and not status.messages[-1].faults and status.messages[-1].state_name == "IDLE")
 
 
 def _faulted(array: DiagnosticArray, name: str) -> bool:
