@@ -171,6 +171,13 @@ class EventType(StrEnum):
     AT_TARGET = "AT_TARGET"
     AT_VELOCITY = "AT_VELOCITY"
     DONE = "DONE"
+    # faults of an axis (docs/faults.md)
+    LIMIT_ERROR = "LIMIT_ERROR"
+    LIMIT_SW_POSITIVE = "LIMIT_SW_POSITIVE"
+    LIMIT_SW_NEGATIVE = "LIMIT_SW_NEGATIVE"
+    AMP_FAULT = "AMP_FAULT"
+    ENCODER_FAULT = "ENCODER_FAULT"
+    FRAME_UNDERFLOW = "FRAME_UNDERFLOW"
 
 
 class Outcome(StrEnum):
@@ -190,6 +197,7 @@ class ActionReply:
     code: int
     state_name: str
     sample: int  # the sample at which the action took effect
+    detail: str = ""  # why it was refused (e.g. RESET while a fault persists)
 
     @property
     def ok(self) -> bool:
@@ -808,9 +816,11 @@ class MotionClient(_Endpoint):
             raise NoResponse(f"the supervisor's action service {self.prefix}/action is not available")
         response = self._wait_future(self._action.call_async(MotionAction.Request(action=name)), None,
                                      f"action {name}")
-        reply = ActionReply(response.message, response.code, response.state_name, response.sample)
+        reply = ActionReply(response.message, response.code, response.state_name, response.sample,
+                            getattr(response, "detail", ""))
         if raise_on_error:
-            raise_for(reply.message, f"{name} in {reply.state_name}", reply)
+            raise_for(reply.message, f"{name} in {reply.state_name}" + (f": {reply.detail}" if reply.detail else ""),
+                      reply)
         return reply
 
     def stop(self) -> ActionReply:

@@ -54,7 +54,7 @@ def _level(status: DiagnosticStatus) -> int:
     return status.level[0] if isinstance(status.level, bytes) else status.level
 
 
-def test_an_injected_amplifier_fault_shows_everywhere_and_recovers_with_reset(suite, probe, service, drive):
+def test_an_injected_amplifier_fault_shows_everywhere_and_recovers_with_reset(suite, client, probe, service, drive):
     events = Collector(probe, MotionEvent, "/mpi/events")
     status = Collector(probe, AxisStatus, "/mpi/axis1/status")
     diagnostics = Collector(probe, DiagnosticArray, "/diagnostics")
@@ -75,6 +75,8 @@ def test_an_injected_amplifier_fault_shows_everywhere_and_recovers_with_reset(su
     assert "axis 1 AMP_FAULT persists" in refused.detail
     trigger = service(probe, Trigger, "/mpi/ms0/reset", Trigger.Request())
     assert not trigger.success and "AMP_FAULT persists" in trigger.message
+    reply = client.action("RESET", raise_on_error=False)  # the Python client carries the reason too
+    assert reply.message == "MPIMotionMessageERROR" and "axis 1 AMP_FAULT persists" in reply.detail
 
     cleared = service(probe, AxisFaultInject, "/mpi/axis1/fault_inject",
                       AxisFaultInject.Request(fault="AMP_FAULT", active=False))
