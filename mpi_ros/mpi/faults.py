@@ -91,10 +91,26 @@ def error_samples(config: AxisFaultConfig, rate: float) -> int:
     return max(0, math.ceil(config.following_error_time * rate - 1e-9)) + 1
 
 
+_NO_ROWS = np.zeros(0, dtype=np.int64)
+
+
+def _configured(config: AxisFaultConfig, fault: Fault) -> bool:
+    """The condition of ``fault`` is checked while stepping on an axis of this configuration."""
+    if fault is Fault.LIMIT_ERROR:
+        return config.following_error_limit > 0.0
+    if fault is Fault.LIMIT_SW_POSITIVE:
+        return config.software_limit_positive_enabled
+    return fault is Fault.LIMIT_SW_NEGATIVE and config.software_limit_negative_enabled
+
+
+def _limit(config: AxisFaultConfig, fault: Fault) -> float:
+    return config.software_limit_positive if fault is Fault.LIMIT_SW_POSITIVE else config.software_limit_negative
+
+
 def _stepping_checks(config: AxisFaultConfig) -> bool:
     """The configuration has a condition checked at every sample (the others are injected)."""
-    return (config.following_error_limit > 0.0 or config.software_limit_positive_enabled
-            or config.software_limit_negative_enabled)
+    return any(_configured(config, fault) for fault in (Fault.LIMIT_ERROR, Fault.LIMIT_SW_POSITIVE,
+                                                         Fault.LIMIT_SW_NEGATIVE))
 
 
 @dataclass(slots=True)
@@ -127,7 +143,9 @@ class FaultMonitor:
         self.encoder_faults: set[int] = set()  # motors whose encoder has an injected fault
         self._watched: list[int] = []  # axes with a condition checked while stepping (limits)
         self._found: list[_Found] = []
-        self._runs: dict[int, np.ndarray] = {}  # following-error runs over the last scanned stretch
+        # the axes whose following error the last scan followed, and its runs over the stretch
+        self._error_rows = _NO_ROWS
+        self._error_runs = np.zeros((0, 0), dtype=np.int64)
 
     # -- configuration -----------------------------------------------------------------
     def check(self, config: AxisFaultConfig) -> Verdict:
@@ -157,51 +175,66 @@ class FaultMonitor:
     # -- stepping ----------------------------------------------------------------------
     def scan(self, stretch: Stretch) -> int | None:
         """The first stretch index at which a fault trips (following error, limits), or None.
-        What was found is kept for :meth:`transition`."""
+        What was found is kept for :meth:`transition`. The axes that check a condition are
+        computed together (rows of the stretch), so a scan costs a few array operations
+        however many axes are watched."""
         self._found = []
-        self._runs = {}
-        for number in self._watched:
-            faults = self.axes[number]
-            config = faults.config
-            if config.following_error_limit > 0.0 and Fault.LIMIT_ERROR not in faults.latched:
-                self._scan_error(number, faults, stretch)
-            if config.software_limit_positive_enabled and Fault.LIMIT_SW_POSITIVE not in faults.latched:
-                self._scan_limit(number, Fault.LIMIT_SW_POSITIVE, config.software_limit_positive, stretch)
-            if config.software_limit_negative_enabled and Fault.LIMIT_SW_NEGATIVE not in faults.latched:
-                self._scan_limit(number, Fault.LIMIT_SW_NEGATIVE, config.software_limit_negative, stretch)
+        self._error_rows = _NO_ROWS
+        if not self._watched:
+            return None
+        self._scan_error(stretch)
+        for fault in (Fault.LIMIT_SW_POSITIVE, Fault.LIMIT_SW_NEGATIVE):
+            self._scan_limit(fault, stretch)
         return min((found.index for found in self._found), default=None)
 
-    def _scan_error(self, number: int, faults: AxisFaults, stretch: Stretch) -> None:
-        """|command - actual| above the limit for the configured time, while the servo runs
-        (with the amplifier off the command is frozen and the motor coasts: no loop to follow)."""
-        if not self._ctl.axes[number].amp_enabled:
-            return
-        limit = faults.config.following_error_limit
-        error = np.abs(stretch.cmd_p[number] - stretch.act_p[number])
-        runs = run_lengths(error > limit, faults.error_run)
-        self._runs[number] = runs
-        need = error_samples(faults.config, self._ctl.rate)
-        tripped = runs >= need
-        if tripped.any():
-            i = int(np.argmax(tripped))
-            self._found.append(_Found(i, number, Fault.LIMIT_ERROR,
-                                      f"following error {error[i]:.1f} counts above the limit {limit:g} "
-                                      f"for {need} samples"))
+    def _rows(self, fault: Fault) -> np.ndarray:
+        """The watched axes that check ``fault`` now: configured, not latched, and for the
+        following error with the amplifier on (off, the command is frozen and the motor
+        coasts: there is no loop to follow)."""
+        axes, faults = self._ctl.axes, self.axes
+        rows = [n for n in self._watched if fault not in faults[n].latched and _configured(faults[n].config, fault)
+                and (fault is not Fault.LIMIT_ERROR or axes[n].amp_enabled)]
+        return np.array(rows, dtype=np.int64)
 
-    def _scan_limit(self, number: int, fault: Fault, limit: float, stretch: Stretch) -> None:
+    def _scan_error(self, stretch: Stretch) -> None:
+        """|command - actual| above the limit for longer than the configured time."""
+        rows = self._rows(Fault.LIMIT_ERROR)
+        if not len(rows):
+            return
+        configs = [self.axes[n].config for n in rows.tolist()]
+        limits = np.array([c.following_error_limit for c in configs])
+        need = np.array([error_samples(c, self._ctl.rate) for c in configs])
+        error = np.abs(stretch.cmd_p[rows] - stretch.act_p[rows])
+        runs = run_lengths(error > limits[:, None], np.array([self.axes[n].error_run for n in rows.tolist()]))
+        self._error_rows, self._error_runs = rows, runs
+        tripped = runs >= need[:, None]
+        for r in np.flatnonzero(tripped.any(axis=1)).tolist():
+            i = int(np.argmax(tripped[r]))
+            self._found.append(_Found(i, int(rows[r]), Fault.LIMIT_ERROR,
+                                      f"following error {error[r, i]:.1f} counts above the limit "
+                                      f"{limits[r]:g} for {need[r]} samples"))
+
+    def _scan_limit(self, fault: Fault, stretch: Stretch) -> None:
         """The actual position (user coordinates, as the encoder reads it) beyond a limit."""
-        position = stretch.act_p[number] - self._ctl.axes[number].origin
-        beyond = position > limit if fault is Fault.LIMIT_SW_POSITIVE else position < limit
-        if beyond.any():
-            i = int(np.argmax(beyond))
-            self._found.append(_Found(i, number, fault, f"actual position {position[i]:.1f} beyond the "
-                                                        f"{_WORDS[fault]} {limit:g}"))
+        rows = self._rows(fault)
+        if not len(rows):
+            return
+        positive = fault is Fault.LIMIT_SW_POSITIVE
+        limits = np.array([_limit(self.axes[n].config, fault) for n in rows.tolist()])
+        origins = np.array([self._ctl.axes[n].origin for n in rows.tolist()])
+        position = stretch.act_p[rows] - origins[:, None]
+        beyond = position > limits[:, None] if positive else position < limits[:, None]
+        for r in np.flatnonzero(beyond.any(axis=1)).tolist():
+            i = int(np.argmax(beyond[r]))
+            self._found.append(_Found(i, int(rows[r]), fault, f"actual position {position[r, i]:.1f} beyond the "
+                                                              f"{_WORDS[fault]} {limits[r]:g}"))
 
     def commit(self, stop: int) -> None:
         """The controller keeps stretch index ``stop``: carry the following-error runs."""
         for number in self._watched:
-            runs = self._runs.get(number)
-            self.axes[number].error_run = int(runs[stop]) if runs is not None else 0
+            self.axes[number].error_run = 0
+        for r, number in enumerate(self._error_rows.tolist()):
+            self.axes[number].error_run = int(self._error_runs[r, stop])
 
     def transition(self, index: int) -> None:
         """Trip what :meth:`scan` found at stretch index ``index`` (the controller is there)."""
