@@ -92,6 +92,17 @@ def error_samples(config: AxisFaultConfig, rate: float) -> int:
 
 
 _NO_ROWS = np.zeros(0, dtype=np.int64)
+_STEPPED = (Fault.LIMIT_ERROR, Fault.LIMIT_SW_POSITIVE, Fault.LIMIT_SW_NEGATIVE)  # checked while stepping
+
+
+@dataclass(frozen=True, slots=True)
+class _Checks:
+    """The axes (rows) that check one condition while stepping, with its limit on each and
+    (the following error) the samples it must hold."""
+
+    rows: np.ndarray
+    limits: np.ndarray
+    need: np.ndarray
 
 
 def _configured(config: AxisFaultConfig, fault: Fault) -> bool:
@@ -109,8 +120,7 @@ def _limit(config: AxisFaultConfig, fault: Fault) -> float:
 
 def _stepping_checks(config: AxisFaultConfig) -> bool:
     """The configuration has a condition checked at every sample (the others are injected)."""
-    return any(_configured(config, fault) for fault in (Fault.LIMIT_ERROR, Fault.LIMIT_SW_POSITIVE,
-                                                         Fault.LIMIT_SW_NEGATIVE))
+    return any(_configured(config, fault) for fault in _STEPPED)
 
 
 @dataclass(slots=True)
@@ -119,7 +129,6 @@ class AxisFaults:
 
     config: AxisFaultConfig
     latched: dict[Fault, str] = field(default_factory=dict)  # fault -> why it tripped, in order
-    error_run: int = 0  # samples the following error has been above its limit, at the current sample
     amp_fault: bool = False  # the injected amplifier fault holds
 
 
@@ -142,6 +151,12 @@ class FaultMonitor:
                      for n in range(len(ctl.axes))]
         self.encoder_faults: set[int] = set()  # motors whose encoder has an injected fault
         self._watched: list[int] = []  # axes with a condition checked while stepping (limits)
+        self._watched_rows = _NO_ROWS
+        # the rows of each condition checked while stepping, with their limits; rebuilt after a
+        # change (configuration, a trip, RESET) or when an amplifier goes off or on (the key)
+        self._checks: tuple[tuple[bool, ...], dict[Fault, _Checks]] | None = None
+        # samples the following error has been above its limit, per axis, at the current sample
+        self.error_runs = np.zeros(len(ctl.axes), dtype=np.int64)
         self._found: list[_Found] = []
         # the axes whose following error the last scan followed, and its runs over the stretch
         self._error_rows = _NO_ROWS
@@ -162,8 +177,10 @@ class FaultMonitor:
             return verdict
         faults = self.axes[number]
         faults.config = config.copy()
-        faults.error_run = 0  # a new limit counts from here
+        self.error_runs[number] = 0  # a new limit counts from here
         self._watched = [n for n, f in enumerate(self.axes) if _stepping_checks(f.config)]
+        self._watched_rows = np.array(self._watched, dtype=np.int64)
+        self._checks = None
         if config.encoder_fault_motor_number in self.encoder_faults:
             self._trip_encoder(number, config.encoder_fault_motor_number)
         return verdict
@@ -187,25 +204,37 @@ class FaultMonitor:
             self._scan_limit(fault, stretch)
         return min((found.index for found in self._found), default=None)
 
-    def _rows(self, fault: Fault) -> np.ndarray:
-        """The watched axes that check ``fault`` now: configured, not latched, and for the
+    def _stepped(self) -> dict[Fault, _Checks]:
+        """The rows that check each condition now (:class:`_Checks`), kept until they change."""
+        axes = self._ctl.axes
+        amps = tuple(axes[n].amp_enabled for n in self._watched)
+        if self._checks is None or self._checks[0] != amps:
+            self._checks = (amps, {fault: self._rows(fault) for fault in _STEPPED})
+        return self._checks[1]
+
+    def _rows(self, fault: Fault) -> _Checks:
+        """The watched axes that check ``fault``: configured, not latched, and for the
         following error with the amplifier on (off, the command is frozen and the motor
         coasts: there is no loop to follow)."""
         axes, faults = self._ctl.axes, self.axes
         rows = [n for n in self._watched if fault not in faults[n].latched and _configured(faults[n].config, fault)
                 and (fault is not Fault.LIMIT_ERROR or axes[n].amp_enabled)]
-        return np.array(rows, dtype=np.int64)
+        configs = [faults[n].config for n in rows]
+        if fault is Fault.LIMIT_ERROR:
+            limits = [c.following_error_limit for c in configs]
+        else:
+            limits = [_limit(c, fault) for c in configs]
+        return _Checks(np.array(rows, dtype=np.int64), np.array(limits, dtype=float),
+                       np.array([error_samples(c, self._ctl.rate) for c in configs], dtype=np.int64))
 
     def _scan_error(self, stretch: Stretch) -> None:
         """|command - actual| above the limit for longer than the configured time."""
-        rows = self._rows(Fault.LIMIT_ERROR)
+        checks = self._stepped()[Fault.LIMIT_ERROR]
+        rows, limits, need = checks.rows, checks.limits, checks.need
         if not len(rows):
             return
-        configs = [self.axes[n].config for n in rows.tolist()]
-        limits = np.array([c.following_error_limit for c in configs])
-        need = np.array([error_samples(c, self._ctl.rate) for c in configs])
         error = np.abs(stretch.cmd_p[rows] - stretch.act_p[rows])
-        runs = run_lengths(error > limits[:, None], np.array([self.axes[n].error_run for n in rows.tolist()]))
+        runs = run_lengths(error > limits[:, None], self.error_runs[rows])
         self._error_rows, self._error_runs = rows, runs
         tripped = runs >= need[:, None]
         for r in np.flatnonzero(tripped.any(axis=1)).tolist():
@@ -216,25 +245,25 @@ class FaultMonitor:
 
     def _scan_limit(self, fault: Fault, stretch: Stretch) -> None:
         """The actual position (user coordinates, as the encoder reads it) beyond a limit."""
-        rows = self._rows(fault)
+        checks = self._stepped()[fault]
+        rows, limits = checks.rows, checks.limits
         if not len(rows):
             return
-        positive = fault is Fault.LIMIT_SW_POSITIVE
-        limits = np.array([_limit(self.axes[n].config, fault) for n in rows.tolist()])
-        origins = np.array([self._ctl.axes[n].origin for n in rows.tolist()])
+        axes = self._ctl.axes
+        origins = np.array([axes[n].origin for n in rows.tolist()])
         position = stretch.act_p[rows] - origins[:, None]
-        beyond = position > limits[:, None] if positive else position < limits[:, None]
+        beyond = position > limits[:, None] if fault is Fault.LIMIT_SW_POSITIVE else position < limits[:, None]
         for r in np.flatnonzero(beyond.any(axis=1)).tolist():
             i = int(np.argmax(beyond[r]))
             self._found.append(_Found(i, int(rows[r]), fault, f"actual position {position[r, i]:.1f} beyond the "
                                                               f"{_WORDS[fault]} {limits[r]:g}"))
 
     def commit(self, stop: int) -> None:
-        """The controller keeps stretch index ``stop``: carry the following-error runs."""
-        for number in self._watched:
-            self.axes[number].error_run = 0
-        for r, number in enumerate(self._error_rows.tolist()):
-            self.axes[number].error_run = int(self._error_runs[r, stop])
+        """The controller keeps stretch index ``stop``: carry the following-error runs (0 on
+        an axis whose error was not followed)."""
+        self.error_runs[self._watched_rows] = 0
+        if len(self._error_rows):
+            self.error_runs[self._error_rows] = self._error_runs[:, stop]
 
     def transition(self, index: int) -> None:
         """Trip what :meth:`scan` found at stretch index ``index`` (the controller is there)."""
@@ -250,6 +279,7 @@ class FaultMonitor:
         if fault in faults.latched:
             return
         faults.latched[fault] = detail
+        self._checks = None
         axis = self._ctl.axes[number]
         action = action_of(faults.config, fault)
         supervisors = self._supervisors_of(axis)
@@ -364,5 +394,6 @@ class FaultMonitor:
             if Fault.AMP_FAULT in faults.latched:
                 amp.add(number)
             faults.latched.clear()
-            faults.error_run = 0
+            self.error_runs[number] = 0
+        self._checks = None
         return amp
