@@ -234,7 +234,10 @@ class FaultMonitor:
         if not len(rows):
             return
         error = np.abs(stretch.cmd_p[rows] - stretch.act_p[rows])
-        runs = run_lengths(error > limits[:, None], self.error_runs[rows])
+        above = error > limits[:, None]
+        if not above.any():
+            return  # no run anywhere: every carry is 0 (commit)
+        runs = run_lengths(above, self.error_runs[rows])
         self._error_rows, self._error_runs = rows, runs
         tripped = runs >= need[:, None]
         for r in np.flatnonzero(tripped.any(axis=1)).tolist():
@@ -261,6 +264,8 @@ class FaultMonitor:
     def commit(self, stop: int) -> None:
         """The controller keeps stretch index ``stop``: carry the following-error runs (0 on
         an axis whose error was not followed)."""
+        if not self._watched:
+            return
         self.error_runs[self._watched_rows] = 0
         if len(self._error_rows):
             self.error_runs[self._error_rows] = self._error_runs[:, stop]
