@@ -18,7 +18,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-from bench_controller import REPO, _baseline_tree
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run with -P: the sibling bench_controller
+from bench_controller import REPO, _baseline_tree  # noqa: E402 - after the path it is found on
 
 CASES = [(32, 16, "velocity", 20, 20_000), (32, 16, "s-curves", 20, 20_000), (32, 16, "velocity", 4096, 200_000)]
 _MEASURE = """
