@@ -47,7 +47,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
-from mpi_ros.srv import MotionAction
+from mpi_ros.srv import AxisFaultInject, MotionAction
 
 from . import errors
 from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
@@ -171,6 +171,13 @@ class EventType(StrEnum):
     AT_TARGET = "AT_TARGET"
     AT_VELOCITY = "AT_VELOCITY"
     DONE = "DONE"
+    # faults of an axis (docs/faults.md)
+    LIMIT_ERROR = "LIMIT_ERROR"
+    LIMIT_SW_POSITIVE = "LIMIT_SW_POSITIVE"
+    LIMIT_SW_NEGATIVE = "LIMIT_SW_NEGATIVE"
+    AMP_FAULT = "AMP_FAULT"
+    ENCODER_FAULT = "ENCODER_FAULT"
+    FRAME_UNDERFLOW = "FRAME_UNDERFLOW"
 
 
 class Outcome(StrEnum):
@@ -190,6 +197,7 @@ class ActionReply:
     code: int
     state_name: str
     sample: int  # the sample at which the action took effect
+    detail: str = ""  # why it was refused (e.g. RESET while a fault persists)
 
     @property
     def ok(self) -> bool:
@@ -198,6 +206,20 @@ class ActionReply:
     @property
     def state(self) -> State:
         return State(self.state_name)
+
+
+@dataclass(frozen=True)
+class FaultReply:
+    """The answer of a fault injection (/<ns>/axis<k>/fault_inject, docs/faults.md)."""
+
+    message: str
+    code: int
+    detail: str  # why it was refused
+    faults: tuple[str, ...]  # the faults latched on the axis afterwards
+
+    @property
+    def ok(self) -> bool:
+        return self.message == errors.OK
 
 
 @dataclass(frozen=True)
@@ -808,10 +830,26 @@ class MotionClient(_Endpoint):
             raise NoResponse(f"the supervisor's action service {self.prefix}/action is not available")
         response = self._wait_future(self._action.call_async(MotionAction.Request(action=name)), None,
                                      f"action {name}")
-        reply = ActionReply(response.message, response.code, response.state_name, response.sample)
+        reply = ActionReply(response.message, response.code, response.state_name, response.sample,
+                            getattr(response, "detail", ""))
         if raise_on_error:
-            raise_for(reply.message, f"{name} in {reply.state_name}", reply)
+            raise_for(reply.message, f"{name} in {reply.state_name}" + (f": {reply.detail}" if reply.detail else ""),
+                      reply)
         return reply
+
+    def fault_inject(self, axis: int, fault: str, active: bool = True) -> FaultReply:
+        """Inject a fault on an axis (AMP_FAULT, ENCODER_FAULT: a condition, cleared with
+        ``active`` False; the others trip once), docs/faults.md. RESET clears it afterwards."""
+        name = f"{self.namespace}/axis{axis}/fault_inject"
+        service = self.node.create_client(AxisFaultInject, name)
+        try:
+            if not service.wait_for_service(timeout_sec=self.timeout):
+                raise NoResponse(f"the axis service {name} is not available")
+            request = AxisFaultInject.Request(fault=fault, active=active)
+            response = self._wait_future(service.call_async(request), None, f"the injection of {fault}")
+        finally:
+            self.node.destroy_client(service)
+        return FaultReply(response.message, response.code, response.detail, tuple(response.faults))
 
     def stop(self) -> ActionReply:
         return self.action(Action.STOP)

@@ -233,6 +233,22 @@ def _axis_position_set(ctl: Controller, command: Command) -> Reply:
     return Reply(message, _refusal_detail(message, check_position("value", value)))
 
 
+def _axis_fault_config_set(ctl: Controller, command: Command) -> Reply:
+    """The fault limits and actions of an axis (docs/faults.md); fields left out keep their values."""
+    _, current = ctl.axis_fault_config_get(command.axis)
+    verdict = ctl.axis_fault_config_set(command.axis, rq.fault_config(command.request.get("config", {}), current))
+    return Reply(verdict.message, verdict.detail)
+
+
+def _axis_fault_inject(ctl: Controller, command: Command) -> Reply:
+    """A fault injected on an axis (docs/faults.md): recorded, so a replay injects it at the same sample."""
+    r = command.request
+    message, detail = ctl.axis_fault_inject(command.axis, rq.text(r.get("fault", ""), "fault"),
+                                            rq.boolean(r.get("active", True), "active"))
+    faults = list(ctl.faults.names(command.axis)) if 0 <= command.axis < len(ctl.axes) else []
+    return Reply(message, detail, value=faults)
+
+
 OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
     MOTION_START: lambda ctl, c: _motion(ctl, c, modify=False),
     MOTION_MODIFY: lambda ctl, c: _motion(ctl, c, modify=True),
@@ -248,6 +264,8 @@ OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
     "io_set": _io_set,
     "axis_config_set": _axis_config_set,
     "axis_position_set": _axis_position_set,
+    "axis_fault_config_set": _axis_fault_config_set,
+    "axis_fault_inject": _axis_fault_inject,
 }
 
 

@@ -27,6 +27,7 @@ from .mpi.params import (
     MAX_COORD_AXES,
     MAX_OBJECTS,
     VALID,
+    AxisFaultConfig,
     AxisInPosition,
     ControllerConfig,
     DecelTime,
@@ -94,6 +95,7 @@ class SuiteConfig:
     ros: RosSettings = field(default_factory=RosSettings)
     source: str = "<defaults>"
     raw: dict = field(default_factory=dict)  # the validated mapping (recorded in bags for replay)
+    faults: list[AxisFaultConfig] = field(default_factory=list)  # per axis (none: the controller's defaults)
 
     @property
     def axis_count(self) -> int:
@@ -112,6 +114,8 @@ class SuiteConfig:
             ctl.axes[n].plant = Plant(plant)  # before the tolerances: they are checked against its encoder
             _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position",
                       first_refusal((in_position.validate(), check_settling_reachable(in_position, plant))))
+        for n, faults in enumerate(self.faults):
+            _require(ctl.axis_fault_config_set(n, faults), f"axes[{n}].faults.")
         for i, spec in enumerate(self.supervisors):
             self._build_supervisor(ctl, spec, f"supervisors[{i}]")
         return ctl
@@ -211,7 +215,8 @@ def _controller(raw: dict | None, axis_count: int, supervisor_count: int) -> Con
     return cfg
 
 
-def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig]]:
+def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig], list[Any]]:
+    """The axes' settings; their faults as given (read by :func:`_faults` once the motors are known)."""
     raw = raw or {}
     unknown = set(raw) - {"count", "defaults", "overrides"}
     if unknown:
@@ -223,12 +228,13 @@ def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig
     overrides = raw.get("overrides") or {}
     if not isinstance(overrides, dict):
         raise ConfigError("axes.overrides: expected a mapping of axis number -> settings")
-    in_position, plants = [], []
+    in_position, plants, faults = [], [], []
     for n in range(count):
         merged = _merge(defaults, overrides.get(n, overrides.get(str(n), {})))
-        extra = set(merged) - {"in_position", "plant"}
+        extra = set(merged) - {"in_position", "plant", "faults"}
         if extra:
-            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: in_position, plant)")
+            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: faults, in_position, plant)")
+        faults.append(merged.get("faults"))
         ip = _dataclass(AxisInPosition, merged.get("in_position"), f"axes[{n}].in_position")
         plant = _dataclass(PlantConfig, merged.get("plant"), f"axes[{n}].plant")
         _require(ip.validate(), f"axes[{n}].in_position.")
@@ -236,7 +242,21 @@ def _axes(raw: dict | None) -> tuple[int, list[AxisInPosition], list[PlantConfig
         _require(check_settling_reachable(ip, plant), f"axes[{n}].in_position.")
         in_position.append(ip)
         plants.append(plant)
-    return count, in_position, plants
+    return count, in_position, plants, faults
+
+
+def _faults(raw: Any, number: int, motors: int) -> AxisFaultConfig:
+    """An axis' fault limits and actions (docs/faults.md); its encoder fault watches its own
+    motor (axis k drives motor k) unless told otherwise, or none if it has no motor."""
+    where = f"axes[{number}].faults"
+    if raw is None or isinstance(raw, dict):
+        raw = {"encoder_fault_motor_number": number if number < motors else -1, **(raw or {})}
+    config = _dataclass(AxisFaultConfig, raw, where)
+    for key in config.__slots__:
+        if key.endswith("_action") and isinstance(getattr(config, key), str):
+            setattr(config, key, getattr(config, key).strip().upper())
+    _require(config.validate(), f"{where}.")
+    return config
 
 
 def _motion_config(raw: dict, where: str) -> MotionConfig:
@@ -310,12 +330,14 @@ def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
     extra = set(data) - known
     if extra:
         raise ConfigError(f"{sorted(extra)[0]}: unknown top-level key (known: {', '.join(sorted(known))})")
-    count, in_position, plants = _axes(data.get("axes"))
+    count, in_position, plants, faults = _axes(data.get("axes"))
     supervisors = _supervisors(data.get("supervisors", [{"number": 0, "axes": [0]}]),
                                data.get("supervisor_defaults"), count)
     supervisor_count = max(s.number for s in supervisors) + 1
     controller = _controller(data.get("controller"), count, supervisor_count)
-    return SuiteConfig(controller, in_position, plants, supervisors, _ros(data.get("ros")), source, copy.deepcopy(data))
+    faults = [_faults(raw, n, controller.motors) for n, raw in enumerate(faults)]
+    return SuiteConfig(controller, in_position, plants, supervisors, _ros(data.get("ros")), source, copy.deepcopy(data),
+                       faults)
 
 
 def load(path: str | Path | None = None, overrides: dict | None = None) -> SuiteConfig:

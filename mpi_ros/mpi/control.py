@@ -22,14 +22,17 @@ from .axis import Axis
 from .bank import AxisBank
 from .clock import ProfileClock
 from .events import Event, MPIEventType
+from .faults import FaultMonitor
 from .io import IoImage
 from .messages import STATE_MESSAGES, Message
 from .motion import MotionSupervisor
 from .params import (
+    AxisFaultConfig,
     AxisInPosition,
     ControllerConfig,
     MotionConfig,
     PlantConfig,
+    Verdict,
     check_position,
     check_settling_reachable,
 )
@@ -77,6 +80,7 @@ class Controller:
         self._supervisors: dict[int, MotionSupervisor] = {}
         self.events: deque[Event] = deque()
         self.listeners: list[EventListener] = []
+        self.faults = FaultMonitor(self)
 
     # -- time -------------------------------------------------------------------------
     @property
@@ -185,6 +189,24 @@ class Controller:
         axis.in_position = in_position.copy()
         return Message.MPIMessageOK
 
+    def axis_fault_config_set(self, number: int, config: AxisFaultConfig) -> Verdict:
+        """The fault limits and actions of an axis (docs/faults.md), checked by the one
+        AxisFaultConfig validator (the YAML loader and the service use it too)."""
+        if not 0 <= number < len(self.axes):
+            return Verdict(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
+        return self.faults.config_set(number, config)
+
+    def axis_fault_config_get(self, number: int) -> tuple[Message, AxisFaultConfig]:
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID, AxisFaultConfig()
+        return Message.MPIMessageOK, self.faults.axes[number].config.copy()
+
+    def axis_fault_inject(self, number: int, fault: object, active: bool = True) -> tuple[Message, str]:
+        """Inject a fault on an axis (faults.FaultMonitor.inject): it acts at once."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}"
+        return self.faults.inject(number, fault, active)
+
     def frame_count(self, number: int) -> int:
         """Frames in an axis' buffer: the rest of the move it runs and the ones queued. A
         path's points beyond the buffer wait in the library (MPI 001, LOW_COUNT): the buffer
@@ -231,6 +253,7 @@ class Controller:
             frame_count=self.frame_count(number),
             supervisor=axis.owner,
             feedforward=axis.feedforward,
+            faults=self.faults.names(number),
         )
 
     # -- gates and I/O -------------------------------------------------------------------
@@ -330,13 +353,19 @@ class Controller:
             first = ms.scan(stretch, status)
             if first is not None and first <= stop:
                 stop = event_at = first
+        fault_at = self.faults.scan(stretch)
+        if fault_at is not None and fault_at <= stop:
+            stop = event_at = fault_at
         self._status_events(stop, stretch, status)
         self._log(stop, stretch, supervisors)
         self._commit(stop, stretch, status)
+        self.faults.commit(stop)
         self.sample = int(stretch.samples[stop])
         if event_at is not None:
             for ms in supervisors:
                 ms.transition(stop, stretch.samples)
+            # after the supervisors' transitions of the same sample (a move done there is done)
+            self.faults.transition(stop)
 
     def _log(self, stop: int, stretch: Stretch, supervisors: list[MotionSupervisor]) -> None:
         for ms in supervisors:

@@ -44,6 +44,13 @@ class MPIEventType(IntFlag):
     AT_TARGET = 1 << 23
     AT_VELOCITY = 1 << 24
     DONE = 1 << 25
+    # Faults of an axis (docs/faults.md; the XMP family's MPIEventType names for them)
+    LIMIT_ERROR = 1 << 26  # following error above its limit for its time
+    LIMIT_SW_POSITIVE = 1 << 27
+    LIMIT_SW_NEGATIVE = 1 << 28
+    AMP_FAULT = 1 << 29
+    ENCODER_FAULT = 1 << 30
+    FRAME_UNDERFLOW = 1 << 31  # an open path's frame buffer ran empty while moving
 
     @classmethod
     def parse(cls, names) -> MPIEventType | None:
@@ -89,8 +96,17 @@ MASK_MOTION = (
     | MPIEventType.ID_TRUNCATED
     | MPIEventType.CROSSCHECK
 )
+MASK_FAULT = (
+    MPIEventType.LIMIT_ERROR
+    | MPIEventType.LIMIT_SW_POSITIVE
+    | MPIEventType.LIMIT_SW_NEGATIVE
+    | MPIEventType.AMP_FAULT
+    | MPIEventType.ENCODER_FAULT
+    | MPIEventType.FRAME_UNDERFLOW
+)
 MASK_AXIS = (
-    MPIEventType.SETTLED
+    MASK_FAULT
+    | MPIEventType.SETTLED
     | MPIEventType.IN_FINE_POSITION
     | MPIEventType.IN_COARSE_POSITION
     | MPIEventType.AT_TARGET
@@ -98,7 +114,8 @@ MASK_AXIS = (
     | MPIEventType.DONE
 )
 MASK_ALL = MASK_MOTION | MASK_AXIS
-_GROUPS = {"ALL": MASK_ALL, "MOTION": MASK_MOTION, "AXIS": MASK_AXIS, "NONE": MPIEventType.NONE}
+_GROUPS = {"ALL": MASK_ALL, "MOTION": MASK_MOTION, "AXIS": MASK_AXIS, "FAULT": MASK_FAULT,
+           "NONE": MPIEventType.NONE}
 
 
 @dataclass(frozen=True, slots=True)

@@ -2,7 +2,8 @@
 
 Publishes /<ns>/axis<k>/status, /<ns>/events, /joint_states, /diagnostics and /clock
 (controller time, for use_sim_time consumers); serves the axis services
-(/<ns>/axis<k>/config_get|config_set|position_set) and the control's gates and I/O
+(/<ns>/axis<k>/config_get|config_set|position_set, and fault_config_get|fault_config_set|fault_inject:
+docs/faults.md) and the control's gates and I/O
 (/<ns>/gate_set|gate_get|io_get|io_set).
 
 For recordings any tool can make: every command the controller applied goes out on
@@ -27,7 +28,18 @@ from sensor_msgs.msg import JointState
 
 from mpi_ros.msg import AxisStatus, MotionEvent, SuiteConfiguration
 from mpi_ros.msg import Command as CommandMsg
-from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisPositionSet, GateGet, GateSet, IoGet, IoSet
+from mpi_ros.srv import (
+    AxisConfigGet,
+    AxisConfigSet,
+    AxisFaultConfigGet,
+    AxisFaultConfigSet,
+    AxisFaultInject,
+    AxisPositionSet,
+    GateGet,
+    GateSet,
+    IoGet,
+    IoSet,
+)
 
 from .. import requests as rq
 from ..commands import Command, Reply, io_space
@@ -84,6 +96,12 @@ class ControllerNode(Node):
                           lambda req, resp, k=k: self._on_config_set(k, req, resp))
             self._service(AxisPositionSet, f"axis{k}/position_set",
                           lambda req, resp, k=k: self._on_position_set(k, req, resp))
+            self._service(AxisFaultConfigGet, f"axis{k}/fault_config_get",
+                          lambda req, resp, k=k: self._on_fault_config_get(k, resp))
+            self._service(AxisFaultConfigSet, f"axis{k}/fault_config_set",
+                          lambda req, resp, k=k: self._on_fault_config_set(k, req, resp))
+            self._service(AxisFaultInject, f"axis{k}/fault_inject",
+                          lambda req, resp, k=k: self._on_fault_inject(k, req, resp))
         self._service(GateSet, "gate_set", self._on_gate_set)
         self._service(GateGet, "gate_get", self._on_gate_get)
         self._service(IoSet, "io_set", self._on_io_set)
@@ -189,7 +207,9 @@ class ControllerNode(Node):
         status = DiagnosticStatus()
         status.name = f"{self.settings.namespace.strip('/')}/axis{axis.number}"
         status.hardware_id = "mpi_ros simulated controller"
-        if not snap.amp_enabled:
+        if snap.faults:
+            level, message = DiagnosticStatus.ERROR, f"fault {', '.join(snap.faults)}: RESET once cleared"
+        elif not snap.amp_enabled:
             level, message = DiagnosticStatus.ERROR, "amplifier disabled (ABORT): RESET to enable"
         elif abs(snap.position_error) > axis.in_position.position_coarse:
             level, message = DiagnosticStatus.WARN, f"position error {snap.position_error:.1f} counts"
@@ -203,7 +223,7 @@ class ControllerNode(Node):
             ("actual_position", f"{snap.actual_position:.3f}"), ("position_error", f"{snap.position_error:.3f}"),
             ("command_velocity", f"{snap.command_velocity:.3f}"), ("done", snap.done), ("settled", snap.settled),
             ("in_fine_position", snap.in_fine_position), ("frame_count", snap.frame_count),
-            ("supervisor", snap.supervisor))]
+            ("supervisor", snap.supervisor), ("amp_enabled", snap.amp_enabled), ("faults", ",".join(snap.faults)))]
         return status
 
     # -- services -------------------------------------------------------------------------
@@ -220,6 +240,24 @@ class ControllerNode(Node):
     def _on_position_set(self, k: int, request, response):
         reply, _ = self.runner.submit(Command("axis_position_set", axis=k,
                                               request={"which": request.which, "value": request.value}))
+        return convert.answer(response, reply)
+
+    def _on_fault_config_get(self, k: int, response):
+        message, cfg = self.runner.read(lambda ctl: ctl.axis_fault_config_get(k))
+        convert.fill(response.config, rq.fault_config_to_dict(cfg))
+        return convert.answer(response, Reply(message))
+
+    def _on_fault_config_set(self, k: int, request, response):
+        reply, _ = self.runner.submit(Command("axis_fault_config_set", axis=k,
+                                              request={"config": convert.to_dict(request.config)}))
+        response.detail = reply.detail
+        return convert.answer(response, reply)
+
+    def _on_fault_inject(self, k: int, request, response):
+        reply, _ = self.runner.submit(Command("axis_fault_inject", axis=k,
+                                              request={"fault": request.fault, "active": request.active}))
+        response.detail = reply.detail
+        response.faults = list(reply.value or [])
         return convert.answer(response, reply)
 
     def _on_gate_set(self, request, response):

@@ -180,6 +180,7 @@ def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) ->
     msg.frame_count = snap.frame_count
     msg.supervisor = snap.supervisor
     msg.feedforward = _finite(snap.feedforward)
+    msg.faults = list(snap.faults)
     return msg
 
 

@@ -457,6 +457,7 @@ class SupervisorNode(Node):
         response.state = int(reply.state)
         response.state_name = reply.state.name
         response.sample = sample
+        response.detail = reply.detail
         return response
 
     def _on_trigger(self, action: str, response):
