@@ -63,6 +63,7 @@ class ReplayReport:
     first: Divergence | None = None
     largest: dict[str, float] = field(default_factory=dict)  # field -> largest numeric difference
     last_sample: int = 0
+    truncated: str = ""  # the bag was cut short (BagReader.truncated): only what it holds was compared
 
     @property
     def identical(self) -> bool:
@@ -79,6 +80,8 @@ class ReplayReport:
     def summary(self) -> str:
         head = (f"{self.bag}: {self.commands} commands, {self.statuses} statuses ({self.values} values), "
                 f"{self.events} events compared up to sample {self.last_sample}")
+        if self.truncated:
+            head = f"{head} in a truncated bag (read up to its last complete record)"
         if self.identical:
             return f"{head}: zero differences"
         worst = ", ".join(f"{k} {v:.6g}" for k, v in sorted(self.largest.items(), key=lambda kv: -kv[1])[:5])
@@ -223,7 +226,7 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     skipped = _SKIPPED_FIELDS if epoch is None else frozenset()
     replayed_events = []
     ctl.listeners.append(lambda e: replayed_events.append(e) if e.type_name not in NOT_REPLAYED else None)
-    report = ReplayReport(str(path))
+    report = ReplayReport(str(path), truncated=reader.truncated)
     recorded_events = []
     timeline = []  # (controller sample, 0 status / 1 command, order, topic, type, msg)
     first_recorded = None  # the first sample the recording saw (a graph recording may start late)
@@ -279,6 +282,10 @@ def _compare_events(report: ReplayReport, recorded, replayed, rate: float, toler
                     epoch: int | None = None, skipped=_SKIPPED_FIELDS, since: int = 0) -> None:
     """Events from ``since`` up to the last compared sample, in order."""
     horizon = report.last_sample
+    if report.truncated:
+        # the cut may fall among the writes of the last sample: events are written as they
+        # happen, before the statuses of any later sample, so those before it are all there
+        horizon -= 1
     replayed = [convert.motion_event(e, rate, epoch or 0) for e in replayed if since <= e.sample <= horizon]
     recorded = [e for e in recorded if e.sample <= horizon]
     # pairs up to the shorter list: a difference in count is a divergence of its own (below)

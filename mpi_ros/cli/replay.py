@@ -7,7 +7,8 @@ BAG is a bag of `mpi-ros record` / `mpi-ros run --record`, or of any recorder of
 (/mpi/configuration, latched) for that. Exit status 0 when the replay reproduces every
 recorded status, event and answer, 1 when it diverges (the first divergence is printed:
 where, which field, by how much), 2 when the bag cannot be replayed (the message says what
-it lacks: the configuration, the commands, the statuses).
+it lacks: the configuration, the commands, the statuses). A bag its recorder did not finish
+(killed) is replayed up to its last complete record, and said to be truncated.
 --set changes the recorded configuration, e.g. --set axes.defaults.plant.bandwidth_hz=20.
 --namespace chooses one suite of a bag that recorded a cell of several (/cell_a, /cell_b).
 """
@@ -52,5 +53,7 @@ def run(args) -> int:
     except (OSError, ValueError, ConfigError) as exc:
         print(f"mpi-ros replay: {exc}", file=sys.stderr)
         return 2
+    if report.truncated:
+        print(f"mpi-ros replay: truncated bag: {report.truncated}", file=sys.stderr)
     print(report.summary())
     return 0 if report.identical else 1
