@@ -89,6 +89,11 @@ class RosSettings:
     executor_threads: int = 32
     clock: bool = True  # publish /clock; in a cell of several suites exactly one should (docs/cell.md)
     discovery: str = "localhost"  # see DISCOVERY_RANGES
+    # s an ended goal's result stays available to a client that asks for it late (rclpy's
+    # ActionServer result_timeout; 900 s in rclpy). The action server keeps each goal and
+    # publishes the status of all it keeps at every goal's change, so at 100 goals a second
+    # rclpy's 900 s meant 90,000 goals kept and ever larger status messages.
+    result_timeout: float = 60.0
 
     @property
     def joint_states_topic(self) -> str:
@@ -321,7 +326,8 @@ def _lost_client_timeout(value: Any, where: str) -> float:
 
 def _ros(raw: dict | None) -> RosSettings:
     ros = _dataclass(RosSettings, raw, "ros")
-    for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate"):
+    for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate",
+                "result_timeout"):
         _positive(getattr(ros, key), f"ros.{key}")
     if ros.status_rate > 1000.0:
         raise ConfigError(f"ros.status_rate: at most 1000 Hz, got {ros.status_rate}")

@@ -162,6 +162,10 @@ class ControllerRunner:
         # a little late rather than early: early, the sample due would still be the one before
         return min(period, max(0.0, due_at - time.monotonic() + _WAKE_MARGIN))
 
+    def backlog(self) -> int:
+        """Outputs (publications) collected and not yet published."""
+        return len(self._outputs)
+
     def due_sample(self) -> int:
         """The sample the controller should be at now."""
         if self.time_scale is None:

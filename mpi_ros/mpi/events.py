@@ -9,6 +9,7 @@ are reproduced and reported as events).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from enum import IntFlag
 
@@ -63,8 +64,14 @@ class MPIEventType(IntFlag):
         return mask
 
     def names(self) -> list[str]:
-        # (a member's name is None only for a combination, which iterating the class never gives)
-        return [m.name for m in MPIEventType if m is not MPIEventType.NONE and m in self and m.name is not None]
+        return list(_names(int(self)))
+
+
+@functools.lru_cache(maxsize=1024)
+def _names(mask: int) -> tuple[str, ...]:
+    """The member names in ``mask``, cached: every status snapshot asks for its latched events."""
+    # (a member's name is None only for a combination, which iterating the class never gives)
+    return tuple(m.name for m in MPIEventType if m is not MPIEventType.NONE and m & mask == m and m.name is not None)
 
 
 MASK_MOTION = (

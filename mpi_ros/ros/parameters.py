@@ -7,7 +7,7 @@ The controller node (``/<ns>/controller``) takes:
 | config | the YAML file (default: --config, else config/default.yaml) |
 | time_scale | --time-scale |
 | sample_rate | controller.sample_rate |
-| status_rate, feedback_rate, joint_states_rate, diagnostics_rate, clock_rate, crosscheck | ros.* |
+| status_rate, feedback_rate, joint_states_rate, diagnostics_rate, clock_rate, crosscheck, result_timeout | ros.* |
 
 The namespace: ``--ros-args -r __ns:=/cell_a`` (rcl's remap of every node's namespace)
 over ``mpi-ros run --namespace`` over ros.namespace in the YAML; the one in effect is the
@@ -30,7 +30,8 @@ from rclpy.node import Node
 
 from .. import config as suite_config
 
-ROS_KEYS = ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate", "crosscheck")
+ROS_KEYS = ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate", "crosscheck",
+            "result_timeout")
 NODE_NAME = "controller"
 _SET_AT_START = "Read only: set at start with --ros-args -p {name}:=VALUE."
 
@@ -75,6 +76,9 @@ SPECS: dict[str, ParameterSpec] = {spec.name: spec for spec in (
     _rate("clock_rate", "/clock is published"),
     ParameterSpec("crosscheck", ParameterType.PARAMETER_BOOL,
                   "check every started or modified profile against ruckig (ros.crosscheck)"),
+    ParameterSpec("result_timeout", ParameterType.PARAMETER_DOUBLE,
+                  "s: how long an ended goal's result is kept for a client that asks late (ros.result_timeout)",
+                  0.0, math.inf, "Must be > 0."),
 )}
 
 

@@ -122,6 +122,14 @@ class _GoalServer(ActionServer):
         self.applied: dict[bytes, tuple[Reply, int] | Exception] = {}
         super().__init__(*args, **kwargs)
 
+    def kept(self) -> int:
+        """Goals rclpy keeps: the unfinished ones and the ended ones until result_timeout."""
+        return len(self._goal_handles)
+
+    def unfiled(self) -> int:
+        """Goal and cancel requests taken and not yet handled, and goals applied and not yet filed."""
+        return len(self._taken) + len(self.applied)
+
     def take_data(self):
         data = super().take_data()
         requests = {key: data.pop(key) for key in ("goal", "cancel") if key in data}
@@ -218,13 +226,21 @@ class SupervisorNode(Node):
         self.watchdog = (LostClientWatchdog(self, lost_client_timeout, self._running, self._client_lost,
                                             self._service_group) if lost_client_timeout > 0 else None)
 
+    def held(self) -> dict[str, int]:
+        """What this node holds of its goals (for /diagnostics: none of it may grow without
+        bound): goals tracked until they end, goals rclpy keeps until their result expires,
+        requests not yet filed. Runner lock held."""
+        return {"goals_tracked": len(self._book), "goals_kept": sum(s.kept() for s in self._servers.values()),
+                "requests_unfiled": sum(s.unfiled() for s in self._servers.values())}
+
     def _action_server(self, action_type, name: str, operation: str) -> _GoalServer:
         return _GoalServer(self, action_type, f"~/{name}", _never_executed,
                            goal_callback=lambda goal: self._on_goal(goal, action_type, operation),
                            handle_accepted_callback=lambda handle: self._accept(handle, action_type),
                            cancel_callback=self._on_cancel,
                            after_cancel=lambda: self.runner.update(self._review),
-                           callback_group=self._goal_group, **ACTION_QOS)
+                           callback_group=self._goal_group, result_timeout=self.settings.result_timeout,
+                           **ACTION_QOS)
 
     def _service(self, srv_type, name, callback):
         """A service of this supervisor: /<ns>/ms<n>/<name>."""
