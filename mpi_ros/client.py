@@ -63,6 +63,7 @@ EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 
 _SUPERVISOR_NODE = re.compile(r"ms(\d+)")
 _POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
+RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting for its result
 # Every node of a process is announced together (one DDS participant per context), but give
 # a late announcement a moment before saying a supervisor is not there.
 _GRACE = 0.5
@@ -165,6 +166,7 @@ class EventType(StrEnum):
     RELATIVE_TRUNCATED = "RELATIVE_TRUNCATED"
     ID_TRUNCATED = "ID_TRUNCATED"
     CROSSCHECK = "CROSSCHECK"
+    CLIENT_LOST = "CLIENT_LOST"
     SETTLED = "SETTLED"
     IN_FINE_POSITION = "IN_FINE_POSITION"
     IN_COARSE_POSITION = "IN_COARSE_POSITION"
@@ -504,11 +506,19 @@ class _Endpoint:
 
 # -- goals and the motion client ---------------------------------------------------------------------------
 class Goal:
-    """A running MotionStart/MotionModify goal."""
+    """A running MotionStart/MotionModify goal.
 
-    def __init__(self, client: MotionClient, handle: Any, result_future: Any, progress: threading.Event):
+    Its result survives a lost link: while waiting, the goal watches its action server on
+    the graph; when the server has left it (a link down past the DDS lease) and comes back,
+    the goal asks for its result again (the suite keeps results of ended goals), because an
+    answer sent while the link was down is lost (docs/cell.md, "A cut link")."""
+
+    def __init__(self, client: MotionClient, handle: Any, result_future: Any, progress: threading.Event,
+                 action_client: ActionClient | None = None):
         self._client = client
         self.handle = handle
+        self._action_client = action_client
+        self.asked_again = 0  # results asked again after the server came back
         self._result_future = result_future
         self._progress = progress  # set by the first feedback or the result
         self._finished = threading.Event()
@@ -539,11 +549,36 @@ class Goal:
 
         ``timeout``: seconds (None: the client's timeout); NoResponse when it passes.
         """
-        response = self._client._wait_future(self._result_future, timeout, "the goal's result")
+        self._follow_server(self._client.timeout if timeout is None else timeout)
+        if not self._result_future.done():
+            raise NoResponse("no answer for the goal's result within the timeout")
+        response = self._result_future.result()
         result = MotionResult.from_ros(response.result, response.status)
         if raise_on_error:
             raise_for(result.message, result.detail, result)
         return result
+
+    def _follow_server(self, timeout: float) -> None:
+        """Wait up to ``timeout`` s for the result, asking again whenever the action server
+        reappears on the graph after having left it."""
+        deadline = time.monotonic() + timeout
+        lost = False
+        while not self._finished.wait(max(0.0, min(RESULT_RECHECK, deadline - time.monotonic()))):
+            if time.monotonic() >= deadline or self._action_client is None:
+                return
+            if not self._action_client.server_is_ready():
+                lost = True
+            elif lost:
+                lost = False
+                self._ask_again()
+
+    def _ask_again(self) -> None:
+        def forward(future: Any) -> None:
+            if not self._result_future.done() and future.result() is not None:
+                self._result_future.set_result(future.result())
+
+        self._client._on_executor(self.handle.get_result_async).add_done_callback(forward)
+        self.asked_again += 1
 
     def cancel(self, timeout: float | None = 5.0) -> None:
         """Cancel = STOP: the axes decelerate over decelTime.stop and the goal ends."""
@@ -666,7 +701,7 @@ class MotionClient(_Endpoint):
         if not handle.accepted:
             raise NoResponse(f"{action_client._action_name} rejected the goal (the suite is shutting down)")
         result = self._on_executor(handle.get_result_async)
-        holder["goal"] = Goal(self, handle, result, progress)
+        holder["goal"] = Goal(self, handle, result, progress, action_client)
         return holder["goal"]
 
     def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float | None = None,

@@ -67,11 +67,20 @@ class SupervisorSpec:
     axes: list[int]
     config: MotionConfig
     event_notify: MPIEventType
+    # The lost-client watchdog (docs/cell.md): STOP this supervisor's motion when the client
+    # of a running goal has been gone from the graph this long (s); 0 = off (the default).
+    lost_client_timeout: float = 0.0
+
+
+DEFAULT_NAMESPACE = "/mpi"
+# ros.discovery: how far DDS discovery reaches (ROS_AUTOMATIC_DISCOVERY_RANGE); the suite's
+# default keeps it on this host (docs/cell.md, "Exposure").
+DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")
 
 
 @dataclass(slots=True)
 class RosSettings:
-    namespace: str = "/mpi"
+    namespace: str = DEFAULT_NAMESPACE
     status_rate: float = 100.0
     feedback_rate: float = 20.0
     joint_states_rate: float = 100.0
@@ -79,11 +88,25 @@ class RosSettings:
     clock_rate: float = 100.0
     crosscheck: bool = False
     executor_threads: int = 32
+    clock: bool = True  # publish /clock; in a cell of several suites exactly one should (docs/cell.md)
+    discovery: str = "localhost"  # see DISCOVERY_RANGES
     # s an ended goal's result stays available to a client that asks for it late (rclpy's
     # ActionServer result_timeout; 900 s in rclpy). The action server keeps each goal and
     # publishes the status of all it keeps at every goal's change, so at 100 goals a second
     # rclpy's 900 s meant 90,000 goals kept and ever larger status messages.
     result_timeout: float = 60.0
+
+    @property
+    def joint_states_topic(self) -> str:
+        """/joint_states for the default namespace (the contract); <namespace>/joint_states
+        for any other, so that suites of a cell neither collide nor interleave there."""
+        return "/joint_states" if self.namespace == DEFAULT_NAMESPACE else f"{self.namespace.rstrip('/')}/joint_states"
+
+    @property
+    def joint_prefix(self) -> str:
+        """Prefix of every joint name: none for the default namespace, else the namespace
+        ("cell_a/axis0"), so joint names stay unique in a cell (one robot description)."""
+        return "" if self.namespace == DEFAULT_NAMESPACE else self.namespace.strip("/") + "/"
 
 
 @dataclass(slots=True)
@@ -280,9 +303,9 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         where = f"supervisors[{i}]"
         if not isinstance(entry, dict):
             raise ConfigError(f"{where}: expected a mapping with number and axes")
-        extra = set(entry) - {"number", "axes", "config", "event_notify"}
+        extra = set(entry) - set(_SUPERVISOR_KEYS)
         if extra:
-            raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: axes, config, event_notify, number)")
+            raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: {', '.join(sorted(_SUPERVISOR_KEYS))})")
         number = entry.get("number", i)
         if isinstance(number, bool) or not isinstance(number, int) or not 0 <= number < MAX_OBJECTS:
             raise ConfigError(f"{where}.number: expected an integer from 0 to {MAX_OBJECTS - 1}, got {number!r}")
@@ -304,8 +327,21 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         mask = MPIEventType.parse(notify_names) if isinstance(notify_names, list) else None
         if mask is None:
             raise ConfigError(f"{where}.event_notify: expected a list of event type names, got {notify_names!r}")
-        specs.append(SupervisorSpec(number, list(axes), config, mask))
+        timeout = _lost_client_timeout(entry.get("lost_client_timeout", defaults.get("lost_client_timeout", 0.0)),
+                                       f"{where}.lost_client_timeout")
+        specs.append(SupervisorSpec(number, list(axes), config, mask, timeout))
     return specs
+
+
+_SUPERVISOR_KEYS = ("number", "axes", "config", "event_notify", "lost_client_timeout")
+
+
+def _lost_client_timeout(value: Any, where: str) -> float:
+    """Seconds, >= 0 (0: the watchdog is off)."""
+    timeout = _coerce(value, 0.0, where)
+    if timeout < 0.0:
+        raise ConfigError(f"{where}: must be >= 0 (0 turns the watchdog off), got {value!r}")
+    return timeout
 
 
 def _ros(raw: dict | None) -> RosSettings:
@@ -315,11 +351,25 @@ def _ros(raw: dict | None) -> RosSettings:
         _positive(getattr(ros, key), f"ros.{key}")
     if ros.status_rate > 1000.0:
         raise ConfigError(f"ros.status_rate: at most 1000 Hz, got {ros.status_rate}")
-    if not ros.namespace.startswith("/"):
-        raise ConfigError(f"ros.namespace: must start with '/', got {ros.namespace!r}")
+    check_namespace(ros.namespace, "ros.namespace")
+    if ros.discovery not in DISCOVERY_RANGES:
+        raise ConfigError(f"ros.discovery: one of {', '.join(DISCOVERY_RANGES)}, got {ros.discovery!r}")
     if ros.executor_threads < 4:
         raise ConfigError("ros.executor_threads: must be >= 4")
     return ros
+
+
+def check_namespace(namespace: str, where: str = "namespace") -> str:
+    """``namespace`` if it is a ROS namespace (absolute, name parts of letters, digits and
+    underscores not starting with a digit: rcl's rules; no trailing slash), else ConfigError
+    naming ``where``."""
+    parts = namespace.split("/")
+    if (not namespace.startswith("/") or namespace == "/" or namespace.endswith("/")
+            or not all(p and (p[0].isalpha() or p[0] == "_") and all(c.isalnum() or c == "_" for c in p)
+                       and p.isascii() for p in parts[1:])):
+        raise ConfigError(f"{where}: expected an absolute ROS namespace like /mpi or /cell_a "
+                          f"(letters, digits, underscores; parts not starting with a digit), got {namespace!r}")
+    return namespace
 
 
 def parse(data: dict, source: str = "<dict>") -> SuiteConfig:

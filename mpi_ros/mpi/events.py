@@ -37,6 +37,9 @@ class MPIEventType(IntFlag):
     ID_TRUNCATED = 1 << 14
     # Ruckig disagreed with a planned profile (mpi_ros crosscheck).
     CROSSCHECK = 1 << 15
+    # The lost-client watchdog stopped the motion: a goal's client left the graph (mpi_ros,
+    # docs/cell.md; the STOP itself follows as its own event).
+    CLIENT_LOST = 1 << 16
     # MPIEventMaskAXIS
     SETTLED = 1 << 20
     IN_FINE_POSITION = 1 << 21
@@ -95,6 +98,7 @@ MASK_MOTION = (
     | MPIEventType.RELATIVE_TRUNCATED
     | MPIEventType.ID_TRUNCATED
     | MPIEventType.CROSSCHECK
+    | MPIEventType.CLIENT_LOST
 )
 MASK_FAULT = (
     MPIEventType.LIMIT_ERROR

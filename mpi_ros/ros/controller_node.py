@@ -1,7 +1,10 @@
 """The node that serves the controller as a whole: /<ns>/controller.
 
 Publishes /<ns>/axis<k>/status, /<ns>/events, /joint_states, /diagnostics and /clock
-(controller time, for use_sim_time consumers); serves the axis services
+(controller time, for use_sim_time consumers; ros.clock: false leaves it to another suite
+of a cell). In a namespace other than /mpi, joint states go to <ns>/joint_states with names
+prefixed by the namespace (RosSettings.joint_states_topic, joint_prefix; docs/cell.md);
+/diagnostics is shared by design, its statuses named by namespace. Serves the axis services
 (/<ns>/axis<k>/config_get|config_set|position_set, and fault_config_get|fault_config_set|fault_inject:
 docs/faults.md) and the control's gates and I/O
 (/<ns>/gate_set|gate_get|io_get|io_set).
@@ -107,9 +110,8 @@ class ControllerNode(Node):
         self._service(IoSet, "io_set", self._on_io_set)
         self._service(IoGet, "io_get", self._on_io_get)
         self._pub_events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
-        self._pub_joints = self.create_publisher(JointState, "/joint_states", 10)
+        self._pub_joints = self.create_publisher(JointState, settings.joint_states_topic, 10)
         self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
         self._pub_commands = self.create_publisher(CommandMsg, "commands", COMMANDS_QOS)
         self._pub_configuration = self.create_publisher(SuiteConfiguration, "configuration", LATCHED_QOS)
         self._applied: list = []  # commands applied since the last change hook, to publish after the lock
@@ -119,7 +121,9 @@ class ControllerNode(Node):
         runner.add_periodic(settings.joint_states_rate, self._collect_joints)
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
-        runner.add_periodic(settings.clock_rate, self._collect_clock)
+        if settings.clock:
+            self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
+            runner.add_periodic(settings.clock_rate, self._collect_clock)
         runner.on_event(lambda event: convert.publish(
             self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns)))
 
@@ -160,10 +164,10 @@ class ControllerNode(Node):
 
     def _collect_joints(self, ctl):
         if not wire.AVAILABLE:
-            msg = convert.joint_state(ctl, self.epoch_ns)
+            msg = convert.joint_state(ctl, self.epoch_ns, self.settings.joint_prefix)
         else:  # packed straight into CDR, from the axis topics' snapshots when they were taken now
             if self._joint_names is None:
-                self._joint_names = convert.joint_names(ctl)
+                self._joint_names = convert.joint_names(ctl, self.settings.joint_prefix)
             values = convert.joint_values(ctl, self._snapshots.taken_axes(ctl))
             msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, self._joint_names, *values)
         return lambda: convert.publish(self, self._pub_joints, msg)

@@ -36,7 +36,8 @@ class Suite:
         self.runner = ControllerRunner(self.controller, time_scale)
         self.controller_node = ControllerNode(self.runner, config.ros, context=context)
         self.supervisor_nodes = [
-            SupervisorNode(self.runner, spec.number, config.ros, context=context) for spec in config.supervisors
+            SupervisorNode(self.runner, spec.number, config.ros, spec.lost_client_timeout, context=context)
+            for spec in config.supervisors
         ]
         self.configuration = self.controller_node.publish_configuration(config)
         self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
