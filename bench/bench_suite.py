@@ -56,6 +56,7 @@ import time
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -182,28 +183,21 @@ class Probe:
     messages a second on a shared core. Here one thread waits on every subscription and
     takes everything queued at each wake."""
 
-    def __init__(self, context, case: Case):
+    def __init__(self, context, topics: list[tuple[type, str, Any]]):
+        """``topics``: (message type, topic name, what counts its messages: on_message(data, info))."""
         from rclpy.node import Node
         from rclpy.qos import QoSProfile, ReliabilityPolicy
-        from rosgraph_msgs.msg import Clock
-        from sensor_msgs.msg import JointState
-
-        from mpi_ros.msg import AxisStatus, MotionStatus
 
         self.context = context
         self.node = Node("bench_suite_probe", context=context)
         # Deep queues: the probe never drops what arrived (/clock is offered best effort).
         deep = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
         clock = QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT)
-        wanted = ([(MotionStatus, f"/mpi/ms{n}/status", case.status_rate, deep) for n in range(case.supervisors)]
-                  + [(AxisStatus, f"/mpi/axis{k}/status", case.status_rate, deep) for k in range(case.axes)]
-                  + [(JointState, "/joint_states", case.status_rate, deep), (Clock, "/clock", 100.0, clock)])
-        self.topics: dict[str, Topic] = {}
         self._subscriptions = []
-        for msg_type, name, rate, qos in wanted:
-            self.topics[name] = Topic(name, rate)
+        for msg_type, name, counter in topics:
+            qos = clock if name == "/clock" else deep
             subscription = self.node.create_subscription(msg_type, name, lambda _: None, qos, raw=True)
-            self._subscriptions.append((subscription, self.topics[name]))
+            self._subscriptions.append((subscription, counter))
         self._stop = threading.Event()
         self.thread = threading.Thread(target=self._drain, name="bench-probe", daemon=True)
         self.thread.start()
@@ -229,7 +223,7 @@ class Probe:
                         self._take_all(subscription, topic)
 
     @staticmethod
-    def _take_all(subscription, topic: Topic) -> None:
+    def _take_all(subscription, topic: Any) -> None:
         handle = subscription.handle
         while (taken := handle.take_message(subscription.msg_type, True)) is not None:
             topic.on_message(*taken)
@@ -238,6 +232,27 @@ class Probe:
         self._stop.set()
         self.thread.join(timeout=2.0)
         self.node.destroy_node()
+
+
+def case_topics(case: Case) -> dict[str, Topic]:
+    """The topics a case counts: every status topic, /joint_states and /clock."""
+    rates = ([(f"/mpi/ms{n}/status", case.status_rate) for n in range(case.supervisors)]
+             + [(f"/mpi/axis{k}/status", case.status_rate) for k in range(case.axes)]
+             + [("/joint_states", case.status_rate), ("/clock", 100.0)])
+    return {name: Topic(name, rate) for name, rate in rates}
+
+
+def topic_type(name: str) -> type:
+    from rosgraph_msgs.msg import Clock
+    from sensor_msgs.msg import JointState
+
+    from mpi_ros.msg import AxisStatus, MotionStatus
+
+    if name == "/clock":
+        return Clock
+    if name == "/joint_states":
+        return JointState
+    return AxisStatus if "/axis" in name else MotionStatus
 
 
 def start_moves(context, case: Case) -> int:
@@ -350,8 +365,9 @@ def run_case(case: Case, seconds: float, command: list[str] | None = None, marks
         context = rclpy.Context()
         rclpy.init(context=context)
         probe = None
+        topics = case_topics(case)
         try:
-            probe = Probe(context, case)
+            probe = Probe(context, [(topic_type(name), name, topic) for name, topic in topics.items()])
             at_velocity = start_moves(context, case)
             threading.Event().wait(SETTLE)
             window = _window(suite.pid, seconds, marks)
@@ -364,8 +380,8 @@ def run_case(case: Case, seconds: float, command: list[str] | None = None, marks
             raise RuntimeError(f"the suite exited with {suite.returncode}:\n{(Path(tmp) / 'suite.log').read_text()}")
     start, end = window.start, window.end
     wall = (end - start) / 1e9
-    return Result(case, label, at_velocity, stopped, wall, *real_time(probe.topics["/mpi/ms0/status"], start, end),
-                  [figures(topic, start, end) for topic in probe.topics.values()], window.suite_cpu / wall,
+    return Result(case, label, at_velocity, stopped, wall, *real_time(topics["/mpi/ms0/status"], start, end),
+                  [figures(topic, start, end) for topic in topics.values()], window.suite_cpu / wall,
                   Counter({name: cpu / wall for name, cpu in window.suite_threads.items()}),
                   window.probe_cpu / wall, window.load_before, window.load_after)
 

@@ -25,6 +25,10 @@ cd "$repo/bench"
     echo
     "$py" -P bench_controller.py
     echo
+    echo "## The faults' checks while stepping (bench/bench_faults.py)"
+    echo
+    "$py" -P bench_faults.py
+    echo
     echo "## Planning a start (bench/bench_planning.py)"
     echo
     "$py" -P bench_planning.py

@@ -50,7 +50,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
-from mpi_ros.srv import AxisConfigGet, AxisConfigSet, MotionAction, MotorFeedbackSecondarySet
+from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisFaultInject, MotionAction, MotorFeedbackSecondarySet
 
 from . import errors
 from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
@@ -66,6 +66,7 @@ EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 
 _SUPERVISOR_NODE = re.compile(r"ms(\d+)")
 _POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
+RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting for its result
 # Every node of a process is announced together (one DDS participant per context), but give
 # a late announcement a moment before saying a supervisor is not there.
 _GRACE = 0.5
@@ -168,12 +169,20 @@ class EventType(StrEnum):
     RELATIVE_TRUNCATED = "RELATIVE_TRUNCATED"
     ID_TRUNCATED = "ID_TRUNCATED"
     CROSSCHECK = "CROSSCHECK"
+    CLIENT_LOST = "CLIENT_LOST"
     SETTLED = "SETTLED"
     IN_FINE_POSITION = "IN_FINE_POSITION"
     IN_COARSE_POSITION = "IN_COARSE_POSITION"
     AT_TARGET = "AT_TARGET"
     AT_VELOCITY = "AT_VELOCITY"
     DONE = "DONE"
+    # faults of an axis (docs/faults.md)
+    LIMIT_ERROR = "LIMIT_ERROR"
+    LIMIT_SW_POSITIVE = "LIMIT_SW_POSITIVE"
+    LIMIT_SW_NEGATIVE = "LIMIT_SW_NEGATIVE"
+    AMP_FAULT = "AMP_FAULT"
+    ENCODER_FAULT = "ENCODER_FAULT"
+    FRAME_UNDERFLOW = "FRAME_UNDERFLOW"
 
 
 class Outcome(StrEnum):
@@ -193,6 +202,7 @@ class ActionReply:
     code: int
     state_name: str
     sample: int  # the sample at which the action took effect
+    detail: str = ""  # why it was refused (e.g. RESET while a fault persists)
 
     @property
     def ok(self) -> bool:
@@ -201,6 +211,20 @@ class ActionReply:
     @property
     def state(self) -> State:
         return State(self.state_name)
+
+
+@dataclass(frozen=True)
+class FaultReply:
+    """The answer of a fault injection (/<ns>/axis<k>/fault_inject, docs/faults.md)."""
+
+    message: str
+    code: int
+    detail: str  # why it was refused
+    faults: tuple[str, ...]  # the faults latched on the axis afterwards
+
+    @property
+    def ok(self) -> bool:
+        return self.message == errors.OK
 
 
 @dataclass(frozen=True)
@@ -539,11 +563,19 @@ class _Endpoint:
 
 # -- goals and the motion client ---------------------------------------------------------------------------
 class Goal:
-    """A running MotionStart/MotionModify goal."""
+    """A running MotionStart/MotionModify goal.
 
-    def __init__(self, client: MotionClient, handle: Any, result_future: Any, progress: threading.Event):
+    Its result survives a lost link: while waiting, the goal watches its action server on
+    the graph; when the server has left it (a link down past the DDS lease) and comes back,
+    the goal asks for its result again (the suite keeps results of ended goals), because an
+    answer sent while the link was down is lost (docs/cell.md, "A cut link")."""
+
+    def __init__(self, client: MotionClient, handle: Any, result_future: Any, progress: threading.Event,
+                 action_client: ActionClient | None = None):
         self._client = client
         self.handle = handle
+        self._action_client = action_client
+        self.asked_again = 0  # results asked again after the server came back
         self._result_future = result_future
         self._progress = progress  # set by the first feedback or the result
         self._finished = threading.Event()
@@ -574,11 +606,36 @@ class Goal:
 
         ``timeout``: seconds (None: the client's timeout); NoResponse when it passes.
         """
-        response = self._client._wait_future(self._result_future, timeout, "the goal's result")
+        self._follow_server(self._client.timeout if timeout is None else timeout)
+        if not self._result_future.done():
+            raise NoResponse("no answer for the goal's result within the timeout")
+        response = self._result_future.result()
         result = MotionResult.from_ros(response.result, response.status)
         if raise_on_error:
             raise_for(result.message, result.detail, result)
         return result
+
+    def _follow_server(self, timeout: float) -> None:
+        """Wait up to ``timeout`` s for the result, asking again whenever the action server
+        reappears on the graph after having left it."""
+        deadline = time.monotonic() + timeout
+        lost = False
+        while not self._finished.wait(max(0.0, min(RESULT_RECHECK, deadline - time.monotonic()))):
+            if time.monotonic() >= deadline or self._action_client is None:
+                return
+            if not self._action_client.server_is_ready():
+                lost = True
+            elif lost:
+                lost = False
+                self._ask_again()
+
+    def _ask_again(self) -> None:
+        def forward(future: Any) -> None:
+            if not self._result_future.done() and future.result() is not None:
+                self._result_future.set_result(future.result())
+
+        self._client._on_executor(self.handle.get_result_async).add_done_callback(forward)
+        self.asked_again += 1
 
     def cancel(self, timeout: float | None = 5.0) -> None:
         """Cancel = STOP: the axes decelerate over decelTime.stop and the goal ends."""
@@ -675,7 +732,7 @@ class MotionClient(_Endpoint):
         if not handle.accepted:
             raise NoResponse(f"{action_client._action_name} rejected the goal (the suite is shutting down)")
         result = self._on_executor(handle.get_result_async)
-        holder["goal"] = Goal(self, handle, result, progress)
+        holder["goal"] = Goal(self, handle, result, progress, action_client)
         return holder["goal"]
 
     def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float | None = None,
@@ -853,10 +910,26 @@ class MotionClient(_Endpoint):
             raise NoResponse(f"the supervisor's action service {self.prefix}/action is not available")
         response = self._wait_future(self._action.call_async(MotionAction.Request(action=name)), None,
                                      f"action {name}")
-        reply = ActionReply(response.message, response.code, response.state_name, response.sample)
+        reply = ActionReply(response.message, response.code, response.state_name, response.sample,
+                            getattr(response, "detail", ""))
         if raise_on_error:
-            raise_for(reply.message, f"{name} in {reply.state_name}", reply)
+            raise_for(reply.message, f"{name} in {reply.state_name}" + (f": {reply.detail}" if reply.detail else ""),
+                      reply)
         return reply
+
+    def fault_inject(self, axis: int, fault: str, active: bool = True) -> FaultReply:
+        """Inject a fault on an axis (AMP_FAULT, ENCODER_FAULT: a condition, cleared with
+        ``active`` False; the others trip once), docs/faults.md. RESET clears it afterwards."""
+        name = f"{self.namespace}/axis{axis}/fault_inject"
+        service = self.node.create_client(AxisFaultInject, name)
+        try:
+            if not service.wait_for_service(timeout_sec=self.timeout):
+                raise NoResponse(f"the axis service {name} is not available")
+            request = AxisFaultInject.Request(fault=fault, active=active)
+            response = self._wait_future(service.call_async(request), None, f"the injection of {fault}")
+        finally:
+            self.node.destroy_client(service)
+        return FaultReply(response.message, response.code, response.detail, tuple(response.faults))
 
     def stop(self) -> ActionReply:
         return self.action(Action.STOP)

@@ -27,6 +27,7 @@ from typing import Any
 
 from . import requests as rq
 from .mpi.control import Controller
+from .mpi.events import MPIEventType
 from .mpi.messages import Message
 from .mpi.params import Verdict, check_position, check_settling_reachable, first_refusal, shown
 from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
@@ -34,6 +35,7 @@ from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
 MOTION_START = "motion_start"
 MOTION_MODIFY = "motion_modify"
 ACTION = "action"
+CLIENT_LOST = "client_lost"
 # The reference has no "internal error" message; of its generic messages, NO_MEMORY ("not
 # enough memory was available") is the one that says the library failed, not the call.
 # Nothing else in the controller answers it, so it tells a bug apart from every refusal.
@@ -113,6 +115,19 @@ def _action(ctl: Controller, command: Command) -> Reply:
     source = ActionSource.CONTROLLER if command.request.get("source") == "CONTROLLER" else ActionSource.USER
     message, detail = ms.action_detail(action, source)
     return Reply(message, detail, state=ms.state)
+
+
+def _client_lost(ctl: Controller, command: Command) -> Reply:
+    """The lost-client watchdog's STOP (mpi_ros/ros/watchdog.py, docs/cell.md): a CLIENT_LOST
+    event with the watchdog's ``detail`` (which goals, whose client, how long), then STOP as
+    the controller's own action, answered as STOP answers. A command like any other, so a
+    bag holds it and replay reproduces both the event and the STOP."""
+    ms = _supervisor(ctl, command)
+    detail = rq.text(command.request.get("detail", ""), "detail")
+    move = ms.current or ms.last_move
+    ctl.emit(MPIEventType.CLIENT_LOST, supervisor=ms.number, move_id=move.id if move else 0, detail=detail)
+    message, why = ms.action_detail(MPIAction.STOP, ActionSource.CONTROLLER)
+    return Reply(message, why, state=ms.state)
 
 
 def _config_set(ctl: Controller, command: Command) -> Reply:
@@ -250,10 +265,27 @@ def _axis_position_set(ctl: Controller, command: Command) -> Reply:
     return Reply(message, _refusal_detail(message, check_position("value", value)))
 
 
+def _axis_fault_config_set(ctl: Controller, command: Command) -> Reply:
+    """The fault limits and actions of an axis (docs/faults.md); fields left out keep their values."""
+    _, current = ctl.axis_fault_config_get(command.axis)
+    verdict = ctl.axis_fault_config_set(command.axis, rq.fault_config(command.request.get("config", {}), current))
+    return Reply(verdict.message, verdict.detail)
+
+
+def _axis_fault_inject(ctl: Controller, command: Command) -> Reply:
+    """A fault injected on an axis (docs/faults.md): recorded, so a replay injects it at the same sample."""
+    r = command.request
+    message, detail = ctl.axis_fault_inject(command.axis, rq.text(r.get("fault", ""), "fault"),
+                                            rq.boolean(r.get("active", True), "active"))
+    faults = list(ctl.faults.names(command.axis)) if 0 <= command.axis < len(ctl.axes) else []
+    return Reply(message, detail, value=faults)
+
+
 OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
     MOTION_START: lambda ctl, c: _motion(ctl, c, modify=False),
     MOTION_MODIFY: lambda ctl, c: _motion(ctl, c, modify=True),
     ACTION: _action,
+    CLIENT_LOST: _client_lost,
     "config_set": _config_set,
     "params_set": _params_set,
     "axis_list_set": _axis_list_set,
@@ -266,6 +298,8 @@ OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
     "axis_config_set": _axis_config_set,
     "secondary_feedback_set": _secondary_feedback_set,
     "axis_position_set": _axis_position_set,
+    "axis_fault_config_set": _axis_fault_config_set,
+    "axis_fault_inject": _axis_fault_inject,
 }
 
 

@@ -27,6 +27,7 @@ from .mpi.params import (
     MAX_COORD_AXES,
     MAX_OBJECTS,
     VALID,
+    AxisFaultConfig,
     AxisInPosition,
     AxisMaster,
     ControllerConfig,
@@ -68,11 +69,20 @@ class SupervisorSpec:
     axes: list[int]
     config: MotionConfig
     event_notify: MPIEventType
+    # The lost-client watchdog (docs/cell.md): STOP this supervisor's motion when the client
+    # of a running goal has been gone from the graph this long (s); 0 = off (the default).
+    lost_client_timeout: float = 0.0
+
+
+DEFAULT_NAMESPACE = "/mpi"
+# ros.discovery: how far DDS discovery reaches (ROS_AUTOMATIC_DISCOVERY_RANGE); the suite's
+# default keeps it on this host (docs/cell.md, "Exposure").
+DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")
 
 
 @dataclass(slots=True)
 class RosSettings:
-    namespace: str = "/mpi"
+    namespace: str = DEFAULT_NAMESPACE
     status_rate: float = 100.0
     feedback_rate: float = 20.0
     joint_states_rate: float = 100.0
@@ -80,6 +90,25 @@ class RosSettings:
     clock_rate: float = 100.0
     crosscheck: bool = False
     executor_threads: int = 32
+    clock: bool = True  # publish /clock; in a cell of several suites exactly one should (docs/cell.md)
+    discovery: str = "localhost"  # see DISCOVERY_RANGES
+    # s an ended goal's result stays available to a client that asks for it late (rclpy's
+    # ActionServer result_timeout; 900 s in rclpy). The action server keeps each goal and
+    # publishes the status of all it keeps at every goal's change, so at 100 goals a second
+    # rclpy's 900 s meant 90,000 goals kept and ever larger status messages.
+    result_timeout: float = 60.0
+
+    @property
+    def joint_states_topic(self) -> str:
+        """/joint_states for the default namespace (the contract); <namespace>/joint_states
+        for any other, so that suites of a cell neither collide nor interleave there."""
+        return "/joint_states" if self.namespace == DEFAULT_NAMESPACE else f"{self.namespace.rstrip('/')}/joint_states"
+
+    @property
+    def joint_prefix(self) -> str:
+        """Prefix of every joint name: none for the default namespace, else the namespace
+        ("cell_a/axis0"), so joint names stay unique in a cell (one robot description)."""
+        return "" if self.namespace == DEFAULT_NAMESPACE else self.namespace.strip("/") + "/"
 
 
 @dataclass(slots=True)
@@ -91,6 +120,7 @@ class SuiteConfig:
     ros: RosSettings = field(default_factory=RosSettings)
     source: str = "<defaults>"
     raw: dict = field(default_factory=dict)  # the validated mapping (recorded in bags for replay)
+    faults: list[AxisFaultConfig] = field(default_factory=list)  # per axis (none: the controller's defaults)
     # per axis: the cam master (MPIAxisConfig.master, masterCorrection) and the secondary
     # feedback input of the axis' motor (docs/cams.md); empty: the defaults
     masters: list[AxisMaster] = field(default_factory=list)
@@ -119,6 +149,8 @@ class SuiteConfig:
             if feedback == SecondaryFeedback():  # (motor n may not exist: motor_count < axes)
                 continue
             _accepted(ctl.secondary_feedback_set(n, feedback), f"axes[{n}].secondary_feedback", feedback.validate())
+        for n, faults in enumerate(self.faults):
+            _require(ctl.axis_fault_config_set(n, faults), f"axes[{n}].faults.")
         for i, spec in enumerate(self.supervisors):
             self._build_supervisor(ctl, spec, f"supervisors[{i}]")
         return ctl
@@ -225,6 +257,7 @@ class _AxesConfig:
     plant: list[PlantConfig]
     masters: list[AxisMaster]
     secondary: list[SecondaryFeedback]
+    faults: list[Any]  # as given (read by _faults once the motors are known)
 
 
 def _axis_master(raw: Any, where: str) -> AxisMaster:
@@ -243,6 +276,7 @@ def _axis_master(raw: Any, where: str) -> AxisMaster:
 
 
 def _axes(raw: dict | None) -> _AxesConfig:
+    """The axes' settings; their faults as given (read by :func:`_faults` once the motors are known)."""
     raw = raw or {}
     unknown = set(raw) - {"count", "defaults", "overrides"}
     if unknown:
@@ -254,13 +288,14 @@ def _axes(raw: dict | None) -> _AxesConfig:
     overrides = raw.get("overrides") or {}
     if not isinstance(overrides, dict):
         raise ConfigError("axes.overrides: expected a mapping of axis number -> settings")
-    out = _AxesConfig(count, [], [], [], [])
+    out = _AxesConfig(count, [], [], [], [], [])
     for n in range(count):
         merged = _merge(defaults, overrides.get(n, overrides.get(str(n), {})))
-        extra = set(merged) - {"in_position", "plant", "master", "secondary_feedback"}
+        extra = set(merged) - {"in_position", "plant", "master", "secondary_feedback", "faults"}
         if extra:
-            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: in_position, master, plant, "
-                              "secondary_feedback)")
+            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: faults, in_position, master, "
+                              "plant, secondary_feedback)")
+        out.faults.append(merged.get("faults"))
         ip = _dataclass(AxisInPosition, merged.get("in_position"), f"axes[{n}].in_position")
         plant = _dataclass(PlantConfig, merged.get("plant"), f"axes[{n}].plant")
         _require(ip.validate(), f"axes[{n}].in_position.")
@@ -273,6 +308,20 @@ def _axes(raw: dict | None) -> _AxesConfig:
         out.masters.append(_axis_master(merged.get("master"), f"axes[{n}].master"))
         out.secondary.append(secondary)
     return out
+
+
+def _faults(raw: Any, number: int, motors: int) -> AxisFaultConfig:
+    """An axis' fault limits and actions (docs/faults.md); its encoder fault watches its own
+    motor (axis k drives motor k) unless told otherwise, or none if it has no motor."""
+    where = f"axes[{number}].faults"
+    if raw is None or isinstance(raw, dict):
+        raw = {"encoder_fault_motor_number": number if number < motors else -1, **(raw or {})}
+    config = _dataclass(AxisFaultConfig, raw, where)
+    for key in config.__slots__:
+        if key.endswith("_action") and isinstance(getattr(config, key), str):
+            setattr(config, key, getattr(config, key).strip().upper())
+    _require(config.validate(), f"{where}.")
+    return config
 
 
 def _motion_config(raw: dict, where: str) -> MotionConfig:
@@ -296,9 +345,9 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         where = f"supervisors[{i}]"
         if not isinstance(entry, dict):
             raise ConfigError(f"{where}: expected a mapping with number and axes")
-        extra = set(entry) - {"number", "axes", "config", "event_notify"}
+        extra = set(entry) - set(_SUPERVISOR_KEYS)
         if extra:
-            raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: axes, config, event_notify, number)")
+            raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: {', '.join(sorted(_SUPERVISOR_KEYS))})")
         number = entry.get("number", i)
         if isinstance(number, bool) or not isinstance(number, int) or not 0 <= number < MAX_OBJECTS:
             raise ConfigError(f"{where}.number: expected an integer from 0 to {MAX_OBJECTS - 1}, got {number!r}")
@@ -320,21 +369,49 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         mask = MPIEventType.parse(notify_names) if isinstance(notify_names, list) else None
         if mask is None:
             raise ConfigError(f"{where}.event_notify: expected a list of event type names, got {notify_names!r}")
-        specs.append(SupervisorSpec(number, list(axes), config, mask))
+        timeout = _lost_client_timeout(entry.get("lost_client_timeout", defaults.get("lost_client_timeout", 0.0)),
+                                       f"{where}.lost_client_timeout")
+        specs.append(SupervisorSpec(number, list(axes), config, mask, timeout))
     return specs
+
+
+_SUPERVISOR_KEYS = ("number", "axes", "config", "event_notify", "lost_client_timeout")
+
+
+def _lost_client_timeout(value: Any, where: str) -> float:
+    """Seconds, >= 0 (0: the watchdog is off)."""
+    timeout = _coerce(value, 0.0, where)
+    if timeout < 0.0:
+        raise ConfigError(f"{where}: must be >= 0 (0 turns the watchdog off), got {value!r}")
+    return timeout
 
 
 def _ros(raw: dict | None) -> RosSettings:
     ros = _dataclass(RosSettings, raw, "ros")
-    for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate"):
+    for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate",
+                "result_timeout"):
         _positive(getattr(ros, key), f"ros.{key}")
     if ros.status_rate > 1000.0:
         raise ConfigError(f"ros.status_rate: at most 1000 Hz, got {ros.status_rate}")
-    if not ros.namespace.startswith("/"):
-        raise ConfigError(f"ros.namespace: must start with '/', got {ros.namespace!r}")
+    check_namespace(ros.namespace, "ros.namespace")
+    if ros.discovery not in DISCOVERY_RANGES:
+        raise ConfigError(f"ros.discovery: one of {', '.join(DISCOVERY_RANGES)}, got {ros.discovery!r}")
     if ros.executor_threads < 4:
         raise ConfigError("ros.executor_threads: must be >= 4")
     return ros
+
+
+def check_namespace(namespace: str, where: str = "namespace") -> str:
+    """``namespace`` if it is a ROS namespace (absolute, name parts of letters, digits and
+    underscores not starting with a digit: rcl's rules; no trailing slash), else ConfigError
+    naming ``where``."""
+    parts = namespace.split("/")
+    if (not namespace.startswith("/") or namespace == "/" or namespace.endswith("/")
+            or not all(p and (p[0].isalpha() or p[0] == "_") and all(c.isalnum() or c == "_" for c in p)
+                       and p.isascii() for p in parts[1:])):
+        raise ConfigError(f"{where}: expected an absolute ROS namespace like /mpi or /cell_a "
+                          f"(letters, digits, underscores; parts not starting with a digit), got {namespace!r}")
+    return namespace
 
 
 def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
@@ -350,8 +427,9 @@ def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
                                data.get("supervisor_defaults"), axes.count)
     supervisor_count = max(s.number for s in supervisors) + 1
     controller = _controller(data.get("controller"), axes.count, supervisor_count)
+    faults = [_faults(raw, n, controller.motors) for n, raw in enumerate(axes.faults)]
     return SuiteConfig(controller, axes.in_position, axes.plant, supervisors, _ros(data.get("ros")), source,
-                       copy.deepcopy(data), axes.masters, axes.secondary)
+                       copy.deepcopy(data), faults, masters=axes.masters, secondary=axes.secondary)
 
 
 def load(path: str | Path | None = None, overrides: dict | None = None) -> SuiteConfig:

@@ -28,6 +28,7 @@ from .mpi.messages import Message
 from .mpi.params import (
     MAX_REQUEST_TEXT,
     MAX_REQUEST_VALUES,
+    AxisFaultConfig,
     AxisInPosition,
     AxisMaster,
     DecelTime,
@@ -456,3 +457,19 @@ def secondary_feedback(data: Any) -> tuple[int, SecondaryFeedback]:
     return (integer(data.get("motor", -1), "motor"),
             SecondaryFeedback(number(data.get("position", 0.0), "position"),
                               number(data.get("velocity", 0.0), "velocity")))
+
+
+def fault_config(data: Any, base: AxisFaultConfig) -> AxisFaultConfig:
+    """An AxisFaultConfig message (as a dict) over ``base`` (the axis' configuration): the
+    fields it leaves out keep their values. Action names are read in any case; the ranges
+    are checked by the controller (AxisFaultConfig.validate)."""
+    merged = {**fault_config_to_dict(base), **mapping(data, "config")}
+    config = _struct(AxisFaultConfig, merged, "config")
+    for key in config.__slots__:
+        if key.endswith("_action"):
+            setattr(config, key, getattr(config, key).strip().upper())
+    return config
+
+
+def fault_config_to_dict(cfg: AxisFaultConfig) -> dict[str, Any]:
+    return {key: getattr(cfg, key) for key in cfg.__slots__}

@@ -121,9 +121,16 @@ class ControllerRunner:
         period = min(self.wake_period, fastest / max(self.time_scale or 1.0, 1e-9))
         while self._running.is_set():
             try:
-                with self.lock:
-                    if self.running:
-                        self._advance_to(self._clock_target(self.due_sample(), period))
+                # Commands step the controller to their sample too (submit catches up), so
+                # under a flood of commands the lock may stay taken for long: then the clock
+                # thread publishes what they collected instead of waiting its turn, so status
+                # keeps flowing and the queue of publications cannot grow without bound.
+                if self.lock.acquire(timeout=period):
+                    try:
+                        if self.running:
+                            self._advance_to(self._clock_target(self.due_sample(), period))
+                    finally:
+                        self.lock.release()
                 self._flush()
             except Exception:  # noqa: BLE001 - the clock must keep running; the error is logged
                 _log.exception("controller clock: a step or its output failed")
@@ -161,6 +168,10 @@ class ControllerRunner:
         due_at = self._anchor_wall + ahead / (scale * self.ctl.rate)
         # a little late rather than early: early, the sample due would still be the one before
         return min(period, max(0.0, due_at - time.monotonic() + _WAKE_MARGIN))
+
+    def backlog(self) -> int:
+        """Outputs (publications) collected and not yet published."""
+        return len(self._outputs)
 
     def due_sample(self) -> int:
         """The sample the controller should be at now."""

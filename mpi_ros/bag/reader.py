@@ -1,4 +1,9 @@
-"""Read a bag this project (or rosbag2) wrote: a bag directory or a bare .mcap file."""
+"""Read a bag this project (or rosbag2) wrote: a bag directory or a bare .mcap file.
+
+A bag whose writer did not finish it (the recorder was killed: no summary, no footer, the
+open chunk lost) is read record by record up to its last complete one; ``truncated`` then
+says so in words (replay reports it), and nothing raises for the cut itself.
+"""
 
 from __future__ import annotations
 
@@ -10,8 +15,10 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from mcap.exceptions import McapError
+from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
+from mcap.records import Channel, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader
 from mcap_ros2._dynamic import generate_dynamic
 
 from . import schema
@@ -59,18 +66,76 @@ def mcap_path(path: str | Path) -> Path:
     return files[0]
 
 
+_UNREADABLE = (McapError, struct.error, EOFError, ValueError)  # what a damaged file raises in mcap
+
+
+@dataclass(slots=True)
+class _Scan:
+    """A bag read record by record (one without a summary): what it holds up to the cut."""
+
+    schemas: dict[int, Schema]
+    channels: dict[int, Channel]
+    metadata: dict[str, dict[str, str]]
+    messages: list[Message]
+    cut: str  # why reading stopped ("" at the end of the file)
+
+
 class BagReader:
     def __init__(self, path: str | Path):
         self.path = mcap_path(path)
+        self._scan: _Scan | None = None if self._finished() else self._read_through()
+
+    def _finished(self) -> bool:
+        """Whether the file has its summary (the writer finished it)."""
+        with open(self.path, "rb") as stream:
+            try:
+                return make_reader(stream).get_summary() is not None
+            except _UNREADABLE:
+                return False
+
+    def _read_through(self) -> _Scan:
+        scan = _Scan({}, {}, {}, [], "")
+        with open(self.path, "rb") as stream:
+            try:
+                for record in StreamReader(stream).records:
+                    if isinstance(record, Message):
+                        scan.messages.append(record)
+                    elif isinstance(record, Schema):
+                        scan.schemas[record.id] = record
+                    elif isinstance(record, Channel):
+                        scan.channels[record.id] = record
+                    elif isinstance(record, Metadata):
+                        scan.metadata[record.name] = dict(record.metadata)
+            except EndOfFile:
+                scan.cut = "it ends inside a record"
+            except _UNREADABLE as exc:
+                if not scan.schemas and not scan.messages:
+                    raise ValueError(f"{self.path}: not a readable MCAP file ({exc or type(exc).__name__})") from exc
+                scan.cut = f"a damaged record ({exc or type(exc).__name__})"
+        scan.messages.sort(key=lambda m: m.log_time)  # stable: the order written within a time
+        return scan
+
+    @property
+    def truncated(self) -> str:
+        """"" for a finished bag, else what is wrong and what could still be read."""
+        if self._scan is None:
+            return ""
+        times = [m.log_time for m in self._scan.messages]
+        span = f", {(times[-1] - times[0]) / 1e9:.3f} s" if times else ""
+        return (f"{self.path} was not finished by its writer (no summary: the recorder was killed or the disk "
+                f"filled?) and {self._scan.cut or 'has no summary'}; read up to its last complete record: "
+                f"{len(times)} messages{span}")
 
     def _reader(self, stream):
         try:
             return make_reader(stream)
-        except (McapError, struct.error, EOFError) as exc:  # not an MCAP file (or cut short)
+        except _UNREADABLE as exc:  # not an MCAP file
             raise ValueError(f"{self.path}: not a readable MCAP file ({exc or type(exc).__name__})") from exc
 
     def metadata(self, name: str) -> dict[str, str] | None:
         """An MCAP metadata record's data, by name."""
+        if self._scan is not None:
+            return self._scan.metadata.get(name)
         with open(self.path, "rb") as stream:
             for record in self._reader(stream).iter_metadata():
                 if record.name == name:
@@ -79,6 +144,9 @@ class BagReader:
 
     def topics(self) -> dict[str, str]:
         """topic -> pkg/msg/Type."""
+        if self._scan is not None:
+            return {ch.topic: self._scan.schemas[ch.schema_id].name for ch in self._scan.channels.values()
+                    if ch.schema_id in self._scan.schemas}
         with open(self.path, "rb") as stream:
             summary = self._reader(stream).get_summary()
         if summary is None:
@@ -88,18 +156,40 @@ class BagReader:
     def messages(self, topics: Iterable[str] | None = None) -> Iterator[Recorded]:
         """Messages in log-time order."""
         wanted = list(topics) if topics is not None else None
+        if self._scan is not None:
+            yield from self._scanned(wanted)
+            return
         with open(self.path, "rb") as stream:
             for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted, log_time_order=True):
-                yield Recorded(channel.topic, schema_.name, message.log_time, message.data, message.sequence,
-                               schema_.data.decode("utf-8", errors="replace"))
+                yield _recorded(schema_, channel, message)
+
+    def _scanned(self, wanted: list[str] | None) -> Iterator[Recorded]:
+        assert self._scan is not None
+        scan = self._scan
+        for message in scan.messages:
+            channel = scan.channels.get(message.channel_id)
+            if channel is None or channel.schema_id not in scan.schemas or (
+                    wanted is not None and channel.topic not in wanted):
+                continue
+            yield _recorded(scan.schemas[channel.schema_id], channel, message)
 
     def decoded(self, topics: Iterable[str] | None = None) -> Iterator[tuple[Recorded, Any]]:
         for recorded in self.messages(topics):
             yield recorded, recorded.decode()
 
     def counts(self) -> dict[str, int]:
+        if self._scan is not None:
+            found: dict[str, int] = {}
+            for recorded in self._scanned(None):
+                found[recorded.topic] = found.get(recorded.topic, 0) + 1
+            return found
         with open(self.path, "rb") as stream:
             summary = self._reader(stream).get_summary()
         if summary is None or summary.statistics is None:
             return {}
         return {summary.channels[cid].topic: n for cid, n in summary.statistics.channel_message_counts.items()}
+
+
+def _recorded(schema_: Schema, channel: Channel, message: Message) -> Recorded:
+    return Recorded(channel.topic, schema_.name, message.log_time, message.data, message.sequence,
+                    schema_.data.decode("utf-8", errors="replace"))

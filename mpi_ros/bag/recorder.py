@@ -71,7 +71,8 @@ class Recorder:
             self.writer.add_topic(f"{ns}/ms{spec.number}/status", "mpi_ros/msg/MotionStatus", status)
         for axis in ctl.axes:
             self.writer.add_topic(f"{ns}/axis{axis.number}/status", "mpi_ros/msg/AxisStatus", status)
-        self.writer.add_topic("/joint_states", "sensor_msgs/msg/JointState", status)
+        self.joint_states_topic, self.joint_prefix = config.ros.joint_states_topic, config.ros.joint_prefix
+        self.writer.add_topic(self.joint_states_topic, "sensor_msgs/msg/JointState", status)
         self.writer.add_metadata(METADATA_NAME, {
             "config": yaml.safe_dump(config.raw, sort_keys=False),
             "sample_rate": repr(self.rate),
@@ -108,9 +109,9 @@ class Recorder:
         return write
 
     def _collect_joints(self, ctl):
-        msg = convert.joint_state(ctl, self.epoch)
+        msg = convert.joint_state(ctl, self.epoch, self.joint_prefix)
         t = self.log_time(ctl.sample)
-        return lambda: self.writer.write("/joint_states", msg, t)
+        return lambda: self.writer.write(self.joint_states_topic, msg, t)
 
     def _on_event(self, event) -> None:
         self.writer.write(f"{self.ns}/events", convert.motion_event(event, self.rate, self.epoch),

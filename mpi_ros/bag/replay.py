@@ -63,6 +63,7 @@ class ReplayReport:
     first: Divergence | None = None
     largest: dict[str, float] = field(default_factory=dict)  # field -> largest numeric difference
     last_sample: int = 0
+    truncated: str = ""  # the bag was cut short (BagReader.truncated): only what it holds was compared
 
     @property
     def identical(self) -> bool:
@@ -79,6 +80,8 @@ class ReplayReport:
     def summary(self) -> str:
         head = (f"{self.bag}: {self.commands} commands, {self.statuses} statuses ({self.values} values), "
                 f"{self.events} events compared up to sample {self.last_sample}")
+        if self.truncated:
+            head = f"{head} in a truncated bag (read up to its last complete record)"
         if self.identical:
             return f"{head}: zero differences"
         worst = ", ".join(f"{k} {v:.6g}" for k, v in sorted(self.largest.items(), key=lambda kv: -kv[1])[:5])
@@ -133,8 +136,11 @@ class Recording:
     graph: bool  # a recording of the graph (any recorder): it may have started after the suite
 
 
-def inspect(reader: BagReader) -> Recording:
-    """The recording's configuration and topics; MissingInput names everything that is missing."""
+def inspect(reader: BagReader, namespace: str | None = None) -> Recording:
+    """The recording's configuration and topics; MissingInput names everything that is missing.
+
+    A recording of a cell's graph holds several suites (one <ns>/configuration each):
+    ``namespace`` chooses one; without it such a bag is refused with the namespaces named."""
     topics = reader.topics()
     stored = reader.metadata(METADATA_NAME)
     config_topics = sorted(t for t, k in topics.items() if k == CONFIGURATION_TYPE)
@@ -144,7 +150,10 @@ def inspect(reader: BagReader) -> Recording:
         stored_epoch = stored.get("stamp_epoch_ns")
         setup = (yaml.safe_load(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
                  int(stored_epoch) if stored_epoch is not None else None, stored.get("namespace"))
+        if namespace is not None and setup[4] not in (None, namespace):
+            raise MissingInput(f"{reader.path}: the bag recorded the suite in {setup[4]}, not {namespace}")
     elif config_topics:
+        config_topics = _chosen(reader, config_topics, namespace)
         found = next((msg for _, msg in reader.decoded(config_topics[:1])), None)
         if found is not None:
             setup = (yaml.safe_load(found.config) or {}, config_topics[0], int(found.start_sample),
@@ -175,6 +184,20 @@ def inspect(reader: BagReader) -> Recording:
     return Recording(raw, source, start, epoch, namespace, commands, events, statuses, source != "metadata")
 
 
+def _chosen(reader: BagReader, config_topics: list[str], namespace: str | None) -> list[str]:
+    """The configuration topic of the suite in ``namespace`` (or the only one)."""
+    if namespace is not None:
+        wanted = f"{namespace.rstrip('/')}/configuration"
+        if wanted not in config_topics:
+            raise MissingInput(f"{reader.path}: no suite in {namespace} (no topic {wanted}; "
+                               f"the bag has {', '.join(config_topics)})")
+        return [wanted]
+    if len(config_topics) > 1:
+        names = ", ".join(t.rsplit("/", 1)[0] for t in config_topics)
+        raise MissingInput(f"{reader.path}: the bag holds several suites ({names}): choose one with --namespace")
+    return config_topics
+
+
 def load_config(reader: BagReader, overrides: dict | None = None) -> suite_config.SuiteConfig:
     """The configuration the bag's run used (from its metadata or its configuration topic)."""
     return _config(reader, inspect(reader), overrides)
@@ -185,15 +208,16 @@ def _config(reader: BagReader, recording: Recording, overrides: dict | None) -> 
 
 
 def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0.0,
-           stop_at_first: bool = False) -> ReplayReport:
-    """Replay a bag; ``overrides`` change the recorded configuration (e.g. a plant gain).
+           stop_at_first: bool = False, namespace: str | None = None) -> ReplayReport:
+    """Replay a bag; ``overrides`` change the recorded configuration (e.g. a plant gain);
+    ``namespace`` chooses the suite of a bag that recorded several (a cell).
 
     The bag may come from ``mpi-ros record`` (configuration in its metadata) or from any
     recorder of the graph (configuration from the latched <ns>/configuration topic).
     Raises MissingInput (a ValueError) naming what the bag lacks."""
     reader = BagReader(path)
     try:
-        recording = inspect(reader)
+        recording = inspect(reader, namespace)
     except McapError as exc:
         raise ValueError(f"{path}: not a readable MCAP file: {exc}") from exc
     cfg = _config(reader, recording, overrides)
@@ -202,7 +226,7 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     skipped = _SKIPPED_FIELDS if epoch is None else frozenset()
     replayed_events = []
     ctl.listeners.append(lambda e: replayed_events.append(e) if e.type_name not in NOT_REPLAYED else None)
-    report = ReplayReport(str(path))
+    report = ReplayReport(str(path), truncated=reader.truncated)
     recorded_events = []
     timeline = []  # (controller sample, 0 status / 1 command, order, topic, type, msg)
     first_recorded = None  # the first sample the recording saw (a graph recording may start late)
@@ -258,6 +282,10 @@ def _compare_events(report: ReplayReport, recorded, replayed, rate: float, toler
                     epoch: int | None = None, skipped=_SKIPPED_FIELDS, since: int = 0) -> None:
     """Events from ``since`` up to the last compared sample, in order."""
     horizon = report.last_sample
+    if report.truncated:
+        # the cut may fall among the writes of the last sample: events are written as they
+        # happen, before the statuses of any later sample, so those before it are all there
+        horizon -= 1
     replayed = [convert.motion_event(e, rate, epoch or 0) for e in replayed if since <= e.sample <= horizon]
     recorded = [e for e in recorded if e.sample <= horizon]
     # pairs up to the shorter list: a difference in count is a divergence of its own (below)

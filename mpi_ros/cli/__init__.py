@@ -36,6 +36,7 @@ COMMANDS: dict[str, str] = {
     "abort": "mpi_ros.cli.abort",
     "reset": "mpi_ros.cli.reset",
     "resume": "mpi_ros.cli.resume",
+    "fault": "mpi_ros.cli.fault",
     "status": "mpi_ros.cli.status",
     "events": "mpi_ros.cli.events",
     "echo": "mpi_ros.cli.echo",

@@ -143,7 +143,8 @@ def print_result(result, supervisor: int, out: TextIO | None = None) -> int:
 def print_reply(action: str, reply, supervisor: int, out: TextIO | None = None) -> int:
     """An action's answer; returns the exit status."""
     out = out or sys.stdout
-    print(f"{action}: {reply.message} (code {reply.code}), state {reply.state_name}, sample {reply.sample}",
+    refusal = f": {reply.detail}" if reply.detail and not reply.ok else ""  # e.g. which fault persists
+    print(f"{action}: {reply.message} (code {reply.code}), state {reply.state_name}, sample {reply.sample}{refusal}",
           file=out)
     _hint(reply.message, supervisor)
     return OK if reply.ok else REFUSED

@@ -1,9 +1,19 @@
 """Run the node suite on the built-in simulated controller.
 
-  mpi-ros run [--config FILE] [--time-scale X] [--record BAG] [--ros-args ...]
+  mpi-ros run [--config FILE] [--time-scale X] [--record BAG] [--namespace NS]
+              [--discovery RANGE] [--ros-args ...]
   ros2 run mpi_ros suite [the same options]         (on a full ROS install; launch uses it too)
 
-X = 1 runs in real time (the default), larger is faster, 0 as fast as possible. Stop it
+X = 1 runs in real time (the default), larger is faster, 0 as fast as possible.
+
+Namespace (one suite per controller of a cell): --namespace /cell_a, or ros.namespace in
+the YAML, or --ros-args -r __ns:=/cell_a (which wins).
+
+Exposure: the suite keeps DDS discovery on this host unless told otherwise, so nothing on
+the plant network can command it by accident. Told otherwise by, first to last:
+--discovery subnet (or localhost, system_default, off), ROS_AUTOMATIC_DISCOVERY_RANGE in
+the environment, ros.discovery in the YAML (default localhost). ROS_STATIC_PEERS adds named
+hosts with any range. DDS security (SROS2) is not available in the PyPI wheels. Stop it
 with Ctrl-C: goals end, the nodes are destroyed and the controller stops. Then, from
 another shell: `mpi-ros status`, `mpi-ros move ...` (see `mpi-ros --help`); or, instead
 of run, `mpi-ros demo` for a narrated, recorded tour.
@@ -12,6 +22,7 @@ of run, `mpi-ros demo` for a narrated, recorded tour.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 
@@ -20,6 +31,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--time-scale", type=float, default=1.0,
                         help="1 real time, larger is faster, 0 as fast as possible (default 1)")
     parser.add_argument("--record", metavar="BAG", help="record the run to this bag directory (see mpi-ros record)")
+    parser.add_argument("--namespace", metavar="NS", help="the suite's namespace (default: ros.namespace, /mpi)")
+    parser.add_argument("--discovery", choices=DISCOVERY_RANGES, type=str.lower,
+                        help="how far DDS discovery reaches (default: ROS_AUTOMATIC_DISCOVERY_RANGE if set, "
+                             "else ros.discovery, localhost)")
+
+
+DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")  # mpi_ros.config.DISCOVERY_RANGES
+RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
+
+
+def discovery_range(flag: str | None, config_path: str | None, environ) -> tuple[str, str]:
+    """(ROS_AUTOMATIC_DISCOVERY_RANGE value, where it came from): the flag, the environment,
+    ros.discovery of the configuration file (default localhost). Raises ConfigError."""
+    from mpi_ros import config as suite_config
+
+    if flag:
+        return flag.upper(), "--discovery"
+    if environ.get(RANGE_VARIABLE):
+        return environ[RANGE_VARIABLE], RANGE_VARIABLE
+    return suite_config.load(config_path).ros.discovery.upper(), "ros.discovery"
 
 
 def run(args) -> int:
@@ -31,6 +62,13 @@ def run(args) -> int:
         print(f"{prog}: --time-scale must be >= 0", file=sys.stderr)
         return 2
 
+    try:  # before rclpy.init: the middleware reads it when the context starts
+        reach, told_by = discovery_range(getattr(args, "discovery", None), args.config, os.environ)
+    except suite_config.ConfigError as exc:
+        print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
+        return 2
+    os.environ[RANGE_VARIABLE] = reach
+
     import rclpy
 
     from mpi_ros.ros import parameters
@@ -39,7 +77,7 @@ def run(args) -> int:
     # rclpy's own SIGINT/SIGTERM handling shuts the context down and wakes the executor.
     rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])])
     try:
-        cfg, time_scale = parameters.resolve(None, args.config, args.time_scale)
+        cfg, time_scale = parameters.resolve(None, args.config, args.time_scale, getattr(args, "namespace", None))
     except suite_config.ConfigError as exc:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         rclpy.try_shutdown()
@@ -59,7 +97,10 @@ def run(args) -> int:
             return 2
     log = suite.controller_node.get_logger()
     log.info(f"mpi_ros suite up: {len(cfg.supervisors)} supervisor(s), {cfg.axis_count} axes, "
-             f"{cfg.controller.sample_rate:g} Hz, time scale {time_scale:g}, config {cfg.source}")
+             f"{cfg.controller.sample_rate:g} Hz, time scale {time_scale:g}, config {cfg.source}, "
+             f"namespace {cfg.ros.namespace}, discovery {reach} ({told_by}"
+             + (f", static peers {os.environ['ROS_STATIC_PEERS']}" if os.environ.get("ROS_STATIC_PEERS") else "")
+             + ")")
     suite.start(spin_in_thread=False)
     try:
         suite.spin()

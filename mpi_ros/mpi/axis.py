@@ -629,6 +629,12 @@ class Axis:
         self.rest = self.cmd_p
         self.mode = CommandMode.COAST
 
+    def amp_fault(self, t: float, clock: ProfileClock | None) -> None:
+        """An amplifier fault (faults.py): the amplifier is off and the motor coasts, while
+        the command goes on along its plan until the fault's action stops the motion."""
+        self.rebase(t, clock)
+        self.mode = CommandMode.COAST
+
     def enable(self, t: float, command_equals_actual: bool) -> None:
         """RESET: amplifier back on (after ABORT the command is set to the actual)."""
         self.rebase(t)

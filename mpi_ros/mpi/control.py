@@ -22,11 +22,13 @@ from .axis import Axis
 from .bank import AxisBank
 from .clock import ProfileClock
 from .events import Event, MPIEventType
+from .faults import FaultMonitor
 from .io import IoImage
 from .masters import SecondaryInputs, Sources
 from .messages import STATE_MESSAGES, Message
 from .motion import MotionSupervisor
 from .params import (
+    AxisFaultConfig,
     AxisInPosition,
     AxisMaster,
     ControllerConfig,
@@ -83,6 +85,7 @@ class Controller:
         self._supervisors: dict[int, MotionSupervisor] = {}
         self.events: deque[Event] = deque()
         self.listeners: list[EventListener] = []
+        self.faults = FaultMonitor(self)
 
     # -- time -------------------------------------------------------------------------
     @property
@@ -235,6 +238,23 @@ class Controller:
         if self._sources is None or self._sources[0] is not stretch:  # one per stretch, for all its slaves
             self._sources = (stretch, self.master_sources(stretch))
         return self._sources[1].position(plan.cam.master), feedrate / owner.config.normal_feedrate
+    def axis_fault_config_set(self, number: int, config: AxisFaultConfig) -> Verdict:
+        """The fault limits and actions of an axis (docs/faults.md), checked by the one
+        AxisFaultConfig validator (the YAML loader and the service use it too)."""
+        if not 0 <= number < len(self.axes):
+            return Verdict(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
+        return self.faults.config_set(number, config)
+
+    def axis_fault_config_get(self, number: int) -> tuple[Message, AxisFaultConfig]:
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID, AxisFaultConfig()
+        return Message.MPIMessageOK, self.faults.axes[number].config.copy()
+
+    def axis_fault_inject(self, number: int, fault: object, active: bool = True) -> tuple[Message, str]:
+        """Inject a fault on an axis (faults.FaultMonitor.inject): it acts at once."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}"
+        return self.faults.inject(number, fault, active)
 
     def frame_count(self, number: int) -> int:
         """Frames in an axis' buffer: the rest of the move it runs and the ones queued. A
@@ -282,6 +302,7 @@ class Controller:
             frame_count=self.frame_count(number),
             supervisor=axis.owner,
             feedforward=axis.feedforward,
+            faults=self.faults.names(number),
         )
 
     # -- gates and I/O -------------------------------------------------------------------
@@ -382,13 +403,19 @@ class Controller:
             first = ms.scan(stretch, status)
             if first is not None and first <= stop:
                 stop = event_at = first
+        fault_at = self.faults.scan(stretch)
+        if fault_at is not None and fault_at <= stop:
+            stop = event_at = fault_at
         self._status_events(stop, stretch, status)
         self._log(stop, stretch, supervisors)
         self._commit(stop, stretch, status)
+        self.faults.commit(stop)
         self.sample = int(stretch.samples[stop])
         if event_at is not None:
             for ms in supervisors:
                 ms.transition(stop, stretch.samples)
+            # after the supervisors' transitions of the same sample (a move done there is done)
+            self.faults.transition(stop)
 
     def _log(self, stop: int, stretch: Stretch, supervisors: list[MotionSupervisor]) -> None:
         for ms in supervisors:

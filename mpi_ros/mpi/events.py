@@ -9,6 +9,7 @@ are reproduced and reported as events).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from enum import IntFlag
 
@@ -36,6 +37,9 @@ class MPIEventType(IntFlag):
     ID_TRUNCATED = 1 << 14
     # Ruckig disagreed with a planned profile (mpi_ros crosscheck).
     CROSSCHECK = 1 << 15
+    # The lost-client watchdog stopped the motion: a goal's client left the graph (mpi_ros,
+    # docs/cell.md; the STOP itself follows as its own event).
+    CLIENT_LOST = 1 << 16
     # MPIEventMaskAXIS
     SETTLED = 1 << 20
     IN_FINE_POSITION = 1 << 21
@@ -43,6 +47,13 @@ class MPIEventType(IntFlag):
     AT_TARGET = 1 << 23
     AT_VELOCITY = 1 << 24
     DONE = 1 << 25
+    # Faults of an axis (docs/faults.md; the XMP family's MPIEventType names for them)
+    LIMIT_ERROR = 1 << 26  # following error above its limit for its time
+    LIMIT_SW_POSITIVE = 1 << 27
+    LIMIT_SW_NEGATIVE = 1 << 28
+    AMP_FAULT = 1 << 29
+    ENCODER_FAULT = 1 << 30
+    FRAME_UNDERFLOW = 1 << 31  # an open path's frame buffer ran empty while moving
 
     @classmethod
     def parse(cls, names) -> MPIEventType | None:
@@ -60,8 +71,14 @@ class MPIEventType(IntFlag):
         return mask
 
     def names(self) -> list[str]:
-        # (a member's name is None only for a combination, which iterating the class never gives)
-        return [m.name for m in MPIEventType if m is not MPIEventType.NONE and m in self and m.name is not None]
+        return list(_names(int(self)))
+
+
+@functools.lru_cache(maxsize=1024)
+def _names(mask: int) -> tuple[str, ...]:
+    """The member names in ``mask``, cached: every status snapshot asks for its latched events."""
+    # (a member's name is None only for a combination, which iterating the class never gives)
+    return tuple(m.name for m in MPIEventType if m is not MPIEventType.NONE and m & mask == m and m.name is not None)
 
 
 MASK_MOTION = (
@@ -81,9 +98,19 @@ MASK_MOTION = (
     | MPIEventType.RELATIVE_TRUNCATED
     | MPIEventType.ID_TRUNCATED
     | MPIEventType.CROSSCHECK
+    | MPIEventType.CLIENT_LOST
+)
+MASK_FAULT = (
+    MPIEventType.LIMIT_ERROR
+    | MPIEventType.LIMIT_SW_POSITIVE
+    | MPIEventType.LIMIT_SW_NEGATIVE
+    | MPIEventType.AMP_FAULT
+    | MPIEventType.ENCODER_FAULT
+    | MPIEventType.FRAME_UNDERFLOW
 )
 MASK_AXIS = (
-    MPIEventType.SETTLED
+    MASK_FAULT
+    | MPIEventType.SETTLED
     | MPIEventType.IN_FINE_POSITION
     | MPIEventType.IN_COARSE_POSITION
     | MPIEventType.AT_TARGET
@@ -91,7 +118,8 @@ MASK_AXIS = (
     | MPIEventType.DONE
 )
 MASK_ALL = MASK_MOTION | MASK_AXIS
-_GROUPS = {"ALL": MASK_ALL, "MOTION": MASK_MOTION, "AXIS": MASK_AXIS, "NONE": MPIEventType.NONE}
+_GROUPS = {"ALL": MASK_ALL, "MOTION": MASK_MOTION, "AXIS": MASK_AXIS, "FAULT": MASK_FAULT,
+           "NONE": MPIEventType.NONE}
 
 
 @dataclass(frozen=True, slots=True)

@@ -523,6 +523,73 @@ class PlantConfig:
         return check_range("encoder_resolution", self.encoder_resolution, 1e-6, MAX_POSITION)
 
 
+# The actions a fault may take (MPIAction; STOP, RESUME, RESET and MAP are not a fault's).
+FAULT_ACTIONS = ("NONE", "E_STOP", "ABORT", "E_STOP_ABORT")
+
+
+def check_action(name: str, value: object) -> Verdict:
+    if isinstance(value, str) and value in FAULT_ACTIONS:
+        return VALID
+    return refuse(f"{name}: must be one of {', '.join(FAULT_ACTIONS)}, got {shown(value)}")
+
+
+@dataclass(slots=True)
+class AxisFaultConfig:
+    """The fault limits of one axis and the action each takes (docs/faults.md). The
+    reference names the encoder fault (MPI 002, MPIAxisMaster, encoderFaultMotorNumber:
+    "If this motor detects an encoder fault this axis will abort. A value of -1 disables")
+    and the actions (MPIAction); the limits and their defaults are this project's, like a
+    real XMP's: off until configured, so existing programs behave as before."""
+
+    following_error_limit: float = 0.0  # counts; 0 disables
+    following_error_time: float = 0.0  # seconds the error must stay above the limit (0: one sample)
+    following_error_action: str = "ABORT"
+    software_limit_positive_enabled: bool = False
+    software_limit_positive: float = 0.0  # counts, user coordinates
+    software_limit_positive_action: str = "E_STOP"
+    software_limit_negative_enabled: bool = False
+    software_limit_negative: float = 0.0
+    software_limit_negative_action: str = "E_STOP"
+    amp_fault_action: str = "ABORT"
+    # -1 disables; the suite configures each axis' own motor (config.py, Controller)
+    encoder_fault_motor_number: int = -1
+    frame_underflow_action: str = "NONE"
+
+    def copy(self) -> AxisFaultConfig:
+        return copy.deepcopy(self)
+
+    def validate(self) -> Verdict:
+        return first_refusal((
+            check_range("following_error_limit", self.following_error_limit, 0.0, MAX_POSITION),
+            check_duration("following_error_time", self.following_error_time),
+            check_action("following_error_action", self.following_error_action),
+            check_bool("software_limit_positive_enabled", self.software_limit_positive_enabled),
+            check_position("software_limit_positive", self.software_limit_positive),
+            check_action("software_limit_positive_action", self.software_limit_positive_action),
+            check_bool("software_limit_negative_enabled", self.software_limit_negative_enabled),
+            check_position("software_limit_negative", self.software_limit_negative),
+            check_action("software_limit_negative_action", self.software_limit_negative_action),
+            self._limits_ordered(),
+            check_action("amp_fault_action", self.amp_fault_action),
+            check_integer("encoder_fault_motor_number", self.encoder_fault_motor_number, -1, MAX_OBJECTS - 1),
+            check_action("frame_underflow_action", self.frame_underflow_action),
+        ))
+
+    def _limits_ordered(self) -> Verdict:
+        """Both limits on: the negative one below the positive one, and (MPI 002, MEIAxisConfig)
+        "The distance between the positive and negative software position limits must be less
+        than 32 bits (4,294,967,296 counts)"."""
+        if not (self.software_limit_positive_enabled is True and self.software_limit_negative_enabled is True
+                and _finite_number(self.software_limit_positive) and _finite_number(self.software_limit_negative)):
+            return VALID  # (a value that is not a number is refused by its own check)
+        span = self.software_limit_positive - self.software_limit_negative
+        if 0.0 < span < 2.0**32:
+            return VALID
+        return refuse(f"software_limit_negative: must be below software_limit_positive and less than "
+                      f"4,294,967,296 counts from it, got {shown(self.software_limit_negative)} and "
+                      f"{shown(self.software_limit_positive)}")
+
+
 def check_settling_reachable(in_position: AxisInPosition, plant: PlantConfig) -> Verdict:
     """The encoder rounds to its resolution, so a reading can be resolution/2 from any
     target: a fine tolerance below that would never be met and no move would end."""

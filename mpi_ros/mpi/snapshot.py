@@ -33,6 +33,7 @@ class AxisSnapshot:
     frame_count: int
     supervisor: int
     feedforward: float = 0.0  # PTF/PVTF feedforward (raw DAC counts)
+    faults: tuple[str, ...] = ()  # the faults latched on the axis (mpi/faults.py)
 
 
 @dataclass(frozen=True, slots=True)

@@ -228,12 +228,17 @@ class ActionsMixin:
 
     def _reset(self, source: ActionSource) -> tuple[Message, str]:
         state = self.state
-        if state is MPIState.IDLE:
+        faults = self._ctl.faults
+        if state is MPIState.IDLE and not faults.latched_on(self.mapped):
             self._map()
             return OK, "already IDLE"
-        refused = self._refuse((MPIState.STOPPED, MPIState.ERROR))
+        refused = self._refuse((MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR))
         if refused:
             return refused
+        persisting = faults.persisting(self.mapped)
+        if persisting:  # docs/faults.md: a fault is cleared by RESET once its condition is gone
+            return Message.MPIMotionMessageERROR, "RESET refused: " + "; ".join(persisting) + ": clear it first"
+        amp_faulted = faults.clear(self.mapped)
         t = self._ctl.time
         self._rebase(t)
         self._drop_pending(STATE_MESSAGES[state.name], f"dropped by RESET in {state.name}")
@@ -241,7 +246,9 @@ class ActionsMixin:
             if axis.owner == self.number or axis.owner == -1:
                 axis.unload(t, self._clock_of(axis))
                 if not axis.amp_enabled or axis.mode is CommandMode.FOLLOW_ACTUAL:
-                    axis.enable(t, command_equals_actual=self._aborted or axis.mode is CommandMode.FOLLOW_ACTUAL)
+                    # after an ABORT or an amplifier fault the motor coasted: the command is set to the actual
+                    axis.enable(t, command_equals_actual=self._aborted or axis.mode is CommandMode.FOLLOW_ACTUAL
+                                or axis.number in amp_faulted)
                 axis.status_mode = StatusMode.POINT_TO_POINT
                 axis.target = axis.rest
         self.clock = self.clock.ramp_to(t, self.config.normal_feedrate, 0.0)

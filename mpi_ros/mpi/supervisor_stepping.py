@@ -144,6 +144,8 @@ class SteppingMixin:
             conditions["frames_empty"] = left == 0
         if stream.empty_count > 0:
             conditions["starving"] = left < stream.empty_count
+        if self.own_state is MPIState.MOVING and self._ctl.faults.watches_underflow(move.plan_axes):
+            conditions["underflow"] = left == 0  # (after "starving": its E_STOP at that sample comes first)
 
     def _all_axes(self, move: Move, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
         """``conditions[key]``: per sample, is ``bit`` set on every axis of ``move`` (the current
@@ -191,6 +193,8 @@ class SteppingMixin:
                 self._due_outputs(key[1])
             elif key in ("frames_low", "frames_empty", "starving"):
                 self._buffer_event(key)
+            elif key == "underflow":
+                self._underflow()
             elif key == "chunk":
                 self._chunk_done()
             elif key == "move_done":
@@ -236,6 +240,13 @@ class SteppingMixin:
         elif key == "starving" and self.own_state is MPIState.MOVING:
             self._e_stop(ActionSource.CONTROLLER, reason=f"fewer than emptyCount = {stream.empty_count} points left "
                                                           "while more are expected (final false)")
+
+    def _underflow(self) -> None:
+        """The frame buffer of the open path ran empty while moving (faults.py): the fault of
+        each of its axes, unless an E_STOP (emptyCount) at this sample got there first."""
+        move = self.current
+        if self.own_state is MPIState.MOVING and move is not None:
+            self._ctl.faults.underflow(move.plan_axes)
 
     def _stop_on_error_complete(self) -> None:
         """E_STOP (or ABORT) has run its course: disable what must be, enter ERROR."""

@@ -1,9 +1,13 @@
 """The node that serves the controller as a whole: /<ns>/controller.
 
 Publishes /<ns>/axis<k>/status, /<ns>/events, /joint_states, /diagnostics and /clock
-(controller time, for use_sim_time consumers); serves the axis services
-(/<ns>/axis<k>/config_get|config_set|position_set) and the control's gates and I/O
-(/<ns>/gate_set|gate_get|io_get|io_set) and the motors' secondary feedback inputs that cams can
+(controller time, for use_sim_time consumers; ros.clock: false leaves it to another suite
+of a cell). In a namespace other than /mpi, joint states go to <ns>/joint_states with names
+prefixed by the namespace (RosSettings.joint_states_topic, joint_prefix; docs/cell.md);
+/diagnostics is shared by design, its statuses named by namespace. Serves the axis services
+(/<ns>/axis<k>/config_get|config_set|position_set, and fault_config_get|fault_config_set|fault_inject:
+docs/faults.md) and the control's gates and I/O
+(/<ns>/gate_set|gate_get|io_get|io_set), and the motors' secondary feedback inputs that cams can
 follow (/<ns>/motor_feedback_secondary_set).
 
 For recordings any tool can make: every command the controller applied goes out on
@@ -31,6 +35,9 @@ from mpi_ros.msg import Command as CommandMsg
 from mpi_ros.srv import (
     AxisConfigGet,
     AxisConfigSet,
+    AxisFaultConfigGet,
+    AxisFaultConfigSet,
+    AxisFaultInject,
     AxisPositionSet,
     GateGet,
     GateSet,
@@ -94,15 +101,20 @@ class ControllerNode(Node):
                           lambda req, resp, k=k: self._on_config_set(k, req, resp))
             self._service(AxisPositionSet, f"axis{k}/position_set",
                           lambda req, resp, k=k: self._on_position_set(k, req, resp))
+            self._service(AxisFaultConfigGet, f"axis{k}/fault_config_get",
+                          lambda req, resp, k=k: self._on_fault_config_get(k, resp))
+            self._service(AxisFaultConfigSet, f"axis{k}/fault_config_set",
+                          lambda req, resp, k=k: self._on_fault_config_set(k, req, resp))
+            self._service(AxisFaultInject, f"axis{k}/fault_inject",
+                          lambda req, resp, k=k: self._on_fault_inject(k, req, resp))
         self._service(GateSet, "gate_set", self._on_gate_set)
         self._service(GateGet, "gate_get", self._on_gate_get)
         self._service(IoSet, "io_set", self._on_io_set)
         self._service(IoGet, "io_get", self._on_io_get)
         self._service(MotorFeedbackSecondarySet, "motor_feedback_secondary_set", self._on_secondary_set)
         self._pub_events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
-        self._pub_joints = self.create_publisher(JointState, "/joint_states", 10)
+        self._pub_joints = self.create_publisher(JointState, settings.joint_states_topic, 10)
         self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
         self._pub_commands = self.create_publisher(CommandMsg, "commands", COMMANDS_QOS)
         self._pub_configuration = self.create_publisher(SuiteConfiguration, "configuration", LATCHED_QOS)
         self._applied: list = []  # commands applied since the last change hook, to publish after the lock
@@ -112,7 +124,9 @@ class ControllerNode(Node):
         runner.add_periodic(settings.joint_states_rate, self._collect_joints)
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
-        runner.add_periodic(settings.clock_rate, self._collect_clock)
+        if settings.clock:
+            self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
+            runner.add_periodic(settings.clock_rate, self._collect_clock)
         runner.on_event(lambda event: convert.publish(
             self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns)))
 
@@ -153,10 +167,10 @@ class ControllerNode(Node):
 
     def _collect_joints(self, ctl):
         if not wire.AVAILABLE:
-            msg = convert.joint_state(ctl, self.epoch_ns)
+            msg = convert.joint_state(ctl, self.epoch_ns, self.settings.joint_prefix)
         else:  # packed straight into CDR, from the axis topics' snapshots when they were taken now
             if self._joint_names is None:
-                self._joint_names = convert.joint_names(ctl)
+                self._joint_names = convert.joint_names(ctl, self.settings.joint_prefix)
             values = convert.joint_values(ctl, self._snapshots.taken_axes(ctl))
             msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, self._joint_names, *values)
         return lambda: convert.publish(self, self._pub_joints, msg)
@@ -200,7 +214,9 @@ class ControllerNode(Node):
         status = DiagnosticStatus()
         status.name = f"{self.settings.namespace.strip('/')}/axis{axis.number}"
         status.hardware_id = "mpi_ros simulated controller"
-        if not snap.amp_enabled:
+        if snap.faults:
+            level, message = DiagnosticStatus.ERROR, f"fault {', '.join(snap.faults)}: RESET once cleared"
+        elif not snap.amp_enabled:
             level, message = DiagnosticStatus.ERROR, "amplifier disabled (ABORT): RESET to enable"
         elif abs(snap.position_error) > axis.in_position.position_coarse:
             level, message = DiagnosticStatus.WARN, f"position error {snap.position_error:.1f} counts"
@@ -214,7 +230,7 @@ class ControllerNode(Node):
             ("actual_position", f"{snap.actual_position:.3f}"), ("position_error", f"{snap.position_error:.3f}"),
             ("command_velocity", f"{snap.command_velocity:.3f}"), ("done", snap.done), ("settled", snap.settled),
             ("in_fine_position", snap.in_fine_position), ("frame_count", snap.frame_count),
-            ("supervisor", snap.supervisor))]
+            ("supervisor", snap.supervisor), ("amp_enabled", snap.amp_enabled), ("faults", ",".join(snap.faults)))]
         return status
 
     # -- services -------------------------------------------------------------------------
@@ -238,6 +254,24 @@ class ControllerNode(Node):
     def _on_position_set(self, k: int, request, response):
         reply, _ = self.runner.submit(Command("axis_position_set", axis=k,
                                               request={"which": request.which, "value": request.value}))
+        return convert.answer(response, reply)
+
+    def _on_fault_config_get(self, k: int, response):
+        message, cfg = self.runner.read(lambda ctl: ctl.axis_fault_config_get(k))
+        convert.fill(response.config, rq.fault_config_to_dict(cfg))
+        return convert.answer(response, Reply(message))
+
+    def _on_fault_config_set(self, k: int, request, response):
+        reply, _ = self.runner.submit(Command("axis_fault_config_set", axis=k,
+                                              request={"config": convert.to_dict(request.config)}))
+        response.detail = reply.detail
+        return convert.answer(response, reply)
+
+    def _on_fault_inject(self, k: int, request, response):
+        reply, _ = self.runner.submit(Command("axis_fault_inject", axis=k,
+                                              request={"fault": request.fault, "active": request.active}))
+        response.detail = reply.detail
+        response.faults = list(reply.value or [])
         return convert.answer(response, reply)
 
     def _on_gate_set(self, request, response):

@@ -180,6 +180,7 @@ def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) ->
     msg.frame_count = snap.frame_count
     msg.supervisor = snap.supervisor
     msg.feedforward = _finite(snap.feedforward)
+    msg.faults = list(snap.faults)
     return msg
 
 
@@ -248,16 +249,18 @@ def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
     return [float(s.actual_position) for s in axes], [float(s.actual_velocity) for s in axes], effort
 
 
-def joint_names(ctl) -> list[str]:
-    return [f"axis{a.number}" for a in ctl.axes]
+def joint_names(ctl, prefix: str = "") -> list[str]:
+    """``<prefix>axis<k>``: the prefix is RosSettings.joint_prefix (the namespace of a suite
+    in a cell, none for the default one)."""
+    return [f"{prefix}axis{a.number}" for a in ctl.axes]
 
 
-def joint_state(ctl, epoch_ns: int | None = None) -> JointState:
+def joint_state(ctl, epoch_ns: int | None = None, prefix: str = "") -> JointState:
     """Every axis as a joint: actual position (counts), actual velocity (counts/s) and the
     servo's control effort (counts/s^2, see :func:`servo_effort`)."""
     msg = JointState()
     msg.header.stamp = stamp(ctl.sample, ctl.rate, epoch_ns)
-    msg.name = joint_names(ctl)
+    msg.name = joint_names(ctl, prefix)
     msg.position, msg.velocity, msg.effort = joint_values(ctl)
     return msg
 

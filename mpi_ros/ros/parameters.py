@@ -7,7 +7,11 @@ The controller node (``/<ns>/controller``) takes:
 | config | the YAML file (default: --config, else config/default.yaml) |
 | time_scale | --time-scale |
 | sample_rate | controller.sample_rate |
-| status_rate, feedback_rate, joint_states_rate, diagnostics_rate, clock_rate, crosscheck | ros.* |
+| status_rate, feedback_rate, joint_states_rate, diagnostics_rate, clock_rate, crosscheck, result_timeout | ros.* |
+
+The namespace: ``--ros-args -r __ns:=/cell_a`` (rcl's remap of every node's namespace)
+over ``mpi-ros run --namespace`` over ros.namespace in the YAML; the one in effect is the
+suite's namespace everywhere (topics, diagnostics names, joint names, recordings).
 
 They are read once, before the suite is built, and validated with the file (a bad value
 stops the start with the key named; ``status_rate:=200`` is taken as 200.0, as a user
@@ -26,7 +30,8 @@ from rclpy.node import Node
 
 from .. import config as suite_config
 
-ROS_KEYS = ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate", "crosscheck")
+ROS_KEYS = ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate", "crosscheck",
+            "result_timeout")
 NODE_NAME = "controller"
 _SET_AT_START = "Read only: set at start with --ros-args -p {name}:=VALUE."
 
@@ -71,6 +76,9 @@ SPECS: dict[str, ParameterSpec] = {spec.name: spec for spec in (
     _rate("clock_rate", "/clock is published"),
     ParameterSpec("crosscheck", ParameterType.PARAMETER_BOOL,
                   "check every started or modified profile against ruckig (ros.crosscheck)"),
+    ParameterSpec("result_timeout", ParameterType.PARAMETER_DOUBLE,
+                  "s: how long an ended goal's result is kept for a client that asks late (ros.result_timeout)",
+                  0.0, math.inf, "Must be > 0."),
 )}
 
 
@@ -101,10 +109,13 @@ def _read(reader: Node, name: str, default):
     return _typed(name, reader.declare_parameter(name, default, loose).value)
 
 
-def resolve(context: Context | None, config_path: str | None,
-            time_scale: float) -> tuple[suite_config.SuiteConfig, float]:
-    """The configuration and time scale in effect, parameter overrides applied."""
-    reader = Node(NODE_NAME, namespace=_namespace(config_path), context=context)
+def resolve(context: Context | None, config_path: str | None, time_scale: float,
+            namespace: str | None = None) -> tuple[suite_config.SuiteConfig, float]:
+    """The configuration and time scale in effect, parameter overrides applied; ``namespace``
+    (``--namespace``) replaces ros.namespace, an ``__ns`` remap replaces both."""
+    if namespace is not None:
+        suite_config.check_namespace(namespace, "--namespace")
+    reader = Node(NODE_NAME, namespace=namespace or _namespace(config_path), context=context)
     try:
         path = _read(reader, "config", config_path or "") or None
         time_scale = _read(reader, "time_scale", float(time_scale))
@@ -117,6 +128,8 @@ def resolve(context: Context | None, config_path: str | None,
             value = _read(reader, key, getattr(base.ros, key))
             if value != getattr(base.ros, key):
                 overrides["ros"][key] = value
+        if reader.get_namespace() != base.ros.namespace:  # --namespace or an __ns remap
+            overrides["ros"]["namespace"] = reader.get_namespace()
         cfg = suite_config.parse(suite_config.merge(base.raw, overrides), base.source)
     finally:
         reader.destroy_node()

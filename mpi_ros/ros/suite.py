@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import threading
 
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
 
@@ -35,10 +36,12 @@ class Suite:
         self.runner = ControllerRunner(self.controller, time_scale)
         self.controller_node = ControllerNode(self.runner, config.ros, context=context)
         self.supervisor_nodes = [
-            SupervisorNode(self.runner, spec.number, config.ros, context=context) for spec in config.supervisors
+            SupervisorNode(self.runner, spec.number, config.ros, spec.lost_client_timeout, context=context)
+            for spec in config.supervisors
         ]
         self.configuration = self.controller_node.publish_configuration(config)
         self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
+        self.controller_node.add_diagnostic(lambda ctl: [self._suite_status()])
         self.executor = MultiThreadedExecutor(num_threads=config.ros.executor_threads, context=context)
         for node in self.nodes:
             self.executor.add_node(node)
@@ -56,6 +59,21 @@ class Suite:
         name = f"{self.config.ros.namespace.strip('/')}/crosscheck"
         self.controller_node.add_diagnostic(lambda ctl: [_crosscheck_status(name, monitor.summary())])
         return monitor
+
+    def _suite_status(self):
+        """/diagnostics "<ns>/suite": how far the controller is behind the wall clock and what
+        the suite holds (publications queued, goals per supervisor), so a long run shows
+        whether anything grows. Runner lock held."""
+        behind = self.runner.due_sample() - self.controller.sample
+        values = {"samples_behind": behind, "outputs_queued": self.runner.backlog()}
+        for node in self.supervisor_nodes:
+            values.update({f"ms{node.number}.{key}": value for key, value in node.held().items()})
+        status = DiagnosticStatus(name=f"{self.config.ros.namespace.strip('/')}/suite",
+                                  hardware_id="mpi_ros simulated controller",
+                                  message=f"{behind} samples behind the wall clock")
+        status.level = DiagnosticStatus.OK
+        status.values = [KeyValue(key=k, value=str(v)) for k, v in values.items()]
+        return status
 
     @property
     def nodes(self):

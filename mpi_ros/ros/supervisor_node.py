@@ -13,6 +13,8 @@ is marked EXECUTING; a goal whose move has ended is handed back to rclpy, whose 
 callback (scheduled then) sets the terminal state and returns the result at once.
 Feedback for every running goal comes from one periodic hook at the feedback rate.
 Goal and cancel requests are handled in the order they arrived (_GoalServer).
+With ``lost_client_timeout`` > 0 a watchdog STOPs the motion of a goal whose client has
+left the graph (watchdog.py, docs/cell.md).
 """
 
 from __future__ import annotations
@@ -56,13 +58,14 @@ from mpi_ros.srv import (
 )
 
 from .. import requests as rq
-from ..commands import ACTION, MOTION_MODIFY, MOTION_START, Command, Reply
+from ..commands import ACTION, CLIENT_LOST, MOTION_MODIFY, MOTION_START, Command, Reply
 from ..config import RosSettings
 from ..mpi.control import Controller
 from ..mpi.messages import Message
 from ..runner import ControllerRunner, Output
 from . import convert, snapshots, wire
 from .goal_tracker import GoalBook, GoalEnd, TrackedGoal
+from .watchdog import LostClientWatchdog
 
 STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feedback publisher
@@ -119,6 +122,14 @@ class _GoalServer(ActionServer):
         self.applied: dict[bytes, tuple[Reply, int] | Exception] = {}
         super().__init__(*args, **kwargs)
 
+    def kept(self) -> int:
+        """Goals rclpy keeps: the unfinished ones and the ended ones until result_timeout."""
+        return len(self._goal_handles)
+
+    def unfiled(self) -> int:
+        """Goal and cancel requests taken and not yet handled, and goals applied and not yet filed."""
+        return len(self._taken) + len(self.applied)
+
     def take_data(self):
         data = super().take_data()
         requests = {key: data.pop(key) for key in ("goal", "cancel") if key in data}
@@ -167,7 +178,8 @@ def _reraise(exc: BaseException, _handle) -> None:
 
 
 class SupervisorNode(Node):
-    def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings, **kwargs):
+    def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings,
+                 lost_client_timeout: float = 0.0, **kwargs):
         super().__init__(f"ms{number}", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.number = number
@@ -182,6 +194,9 @@ class SupervisorNode(Node):
         self._closing = threading.Condition()
         self._unfinished = 0  # goals handed to rclpy whose execute callback has not run yet
         actions = ((MotionStart, "motion_start", MOTION_START), (MotionModify, "motion_modify", MOTION_MODIFY))
+        # each action's feedback topic: its clients subscribe there (the watchdog looks for them)
+        self._feedback_topics = {action_type: f"{self.get_fully_qualified_name()}/{name}/_action/feedback"
+                                 for action_type, name, _ in actions}
         self._servers = {action_type: self._action_server(action_type, name, operation)
                          for action_type, name, operation in actions}
         # Feedback goes out pre-serialized on the actions' own feedback topics (see _collect_feedback).
@@ -208,6 +223,15 @@ class SupervisorNode(Node):
         runner.add_periodic(settings.status_rate, self._collect_status)
         runner.add_periodic(settings.feedback_rate, self._collect_feedback)
         runner.on_change(self._review)
+        self.watchdog = (LostClientWatchdog(self, lost_client_timeout, self._running, self._client_lost,
+                                            self._service_group) if lost_client_timeout > 0 else None)
+
+    def held(self) -> dict[str, int]:
+        """What this node holds of its goals (for /diagnostics: none of it may grow without
+        bound): goals tracked until they end, goals rclpy keeps until their result expires,
+        requests not yet filed. Runner lock held."""
+        return {"goals_tracked": len(self._book), "goals_kept": sum(s.kept() for s in self._servers.values()),
+                "requests_unfiled": sum(s.unfiled() for s in self._servers.values())}
 
     def _action_server(self, action_type, name: str, operation: str) -> _GoalServer:
         return _GoalServer(self, action_type, f"~/{name}", _never_executed,
@@ -215,7 +239,8 @@ class SupervisorNode(Node):
                            handle_accepted_callback=lambda handle: self._accept(handle, action_type),
                            cancel_callback=self._on_cancel,
                            after_cancel=lambda: self.runner.update(self._review),
-                           callback_group=self._goal_group, **ACTION_QOS)
+                           callback_group=self._goal_group, result_timeout=self.settings.result_timeout,
+                           **ACTION_QOS)
 
     def _service(self, srv_type, name, callback):
         """A service of this supervisor: /<ns>/ms<n>/<name>."""
@@ -281,6 +306,8 @@ class SupervisorNode(Node):
         else:  # refused, or answered without a move to follow (NO_WAIT): the reply is the result
             goal.end = GoalEnd(reply.message, reply.detail, sample)
         self.runner.update(partial(self._file, goal))
+        if self.watchdog is not None:
+            self.watchdog.watch(key, self._feedback_topics[action_type])
 
     def _file(self, goal: TrackedGoal, ctl: Controller) -> Output | None:
         """Runner lock held: file the goal and review the book. What its move did since its
@@ -305,6 +332,18 @@ class SupervisorNode(Node):
 
     def _stop(self) -> None:
         self.runner.submit(Command(ACTION, self.number, request={"action": "STOP"}))
+
+    # -- the lost-client watchdog (watchdog.py; its timer, service group) ---------------
+    def _running(self, keys: list[bytes]) -> set[bytes]:
+        """Which of these goals have not ended."""
+        def read(_ctl) -> set[bytes]:
+            return {key for key in keys if (goal := self._book.get(key)) is not None and goal.end is None}
+        return self.runner.read(read)
+
+    def _client_lost(self, detail: str) -> None:
+        reply, sample = self.runner.submit(Command(CLIENT_LOST, self.number, request={"detail": detail}))
+        self.get_logger().warning(f"lost-client watchdog at sample {sample}: {detail} "
+                                  f"(STOP answered {reply.message.name})")
 
     # -- goals: the runner's hooks (runner lock held) ---------------------------------
     def _review(self, ctl: Controller) -> Output | None:
@@ -441,6 +480,7 @@ class SupervisorNode(Node):
         response.state = int(reply.state)
         response.state_name = reply.state.name
         response.sample = sample
+        response.detail = reply.detail
         return response
 
     def _on_trigger(self, action: str, response):

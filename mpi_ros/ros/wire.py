@@ -63,8 +63,11 @@ _JOINT_FIELDS = {"header": "std_msgs/Header", "name": "sequence<string>", "posit
 # Interfaces built from a later msg/AxisStatus.msg end with the PTF/PVTF feedforward (issue 11):
 # the snapshot's, finite, as convert.axis_status sets it there (0.0 where the snapshot has none).
 _FEEDFORWARD = {**_AXIS_FIELDS, "feedforward": "double"}
-FEEDFORWARD = AxisStatus.get_fields_and_field_types() == _FEEDFORWARD
-AVAILABLE = (AxisStatus.get_fields_and_field_types() in (_AXIS_FIELDS, _FEEDFORWARD)
+# ... and then the faults latched on the axis (issue 14, docs/faults.md).
+_FAULTS = {**_FEEDFORWARD, "faults": "sequence<string>"}
+FAULTS = AxisStatus.get_fields_and_field_types() == _FAULTS
+FEEDFORWARD = FAULTS or AxisStatus.get_fields_and_field_types() == _FEEDFORWARD
+AVAILABLE = (AxisStatus.get_fields_and_field_types() in (_AXIS_FIELDS, _FEEDFORWARD, _FAULTS)
              and MotionStatus.get_fields_and_field_types() == _MOTION_FIELDS
              and JointState.get_fields_and_field_types() == _JOINT_FIELDS)
 
@@ -157,6 +160,17 @@ def _axis(out: bytearray, snap: AxisSnapshot, rate: float, epoch_ns: int | None)
     if FEEDFORWARD:
         values += (_finite(getattr(snap, "feedforward", 0.0)),)
     out += layout.pack(*values)
+    if FAULTS:
+        _strings(out, snap.faults)
+
+
+def _strings(out: bytearray, texts: Sequence[str]) -> None:
+    """A sequence of strings: its count, then each string (4-byte aligned lengths)."""
+    encoded = [text.encode("utf-8") for text in texts]
+    layout = _Layout((len(out) - len(HEADER)) % 8).add("I", 4)
+    for text in encoded:
+        layout.string(len(text))
+    out += layout.struct().pack(len(encoded), *(x for text in encoded for x in (len(text) + 1, text)))
 
 
 def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) -> bytes:

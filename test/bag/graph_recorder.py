@@ -10,7 +10,7 @@ rule), history 1000. Every message is serialised again with rclpy.serialization 
 with the plain mcap Writer in the rosbag2 layout (profile ros2, ros2msg schemas, cdr, log
 time = the time it arrived, a sequence number per channel). It prints "subscribed TOPIC
 TYPE" for each topic (so a test knows when it listens) and, when stopped with SIGINT or
-SIGTERM, takes what has already arrived, finishes the file and prints "recorded N messages".
+SIGTERM, takes what has already arrived (for up to 2 s), finishes the file and prints "recorded N messages".
 """
 
 from __future__ import annotations
@@ -111,9 +111,10 @@ def main(argv: list[str]) -> int:
                     recorder.discover()
                     next_look = time.monotonic() + 0.05
                 executor.spin_once(timeout_sec=0.02)
-            # take what has arrived: until two spins in a row find no message
-            idle = 0
-            while idle < 2:
+            # take what has arrived: until two spins in a row find no message (at most 2 s:
+            # suites that keep running keep publishing)
+            idle, drained_by = 0, time.monotonic() + 2.0
+            while idle < 2 and time.monotonic() < drained_by:
                 before = recorder.handled
                 executor.spin_once(timeout_sec=0.2)
                 idle = idle + 1 if recorder.handled == before else 0

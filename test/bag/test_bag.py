@@ -24,7 +24,7 @@ SCENARIOS = {p.stem for p in (FIXTURES / "scenarios").glob("*.yaml")}
 def test_every_scenario_has_a_fixture():
     assert {b.name for b in BAGS} == SCENARIOS == {
         "p2p_modify", "stop_resume", "estop_reset", "append_queue", "sync_end", "two_supervisors", "streamed_path",
-        "cams"}
+        "cams", "faults"}
 
 
 def test_a_bag_recorded_before_a_type_changed_replays_by_its_own_definitions():

@@ -33,7 +33,7 @@ def _default_sigint() -> None:
 # The verbs that look for the suite on the graph (--timeout, default 5 s). The tests give
 # them longer: on a busy machine DDS discovery can take seconds, and a verb that finds the
 # suite goes on at once, so only a test that fails waits the whole time.
-CONSOLE_VERBS = {"move", "modify", "stop", "e-stop", "abort", "reset", "resume", "status", "events", "echo"}
+CONSOLE_VERBS = {"move", "modify", "stop", "e-stop", "abort", "reset", "resume", "fault", "status", "events", "echo"}
 
 
 def with_timeout(argv: tuple[str, ...] | list[str]) -> list[str]:

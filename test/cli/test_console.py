@@ -283,3 +283,19 @@ def _leave_the_suite_idle(clients):
     yield
     for client in clients.values():
         make_idle(client)
+
+
+def test_fault_injects_and_clears_and_reset_says_what_persists(ms1, capsys):
+    """`mpi-ros fault` (docs/faults.md): an amplifier fault ABORTs ms1; RESET is refused while
+    it persists, saying so; cleared, RESET recovers."""
+    assert console("fault", "AMP_FAULT", "--axis", "3", "--supervisor", "1") == 0
+    assert "AMP_FAULT on axis 3: MPIMessageOK (code 0), faults [AMP_FAULT]" in capsys.readouterr().out
+    ms1.wait_for_state("ERROR", WAIT)
+    assert console("reset", "-s", "1") == 1
+    assert "RESET: MPIMotionMessageERROR" in (out := capsys.readouterr().out) and "axis 3 AMP_FAULT persists" in out
+    assert console("fault", "AMP_FAULT", "--axis", "3", "--clear", "-s", "1") == 0
+    capsys.readouterr()
+    assert console("fault", "OVERHEAT", "--axis", "3", "-s", "1") == 1
+    assert "MPIMessagePARAM_INVALID" in (out := capsys.readouterr().out) and "unknown fault" in out
+    assert console("reset", "-s", "1") == 0
+    assert "state IDLE" in capsys.readouterr().out

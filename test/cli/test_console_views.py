@@ -136,8 +136,8 @@ def test_goal_usage_errors(argv, text):
     assert str(caught.value).startswith(text)
 
 
-@pytest.mark.parametrize("verb", ["move", "modify", "stop", "e-stop", "abort", "reset", "resume", "status",
-                                  "events", "echo", "demo"])
+@pytest.mark.parametrize("verb", ["move", "modify", "stop", "e-stop", "abort", "reset", "resume", "fault",
+                                  "status", "events", "echo", "demo"])
 def test_every_console_verb_explains_itself_with_an_example(verb):
     sub = build_parser()._subparsers._group_actions[0].choices[verb]
     text = sub.format_help()

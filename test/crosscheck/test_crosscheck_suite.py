@@ -117,6 +117,10 @@ def test_crosscheck_is_off_by_default(ros_context):
 
     suite = Suite(config.load(), time_scale=None, context=ros_context)
     try:
-        assert suite.crosscheck is None and suite.controller_node.diagnostic_providers == []
+        assert suite.crosscheck is None
+        # only the suite's own entry (mpi/suite), no crosscheck entry
+        names = [status.name for provide in suite.controller_node.diagnostic_providers
+                 for status in provide(suite.controller)]
+        assert names == ["mpi/suite"]
     finally:
         suite.shutdown()

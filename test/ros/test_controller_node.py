@@ -77,8 +77,14 @@ def test_diagnostics_go_to_error_on_e_stop(suite, client, probe, applied, drive)
     diagnostics = Collector(probe, DiagnosticArray, "/diagnostics")
     drive(lambda: bool(diagnostics.messages), chunk=500)
     names = [s.name for s in diagnostics.messages[0].status]
-    assert names == ["mpi/ms0", "mpi/ms1", "mpi/axis0", "mpi/axis1", "mpi/axis2", "mpi/axis3"]
+    assert names == ["mpi/ms0", "mpi/ms1", "mpi/axis0", "mpi/axis1", "mpi/axis2", "mpi/axis3", "mpi/suite"]
     assert {s.level for s in diagnostics.messages[0].status} == {DiagnosticStatus.OK}
+    # what the suite holds, for long runs: no goals at rest; manual clock: never behind; the
+    # publications of the batch being stepped (500 samples) queued until it ends, fewer than one a sample
+    held = {v.key: int(v.value) for v in diagnostics.messages[0].status[-1].values}
+    assert held.pop("outputs_queued") <= 500
+    assert held == {"samples_behind": 0, **{
+        f"ms{n}.{key}": 0 for n in (0, 1) for key in ("goals_tracked", "goals_kept", "requests_unfiled")}}
     client.e_stop()
     drive(lambda: any(s.name == "mpi/ms0" and s.level == DiagnosticStatus.ERROR
                       for m in diagnostics.messages for s in m.status), chunk=500)

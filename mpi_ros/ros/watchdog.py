@@ -1,0 +1,119 @@
+"""The lost-client watchdog of one supervisor (optional; docs/cell.md, "Lost clients").
+
+A client that holds a running goal and vanishes (process killed, link cut) can no longer
+cancel it: the move would run to its end with nobody watching. With
+``lost_client_timeout: T`` (seconds, per supervisor; 0, the default, is off) the suite
+STOPs that supervisor's motion once the goal's client has been gone from the graph for T
+seconds, with a CLIENT_LOST event saying which goal and why.
+
+How "the goal's client" is found on the graph: rclpy does not tell an action server who
+sent a goal, but every ROS action client (rclpy, rclcpp, the ros2 tool) subscribes to the
+action's feedback topic (``<action>/_action/feedback``) when it is created, before it can
+send a goal. So the goal's client is one of the feedback topic's subscribers when the goal
+arrives; the watchdog keeps their endpoint GIDs and counts the client gone when none of
+them is on the graph any more. That never stops a goal whose client may still be there: if
+several clients of the same action were present when the goal came, it waits until all of
+them have left (the graph cannot tell which one sent it). The graph shows an endpoint gone
+as soon as its process closes it, and within the DDS participant lease duration when the
+process is killed or its link cut (Fast DDS: 20 s by default; a profile sets it shorter):
+the STOP comes T seconds after that. A client that comes back in time (link restored
+before lease + T) is seen again and nothing is stopped.
+
+The STOP is a command (commands.CLIENT_LOST) through the runner, like any other: it is on
+<ns>/commands, in bags, and replays exactly.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+from rclpy.callback_groups import CallbackGroup
+from rclpy.node import Node
+
+PERIOD = 0.1  # s between looks at the graph (shorter for a shorter timeout)
+
+
+@dataclass(slots=True)
+class _Watched:
+    key: bytes  # the goal id
+    topic: str  # its action's feedback topic
+    clients: frozenset  # GIDs of the topic's subscribers when the goal came (its client among them)
+    gone_since: float | None = None  # monotonic time the last of them left the graph
+
+
+def _gids(node: Node, topic: str) -> frozenset:
+    return frozenset(bytes(info.endpoint_gid) for info in node.get_subscriptions_info_by_topic(topic))
+
+
+def describe(keys: Iterable[bytes]) -> str:
+    """Goal ids as their first 8 hex digits (what logs and the event show)."""
+    return ", ".join(key.hex()[:8] for key in keys)
+
+
+class LostClientWatchdog:
+    """``watch(goal id, feedback topic)`` when a goal is accepted; ``running(keys)`` answers
+    which of them still run (the goal book); ``on_lost(detail)`` is called (from the timer,
+    once per look that finds lost clients) to STOP."""
+
+    def __init__(self, node: Node, timeout: float, running: Callable[[list[bytes]], set[bytes]],
+                 on_lost: Callable[[str], None], group: CallbackGroup,
+                 clock: Callable[[], float] = time.monotonic):
+        self.node = node
+        self.timeout = timeout
+        self._running = running
+        self._on_lost = on_lost
+        self._clock = clock
+        self._goals: dict[bytes, _Watched] = {}
+        self._lock = threading.Lock()
+        self.timer = node.create_timer(min(PERIOD, max(timeout / 4.0, 0.01)), self.check, callback_group=group)
+
+    def watch(self, key: bytes, topic: str) -> None:
+        watched = _Watched(key, topic, _gids(self.node, topic))
+        with self._lock:
+            self._goals[key] = watched
+
+    def check(self) -> None:
+        """The timer: forget ended goals, time the ones whose client is gone, STOP at T."""
+        with self._lock:
+            goals = list(self._goals.values())
+        if not goals:
+            return
+        still = self._running([w.key for w in goals])
+        present: dict[str, frozenset] = {}
+        now = self._clock()
+        lost = []
+        for watched in goals:
+            if watched.key not in still:
+                self._forget(watched.key)
+                continue
+            if watched.topic not in present:
+                present[watched.topic] = _gids(self.node, watched.topic)
+            if self._gone(watched, present[watched.topic], now):
+                lost.append(watched)
+                self._forget(watched.key)
+        if lost:
+            self._on_lost(f"the client of goal {describe(w.key for w in lost)} left the graph: STOP after "
+                          f"{self.timeout:g} s without it (lost_client_timeout)")
+
+    def _gone(self, watched: _Watched, present: frozenset, now: float) -> bool:
+        if not watched.clients:  # its client's subscription was not discovered yet when it came
+            watched.clients = present
+            return False
+        if watched.clients & present:
+            watched.gone_since = None
+            return False
+        if watched.gone_since is None:
+            watched.gone_since = now
+        return now - watched.gone_since >= self.timeout
+
+    def _forget(self, key: bytes) -> None:
+        with self._lock:
+            self._goals.pop(key, None)
+
+    @property
+    def watched(self) -> int:
+        with self._lock:
+            return len(self._goals)

@@ -1,0 +1,89 @@
+"""The suite SIGKILLed while recording (issue 14, "Lost clients"): the bag is read up to its
+last complete record, `mpi-ros replay` says it is truncated (no traceback) and replays what
+it holds; restarted, the suite comes up with its configuration."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import yaml
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+from mpi_ros.bag.reader import BagReader
+
+WAIT = 20.0
+CONFIG = """
+supervisors:
+  - {number: 0, axes: [0, 1]}
+ros:
+  namespace: /killed
+  feedback_rate: 25.0
+"""
+
+
+def mpi_ros(*args: str) -> list[str]:
+    return [sys.executable, "-P", "-m", "mpi_ros.cli", *args]
+
+
+def wait_for_file(path: Path, size: int, process: subprocess.Popen) -> None:
+    """Until ``path`` holds ``size`` bytes (complete chunks on disk) while ``process`` runs."""
+    pause = threading.Event()
+    for _ in range(int(WAIT / 0.05)):
+        assert process.poll() is None, process.stderr.read() if process.stderr else ""
+        if path.is_file() and path.stat().st_size >= size:
+            return
+        pause.wait(0.05)
+    raise AssertionError(f"{path} did not reach {size} bytes within {WAIT} s")
+
+
+def test_a_killed_recording_replays_as_truncated_and_the_suite_restarts(tmp_path, ros_context):
+    from mpi_ros.client import MotionClient
+    from mpi_ros.msg import SuiteConfiguration
+
+    config = tmp_path / "cell.yaml"
+    config.write_text(CONFIG)
+    bag = tmp_path / "bag"
+    suite = subprocess.Popen(mpi_ros("run", "--config", str(config), "--time-scale", "5", "--record", str(bag)),
+                             cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        with MotionClient(0, namespace="/killed", context=ros_context, timeout=WAIT) as ms0:
+            assert ms0.wait_for_server(WAIT)
+            assert ms0.move([20000.0, -5000.0], velocity=50000.0, acceleration=500000.0).message == "MPIMessageOK"
+        wait_for_file(bag / "bag_0.mcap", 150_000, suite)  # a few compressed chunks written
+    finally:
+        suite.send_signal(signal.SIGKILL)
+        suite.wait(timeout=WAIT)
+    assert not (bag / "metadata.yaml").exists()  # written on a clean close only
+
+    reader = BagReader(bag)
+    assert "was not finished by its writer" in reader.truncated
+    commands = [msg.operation for _, msg in reader.decoded(["/killed/commands"])]
+    assert commands == ["motion_start"]  # everything up to the last complete record is there
+    replayed = subprocess.run(mpi_ros("replay", str(bag)), capture_output=True, text=True, timeout=120)
+    assert "Traceback" not in replayed.stderr
+    assert "truncated bag" in replayed.stderr and "read up to its last complete record" in replayed.stderr
+    assert replayed.returncode == 0 and "zero differences" in replayed.stdout, replayed.stdout + replayed.stderr
+
+    restarted = subprocess.Popen(mpi_ros("run", "--config", str(config), "--time-scale", "5"), cwd=tmp_path,
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        with MotionClient(0, namespace="/killed", context=ros_context, timeout=WAIT) as ms0:
+            assert ms0.wait_for_server(WAIT)
+            got: list = []
+            arrived = threading.Event()
+            latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                                 durability=DurabilityPolicy.TRANSIENT_LOCAL)
+            ms0.node.create_subscription(SuiteConfiguration, "/killed/configuration",
+                                         lambda msg: (got.append(msg), arrived.set()), latched)
+            assert arrived.wait(WAIT), "no configuration from the restarted suite"
+            running = yaml.safe_load(got[0].config)
+            assert running["ros"]["feedback_rate"] == 25.0 and got[0].ros_namespace == "/killed"
+            assert ms0.move([0.0, 0.0], velocity=50000.0, acceleration=500000.0).message == "MPIMessageOK"
+    finally:
+        restarted.send_signal(signal.SIGINT)
+        _, err = restarted.communicate(timeout=WAIT)
+    assert restarted.returncode == 0 and "Traceback" not in err

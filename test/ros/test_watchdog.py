@@ -1,0 +1,177 @@
+"""The lost-client watchdog (docs/cell.md, "Lost clients"; mpi_ros/ros/watchdog.py): off by
+default; with lost_client_timeout on a supervisor, a goal whose client leaves the graph has its
+motion STOPped, with a CLIENT_LOST event, through a recorded command."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from mpi_ros import config
+from mpi_ros.commands import CLIENT_LOST, Command, apply
+from mpi_ros.mpi.types import MPIState
+
+from .conftest import WAIT
+
+LEASE_PROFILE = Path(__file__).resolve().parents[2] / "config" / "fastdds_short_lease.xml"
+TIMEOUT = 0.5  # s: ms1's lost_client_timeout here
+LEASE = 2.0  # s: the killed client's DDS lease (config/fastdds_short_lease.xml)
+
+
+@pytest.fixture
+def suite_config():
+    return config.load(overrides={"supervisors": [{"number": 0, "axes": [0, 1]},
+                                                  {"number": 1, "axes": [2, 3], "lost_client_timeout": TIMEOUT}]})
+
+
+def test_the_watchdog_is_off_by_default_and_validated():
+    cfg = config.load()
+    assert [spec.lost_client_timeout for spec in cfg.supervisors] == [0.0, 0.0]
+    on = config.load(overrides={"supervisor_defaults": {"lost_client_timeout": 2}})
+    assert [spec.lost_client_timeout for spec in on.supervisors] == [2.0, 2.0]
+    for bad in (-1.0, "soon", float("inf"), True):
+        with pytest.raises(config.ConfigError, match=r"supervisors\[0\]\.lost_client_timeout"):
+            config.load(overrides={"supervisors": [{"number": 0, "axes": [0], "lost_client_timeout": bad}]})
+
+
+class Events:
+    """The controller's events and applied commands, as the suite's hooks see them."""
+
+    def __init__(self, runner):
+        self.events: list = []
+        self.commands: list = []
+        self._cond = threading.Condition()
+        runner.on_event(self._add(self.events))
+        runner.on_command(lambda sample, command, reply: self._add(self.commands)((sample, command, reply)))
+
+    def _add(self, into: list):
+        def add(item) -> None:
+            with self._cond:
+                into.append(item)
+                self._cond.notify_all()
+        return add
+
+    def wait_command(self, operation: str, timeout: float):
+        with self._cond:
+            assert self._cond.wait_for(lambda: any(c.operation == operation for _, c, _ in self.commands), timeout), (
+                f"no {operation} command within {timeout} s")
+            return next(entry for entry in self.commands if entry[1].operation == operation)
+
+
+def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_path):
+    seen = Events(suite.runner)
+    script = tmp_path / "doomed_client.py"
+    script.write_text(textwrap.dedent("""
+        import sys
+        from mpi_ros.client import MotionClient
+        client = MotionClient(1, timeout=20.0)
+        client.wait_for_server()
+        client.start({"type": "S_CURVE", "position": [500000.0, 0.0],
+                      "trajectory": [{"velocity": 1000.0, "acceleration": 10000.0, "deceleration": 10000.0}]})
+        print("sent", flush=True)
+        sys.stdin.readline()  # wait to be killed
+    """))
+    env = dict(os.environ, FASTRTPS_DEFAULT_PROFILES_FILE=str(LEASE_PROFILE))
+    doomed = subprocess.Popen([sys.executable, "-P", str(script)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                              text=True, cwd=tmp_path, env=env)
+    watchdog = suite.supervisor_nodes[1].watchdog
+    assert suite.supervisor_nodes[0].watchdog is None  # off where not configured
+    try:
+        assert doomed.stdout.readline().strip() == "sent"
+        seen.wait_command("motion_start", WAIT)
+        drive(lambda: suite.runner.ctl.axes[2].cmd_v > 500.0)
+        assert watchdog.watched == 1
+    finally:
+        killed_at = time.monotonic()
+        doomed.kill()
+        doomed.wait(timeout=10)
+    sample, command, reply = seen.wait_command(CLIENT_LOST, LEASE + TIMEOUT + WAIT)
+    took = time.monotonic() - killed_at
+    assert TIMEOUT <= took < LEASE + TIMEOUT + WAIT
+    assert command.supervisor == 1 and reply.message.name == "MPIMessageOK" and reply.state is MPIState.STOPPING
+    lost = [e for e in seen.events if e.type_name == "CLIENT_LOST"]
+    assert len(lost) == 1 and lost[0].supervisor == 1 and "left the graph" in lost[0].detail
+    after = [e.type_name for e in seen.events[seen.events.index(lost[0]):] if e.supervisor == 1]
+    assert after[:2] == ["CLIENT_LOST", "STOP"] and lost[0].sample == sample - 1  # applied at the next sample
+    drive(lambda: suite.runner.read(lambda ctl: ctl.supervisor(1).state is MPIState.STOPPED))
+    assert suite.runner.read(lambda ctl: ctl.supervisor(0).state) is MPIState.IDLE  # the other one untouched
+    assert watchdog.watched == 0  # the goal ended (STOPPED): nothing left to watch
+
+
+def test_a_client_lost_command_replays_as_recorded():
+    """The watchdog's STOP is data: applied again to a fresh controller it gives the same
+    answer and the same event (what `mpi-ros replay` relies on)."""
+    answers = []
+    for _ in range(2):
+        ctl = config.load().build_controller()
+        events: list = []
+        ctl.listeners.append(events.append)
+        apply(ctl, Command("motion_start", 0, request={
+            "type": "TRAPEZOIDAL", "position": [100000.0, 0.0],
+            "trajectory": [{"velocity": 1000.0, "acceleration": 10000.0, "deceleration": 10000.0}]}))
+        ctl.step(100)
+        reply = apply(ctl, Command(CLIENT_LOST, 0, request={"detail": "the client of goal 0123abcd left the graph"}))
+        answers.append((reply.message, reply.state, [(e.sample, e.type_name, e.detail) for e in events]))
+    assert answers[0] == answers[1]
+    assert answers[0][0].name == "MPIMessageOK" and answers[0][1] is MPIState.STOPPING
+    refused = apply(config.load().build_controller(), Command(CLIENT_LOST, 0, request={"detail": 5}))
+    assert refused.message.name == "MPIMessagePARAM_INVALID"
+
+
+class FakeGraph:
+    """A node's graph queries and timer, for the watchdog's logic without DDS."""
+
+    def __init__(self):
+        self.subscribers: dict[str, list[bytes]] = {}
+
+    def get_subscriptions_info_by_topic(self, topic):
+        return [SimpleNamespace(endpoint_gid=list(gid)) for gid in self.subscribers.get(topic, [])]
+
+    def create_timer(self, period, callback, callback_group=None):
+        return SimpleNamespace(period=period, callback=callback)
+
+
+def test_the_watchdog_times_the_clients_absence_and_forgives_a_return():
+    from mpi_ros.ros.watchdog import LostClientWatchdog
+
+    graph, now, lost, running = FakeGraph(), [0.0], [], {b"g" * 16}
+    topic = "/mpi/ms0/motion_start/_action/feedback"
+    graph.subscribers[topic] = [b"A" * 16, b"B" * 16]
+    watchdog = LostClientWatchdog(graph, 1.0, lambda keys: running & set(keys), lost.append, None,
+                                  clock=lambda: now[0])
+    assert watchdog.timer.period == 0.1
+    watchdog.watch(b"g" * 16, topic)
+    graph.subscribers[topic] = [b"B" * 16]  # one of the two candidates remains: maybe the sender
+    now[0] = 5.0
+    watchdog.check()
+    assert not lost
+    graph.subscribers[topic] = [b"C" * 16]  # both gone; a newcomer is not the goal's client
+    watchdog.check()
+    now[0] = 5.9
+    watchdog.check()
+    assert not lost
+    graph.subscribers[topic] = [b"B" * 16]  # back in time (a link restored): forgiven
+    now[0] = 6.5
+    watchdog.check()
+    graph.subscribers[topic] = []
+    now[0] = 7.0
+    watchdog.check()
+    now[0] = 7.99
+    watchdog.check()
+    assert not lost
+    now[0] = 8.0
+    watchdog.check()
+    assert len(lost) == 1 and "67676767" in lost[0] and "1 s" in lost[0]
+    assert watchdog.watched == 0
+    watchdog.watch(b"h" * 16, topic)  # a goal that ended is forgotten, never stopped
+    now[0] = 20.0
+    watchdog.check()
+    assert watchdog.watched == 0 and len(lost) == 1
