@@ -34,6 +34,7 @@ import importlib
 import re
 import threading
 import time
+import uuid
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -43,10 +44,12 @@ from typing import Any, Self
 import rclpy
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
+from rclpy.action.client import ClientGoalHandle
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from unique_identifier_msgs.msg import UUID
 
 from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
@@ -70,6 +73,7 @@ RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting
 # Every node of a process is announced together (one DDS participant per context), but give
 # a late announcement a moment before saying a supervisor is not there.
 _GRACE = 0.5
+_PROBE_ANSWER = 1.0  # s: an unanswered readiness round trip (MotionClient.wait_for_server) is sent again
 
 
 # -- typed arguments and answers --------------------------------------------------------------
@@ -694,11 +698,35 @@ class MotionClient(_Endpoint):
         self._start_spinning()
 
     def wait_for_server(self, timeout: float | None = None) -> bool:
-        """Wait for the supervisor's actions and services (False if they did not appear)."""
+        """Wait for the supervisor's actions and services (False if they did not appear),
+        then until each action has answered a round trip.
+
+        Why the round trip: the middleware sees the server from this client before the
+        server sees this client, and Fast DDS drops a response to a client it has not matched
+        yet ("client will not receive response"): a goal sent in that window is applied, but
+        its answer never comes. A result request for a goal that does not exist changes
+        nothing (the server answers STATUS_UNKNOWN), so it is sent again until one is answered.
+        """
         timeout = self.timeout if timeout is None else timeout
-        return all(wait(timeout_sec=timeout) for wait in (self._start.wait_for_server,
-                                                            self._modify.wait_for_server,
-                                                            self._action.wait_for_service))
+        deadline = time.monotonic() + timeout
+        return (all(wait(timeout_sec=timeout) for wait in (self._start.wait_for_server,
+                                                          self._modify.wait_for_server,
+                                                          self._action.wait_for_service))
+                and all(self._answered(client, action_type, deadline)
+                        for client, action_type in ((self._start, MotionStart), (self._modify, MotionModify))))
+
+    def _answered(self, action_client: ActionClient, action_type: Any, deadline: float) -> bool:
+        """A result request for an unknown goal, sent again each _PROBE_ANSWER s until answered."""
+        while (remaining := deadline - time.monotonic()) > 0:
+            handle = ClientGoalHandle(action_client, UUID(uuid=list(uuid.uuid4().bytes)),
+                                      action_type.Impl.SendGoalService.Response(accepted=True))
+            try:
+                self._wait_future(self._on_executor(handle.get_result_async), min(_PROBE_ANSWER, remaining),
+                                  "a result request")
+                return True
+            except NoResponse:
+                continue
+        return False
 
     # -- goals ---------------------------------------------------------------------------
     def start(self, goal: Mapping[str, Any] | Any, feedback: Callable[[Any], None] | None = None) -> Goal:
