@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
-import textwrap
+from pathlib import Path
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -42,6 +42,8 @@ goals = st.fixed_dictionaries(
         "use_stored_params": st.booleans(),
     })
 actions = st.sampled_from(["STOP", "E_STOP", "ABORT", "E_STOP_ABORT", "RESET", "RESUME", "MAP"])
+
+DOOMED = Path(__file__).with_name("doomed_client.py")  # a client process killed mid-goal
 
 
 def _finite_state(ctl) -> bool:
@@ -113,19 +115,8 @@ def test_fuzzed_goals_through_the_action_server(suite, client, drive):
 
 
 def test_a_client_killed_mid_goal_leaves_the_suite_working(suite, client, applied, drive, tmp_path):
-    script = tmp_path / "doomed_client.py"
-    script.write_text(textwrap.dedent("""
-        import sys
-        from mpi_ros.client import MotionClient
-        client = MotionClient(0, timeout=20.0)
-        client.wait_for_server()
-        client.start({"type": "S_CURVE", "position": [50000.0, 0.0],
-                      "trajectory": [{"velocity": 1000.0, "acceleration": 10000.0, "deceleration": 10000.0}]})
-        print("sent", flush=True)
-        sys.stdin.readline()  # wait to be killed
-    """))
-    doomed = subprocess.Popen([sys.executable, "-P", str(script)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                              text=True, cwd=tmp_path)
+    doomed = subprocess.Popen([sys.executable, "-P", str(DOOMED), "0", "50000.0"], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         assert doomed.stdout.readline().strip() == "sent"
         applied.wait(1)

@@ -7,7 +7,6 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import textwrap
 import threading
 import time
 from pathlib import Path
@@ -24,6 +23,8 @@ from .conftest import WAIT
 LEASE_PROFILE = Path(__file__).resolve().parents[2] / "config" / "fastdds_short_lease.xml"
 TIMEOUT = 0.5  # s: ms1's lost_client_timeout here
 LEASE = 2.0  # s: the killed client's DDS lease (config/fastdds_short_lease.xml)
+
+DOOMED = Path(__file__).with_name("doomed_client.py")  # a client process killed mid-goal
 
 
 @pytest.fixture
@@ -68,20 +69,9 @@ class Events:
 
 def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_path):
     seen = Events(suite.runner)
-    script = tmp_path / "doomed_client.py"
-    script.write_text(textwrap.dedent("""
-        import sys
-        from mpi_ros.client import MotionClient
-        client = MotionClient(1, timeout=20.0)
-        client.wait_for_server()
-        client.start({"type": "S_CURVE", "position": [500000.0, 0.0],
-                      "trajectory": [{"velocity": 1000.0, "acceleration": 10000.0, "deceleration": 10000.0}]})
-        print("sent", flush=True)
-        sys.stdin.readline()  # wait to be killed
-    """))
     env = dict(os.environ, FASTRTPS_DEFAULT_PROFILES_FILE=str(LEASE_PROFILE))
-    doomed = subprocess.Popen([sys.executable, "-P", str(script)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                              text=True, cwd=tmp_path, env=env)
+    doomed = subprocess.Popen([sys.executable, "-P", str(DOOMED), "1", "500000.0"], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True, cwd=tmp_path, env=env)
     watchdog = suite.supervisor_nodes[1].watchdog
     assert suite.supervisor_nodes[0].watchdog is None  # off where not configured
     try:
