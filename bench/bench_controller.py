@@ -104,8 +104,8 @@ def _measure_in(source: Path, case: tuple) -> dict[str, float]:
 
 
 # -- the table ------------------------------------------------------------------------------
-def _baseline_tree(revision: str, into: Path) -> Path | None:
-    """The repository at ``revision`` (git archive), or None where there is no git history."""
+def baseline_tree(revision: str, into: Path) -> Path | None:
+    """The package at ``revision`` (git archive), or None where there is no git history."""
     try:
         archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros"],
                                  check=True, capture_output=True).stdout
@@ -127,7 +127,7 @@ def main(baseline: str = "dd12ae1", rounds: int = 3) -> list[str]:
             f"{baseline}: axis-samples/s | {baseline}: per CPU second | speed-up (CPU) |",
             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     with tempfile.TemporaryDirectory() as scratch:
-        old = _baseline_tree(baseline, Path(scratch))
+        old = baseline_tree(baseline, Path(scratch))
         for case in CASES:
             new_runs, old_runs = [], []
             for _ in range(rounds):  # alternate, so both see the same load

@@ -19,7 +19,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run with -P: the sibling bench_controller
-from bench_controller import REPO, _baseline_tree  # noqa: E402 - after the path it is found on
+from bench_controller import REPO, baseline_tree  # noqa: E402 - after the path it is found on
 
 CASES = [(32, 16, "velocity", 20, 20_000), (32, 16, "s-curves", 20, 20_000), (32, 16, "velocity", 4096, 200_000)]
 _MEASURE = """
@@ -53,7 +53,7 @@ def main(baseline: str, rounds: int) -> list[str]:
     rows = [f"| axes | motion | batch | {baseline}: axis-samples per CPU s | no fault configured | "
             "3 checks on every axis |", "| --- | --- | --- | --- | --- | --- |"]
     with tempfile.TemporaryDirectory() as scratch:
-        old = _baseline_tree(baseline, Path(scratch))
+        old = baseline_tree(baseline, Path(scratch))
         if old is None:
             raise SystemExit("no git history: the baseline cannot be extracted")
         trees = [(old, False), (REPO, False), (REPO, True)]

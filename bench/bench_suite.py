@@ -49,7 +49,6 @@ import statistics
 import struct
 import subprocess
 import sys
-import tarfile
 import tempfile
 import threading
 import time
@@ -64,6 +63,9 @@ import yaml
 # generated interfaces: mpi_ros/__init__.py), here and in the suite's process.
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "bench"))  # run with -P: the sibling bench_controller
+from bench_controller import baseline_tree  # noqa: E402 - after the path it is found on
+
 os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)
 # Its own DDS domain (a pid-based one may be taken by a suite of a concurrent test run).
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(150, 200)))
@@ -569,19 +571,6 @@ def report(results: list[Result]) -> list[str]:
     for result in results:
         lines += rows(result)
     return lines
-
-
-def baseline_tree(revision: str, into: Path) -> Path | None:
-    """The package at ``revision`` (git archive), or None where there is no git history."""
-    try:
-        archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros"],
-                                 check=True, capture_output=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    (into / "tree.tar").write_bytes(archive)
-    with tarfile.open(into / "tree.tar") as tar:
-        tar.extractall(into / "tree", filter="data")
-    return into / "tree"
 
 
 def summary(results: list[Result]) -> list[str]:

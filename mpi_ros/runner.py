@@ -1,7 +1,7 @@
 """Runs the controller on its own clock thread and serialises access to it.
 
 Python cannot sleep 500 us reliably, so the thread wakes every few milliseconds and
-steps, in one batch, the samples that wall time x scale says are due (DESIGN.md): it
+steps, in one batch, the samples that wall time x scale says are due: it
 wakes as the next periodic stop (a status, say) becomes due and steps to it, not past it
 (see ``_clock_target``). A command first catches the controller up to the sample that is
 due now and is then applied, so it takes effect within one sample of arriving. One lock

@@ -38,17 +38,23 @@ class Inbox:
     def __init__(self, node, msg_type, topic: str, qos):
         self.messages: list = []
         self.arrived: list[float] = []
-        self._lock = threading.Lock()
+        self._lock = threading.Condition()
         node.create_subscription(msg_type, topic, self._add, qos)
 
     def _add(self, msg) -> None:
         with self._lock:
             self.messages.append(msg)
             self.arrived.append(time.monotonic())
+            self._lock.notify_all()
 
     def since(self, start: int) -> list:
         with self._lock:
             return self.messages[start:]
+
+    def wait_for(self, predicate, timeout: float) -> bool:
+        """Wait (up to ``timeout`` s) until a message for which ``predicate`` holds has arrived."""
+        with self._lock:
+            return self._lock.wait_for(lambda: any(predicate(m) for m in self.messages), timeout)
 
 
 def in_order(samples: list[int]) -> bool:
@@ -100,9 +106,7 @@ def cut(clients: dict[str, MotionClient], ns_a: str, ns_b: str) -> dict:
                                 durability=DurabilityPolicy.TRANSIENT_LOCAL))
     back = a.move([0.0, 0.0], wait=True, timeout=WAIT, **FAST)
     other = clients[ns_b].move([0.0, 0.0], wait=True, timeout=WAIT, **FAST)
-    deadline = time.monotonic() + WAIT
-    while not any(m.operation == "client_lost" for m in commands.since(0)) and time.monotonic() < deadline:
-        time.sleep(0.05)
+    commands.wait_for(lambda m: m.operation == "client_lost", WAIT)  # the caller checks it is there
     return {"stale_state": stale.state_name, "stale_sample": stale.sample, "result": result.message,
             "result_state": result.state_name, "result_detail": result.detail, "asked_again": goal.asked_again,
             "fresh_state": fresh.state_name, "fresh_sample": fresh.sample,
