@@ -17,7 +17,10 @@ them have left (the graph cannot tell which one sent it). The graph shows an end
 as soon as its process closes it, and within the DDS participant lease duration when the
 process is killed or its link cut (Fast DDS: 20 s by default; a profile sets it shorter):
 the STOP comes T seconds after that. A client that comes back in time (link restored
-before lease + T) is seen again and nothing is stopped.
+before lease + T) is seen again and nothing is stopped. A goal whose client was never seen
+on the graph at all (killed before the suite discovered its subscription, which a loaded
+machine can take tens of milliseconds to do) counts as lost from its arrival once
+DISCOVERY_GRACE more has passed: no client that could cancel it was ever there.
 
 The STOP is a command (commands.CLIENT_LOST) through the runner, like any other: it is on
 <ns>/commands, in bags, and replays exactly.
@@ -34,6 +37,7 @@ from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
 
 PERIOD = 0.1  # s between looks at the graph (shorter for a shorter timeout)
+DISCOVERY_GRACE = 1.0  # s a goal's client may take to appear on the graph after its goal
 
 
 @dataclass(slots=True)
@@ -41,6 +45,7 @@ class _Watched:
     key: bytes  # the goal id
     topic: str  # its action's feedback topic
     clients: frozenset  # GIDs of the topic's subscribers when the goal came (its client among them)
+    since: float  # monotonic time the goal came
     gone_since: float | None = None  # monotonic time the last of them left the graph
 
 
@@ -71,7 +76,7 @@ class LostClientWatchdog:
         self.timer = node.create_timer(min(PERIOD, max(timeout / 4.0, 0.01)), self.check, callback_group=group)
 
     def watch(self, key: bytes, topic: str) -> None:
-        watched = _Watched(key, topic, _gids(self.node, topic))
+        watched = _Watched(key, topic, _gids(self.node, topic), self._clock())
         with self._lock:
             self._goals[key] = watched
 
@@ -101,7 +106,8 @@ class LostClientWatchdog:
     def _gone(self, watched: _Watched, present: frozenset, now: float) -> bool:
         if not watched.clients:  # its client's subscription was not discovered yet when it came
             watched.clients = present
-            return False
+            # never seen at all: gone since the goal came, once discovery had its time
+            return not present and now - watched.since >= self.timeout + DISCOVERY_GRACE
         if watched.clients & present:
             watched.gone_since = None
             return False
@@ -112,6 +118,15 @@ class LostClientWatchdog:
     def _forget(self, key: bytes) -> None:
         with self._lock:
             self._goals.pop(key, None)
+
+    def describe_watched(self) -> list[str]:
+        """Each watched goal, its candidate clients and how long they have been gone (logs,
+        a failing test's message)."""
+        now = self._clock()
+        with self._lock:
+            goals = list(self._goals.values())
+        return [f"goal {describe([w.key])}: {len(w.clients)} candidate client(s), came {now - w.since:.2f} s ago, "
+                + ("present" if w.gone_since is None else f"gone for {now - w.gone_since:.2f} s") for w in goals]
 
     @property
     def watched(self) -> int:

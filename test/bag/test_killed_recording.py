@@ -29,15 +29,16 @@ def mpi_ros(*args: str) -> list[str]:
     return [sys.executable, "-P", "-m", "mpi_ros.cli", *args]
 
 
-def wait_for_file(path: Path, size: int, process: subprocess.Popen) -> None:
-    """Until ``path`` holds ``size`` bytes (complete chunks on disk) while ``process`` runs."""
+def wait_for_record(bag: Path, topic: str, process: subprocess.Popen) -> None:
+    """Until a chunk holding a message of ``topic`` is on disk while ``process`` runs: the
+    writer flushes whole compressed chunks, so the message is then safe from a SIGKILL."""
     pause = threading.Event()
-    for _ in range(int(WAIT / 0.05)):
+    for _ in range(int(WAIT / 0.1)):
         assert process.poll() is None, process.stderr.read() if process.stderr else ""
-        if path.is_file() and path.stat().st_size >= size:
+        if (bag / "bag_0.mcap").is_file() and any(True for _ in BagReader(bag).decoded([topic])):
             return
-        pause.wait(0.05)
-    raise AssertionError(f"{path} did not reach {size} bytes within {WAIT} s")
+        pause.wait(0.1)
+    raise AssertionError(f"no {topic} message on disk in {bag} within {WAIT} s")
 
 
 def test_a_killed_recording_replays_as_truncated_and_the_suite_restarts(tmp_path, ros_context):
@@ -53,7 +54,7 @@ def test_a_killed_recording_replays_as_truncated_and_the_suite_restarts(tmp_path
         with MotionClient(0, namespace="/killed", context=ros_context, timeout=WAIT) as ms0:
             assert ms0.wait_for_server(WAIT)
             assert ms0.move([20000.0, -5000.0], velocity=50000.0, acceleration=500000.0).message == "MPIMessageOK"
-        wait_for_file(bag / "bag_0.mcap", 150_000, suite)  # a few compressed chunks written
+        wait_for_record(bag, "/killed/commands", suite)  # its chunk is written; more may follow
     finally:
         suite.send_signal(signal.SIGKILL)
         suite.wait(timeout=WAIT)

@@ -9,6 +9,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -25,6 +26,7 @@ TIMEOUT = 0.5  # s: ms1's lost_client_timeout here
 LEASE = 2.0  # s: the killed client's DDS lease (config/fastdds_short_lease.xml)
 
 DOOMED = Path(__file__).with_name("doomed_client.py")  # a client process killed mid-goal
+FEEDBACK = "/mpi/ms1/motion_start/_action/feedback"  # where the doomed client subscribes
 
 
 @pytest.fixture
@@ -60,10 +62,10 @@ class Events:
                 self._cond.notify_all()
         return add
 
-    def wait_command(self, operation: str, timeout: float):
+    def wait_command(self, operation: str, timeout: float, why: Callable[[], str] = str):
         with self._cond:
             assert self._cond.wait_for(lambda: any(c.operation == operation for _, c, _ in self.commands), timeout), (
-                f"no {operation} command within {timeout} s")
+                f"no {operation} command within {timeout} s; {why()}")
             return next(entry for entry in self.commands if entry[1].operation == operation)
 
 
@@ -83,7 +85,10 @@ def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_
         killed_at = time.monotonic()
         doomed.kill()
         doomed.wait(timeout=10)
-    sample, command, reply = seen.wait_command(CLIENT_LOST, LEASE + TIMEOUT + WAIT)
+    sample, command, reply = seen.wait_command(
+        CLIENT_LOST, LEASE + TIMEOUT + WAIT,
+        lambda: f"watched: {watchdog.describe_watched()}; subscribers of the feedback topic: "
+                f"{suite.supervisor_nodes[1].get_subscriptions_info_by_topic(FEEDBACK)}")
     took = time.monotonic() - killed_at
     assert TIMEOUT <= took < LEASE + TIMEOUT + WAIT
     assert command.supervisor == 1 and reply.message.name == "MPIMessageOK" and reply.state is MPIState.STOPPING
@@ -165,3 +170,26 @@ def test_the_watchdog_times_the_clients_absence_and_forgives_a_return():
     now[0] = 20.0
     watchdog.check()
     assert watchdog.watched == 0 and len(lost) == 1
+
+
+def test_a_goal_whose_client_was_never_seen_is_stopped_after_the_discovery_grace():
+    """A client killed right after its goal, before the suite discovered its subscription,
+    never shows on the graph: its goal counts as lost from its arrival, once discovery had
+    DISCOVERY_GRACE to show the client."""
+    from mpi_ros.ros.watchdog import DISCOVERY_GRACE, LostClientWatchdog
+
+    graph, now, lost = FakeGraph(), [10.0], []
+    topic = "/mpi/ms0/motion_start/_action/feedback"
+    watchdog = LostClientWatchdog(graph, 0.5, lambda keys: set(keys), lost.append, None, clock=lambda: now[0])
+    watchdog.watch(b"g" * 16, topic)
+    now[0] = 10.0 + 0.5 + DISCOVERY_GRACE - 0.01
+    watchdog.check()
+    assert not lost and "came 1.49 s ago" in watchdog.describe_watched()[0]
+    now[0] = 10.0 + 0.5 + DISCOVERY_GRACE
+    watchdog.check()
+    assert len(lost) == 1 and watchdog.watched == 0
+    watchdog.watch(b"h" * 16, topic)  # seen late (discovery lagged): watched as usual from then on
+    graph.subscribers[topic] = [b"A" * 16]
+    now[0] = 30.0
+    watchdog.check()
+    assert len(lost) == 1 and watchdog.watched == 1
