@@ -10,7 +10,7 @@ params.MAX_REQUEST_TEXT characters is refused (MPIMessagePARAM_INVALID, "request
 large: ...") before any of it is read, and recorded compacted (:meth:`Command.to_json`),
 so input refused for its size costs a bounded time and leaves nothing large behind.
 
-Errors: a request that cannot be read (:class:`mpi_ros.requests.RequestError`) is the
+Errors: a request that cannot be read (:class:`mpi_ros.mpi.outcome.Refused`) is the
 user's and answers its message (MPIMessagePARAM_INVALID unless named). Any other
 exception is a bug of this package, not of the request: it is logged with its traceback
 and answered with :data:`INTERNAL_ERROR`, so it never passes for the user's fault, and
@@ -29,7 +29,8 @@ from . import requests as rq
 from .mpi.control import Controller
 from .mpi.events import MPIEventType
 from .mpi.messages import Message
-from .mpi.params import Verdict, check_position, check_settling_reachable, first_refusal, shown
+from .mpi.outcome import Outcome, Refused
+from .mpi.params import check_position, check_settling_reachable, first_refusal, shown
 from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
 
 MOTION_START = "motion_start"
@@ -72,18 +73,32 @@ class Command:
 
 @dataclass(frozen=True, slots=True)
 class Reply:
-    message: Message
-    detail: str = ""
+    """The controller's answer to a command: its outcome, with what the command made."""
+
+    outcome: Outcome
     serial: int = 0  # the move a start/modify made or changed (0 if none)
     state: MPIState = MPIState.INVALID
     value: Any = None  # what an edit returns (e.g. the axis list)
+
+    @classmethod
+    def of(cls, message: Message, detail: str = "", serial: int = 0, state: MPIState = MPIState.INVALID,
+           value: Any = None) -> Reply:
+        return cls(Outcome(message, detail), serial, state, value)
+
+    @property
+    def message(self) -> Message:
+        return self.outcome.message
+
+    @property
+    def detail(self) -> str:
+        return self.outcome.detail
 
     @property
     def accepted(self) -> bool:
         return self.message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
 
 
-def _refusal_detail(message: Message, verdict: Verdict) -> str:
+def _refusal_detail(message: Message, verdict: Outcome) -> str:
     """The validator's words for a refusal the controller answered (a call that returns a
     bare Message, like the C API): the same validator, so the same verdict."""
     return verdict.detail if message is verdict.message else ""
@@ -92,16 +107,16 @@ def _refusal_detail(message: Message, verdict: Verdict) -> str:
 def _supervisor(ctl: Controller, command: Command):
     ms = ctl.supervisor(command.supervisor)
     if ms is None:
-        raise rq.RequestError(Message.MPIMotionMessageMOTION_INVALID, f"no supervisor {command.supervisor}")
+        raise Refused(Message.MPIMotionMessageMOTION_INVALID, f"no supervisor {command.supervisor}")
     return ms
 
 
 def _motion(ctl: Controller, command: Command, modify: bool) -> Reply:
     ms = _supervisor(ctl, command)
     request = rq.motion_request(command.request)
-    message, detail, serial = ms.command(request.type, request.attributes, request.params, modify)
-    accepted = message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
-    return Reply(message, detail, serial if accepted else 0, ms.state)
+    outcome, serial = ms.command(request.type, request.attributes, request.params, modify)
+    reply = Reply(outcome, serial, ms.state)
+    return reply if reply.accepted else replace(reply, serial=0)
 
 
 def _action(ctl: Controller, command: Command) -> Reply:
@@ -109,12 +124,11 @@ def _action(ctl: Controller, command: Command) -> Reply:
     name = rq.text(command.request.get("action", ""), "action").strip().upper()
     action = MPIAction.__members__.get(name)
     if action is None or action is MPIAction.NONE:
-        return Reply(Message.MPIMessagePARAM_INVALID,
-                     f"unknown action {shown(name)} (STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME, MAP)",
-                     state=ms.state)
+        return Reply.of(Message.MPIMessagePARAM_INVALID,
+                        f"unknown action {shown(name)} (STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME, MAP)",
+                        state=ms.state)
     source = ActionSource.CONTROLLER if command.request.get("source") == "CONTROLLER" else ActionSource.USER
-    message, detail = ms.action_detail(action, source)
-    return Reply(message, detail, state=ms.state)
+    return Reply(ms.action_detail(action, source), state=ms.state)
 
 
 def _client_lost(ctl: Controller, command: Command) -> Reply:
@@ -126,8 +140,7 @@ def _client_lost(ctl: Controller, command: Command) -> Reply:
     detail = rq.text(command.request.get("detail", ""), "detail")
     move = ms.current or ms.last_move
     ctl.emit(MPIEventType.CLIENT_LOST, supervisor=ms.number, move_id=move.id if move else 0, detail=detail)
-    message, why = ms.action_detail(MPIAction.STOP, ActionSource.CONTROLLER)
-    return Reply(message, why, state=ms.state)
+    return Reply(ms.action_detail(MPIAction.STOP, ActionSource.CONTROLLER), state=ms.state)
 
 
 def _config_set(ctl: Controller, command: Command) -> Reply:
@@ -135,8 +148,8 @@ def _config_set(ctl: Controller, command: Command) -> Reply:
     config = rq.motion_config(command.request.get("config", {}))
     message = ms.config_set(config)  # validates with MotionConfig.validate
     if message is Message.MPIMotionMessageAXIS_COUNT:  # spec 000 MPIMotionMessageAXIS_COUNT
-        return Reply(message, "the motion supervisor has no axes", state=ms.state)
-    return Reply(message, _refusal_detail(message, config.validate()), state=ms.state)
+        return Reply.of(message, "the motion supervisor has no axes", state=ms.state)
+    return Reply.of(message, _refusal_detail(message, config.validate()), state=ms.state)
 
 
 def _params_set(ctl: Controller, command: Command) -> Reply:
@@ -145,8 +158,8 @@ def _params_set(ctl: Controller, command: Command) -> Reply:
     # mpiMotionParamsSet stores them for any later start: every value must be one it can hold
     verdict = params.validate()
     if not verdict.ok:
-        return Reply(verdict.message, verdict.detail, state=ms.state)
-    return Reply(ms.params_set(params), state=ms.state)
+        return Reply.of(verdict.message, verdict.detail, state=ms.state)
+    return Reply.of(ms.params_set(params), state=ms.state)
 
 
 def _axis_list_set(ctl: Controller, command: Command) -> Reply:
@@ -156,16 +169,17 @@ def _axis_list_set(ctl: Controller, command: Command) -> Reply:
     numbers = rq.integers(command.request.get("axis_numbers", []), "axis_numbers")
     mapping = rq.boolean(command.request.get("map", True), "map")
     if mapping and not numbers:
-        return Reply(Message.MEIMotionMessageNO_AXES_MAPPED, "map true with an empty axis list: nothing to map "
-                     "(map false empties the list)", state=ms.state, value=list(ms.axis_list))
+        return Reply.of(Message.MEIMotionMessageNO_AXES_MAPPED, "map true with an empty axis list: nothing to map "
+                        "(map false empties the list)", state=ms.state, value=list(ms.axis_list))
     previous = list(ms.axis_list)
     message = ms.axis_list_set(numbers)
     detail = ""
     if message.ok and mapping:
-        message, detail = ms.action_detail(MPIAction.MAP)
+        mapped = ms.action_detail(MPIAction.MAP)
+        message, detail = mapped.message, mapped.detail
         if not message.ok:
             ms.axis_list_set(previous)  # valid a moment ago, in the same state
-    return Reply(message, detail, state=ms.state, value=list(ms.axis_list))
+    return Reply.of(message, detail, state=ms.state, value=list(ms.axis_list))
 
 
 def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
@@ -179,9 +193,9 @@ def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
     elif operation == "REMOVE":
         message = ms.axis_remove(axis)
     else:
-        return Reply(Message.MPIMessagePARAM_INVALID, f"unknown operation {shown(operation)} (APPEND, INSERT, REMOVE)",
-                     value=list(ms.axis_list))
-    return Reply(message, state=ms.state, value=list(ms.axis_list))
+        return Reply.of(Message.MPIMessagePARAM_INVALID,
+                        f"unknown operation {shown(operation)} (APPEND, INSERT, REMOVE)", value=list(ms.axis_list))
+    return Reply.of(message, state=ms.state, value=list(ms.axis_list))
 
 
 def _position_set(ctl: Controller, command: Command) -> Reply:
@@ -192,36 +206,36 @@ def _position_set(ctl: Controller, command: Command) -> Reply:
     ranges = first_refusal(check_position(f"{name}[{i}]", x)
                            for name, values in (("actual", actual), ("command", commanded))
                            for i, x in enumerate(values))
-    return Reply(message, _refusal_detail(message, ranges), state=ms.state)
+    return Reply.of(message, _refusal_detail(message, ranges), state=ms.state)
 
 
 def _event_notify_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
-    return Reply(ms.event_notify_set(rq.event_mask(command.request.get("event_types"), "event_types")))
+    return Reply.of(ms.event_notify_set(rq.event_mask(command.request.get("event_types"), "event_types")))
 
 
 def _event_reset(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
     message = ms.event_reset(rq.event_mask(command.request.get("event_types"), "event_types"))
-    return Reply(message, value=ms.latched.names())
+    return Reply.of(message, value=ms.latched.names())
 
 
 def _gate_set(ctl: Controller, command: Command) -> Reply:
     r = command.request
-    return Reply(ctl.gate_set(rq.integer(r.get("gate", -1), "gate"), rq.boolean(r.get("closed", False), "closed")))
+    return Reply.of(ctl.gate_set(rq.integer(r.get("gate", -1), "gate"), rq.boolean(r.get("closed", False), "closed")))
 
 
 def io_space(name) -> IoSpace:
     try:
         return IoSpace(str(name).strip().upper())
     except ValueError as exc:
-        raise rq.RequestError(Message.MPIMessagePARAM_INVALID,
+        raise Refused(Message.MPIMessagePARAM_INVALID,
                               f"unknown I/O space {shown(name)} (IO, MOTOR_GENERAL_IO, MOTOR_DEDICATED_IO)") from exc
 
 
 def _io_set(ctl: Controller, command: Command) -> Reply:
     r = command.request
-    return Reply(ctl.io_set(io_space(r.get("space")), rq.integer(r.get("index", -1), "index"),
+    return Reply.of(ctl.io_set(io_space(r.get("space")), rq.integer(r.get("index", -1), "index"),
                             rq.integer(r.get("value", 0), "value"), rq.integer(r.get("mask", -1), "mask")))
 
 
@@ -230,25 +244,25 @@ def _axis_config_set(ctl: Controller, command: Command) -> Reply:
     request = command.request
     in_position = rq.in_position(request.get("in_position", {}))
     if not 0 <= command.axis < len(ctl.axes):
-        return Reply(ctl.axis_in_position_set(command.axis, in_position), f"no axis {command.axis}")
+        return Reply.of(ctl.axis_in_position_set(command.axis, in_position), f"no axis {command.axis}")
     master = rq.axis_master(request.get("master"), request.get("master_correction"), ctl.axes[command.axis].master)
     verdict = ctl.axis_master_check(command.axis, master)  # the one AxisMaster validator
     if not verdict.ok:
-        return Reply(verdict.message, verdict.prefixed("master.").detail)
+        return Reply.of(verdict.message, verdict.prefixed("master.").detail)
     message = ctl.axis_in_position_set(command.axis, in_position)  # validates with AxisInPosition.validate
     # (and against the axis' encoder)
     checks = [in_position.validate(), check_settling_reachable(in_position, ctl.axes[command.axis].plant.config)]
     if message.ok:
         message = ctl.axis_master_set(command.axis, master)
-    return Reply(message, _refusal_detail(message, first_refusal(checks)))
+    return Reply.of(message, _refusal_detail(message, first_refusal(checks)))
 
 
 def _secondary_feedback_set(ctl: Controller, command: Command) -> Reply:
     motor, feedback = rq.secondary_feedback(command.request)
     message = ctl.secondary_feedback_set(motor, feedback)  # validates with SecondaryFeedback.validate
     if not 0 <= motor < len(ctl.secondary):
-        return Reply(message, f"no motor {motor} ({len(ctl.secondary)} motors)")
-    return Reply(message, _refusal_detail(message, feedback.validate()))
+        return Reply.of(message, f"no motor {motor} ({len(ctl.secondary)} motors)")
+    return Reply.of(message, _refusal_detail(message, feedback.validate()))
 
 
 def _axis_position_set(ctl: Controller, command: Command) -> Reply:
@@ -260,25 +274,25 @@ def _axis_position_set(ctl: Controller, command: Command) -> Reply:
         "ORIGIN": ctl.axis_origin_set,
     }.get(which)
     if setter is None:
-        return Reply(Message.MPIMessagePARAM_INVALID, f"unknown position {shown(which)} (COMMAND, ACTUAL, ORIGIN)")
+        return Reply.of(Message.MPIMessagePARAM_INVALID, f"unknown position {shown(which)} (COMMAND, ACTUAL, ORIGIN)")
     message = setter(command.axis, value)  # the axis checks the range with params.check_position
-    return Reply(message, _refusal_detail(message, check_position("value", value)))
+    return Reply.of(message, _refusal_detail(message, check_position("value", value)))
 
 
 def _axis_fault_config_set(ctl: Controller, command: Command) -> Reply:
     """The fault limits and actions of an axis (docs/faults.md); fields left out keep their values."""
     _, current = ctl.axis_fault_config_get(command.axis)
     verdict = ctl.axis_fault_config_set(command.axis, rq.fault_config(command.request.get("config", {}), current))
-    return Reply(verdict.message, verdict.detail)
+    return Reply.of(verdict.message, verdict.detail)
 
 
 def _axis_fault_inject(ctl: Controller, command: Command) -> Reply:
     """A fault injected on an axis (docs/faults.md): recorded, so a replay injects it at the same sample."""
     r = command.request
-    message, detail = ctl.axis_fault_inject(command.axis, rq.text(r.get("fault", ""), "fault"),
-                                            rq.boolean(r.get("active", True), "active"))
+    outcome = ctl.axis_fault_inject(command.axis, rq.text(r.get("fault", ""), "fault"),
+                                    rq.boolean(r.get("active", True), "active"))
     faults = list(ctl.faults.names(command.axis)) if 0 <= command.axis < len(ctl.axes) else []
-    return Reply(message, detail, value=faults)
+    return Reply(outcome, value=faults)
 
 
 OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
@@ -307,19 +321,19 @@ def apply(ctl: Controller, command: Command) -> Reply:
     """Carry out ``command`` at the controller's current sample."""
     handler = OPERATIONS.get(command.operation)
     if handler is None:
-        return Reply(Message.MPIMessageUNSUPPORTED, f"unknown operation {shown(command.operation)}")
+        return Reply.of(Message.MPIMessageUNSUPPORTED, f"unknown operation {shown(command.operation)}")
     try:
         if command.request is None:  # no request: every field takes its default
             command = replace(command, request={})
         rq.mapping(command.request, "request")
         rq.check_size(command.request)  # before reading any of it
         return handler(ctl, command)
-    except rq.RequestError as exc:
-        return Reply(exc.message, exc.detail, state=_state(ctl, command))
+    except Refused as exc:
+        return Reply.of(exc.message, exc.detail, state=_state(ctl, command))
     except Exception as exc:  # noqa: BLE001 - a bug, not the request: logged in full, answered, the node stays up
         _log.exception("internal error applying %s (supervisor %s, axis %s, request %s)",
                        command.operation, command.supervisor, command.axis, _logged(command.request))
-        return Reply(INTERNAL_ERROR, f"{INTERNAL_DETAIL}: {type(exc).__name__}: {exc}", state=_state(ctl, command))
+        return Reply.of(INTERNAL_ERROR, f"{INTERNAL_DETAIL}: {type(exc).__name__}: {exc}", state=_state(ctl, command))
 
 
 def _logged(request: Any) -> str:

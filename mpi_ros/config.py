@@ -23,10 +23,10 @@ import yaml
 from .mpi.control import Controller
 from .mpi.events import MPIEventType
 from .mpi.messages import Message
+from .mpi.outcome import VALID, Outcome
 from .mpi.params import (
     MAX_COORD_AXES,
     MAX_OBJECTS,
-    VALID,
     AxisFaultConfig,
     AxisInPosition,
     AxisMaster,
@@ -35,7 +35,6 @@ from .mpi.params import (
     MotionConfig,
     PlantConfig,
     SecondaryFeedback,
-    Verdict,
     check_settling_reachable,
     first_refusal,
 )
@@ -167,13 +166,13 @@ class SuiteConfig:
         _accepted(ms.action(MPIAction.MAP), f"{where}.axes")
 
 
-def _require(verdict: Verdict, where: str) -> None:
+def _require(verdict: Outcome, where: str) -> None:
     """Stop on a refusal; ``where`` ends where the field the verdict names is appended."""
     if not verdict.ok:
         raise ConfigError(f"{where}{verdict.detail}")
 
 
-def _accepted(message: Message, where: str, verdict: Verdict = VALID) -> None:
+def _accepted(message: Message, where: str, verdict: Outcome = VALID) -> None:
     """Stop unless the controller accepted a call; the validator that refused it (if it was
     one) names the field."""
     if message.ok:

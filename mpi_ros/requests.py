@@ -5,7 +5,7 @@ JSON; replay and the Python client build them directly. Names are the spec's wit
 prefix (type "S_CURVE", attribute "APPEND", hold type "GATE", event "MOTION_DONE").
 
 Parsing only checks that a request can be read (a mapping where one is expected, a
-number where a number is): anything else raises :class:`RequestError`, the only error
+number where a number is): anything else raises :class:`Refused`, the only error
 the command layer answers as the user's (MPIMessagePARAM_INVALID unless named). Ranges
 are the structs' validators' business (mpi_ros/mpi/params.py), run by the controller.
 
@@ -25,6 +25,7 @@ from typing import Any
 
 from .mpi.events import MPIEventType
 from .mpi.messages import Message
+from .mpi.outcome import Refused
 from .mpi.params import (
     MAX_REQUEST_TEXT,
     MAX_REQUEST_VALUES,
@@ -44,15 +45,6 @@ from .mpi.params import (
 from .mpi.types import AxisMasterType, HoldType, MotionAttr, MPIMotionType, OutputType
 
 
-class RequestError(ValueError):
-    """A request that cannot be understood; ``message`` is the spec's answer."""
-
-    def __init__(self, message: Message, detail: str):
-        super().__init__(detail)
-        self.message = message
-        self.detail = detail
-
-
 @dataclass(frozen=True, slots=True)
 class MotionRequest:
     type: MPIMotionType
@@ -60,8 +52,8 @@ class MotionRequest:
     params: MotionParams | None  # None: the parameters stored with params_set
 
 
-def _unreadable(what: str, expected: str, value: Any) -> RequestError:
-    return RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: {expected} expected, got {shown(value)}")
+def _unreadable(what: str, expected: str, value: Any) -> Refused:
+    return Refused(Message.MPIMessagePARAM_INVALID, f"{what}: {expected} expected, got {shown(value)}")
 
 
 # -- size ----------------------------------------------------------------------------------------
@@ -90,16 +82,16 @@ class RequestSize:
     def ok(self) -> bool:
         return self.values <= MAX_REQUEST_VALUES and self.text <= MAX_REQUEST_TEXT
 
-    def refusal(self) -> RequestError:
+    def refusal(self) -> Refused:
         """The answer to a request of this size, when it is not ``ok``."""
         if self.values > MAX_REQUEST_VALUES:
             where, count = self.longest_array
-            return RequestError(Message.MPIMessagePARAM_INVALID,
+            return Refused(Message.MPIMessagePARAM_INVALID,
                                 f"request too large: {self.values:,} array elements ({where} has {count:,}); at most "
                                 f"{MAX_REQUEST_VALUES:,} in one request (params.MAX_REQUEST_VALUES): stream a longer "
                                 "path in parts (APPEND)")
         where, count = self.longest_text
-        return RequestError(Message.MPIMessagePARAM_INVALID,
+        return Refused(Message.MPIMessagePARAM_INVALID,
                             f"request too large: {self.text:,} characters of text ({where} has {count:,}); at most "
                             f"{MAX_REQUEST_TEXT:,} in one request (params.MAX_REQUEST_TEXT)")
 
@@ -152,7 +144,7 @@ def request_size(data: Any, where: str = "request") -> RequestSize:
 
 
 def check_size(data: Any) -> None:
-    """Raise RequestError (MPIMessagePARAM_INVALID, naming the longest array or string) if
+    """Raise Refused (MPIMessagePARAM_INVALID, naming the longest array or string) if
     the request is too large to be read (see :class:`RequestSize`)."""
     size = request_size(data)
     if not size.ok:
@@ -257,7 +249,7 @@ def enum_by_name(enum, name: Any, what: str, message: Message = Message.MPIMessa
     key = str(name).strip().upper()
     member = enum.__members__.get(key)
     if member is None:
-        raise RequestError(message, f"unknown {what} {shown(name)}")
+        raise Refused(message, f"unknown {what} {shown(name)}")
     return member
 
 
@@ -265,7 +257,7 @@ def event_mask(names: Any, what: str) -> MPIEventType:
     values = sequence(names, what)
     mask = MPIEventType.parse(values)
     if mask is None:
-        raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown event type in {shown(values)}")
+        raise Refused(Message.MPIMessagePARAM_INVALID, f"{what}: unknown event type in {shown(values)}")
     return mask
 
 
@@ -280,7 +272,7 @@ def _struct(cls, data: Any, what: str, enum_fields: dict | None = None):
     known = {f.name for f in fields(cls)}
     for key, value in mapping(data, what).items():
         if key not in known:
-            raise RequestError(Message.MPIMessagePARAM_INVALID, f"{what}: unknown field {shown(key)}")
+            raise Refused(Message.MPIMessagePARAM_INVALID, f"{what}: unknown field {shown(key)}")
         if key in enum_fields:
             enum, message = enum_fields[key]
             kwargs[key] = enum.NONE if value in ("", None) else enum_by_name(enum, value, f"{what} type", message)
@@ -301,7 +293,7 @@ def motion_request(data: Any) -> MotionRequest:
     names = sequence(data.get("attributes"), "attributes")
     attributes = MotionAttr.parse(names)
     if attributes is None:
-        raise RequestError(Message.MPIMotionMessageTYPE_INVALID, f"unknown attribute in {shown(names)}")
+        raise Refused(Message.MPIMotionMessageTYPE_INVALID, f"unknown attribute in {shown(names)}")
     if boolean(data.get("use_stored_params", False), "use_stored_params"):
         return MotionRequest(motion_type, attributes, None)
     return MotionRequest(motion_type, attributes, motion_params(data))
@@ -388,7 +380,7 @@ def motion_config(data: Any) -> MotionConfig:
     data = mapping(data, "config")
     unknown = sorted(str(key) for key in data if key not in _CONFIG_FIELDS)
     if unknown:
-        raise RequestError(Message.MPIMessagePARAM_INVALID, f"config: unknown field {shown(unknown[0])}")
+        raise Refused(Message.MPIMessagePARAM_INVALID, f"config: unknown field {shown(unknown[0])}")
     value = {key: number(data.get(key, 0.0), key) for key in _CONFIG_NUMBERS}
     return MotionConfig(
         decel_time=DecelTime(value["decel_time_stop"], value["decel_time_e_stop"]),
@@ -433,7 +425,7 @@ def axis_master(data: Any, correction: Any, current: AxisMaster) -> AxisMaster:
         data = mapping(data, "master")
         unknown = sorted(str(key) for key in data if key not in _MASTER_FIELDS)
         if unknown:
-            raise RequestError(Message.MPIMessagePARAM_INVALID, f"master: unknown field {shown(unknown[0])}")
+            raise Refused(Message.MPIMessagePARAM_INVALID, f"master: unknown field {shown(unknown[0])}")
         kind = text(data.get("type", ""), "master.type")
         if kind.strip():
             master.type = enum_by_name(AxisMasterType, kind, "master type (MOTOR_FEEDBACK_PRIMARY, "

@@ -20,18 +20,16 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections import OrderedDict, deque
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from .commands import Command, Reply, apply
 from .mpi.control import Controller
 from .mpi.events import Event
-from .mpi.motion import MoveEnd
 
 _log = logging.getLogger("mpi_ros.runner")
 FAST_BATCH = 2000  # samples per batch when running as fast as possible
-_OUTCOMES_KEPT = 100_000
 _WAKE_MARGIN = 0.0002  # s the clock thread wakes after a periodic stop is due
 CATCH_UP = 10  # wake periods the clock thread steps at most before it publishes (when behind)
 
@@ -54,9 +52,6 @@ class ControllerRunner:
         self.wake_period = wake_period
         self.lock = threading.RLock()
         self.changed = threading.Condition(self.lock)
-        # serial -> the move's outcomes (MoveEnd: how it ended, or that it reached its velocity),
-        # in the order the controller recorded them; a modified move can have several
-        self.outcomes: OrderedDict[int, list[MoveEnd]] = OrderedDict()
         self._periodic: list[_Periodic] = []
         self._command_listeners: list[Callable[[int, Command, Reply], None]] = []
         self._change_hooks: list[Callable[[Controller], Output | None]] = []
@@ -84,9 +79,9 @@ class ControllerRunner:
         self._command_listeners.append(listener)
 
     def on_change(self, hook: Callable[[Controller], Output | None]) -> None:
-        """Call ``hook(controller)`` (under the lock) after every step batch and every command,
-        once the moves that ended are in ``outcomes``; what it returns is run after the lock
-        is released, in order with the other deferred work."""
+        """Call ``hook(controller)`` (under the lock) after every step batch and every command
+        (the moves that ended are in the controller's move log then); what it returns is run
+        after the lock is released, in order with the other deferred work."""
         self._change_hooks.append(hook)
 
     def on_event(self, listener: Callable[[Event], None]) -> None:
@@ -201,7 +196,6 @@ class ControllerRunner:
             stop = min([target] + [p.next_sample for p in self._periodic])
             if stop > ctl.sample:
                 ctl.step(stop - ctl.sample)
-                self._collect_outcomes()  # periodic callbacks see the moves that have ended
             for periodic in self._periodic:
                 if periodic.next_sample <= ctl.sample:
                     behind = (ctl.sample - periodic.next_sample) // periodic.every + 1
@@ -212,8 +206,7 @@ class ControllerRunner:
         self._changed()
 
     def _changed(self) -> None:
-        """After a step batch or a command (under the lock): outcomes, hooks, waiters."""
-        self._collect_outcomes()
+        """After a step batch or a command (under the lock): hooks, waiters."""
         for hook in self._change_hooks:
             try:
                 output = hook(self.ctl)
@@ -224,14 +217,6 @@ class ControllerRunner:
             if output is not None:
                 self._outputs.append(output)
         self.changed.notify_all()
-
-    def _collect_outcomes(self) -> None:
-        for ms in self.ctl.supervisors:
-            for end in ms.move_ends:
-                self.outcomes.setdefault(end.serial, []).append(end)
-            ms.move_ends.clear()
-        while len(self.outcomes) > _OUTCOMES_KEPT:
-            self.outcomes.popitem(last=False)
 
     # -- access -------------------------------------------------------------------------
     def submit(self, command: Command) -> tuple[Reply, int]:

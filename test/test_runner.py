@@ -40,7 +40,7 @@ def test_a_command_takes_effect_at_the_next_sample_and_listeners_see_it():
     # DESIGN.md: "a command is applied at the first sample after the controller's current one"
     assert sample == 38 and log == [(38, "motion_start", "MPIMessageOK")]
     runner.step(2000)
-    assert [end.message.name for end in runner.outcomes[reply.serial]] == ["MPIMessageOK"]
+    assert [end.message.name for end in runner.ctl.move_log.ends(reply.serial)] == ["MPIMessageOK"]
 
 
 def test_wait_wakes_when_the_controller_changes():
@@ -48,7 +48,7 @@ def test_wait_wakes_when_the_controller_changes():
     reply, _ = runner.submit(Command("motion_start", 0, request=GOAL))
     result = {}
     waiter = threading.Thread(target=lambda: result.setdefault(
-        "ok", runner.wait(lambda ctl: reply.serial in runner.outcomes, timeout=10.0)))
+        "ok", runner.wait(lambda ctl: bool(ctl.move_log.ends(reply.serial)), timeout=10.0)))
     waiter.start()
     runner.step(2000)
     waiter.join(timeout=10.0)
@@ -65,20 +65,20 @@ def test_real_time_mode_keeps_up_with_wall_time():
     assert not runner.running
 
 
-def test_change_hooks_see_every_batch_and_command_with_the_outcomes_collected():
+def test_change_hooks_see_every_batch_and_command_with_the_moves_ended_in_the_log():
     runner = manual()
     seen = []
 
     def hook(ctl):
         assert runner.lock._is_owned()
-        seen.append((ctl.sample, {serial: [e.message.name for e in ends] for serial, ends in runner.outcomes.items()}))
+        seen.append((ctl.sample, [(e.serial, e.message.name) for e in ctl.move_log.recent()]))
         return lambda: seen.append(("output", runner.lock._is_owned()))
 
     runner.on_change(hook)
     reply, _ = runner.submit(Command("motion_start", 0, request=GOAL))
-    assert seen == [(0, {}), ("output", False)]
-    runner.step(2000)  # the move ends within this batch: the hook sees its outcome
-    assert seen[2:] == [(2000, {reply.serial: ["MPIMessageOK"]}), ("output", False)]
+    assert seen == [(0, []), ("output", False)]
+    runner.step(2000)  # the move ends within this batch: the hook sees its end
+    assert seen[2:] == [(2000, [(reply.serial, "MPIMessageOK")]), ("output", False)]
 
 
 def test_a_modified_move_keeps_each_of_its_outcomes_in_order():
@@ -92,7 +92,7 @@ def test_a_modified_move_keeps_each_of_its_outcomes_in_order():
         **velocity, "trajectory": [{"velocity": -300.0, "acceleration": 5000.0}]}))
     runner.step(400)
     assert modified.serial == reply.serial
-    ends = runner.outcomes[reply.serial]
+    ends = runner.ctl.move_log.ends(reply.serial)
     assert [(e.message.name, e.detail) for e in ends] == [("MPIMessageOK", "at velocity")] * 2
     assert ends[0].sample < modify_sample <= ends[1].sample
 

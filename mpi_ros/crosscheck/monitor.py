@@ -63,7 +63,7 @@ class CrosscheckMonitor:
         ms = self.ctl.supervisor(command.supervisor)
         if ms is None:
             return []
-        move = _find_move(ms, reply.serial)
+        move = ms.move(reply.serial)
         if move is None:
             return []
         return self.check_move(ms.number, move, self.ctl.sample if sample is None else sample)
@@ -110,12 +110,3 @@ class CrosscheckMonitor:
                                       if last else ""),
                 "last_error": self.last_error,
             }
-
-
-def _find_move(ms, serial: int) -> Move | None:
-    """The move with ``serial`` (a modify keeps the serial of the move it replaces)."""
-    for move in reversed(list(ms.queue)):
-        if move.serial == serial:
-            return move
-    current = ms.current
-    return current if current is not None and current.serial == serial else None

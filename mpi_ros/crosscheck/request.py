@@ -23,8 +23,9 @@ from typing import Any
 
 from ..mpi import validate
 from ..mpi.frames import AxisPlan
+from ..mpi.outcome import Refused
 from ..mpi.params import MotionParams, Trajectory
-from ..mpi.planner import AxisStart, PlanError, compile_move
+from ..mpi.planner import AxisStart, compile_move
 from ..mpi.types import MotionAttr, MPIMotionType
 
 SUPPORTED_TYPES = (MPIMotionType.TRAPEZOIDAL, MPIMotionType.S_CURVE, MPIMotionType.VELOCITY)
@@ -159,6 +160,6 @@ class ProfileRequest:
         start = AxisStart(0, self.start_position, self.start_velocity, 0.0, self.start_acceleration)
         try:
             move, _ = compile_move(0, self.type, attrs, params, [start], sample_rate)
-        except PlanError as exc:
+        except Refused as exc:
             raise RequestInvalid(f"{exc.message.name}: {exc.detail}") from exc
         return move.plans[0]

@@ -11,9 +11,10 @@ not depend on how the samples are batched.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
@@ -27,6 +28,8 @@ from .io import IoImage
 from .masters import SecondaryInputs, Sources
 from .messages import STATE_MESSAGES, Message
 from .motion import MotionSupervisor
+from .move_log import MoveLog
+from .outcome import MoveEnd, Outcome
 from .params import (
     AxisFaultConfig,
     AxisInPosition,
@@ -35,14 +38,13 @@ from .params import (
     MotionConfig,
     PlantConfig,
     SecondaryFeedback,
-    Verdict,
     check_position,
     check_settling_reachable,
 )
-from .snapshot import AxisSnapshot
+from .snapshot import AxisSnapshot, MotionFeedback
 from .status import BITS, EVENT_BITS, StretchStatus, compute, rising_edges
 from .stretch import Stretch
-from .types import IoSpace, MPIState
+from .types import ActionSource, IoSpace, MPIAction, MPIState
 
 MAX_STRETCH = 4096  # samples computed at once
 # Elements (axes x samples) of a stretch at most: its arrays stay a few megabytes (they live in
@@ -86,6 +88,8 @@ class Controller:
         self.events: deque[Event] = deque()
         self.listeners: list[EventListener] = []
         self.faults = FaultMonitor(self)
+        self.move_log = MoveLog()  # how moves ended: what their goals wait for (move_end)
+        self._serials = itertools.count(1)
 
     # -- time -------------------------------------------------------------------------
     @property
@@ -137,6 +141,75 @@ class Controller:
 
     def supervisor(self, number: int) -> MotionSupervisor | None:
         return self._supervisors.get(number)
+
+    # -- what supervisors ask of the controller (host.SupervisorHost) ------------------------
+    def next_serial(self) -> int:
+        """The serial of a move a supervisor takes (each controller counts its own)."""
+        return next(self._serials)
+
+    def record_end(self, end: MoveEnd) -> None:
+        self.move_log.record(end)
+
+    def clock_changed(self, supervisor: int, clock: ProfileClock) -> None:
+        self.bank.clock_changed(supervisor, clock)
+
+    def own_state_of(self, supervisor: int) -> MPIState | None:
+        """Supervisor ``supervisor``'s own state (None if there is none)."""
+        ms = self._supervisors.get(supervisor)
+        return ms.own_state if ms is not None else None
+
+    def clock_of(self, supervisor: int) -> ProfileClock | None:
+        ms = self._supervisors.get(supervisor)
+        return ms.clock if ms is not None else None
+
+    def act_on(self, supervisor: int, action: MPIAction, source: ActionSource) -> Outcome:
+        """An action a supervisor passes to another one (the motion that holds its axes)."""
+        ms = self._supervisors.get(supervisor)
+        if ms is None:
+            return Outcome(Message.MPIMotionMessageMOTION_INVALID, f"no supervisor {supervisor}")
+        return ms.action_detail(action, source)
+
+    # -- queries ------------------------------------------------------------------------
+    def move_end(self, supervisor: int, serial: int, since: int) -> MoveEnd | None:
+        """How the goals that follow move ``serial`` of ``supervisor`` from sample ``since``
+        ended, or None while the move runs or waits its turn (move_log.py says when)."""
+        return self.move_ends(supervisor, [(serial, since)])[0]
+
+    def move_ends(self, supervisor: int, goals: Iterable[tuple[int, int]]) -> list[MoveEnd | None]:
+        """:meth:`move_end` of each (serial, since) in ``goals``: hundreds of goals may follow
+        one move, and the supervisor is asked once per move."""
+        ms = self._supervisors.get(supervisor)
+        now: dict[int, MoveEnd | None] = {}
+        ends = []
+        for serial, since in goals:
+            end = self.move_log.since(serial, since)
+            if end is None:
+                if serial not in now:
+                    now[serial] = (ms.end_now(serial) if ms is not None else MoveEnd(
+                        serial, Outcome(Message.MPIMotionMessageMOTION_INVALID, "supervisor deleted"), self.sample))
+                end = now[serial]
+            ends.append(end)
+        return ends
+
+    def current_serial(self, supervisor: int) -> int | None:
+        """The serial of the move supervisor ``supervisor`` runs now (None: none, or no such one)."""
+        ms = self._supervisors.get(supervisor)
+        move = ms.current if ms is not None else None
+        return move.serial if move is not None else None
+
+    def motion_feedback(self, supervisor: int) -> MotionFeedback | None:
+        """What a goal's feedback and result show of a supervisor now (None: no such one)."""
+        ms = self._supervisors.get(supervisor)
+        if ms is None:
+            return None
+        axes = [self.axes[n] for n in ms.mapped]
+        move = ms.current or ms.last_move
+        state = ms.state
+        return MotionFeedback(
+            sample=self.sample, state=state, command_position=tuple(a.command_position for a in axes),
+            actual_position=tuple(a.actual_position for a in axes), command_velocity=tuple(a.cmd_v for a in axes),
+            progress=float(ms.progress()) if ms.current is not None else 0.0, move_id=move.id if move else 0,
+            element_id=ms.element_id, serial=ms.current.serial if ms.current is not None else None)
 
     @property
     def supervisors(self) -> list[MotionSupervisor]:
@@ -194,10 +267,10 @@ class Controller:
         axis.in_position = in_position.copy()
         return Message.MPIMessageOK
 
-    def axis_master_check(self, number: int, master: AxisMaster) -> Verdict:
+    def axis_master_check(self, number: int, master: AxisMaster) -> Outcome:
         """The one AxisMaster validator, against this controller's axes, motors and I/O words."""
         if not 0 <= number < len(self.axes):
-            return Verdict(Message.MPIAxisMessageAXIS_INVALID, f"no axis {number}")
+            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"no axis {number}")
         return master.validate(len(self.axes), self.config.motors, self.config.io_words)
 
     def axis_master_set(self, number: int, master: AxisMaster) -> Message:
@@ -238,11 +311,11 @@ class Controller:
         if self._sources is None or self._sources[0] is not stretch:  # one per stretch, for all its slaves
             self._sources = (stretch, self.master_sources(stretch))
         return self._sources[1].position(plan.cam.master), feedrate / owner.config.normal_feedrate
-    def axis_fault_config_set(self, number: int, config: AxisFaultConfig) -> Verdict:
+    def axis_fault_config_set(self, number: int, config: AxisFaultConfig) -> Outcome:
         """The fault limits and actions of an axis (docs/faults.md), checked by the one
         AxisFaultConfig validator (the YAML loader and the service use it too)."""
         if not 0 <= number < len(self.axes):
-            return Verdict(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
+            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
         return self.faults.config_set(number, config)
 
     def axis_fault_config_get(self, number: int) -> tuple[Message, AxisFaultConfig]:
@@ -250,10 +323,10 @@ class Controller:
             return Message.MPIAxisMessageAXIS_INVALID, AxisFaultConfig()
         return Message.MPIMessageOK, self.faults.axes[number].config.copy()
 
-    def axis_fault_inject(self, number: int, fault: object, active: bool = True) -> tuple[Message, str]:
+    def axis_fault_inject(self, number: int, fault: object, active: bool = True) -> Outcome:
         """Inject a fault on an axis (faults.FaultMonitor.inject): it acts at once."""
         if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}"
+            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
         return self.faults.inject(number, fault, active)
 
     def frame_count(self, number: int) -> int:
@@ -266,9 +339,7 @@ class Controller:
             count += axis.plan.frames_left(axis.rel if np.isfinite(axis.rel) else 0.0)
         owner = self.supervisor(axis.owner)
         if owner is not None:
-            held = owner.current.plan_for(number) if axis.holding and owner.current is not None else None
-            count += held.frame_count if held is not None else 0
-            count += sum(m.frame_counts.get(number, 0) for m in owner.queue)
+            count += owner.frames_queued(number)
         return min(count, self.config.frame_buffer_size)
 
     def axis_snapshot(self, number: int) -> AxisSnapshot:
@@ -327,7 +398,7 @@ class Controller:
 
     def _io_changed(self) -> None:
         for ms in self.supervisors:
-            ms.release_holds(self.io)
+            ms.release_holds()
 
     # -- events -------------------------------------------------------------------------
     def emit(self, kind: MPIEventType, supervisor: int = -1, axis: int = -1, move_id: int = 0,

@@ -30,7 +30,8 @@ import numpy as np
 
 from .events import MPIEventType
 from .messages import Message
-from .params import AxisFaultConfig, Verdict, refuse, shown
+from .outcome import Outcome
+from .params import AxisFaultConfig, refuse, shown
 from .status import run_lengths
 from .types import ActionSource, MPIAction
 
@@ -163,7 +164,7 @@ class FaultMonitor:
         self._error_runs = np.zeros((0, 0), dtype=np.int64)
 
     # -- configuration -----------------------------------------------------------------
-    def check(self, config: AxisFaultConfig) -> Verdict:
+    def check(self, config: AxisFaultConfig) -> Outcome:
         """The struct's validator, then what only the controller knows (its motors)."""
         verdict = config.validate()
         if verdict.ok and config.encoder_fault_motor_number >= self._ctl.config.motors:
@@ -171,7 +172,7 @@ class FaultMonitor:
                           f"exist ({self._ctl.config.motors} motors)")
         return verdict
 
-    def config_set(self, number: int, config: AxisFaultConfig) -> Verdict:
+    def config_set(self, number: int, config: AxisFaultConfig) -> Outcome:
         verdict = self.check(config)
         if not verdict.ok:
             return verdict
@@ -317,38 +318,39 @@ class FaultMonitor:
         return any(Fault.FRAME_UNDERFLOW not in self.axes[n].latched for n in numbers)
 
     # -- injection ---------------------------------------------------------------------
-    def inject(self, number: int, name: object, active: bool) -> tuple[Message, str]:
+    def inject(self, number: int, name: object, active: bool) -> Outcome:
         """Inject a fault on an axis: AMP_FAULT and ENCODER_FAULT set (``active``) or clear
         a condition that holds until cleared; the others trip once, as if detected."""
         fault = Fault.__members__.get(str(name).strip().upper()) if isinstance(name, str) else None
         if fault is None:
-            return (Message.MPIMessagePARAM_INVALID,
-                    f"fault: unknown fault {shown(name)} ({', '.join(f.value for f in Fault)})")
+            return Outcome(Message.MPIMessagePARAM_INVALID,
+                           f"fault: unknown fault {shown(name)} ({', '.join(f.value for f in Fault)})")
         if fault is Fault.AMP_FAULT:
             self.axes[number].amp_fault = active
             if active:
                 self.trip(number, fault, "amplifier fault injected: amplifier disabled, the motor coasts")
-            return OK, ""
+            return Outcome(OK)
         if fault is Fault.ENCODER_FAULT:
             return self._inject_encoder(number, active)
         if not active:
-            return (Message.MPIMessagePARAM_INVALID, f"fault: {fault.value} is not a condition that holds: "
-                    "it trips once (active true) and is cleared by RESET")
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"fault: {fault.value} is not a condition that holds: "
+                           "it trips once (active true) and is cleared by RESET")
         self.trip(number, fault, "injected")
-        return OK, ""
+        return Outcome(OK)
 
-    def _inject_encoder(self, number: int, active: bool) -> tuple[Message, str]:
+    def _inject_encoder(self, number: int, active: bool) -> Outcome:
         """The encoder of the axis' own motor (axis k drives motor k)."""
         if number >= self._ctl.config.motors:
-            return Message.MPIMessagePARAM_INVALID, f"axis {number} has no motor ({self._ctl.config.motors} motors)"
+            motors = self._ctl.config.motors
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"axis {number} has no motor ({motors} motors)")
         if not active:
             self.encoder_faults.discard(number)
-            return OK, ""
+            return Outcome(OK)
         self.encoder_faults.add(number)
         for watcher, faults in enumerate(self.axes):
             if faults.config.encoder_fault_motor_number == number:
                 self._trip_encoder(watcher, number)
-        return OK, ""
+        return Outcome(OK)
 
     def _trip_encoder(self, number: int, motor: int) -> None:
         self.trip(number, Fault.ENCODER_FAULT, f"the encoder of motor {motor} faulted")

@@ -9,7 +9,6 @@ spec 000 mpiMotionStart: "Each axis has a 128 frame buffer (FIFO)".
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -25,15 +24,10 @@ from .types import MotionAttr, MPIMotionType
 if TYPE_CHECKING:
     from .cams import CamFollow
 
-_serials = itertools.count(1)
 # A point's time is a sum of its dts in floating point, off the sample grid by rounding: a
 # point counts as reached from the sample within this many seconds of its time (far below
 # one sample at any rate the controller takes).
 POINT_TIME_TOLERANCE = 1e-9
-
-
-def next_serial() -> int:
-    return next(_serials)
 
 
 def reached(rel):
@@ -216,7 +210,7 @@ class Move:
     id: int = 0
     element_id: int = 0
     event_mask: MPIEventType = MPIEventType.NONE
-    serial: int = field(default_factory=next_serial)
+    serial: int = 0  # given when a supervisor takes the move (SupervisorHost.next_serial)
     stream: Stream | None = None  # a path move: its streaming state
     # Facts the controller asks every stretch (a move's plans never change once compiled).
     is_velocity: bool = field(init=False)  # a VELOCITY move

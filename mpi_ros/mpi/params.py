@@ -3,7 +3,7 @@
 C pointers become data (DESIGN.md): a NULL array is an empty list here, a hold or
 output is a value, an I/O address is the index of a word in the simulated I/O image.
 
-Each struct has one validator, ``validate() -> Verdict``: the ranges a controller can
+Each struct has one validator, ``validate() -> Outcome``: the ranges a controller can
 hold (docs/decisions.md, "Validation and ranges"). The YAML loader, the services and
 the controller all call it, so a value is accepted or refused the same way whatever
 way it comes in, and a value the controller accepted can never break its clock.
@@ -21,6 +21,7 @@ from typing import TypeGuard
 
 from .events import MASK_ALL, MPIEventType
 from .messages import Message
+from .outcome import VALID, Outcome
 from .types import (
     HOLD_ATTRS,
     POINT_TO_POINT_TYPES,
@@ -74,24 +75,6 @@ MAX_REQUEST_VALUES = 1 << 16
 MAX_REQUEST_TEXT = 1 << 14
 
 
-# -- the outcome of a check -------------------------------------------------------------------
-@dataclass(frozen=True, slots=True)
-class Verdict:
-    """OK, or the spec's message and why (``detail`` names the field first: "field: why")."""
-
-    message: Message
-    detail: str = ""
-
-    @property
-    def ok(self) -> bool:
-        return self.message is Message.MPIMessageOK
-
-    def prefixed(self, prefix: str) -> Verdict:
-        """The same verdict with ``prefix`` before the field it names (for nested structs)."""
-        return self if self.ok else Verdict(self.message, prefix + self.detail)
-
-
-VALID = Verdict(Message.MPIMessageOK)
 
 
 _SHOWN = reprlib.Repr()
@@ -108,11 +91,11 @@ def shown(value: object) -> str:
         return f"<{type(value).__name__}>"
 
 
-def refuse(detail: str, message: Message = Message.MPIMessagePARAM_INVALID) -> Verdict:
-    return Verdict(message, detail)
+def refuse(detail: str, message: Message = Message.MPIMessagePARAM_INVALID) -> Outcome:
+    return Outcome(message, detail)
 
 
-def first_refusal(verdicts: Iterable[Verdict]) -> Verdict:
+def first_refusal(verdicts: Iterable[Outcome]) -> Outcome:
     """The first verdict that refuses, else VALID."""
     return next((v for v in verdicts if not v.ok), VALID)
 
@@ -127,7 +110,7 @@ def _finite_number(value: object) -> TypeGuard[float]:
         return False
 
 
-def check_range(name: str, value: object, low: float, high: float, above_low: bool = False) -> Verdict:
+def check_range(name: str, value: object, low: float, high: float, above_low: bool = False) -> Outcome:
     """``value`` is a finite number within [low, high] ((low, high] with ``above_low``)."""
     if _finite_number(value) and low <= value <= high and not (above_low and value == low):
         return VALID
@@ -135,42 +118,42 @@ def check_range(name: str, value: object, low: float, high: float, above_low: bo
     return refuse(f"{name}: must be a finite number {lower} and <= {high:g}, got {shown(value)}")
 
 
-def check_integer(name: str, value: object, low: int, high: int) -> Verdict:
+def check_integer(name: str, value: object, low: int, high: int) -> Outcome:
     if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= int(value) <= high:
         return VALID
     return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {shown(value)}")
 
 
-def check_long(name: str, value: object) -> Verdict:
+def check_long(name: str, value: object) -> Outcome:
     """An integer a C long (the MPI's 32 bits) holds."""
     return check_integer(name, value, LONG_MIN, LONG_MAX)
 
 
-def check_bool(name: str, value: object) -> Verdict:
+def check_bool(name: str, value: object) -> Outcome:
     return VALID if isinstance(value, bool) else refuse(f"{name}: must be true or false, got {shown(value)}")
 
 
-def check_magnitude(name: str, value: object, limit: float) -> Verdict:
+def check_magnitude(name: str, value: object, limit: float) -> Outcome:
     if _finite_number(value) and abs(value) <= limit:
         return VALID
     return refuse(f"{name}: must be a finite number of magnitude <= {limit:g}, got {shown(value)}")
 
 
-def check_position(name: str, value: object) -> Verdict:
+def check_position(name: str, value: object) -> Outcome:
     """A position, origin or distance (counts)."""
     return check_magnitude(name, value, MAX_POSITION)
 
 
-def check_duration(name: str, value: object, positive: bool = False) -> Verdict:
+def check_duration(name: str, value: object, positive: bool = False) -> Outcome:
     """A time in seconds that fits the sample counter (> 0 with ``positive``)."""
     return check_range(name, value, 0.0, MAX_DURATION, above_low=positive)
 
 
-def _each(name: str, values: Iterable[object], check) -> Iterable[Verdict]:
+def _each(name: str, values: Iterable[object], check) -> Iterable[Outcome]:
     return (check(f"{name}[{i}]", v) for i, v in enumerate(values))
 
 
-def _each_struct(name: str, structs: Iterable) -> Iterable[Verdict]:
+def _each_struct(name: str, structs: Iterable) -> Iterable[Outcome]:
     return (s.validate().prefixed(f"{name}[{i}].") for i, s in enumerate(structs))
 
 
@@ -185,7 +168,7 @@ class Trajectory:
     acceleration_jerk: float = 0.0
     deceleration_jerk: float = 0.0
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         """Magnitudes a controller can hold. Which must be positive depends on the motion
         type and is checked with the move (validate.check_params): VELOCITY ignores the
         deceleration, the jerk types the jerk percentage (spec 000, MPIMotionSCurve and
@@ -213,7 +196,7 @@ class Hold:
     position: float = 0.0
     timeout: float = 0.0
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         """The trigger position, the timeout, and C longs (the MPI's 32 bits) elsewhere; the
         source (gate, word, motor, axis) is checked against the controller's objects with
         the move (validate.check_params)."""
@@ -235,7 +218,7 @@ class Output:
     off_mask: int = 0
     point_index: int = 0
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         """C longs (32 bits, as the ROS interface's int32); the motor or I/O word is checked
         against the controller's objects with the move (validate.check_params)."""
         return first_refusal(check_long(name, getattr(self, name))
@@ -252,7 +235,7 @@ class UserFrame:
     jerk: float = 0.0
     time: float = 0.0
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         return first_refusal((
             check_position("position", self.position),
             check_magnitude("velocity", self.velocity, MAX_VELOCITY),
@@ -303,7 +286,7 @@ class MotionParams:
         holds fewer than 0 points, so the trigger could never fire anyway)."""
         return self.empty_count <= 0
 
-    def validate(self, motion_type: MPIMotionType | None = None, attributes: MotionAttr | None = None) -> Verdict:
+    def validate(self, motion_type: MPIMotionType | None = None, attributes: MotionAttr | None = None) -> Outcome:
         """The values a move of ``motion_type`` with ``attributes`` uses (None: every value,
         as mpiMotionParamsSet stores them for any later start). Values a move ignores are
         not read (spec 000 MPIMotionSCurve, position: VELOCITY "will ignore these values";
@@ -314,7 +297,7 @@ class MotionParams:
         def uses(attr: MotionAttr) -> bool:
             return attributes is None or bool(attributes & attr)
 
-        checks: list[Iterable[Verdict]] = [
+        checks: list[Iterable[Outcome]] = [
             _each("position", self.position if every or motion_type not in VELOCITY_TYPES else (), check_position),
             _each_struct("trajectory", self.trajectory),
             (check_bool("final", self.final),
@@ -341,7 +324,7 @@ class MotionParams:
             checks += self._path_checks()
         return first_refusal(v for group in checks for v in group)
 
-    def _path_checks(self) -> list[Iterable[Verdict]]:
+    def _path_checks(self) -> list[Iterable[Outcome]]:
         """Path, cam and frame data (read only by those types)."""
         return [
             _each("point_velocity", self.point_velocity, lambda n, v: check_magnitude(n, v, MAX_VELOCITY)),
@@ -361,7 +344,7 @@ class DecelTime:
     stop: float = 0.5
     e_stop: float = 0.05
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         """Durations (spec 000 MPIMotionDecelTime, seconds); a stop takes some time."""
         return first_refusal((check_duration("stop", self.stop, positive=True),
                               check_duration("e_stop", self.e_stop, positive=True)))
@@ -385,7 +368,7 @@ class MotionConfig:
     def copy(self) -> MotionConfig:
         return copy.deepcopy(self)
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         """spec 000 MPIMotionConfig/MEIMotionConfig. The decel times are named as the ROS
         interface and the YAML name them (decel_time_stop); axis_numbers is read only."""
         return first_refusal((
@@ -396,14 +379,14 @@ class MotionConfig:
             self._user_label(),
         ))
 
-    def _pause_feedrate(self) -> Verdict:
+    def _pause_feedrate(self) -> Outcome:
         # 0 (the default) stops; a pause feedrate above 0 keeps the axes crawling and is held
         # to the range of the normal one.
         if self.pause_feedrate == 0.0 and _finite_number(self.pause_feedrate):
             return VALID
         return check_range("pause_feedrate", self.pause_feedrate, FEEDRATE_MIN, FEEDRATE_MAX)
 
-    def _user_label(self) -> Verdict:
+    def _user_label(self) -> Outcome:
         if isinstance(self.user_label, str) and len(self.user_label) <= USER_LABEL_MAX:
             return VALID
         return refuse(f"user_label: at most {USER_LABEL_MAX} characters (MEIObjectLabelCharMAX), "
@@ -426,7 +409,7 @@ class AxisInPosition:
     def copy(self) -> AxisInPosition:
         return copy.deepcopy(self)
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         """spec 002 MPIAxisInPosition. The tolerances are compared with a strict "<" (the
         NOTEs under the status tables), so a zero tolerance could never be met."""
         return first_refusal((
@@ -456,7 +439,7 @@ class AxisMaster:
     def copy(self) -> AxisMaster:
         return copy.deepcopy(self)
 
-    def validate(self, axes: int = MAX_OBJECTS, motors: int = MAX_OBJECTS, io_words: int = IO_WORDS_MAX) -> Verdict:
+    def validate(self, axes: int = MAX_OBJECTS, motors: int = MAX_OBJECTS, io_words: int = IO_WORDS_MAX) -> Outcome:
         """Against a controller of ``axes`` axes, ``motors`` motors and ``io_words`` I/O words.
         The primary feedback of motor n is the encoder of axis n's motor (the simulated plant),
         so it needs an axis n; a secondary input exists for every motor."""
@@ -483,7 +466,7 @@ class SecondaryFeedback:
     position: float = 0.0
     velocity: float = 0.0
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         return first_refusal((check_position("position", self.position),
                               check_magnitude("velocity", self.velocity, MAX_VELOCITY)))
 
@@ -504,7 +487,7 @@ class PlantConfig:
     # a full-scale 32,767 gives about 1e6 counts/s^2 by default.
     dac_acceleration: float = 30.0
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         return first_refusal((
             check_range("bandwidth_hz", self.bandwidth_hz, BANDWIDTH_MIN_HZ, BANDWIDTH_MAX_HZ),
             check_range("damping", self.damping, 0.0, DAMPING_MAX, above_low=True),
@@ -515,7 +498,7 @@ class PlantConfig:
             check_magnitude("dac_acceleration", self.dac_acceleration, MAX_ACCELERATION),
         ))
 
-    def _encoder_resolution(self) -> Verdict:
+    def _encoder_resolution(self) -> Outcome:
         # 0 reads the exact position; a step finer than 1e-6 count would overflow the reading
         # of a large position (y / resolution).
         if self.encoder_resolution == 0.0 and _finite_number(self.encoder_resolution):
@@ -527,7 +510,7 @@ class PlantConfig:
 FAULT_ACTIONS = ("NONE", "E_STOP", "ABORT", "E_STOP_ABORT")
 
 
-def check_action(name: str, value: object) -> Verdict:
+def check_action(name: str, value: object) -> Outcome:
     if isinstance(value, str) and value in FAULT_ACTIONS:
         return VALID
     return refuse(f"{name}: must be one of {', '.join(FAULT_ACTIONS)}, got {shown(value)}")
@@ -558,7 +541,7 @@ class AxisFaultConfig:
     def copy(self) -> AxisFaultConfig:
         return copy.deepcopy(self)
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         return first_refusal((
             check_range("following_error_limit", self.following_error_limit, 0.0, MAX_POSITION),
             check_duration("following_error_time", self.following_error_time),
@@ -575,7 +558,7 @@ class AxisFaultConfig:
             check_action("frame_underflow_action", self.frame_underflow_action),
         ))
 
-    def _limits_ordered(self) -> Verdict:
+    def _limits_ordered(self) -> Outcome:
         """Both limits on: the negative one below the positive one, and (MPI 002, MEIAxisConfig)
         "The distance between the positive and negative software position limits must be less
         than 32 bits (4,294,967,296 counts)"."""
@@ -590,7 +573,7 @@ class AxisFaultConfig:
                       f"{shown(self.software_limit_positive)}")
 
 
-def check_settling_reachable(in_position: AxisInPosition, plant: PlantConfig) -> Verdict:
+def check_settling_reachable(in_position: AxisInPosition, plant: PlantConfig) -> Outcome:
     """The encoder rounds to its resolution, so a reading can be resolution/2 from any
     target: a fine tolerance below that would never be met and no move would end."""
     if plant.encoder_resolution / 2.0 < in_position.position_fine:
@@ -616,7 +599,7 @@ class ControllerConfig:
     def motors(self) -> int:
         return self.axis_count if self.motor_count < 0 else self.motor_count
 
-    def validate(self) -> Verdict:
+    def validate(self) -> Outcome:
         return first_refusal((
             check_range("sample_rate", self.sample_rate, SAMPLE_RATE_MIN, SAMPLE_RATE_MAX),
             check_integer("axis_count", self.axis_count, 1, MAX_OBJECTS),

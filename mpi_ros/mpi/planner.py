@@ -26,6 +26,7 @@ from . import cams
 from .events import MPIEventType
 from .frames import AxisPlan, Move, Stream
 from .messages import Message
+from .outcome import Refused
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, MotionParams, Trajectory
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
@@ -42,13 +43,6 @@ _RELATIVE, _FINAL_VEL, _NO_REVERSAL, _DELAY, _OUTPUT, _ID, _ELEMENT_ID, _EVENT =
     int, (A.RELATIVE, A.FINAL_VEL, A.NO_REVERSAL, A.DELAY, A.OUTPUT, A.ID, A.ELEMENT_ID, A.EVENT))
 _SYNC, _HOLDS = int(A.SYNC_START | A.SYNC_END), int(HOLD_ATTRS)
 _duration_of = attrgetter("duration")
-
-
-class PlanError(Exception):
-    def __init__(self, message: Message, detail: str):
-        super().__init__(detail)
-        self.message = message
-        self.detail = detail
 
 
 @dataclass(slots=True)
@@ -204,7 +198,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
     along, parallel = _along(v0, unit, speed)
     final_along, final_parallel = _along(finals, unit, math.hypot(*finals))
     if not final_parallel:
-        raise PlanError(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
+        raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
     accels = [s.acceleration for s in starts]
@@ -266,7 +260,7 @@ def compile_move(
 ) -> tuple[Move, PlanNotes]:
     """The frames of a request for the axes ``starts`` (in the supervisor's order).
 
-    Raises PlanError with the spec's message when the profile cannot be made. A profile
+    Raises Refused with the spec's message when the profile cannot be made. A profile
     that starts while its axes move cannot wait first: a non-zero DELAY is
     MPIMotionMessageILLEGAL_DELAY (spec 000, for a modify in motion) and a HOLD
     MPIMotionMessageATTRIBUTE_INVALID (spec 000: HOLD is not permitted in modifies); either
@@ -276,9 +270,9 @@ def compile_move(
     notes = PlanNotes()
     moving = any(s.velocity != 0.0 for s in starts)
     if int(attrs) & _DELAY and moving and any(d != 0.0 for d in params.delay):
-        raise PlanError(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
+        raise Refused(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
     if int(attrs) & _HOLDS and moving:
-        raise PlanError(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
+        raise Refused(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
     stream = None
     try:
         if motion_type in CAM_TYPES:
@@ -291,7 +285,7 @@ def compile_move(
         else:
             plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
-        raise PlanError(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
+        raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
     move = Move(
         supervisor=supervisor,
         type=motion_type,
@@ -346,7 +340,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     plans = []
     for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
-            raise PlanError(Message.MPIMotionMessagePROFILE_ERROR,
+            raise Refused(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
         if bits & _DELAY:
             prof = _wait(start.position, params.delay[i]) + prof

@@ -64,3 +64,19 @@ class FrameBufferStatus:
     axis: int
     size: int
     frame_count: int
+
+
+@dataclass(frozen=True, slots=True)
+class MotionFeedback:
+    """What a goal's feedback and result show of a supervisor at a sample
+    (Controller.motion_feedback): lighter than mpiMotionStatus, taken for every feedback."""
+
+    sample: int
+    state: MPIState
+    command_position: tuple[float, ...]
+    actual_position: tuple[float, ...]
+    command_velocity: tuple[float, ...]
+    progress: float  # 0..1 along the move in progress (0 without one)
+    move_id: int  # the move in progress, else the last one
+    element_id: int
+    serial: int | None  # the move in progress (None without one)

@@ -1,8 +1,8 @@
 """What happens to a motion supervisor while the controller steps: moves done, stops
 complete, errors entered, holds released, each at the exact sample its condition holds.
 
-The controller asks :meth:`scan` for the samples of a stretch at which a transition
-happens, stops there, and calls :meth:`transition`.
+The controller asks :meth:`Transitions.scan` for the samples of a stretch at which a
+transition happens, stops there, and calls :meth:`Transitions.transition`.
 """
 
 from __future__ import annotations
@@ -21,57 +21,28 @@ from .status import AT_VELOCITY, DONE, StatusMode
 from .types import ActionSource, HoldType, MPIState
 
 if TYPE_CHECKING:
-    from collections import deque
-
-    from .clock import ProfileClock
-    from .control import Controller
-    from .frames import AxisPlan, Move, Stream
-    from .params import Hold, Output
+    from .frames import Move, Stream
+    from .host import SupervisorHost
+    from .moves import Moves
     from .status import StretchStatus
     from .stretch import Stretch
+    from .supervisor_actions import Actions
+    from .supervisor_state import SupervisorState
 
 OK = Message.MPIMessageOK
 
 
-class SteppingMixin:
-    """The transitions of MotionSupervisor."""
+class Transitions:
+    """The transitions of one motion supervisor while the controller steps: on its ``state``
+    and ``moves``; ``actions`` for the E_STOP a starving path gets."""
 
-    if TYPE_CHECKING:
-        # What this mixin uses of MotionSupervisor (motion.py) and ActionsMixin: declarations
-        # for the type checker only.
-        _ctl: Controller
-        number: int
-        own_state: MPIState
-        last_action: str
-        action_source: ActionSource
-        current: Move | None
-        queue: deque[Move]
-        clock: ProfileClock
-        _stop_end: float
-        _abort_after_stop: bool
-        _error_at: int | None
-        _holds: dict[int, HoldWait]
+    def __init__(self, host: SupervisorHost, state: SupervisorState, moves: Moves, actions: Actions):
+        self._host = host
+        self._state = state
+        self._moves = moves
+        self._actions = actions
         # what :meth:`scan` found for :meth:`transition`: by a name, or (a name, an axis number)
-        _conditions: dict[Any, np.ndarray]
-        _at_velocity_sent: bool
-
-        @property
-        def axes(self) -> list[Axis]: ...
-        def _axis(self, number: int) -> Axis: ...
-        def _emit(self, kind: MPIEventType, axis: int = -1, move: Move | None = None, detail: str = "",
-                  sample: int | None = None) -> None: ...
-        def _set_state(self, state: MPIState, action: str, source: ActionSource) -> None: ...
-        def _rebase(self, t: float) -> None: ...
-        def _load(self, move: Move, announce: bool = True) -> None: ...
-        def _drop_pending(self, message: Message, detail: str) -> None: ...
-        def _end_move(self, move: Move, message: Message, detail: str) -> None: ...
-        def _end_serial(self, serial: int, message: Message, detail: str) -> None: ...
-        def _position_of(self, hold: Hold) -> float: ...
-        def _fire_outputs(self, plan: AxisPlan) -> None: ...
-        def _fire_output(self, output: Output) -> None: ...
-        def _at_velocity_reached(self) -> None: ...
-        def _disable_amps(self, t: float) -> None: ...
-        def _e_stop(self, source: ActionSource, then_abort: bool = False, reason: str = "") -> tuple[Message, str]: ...
+        self._conditions: dict[Any, np.ndarray] = {}
 
     def scan(self, stretch: Stretch, status: StretchStatus) -> int | None:
         """The first sample of a stretch (stretch.Stretch, status.StretchStatus) at which a
@@ -81,17 +52,17 @@ class SteppingMixin:
         """
         conditions: dict[Any, np.ndarray] = {}
         self._conditions = conditions
-        state = self.own_state
-        if self._holds and state in (MPIState.MOVING, MPIState.STOPPED):
-            for axis_number, wait in self._holds.items():
+        state = self._state.own_state
+        if self._moves.holds and state in (MPIState.MOVING, MPIState.STOPPED):
+            for axis_number, wait in self._moves.holds.items():
                 conditions[("hold", axis_number)] = self._hold_trigger(wait, stretch)
-        if state is MPIState.MOVING and self.current is not None and not self._holds:
-            self._scan_move(self.current, stretch, status, conditions)
+        if state is MPIState.MOVING and self._moves.current is not None and not self._moves.holds:
+            self._scan_move(self._moves.current, stretch, status, conditions)
         if state is MPIState.STOPPING:
             conditions["stopped"] = self._stop_complete(stretch.t, status, lambda a: a.in_position.settle_on_stop)
         elif state is MPIState.STOPPING_ERROR:
-            if self._error_at is not None:
-                conditions["error"] = stretch.samples >= self._error_at
+            if self._state.error_at is not None:
+                conditions["error"] = stretch.samples >= self._state.error_at
             else:
                 conditions["error"] = self._stop_complete(stretch.t, status, lambda a: a.in_position.settle_on_estop)
         firsts = [int(np.argmax(fired)) for fired in conditions.values() if fired.any()]
@@ -108,12 +79,12 @@ class SteppingMixin:
         # over at its trajectory's end; with none, the axes go on at the final velocity
         # (MOVING) until a modify, an append or a stop.
         if move.ends_moving:
-            if self.queue:
+            if self._moves.queue:
                 conditions["move_done"] = np.logical_and.reduce(
                     [stretch.rel[plan.axis] >= plan.duration for plan in move.plans])
         else:
             self._all_axes(move, conditions, "move_done", status, DONE)
-        if move.is_velocity and not self._at_velocity_sent:
+        if move.is_velocity and not self._moves.at_velocity_sent:
             # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
             self._all_axes(move, conditions, "at_velocity", status, AT_VELOCITY)
 
@@ -125,7 +96,7 @@ class SteppingMixin:
         ``move``: the current one, a path; ``stream``: its streaming state."""
         left = None
         for plan in move.plans:
-            axis = self._axis(plan.axis)
+            axis = self._moves.axis(plan.axis)
             if axis.plan is not plan:
                 continue
             rel = np.nan_to_num(stretch.rel[plan.axis], nan=-np.inf)
@@ -144,7 +115,7 @@ class SteppingMixin:
             conditions["frames_empty"] = left == 0
         if stream.empty_count > 0:
             conditions["starving"] = left < stream.empty_count
-        if self.own_state is MPIState.MOVING and self._ctl.faults.watches_underflow(move.plan_axes):
+        if self._state.own_state is MPIState.MOVING and self._host.faults.watches_underflow(move.plan_axes):
             conditions["underflow"] = left == 0  # (after "starving": its E_STOP at that sample comes first)
 
     def _all_axes(self, move: Move, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
@@ -157,15 +128,9 @@ class SteppingMixin:
                 return
         conditions[key] = np.logical_and.reduce(status.bits[bit, list(axes)], axis=0)
 
-    def cruising(self) -> bool:
-        """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
-        move = self.current  # ends_moving: it ends at its target with a velocity (FINAL_VEL)
-        return move is not None and move.ends_moving and all(
-            self._axis(p.axis).plan is p and self._axis(p.axis).rel >= p.duration for p in move.plans)
-
     def _stop_complete(self, t: np.ndarray, status: StretchStatus, settle: Callable[[Axis], bool]) -> np.ndarray:
-        ready = t >= self._stop_end - 1e-12
-        for axis in self.axes:
+        ready = t >= self._state.stop_end - 1e-12
+        for axis in self._moves.axes:
             if settle(axis):
                 ready = ready & status.bits[DONE, axis.number]
         return ready
@@ -174,9 +139,9 @@ class SteppingMixin:
         if wait.watches_position:
             number = wait.hold.number
             raw = stretch.act_p[number] if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else stretch.cmd_p[number]
-            fired = wait.position_trigger(raw - self._axis(number).origin)
+            fired = wait.position_trigger(raw - self._moves.axis(number).origin)
         else:
-            fired = np.full(len(stretch), wait.static_trigger(self._ctl.io))
+            fired = np.full(len(stretch), wait.static_trigger(self._host.io))
         return fired | wait.timed_out(stretch.samples)
 
     def transition(self, index: int, samples: np.ndarray) -> None:
@@ -186,9 +151,10 @@ class SteppingMixin:
             if not fired[index]:
                 continue
             if key[0] == "hold":
-                wait = self._holds.get(key[1])
+                wait = self._moves.holds.get(key[1])
                 if wait is not None:
-                    self._release(key[1], wait, timed_out=bool(wait.timed_out(samples[index:index + 1])[0]))
+                    timed_out = bool(wait.timed_out(samples[index:index + 1])[0])
+                    self._moves.release(key[1], wait, timed_out=timed_out)
             elif key[0] == "output":
                 self._due_outputs(key[1])
             elif key in ("frames_low", "frames_empty", "starving"):
@@ -200,106 +166,84 @@ class SteppingMixin:
             elif key == "move_done":
                 self._move_done()
             elif key == "at_velocity":
-                self._at_velocity_reached()
+                self._moves.at_velocity_reached()
             elif key == "stopped":
-                self._set_state(MPIState.STOPPED, self.last_action, self.action_source)
+                self._state.enter(MPIState.STOPPED, self._state.last_action, self._state.action_source)
             elif key == "error":
                 self._stop_on_error_complete()
 
     def _due_outputs(self, axis_number: int) -> None:
         """Apply the outputs whose point the path has reached (the controller is there)."""
-        axis = self._axis(axis_number)
+        axis = self._moves.axis(axis_number)
         plan = axis.plan
-        if plan is None or self.current is None or plan not in self.current.plans:
+        if plan is None or self._moves.current is None or plan not in self._moves.current.plans:
             return
         now = reached(axis.rel)
         due = [out for when, out in plan.timed_outputs if when <= now]
         plan.timed_outputs = [(when, out) for when, out in plan.timed_outputs if when > now]
         for out in due:
-            self._fire_output(out)
+            self._moves.fire_output(out)
 
     def _chunk_done(self) -> None:
         """The last point of the oldest pending append is reached: that append is done."""
-        move = self.current
+        move = self._moves.current
         assert move is not None and move.stream is not None  # scan found it on the current path
         chunks = move.stream.chunks
         if chunks:
             serial, _ = chunks.pop(0)
-            self._end_serial(serial, OK, "points executed")
+            self._moves.end_serial(serial, OK, "points executed")
 
     def _buffer_event(self, key: str) -> None:
-        move = self.current
+        move = self._moves.current
         assert move is not None and move.stream is not None  # scan found it on the current path
         stream = move.stream
         if key == "frames_low" and not stream.low_sent:
             stream.low_sent = True
-            self._emit(MPIEventType.FRAMES_LOW, detail=f"fewer than {stream.low_count} points left: append more")
+            self._moves.emit(MPIEventType.FRAMES_LOW, detail=f"fewer than {stream.low_count} points left: append more")
         elif key == "frames_empty" and not stream.empty_sent:
             stream.empty_sent = True
-            self._emit(MPIEventType.FRAMES_EMPTY, detail="no points left; the path rests on its last point")
-        elif key == "starving" and self.own_state is MPIState.MOVING:
-            self._e_stop(ActionSource.CONTROLLER, reason=f"fewer than emptyCount = {stream.empty_count} points left "
-                                                          "while more are expected (final false)")
+            self._moves.emit(MPIEventType.FRAMES_EMPTY, detail="no points left; the path rests on its last point")
+        elif key == "starving" and self._state.own_state is MPIState.MOVING:
+            self._actions.e_stop(ActionSource.CONTROLLER, reason=f"fewer than emptyCount = {stream.empty_count} "
+                                                                 "points left while more are expected (final false)")
 
     def _underflow(self) -> None:
         """The frame buffer of the open path ran empty while moving (faults.py): the fault of
         each of its axes, unless an E_STOP (emptyCount) at this sample got there first."""
-        move = self.current
-        if self.own_state is MPIState.MOVING and move is not None:
-            self._ctl.faults.underflow(move.plan_axes)
+        move = self._moves.current
+        if self._state.own_state is MPIState.MOVING and move is not None:
+            self._host.faults.underflow(move.plan_axes)
 
     def _stop_on_error_complete(self) -> None:
         """E_STOP (or ABORT) has run its course: disable what must be, enter ERROR."""
-        t = self._ctl.time
-        if self._error_at is None:
-            if self._abort_after_stop:
-                self._disable_amps(t)
-            for axis in self.axes:
+        t = self._host.time
+        if self._state.error_at is None:
+            if self._state.abort_after_stop:
+                self._actions.disable_amps(t)
+            for axis in self._moves.axes:
                 if axis.mode is CommandMode.FOLLOW_ACTUAL:
                     # settleOnEstopCmdEqAct: "After the Estop time elapses, the axis'
                     # motors will disable the amplifiers."
                     axis.disable(t, None)
                     axis.status_mode = StatusMode.ABORT
-        self._error_at = None
-        self._rebase(t)
-        self._drop_pending(Message.MPIMotionMessageERROR, f"{self.last_action} by {self.action_source.value}")
-        for axis in self.axes:
-            if axis.owner == self.number and axis.plan is not None:
-                axis.unload(t, self.clock)
-        self._set_state(MPIState.ERROR, self.last_action, self.action_source)
+        self._state.error_at = None
+        self._moves.rebase(t)
+        state = self._state
+        self._moves.drop_pending(Message.MPIMotionMessageERROR, f"{state.last_action} by {state.action_source.value}")
+        for axis in self._moves.axes:
+            if axis.owner == self._state.number and axis.plan is not None:
+                axis.unload(t, self._state.clock)
+        self._state.enter(MPIState.ERROR, self._state.last_action, self._state.action_source)
 
     def _move_done(self) -> None:
-        move = self.current
+        move = self._moves.current
         assert move is not None  # scan found the current move done
-        self._emit(MPIEventType.MOTION_DONE, move=move)
-        self._end_move(move, OK, "motion done")
-        t = self._ctl.time
+        self._moves.emit(MPIEventType.MOTION_DONE, move=move)
+        self._moves.end_move(move, OK, "motion done")
+        t = self._host.time
         for plan in move.plans:
-            axis = self._axis(plan.axis)
+            axis = self._moves.axis(plan.axis)
             if plan.cam is not None and axis.plan is plan:
-                axis.unload(t, self.clock)  # at the table's end the slave rests: it follows no longer
-        self.current = None
-        if self.queue:
-            self._load(self.queue.popleft())
-        else:
-            self._set_state(MPIState.IDLE, self.last_action, self.action_source)
-
-    def release_holds(self, io) -> None:
-        """Release holds whose trigger is true now (after a gate or I/O change, a load)."""
-        for axis_number, wait in list(self._holds.items()):
-            if wait.watches_position:
-                fired = bool(wait.position_trigger(np.array([self._position_of(wait.hold)]))[0])
-            else:
-                fired = wait.static_trigger(io)
-            if fired:
-                self._release(axis_number, wait, timed_out=False)
-
-    def _release(self, axis_number: int, wait: HoldWait, timed_out: bool) -> None:
-        del self._holds[axis_number]
-        t = self._ctl.time
-        axis = self._axis(axis_number)
-        axis.load(wait.plan, self.clock.tau_at(t), t, self.clock)
-        self._fire_outputs(wait.plan)
-        kind = MPIEventType.HOLD_TIMEOUT if timed_out else MPIEventType.HOLD_RELEASED
-        self._emit(kind, axis=axis_number, move=self.current, detail=wait.hold.type.name)
-
+                axis.unload(t, self._state.clock)  # at the table's end the slave rests: it follows no longer
+        if not self._moves.next_move():
+            self._state.enter(MPIState.IDLE, self._state.last_action, self._state.action_source)

@@ -12,7 +12,8 @@ import math
 from dataclasses import replace
 
 from .messages import Message
-from .params import MAX_COORD_AXES, MAX_GATES, MAX_REQUEST_VALUES, Hold, MotionParams, Output, Verdict
+from .outcome import Outcome
+from .params import MAX_COORD_AXES, MAX_GATES, MAX_REQUEST_VALUES, Hold, MotionParams, Output
 from .types import (
     CAM_ATTRS,
     CAM_TYPES,
@@ -71,16 +72,16 @@ EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES | STREAMED_TYPES | CAM_TY
 MAX_PATH_VALUES = MAX_REQUEST_VALUES
 
 
-OK = Verdict(Message.MPIMessageOK)
+OK = Outcome(Message.MPIMessageOK)
 
 
-def _bad(message: Message, detail: str) -> Verdict:
-    return Verdict(message, detail)
+def _bad(message: Message, detail: str) -> Outcome:
+    return Outcome(message, detail)
 
 
 def check_type(
     motion_type: MPIMotionType, modify: bool, firmware_option_21: bool, append: bool = False
-) -> Verdict:
+) -> Outcome:
     """Is the type known, supported and (for a modify) modifiable? A modify with APPEND adds
     points to a path and changes nothing of the motion in progress, so it is open to every
     type that may carry APPEND (docs/paths.md), not only to the types MPI 000, mpiMotionModify
@@ -104,7 +105,7 @@ def check_type(
 
 def check_attributes(
     motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool
-) -> Verdict:
+) -> Outcome:
     bad = Message.MPIMotionMessageATTRIBUTE_INVALID
     allowed = ALLOWED_ATTRIBUTES.get(motion_type)
     if allowed is not None and attrs & ~allowed:
@@ -145,7 +146,7 @@ def check_params(
     sample_rate: float = 0.0,
     append_to: bool = False,
     frame_buffer_size: int = 128,
-) -> Verdict:
+) -> Outcome:
     """The request's values for a move of ``axis_count`` axes (``sample_rate``: the
     controller's, for a path's time slices; ``append_to``: the points go to an open path;
     ``frame_buffer_size``: the axes', for LOW_COUNT)."""
@@ -179,7 +180,7 @@ def check_params(
 
 
 def _check_attribute_data(attrs: MotionAttr, params: MotionParams, axis_count: int, io_words: int, motors: int,
-                          axes: int, points: int) -> Verdict:
+                          axes: int, points: int) -> Outcome:
     """The arrays the attributes read, for a move of ``points`` points (1 for a
     point-to-point or velocity move)."""
     bad = Message.MPIMessagePARAM_INVALID
@@ -211,7 +212,7 @@ def _check_attribute_data(attrs: MotionAttr, params: MotionParams, axis_count: i
 
 
 def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, axis_count: int,
-                io_words: int, motors: int, axes: int, sample_rate: float, append_to: bool) -> Verdict:
+                io_words: int, motors: int, axes: int, sample_rate: float, append_to: bool) -> Outcome:
     """A path or FRAME request (MPI 000, MPIMotionPT .. MEIMotionFrame, MPIMotionPoint).
 
     Order: non-finite data first (MEIMotionMessageBAD_PATH_DATA: "If any of the motion
@@ -251,7 +252,7 @@ def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPar
     return _check_path_shape(motion_type, params, sample_rate)
 
 
-def _check_cam(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, axis_count: int) -> Verdict:
+def _check_cam(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, axis_count: int) -> Outcome:
     """A cam (MPI 000, MPIMotionCam): pointCount segments, each with a master distance
     (masterDistance: pointCount elements), a slave distance per axis (slavePosition) and, for
     CAM_CUBIC, a gear ratio per axis at its end (gearRatio; a linear cam ignores it). The
@@ -288,7 +289,7 @@ def _check_cam(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPara
 
 
 def _check_path_attributes(attrs: MotionAttr, params: MotionParams, axis_count: int,
-                           frame_buffer_size: int) -> Verdict:
+                           frame_buffer_size: int) -> Outcome:
     """The fields of MPI 001's path attributes (MPIMotionPathAttributes), read only with
     their attribute."""
     if A.EXPECTED_AXES in attrs and params.expected_axes != axis_count:
@@ -319,7 +320,7 @@ def _finite(value: object) -> bool:
         return True  # not a number at all: the range checks answer it (PARAM_INVALID)
 
 
-def _path_lengths(motion_type: MPIMotionType, params: MotionParams, axis_count: int, points: int) -> Verdict:
+def _path_lengths(motion_type: MPIMotionType, params: MotionParams, axis_count: int, points: int) -> Outcome:
     bad = Message.MPIMessagePARAM_INVALID
     if motion_type is MPIMotionType.FRAME:
         if len(params.frames) % axis_count:
@@ -338,7 +339,7 @@ def _path_lengths(motion_type: MPIMotionType, params: MotionParams, axis_count: 
     return OK
 
 
-def _check_path_shape(motion_type: MPIMotionType, params: MotionParams, sample_rate: float) -> Verdict:
+def _check_path_shape(motion_type: MPIMotionType, params: MotionParams, sample_rate: float) -> Outcome:
     bad = Message.MPIMotionMessagePATH_ERROR
     if not params.final and not A.APPEND & ALLOWED_ATTRIBUTES[motion_type]:
         return _bad(bad, f"final is false, but no points can be appended to a {motion_type.name} path "
@@ -350,7 +351,7 @@ def _check_path_shape(motion_type: MPIMotionType, params: MotionParams, sample_r
     return OK
 
 
-def _check_trajectory(motion_type: MPIMotionType, traj) -> Verdict:
+def _check_trajectory(motion_type: MPIMotionType, traj) -> Outcome:
     bad = Message.MPIMessagePARAM_INVALID
     if motion_type in VELOCITY_TYPES:
         if traj.acceleration <= 0.0:
@@ -368,7 +369,7 @@ def _check_trajectory(motion_type: MPIMotionType, traj) -> Verdict:
     return OK
 
 
-def _check_hold(hold: Hold, attrs: MotionAttr, io_words: int, motors: int, axes: int) -> Verdict:
+def _check_hold(hold: Hold, attrs: MotionAttr, io_words: int, motors: int, axes: int) -> Outcome:
     bad = Message.MPIMessagePARAM_INVALID
     kind = hold.type
     if kind is HoldType.INVALID:
@@ -384,7 +385,7 @@ def _check_hold(hold: Hold, attrs: MotionAttr, io_words: int, motors: int, axes:
     return OK
 
 
-def _check_output(output: Output, io_words: int, motors: int) -> Verdict:
+def _check_output(output: Output, io_words: int, motors: int) -> Outcome:
     bad = Message.MPIMessagePARAM_INVALID
     if output.type is OutputType.INVALID:
         return _bad(bad, "output type INVALID")

@@ -50,6 +50,7 @@ from .. import requests as rq
 from ..commands import Command, Reply, io_space
 from ..config import RosSettings
 from ..mpi.messages import Message
+from ..mpi.outcome import Refused
 from ..mpi.types import MPIState
 from ..runner import ControllerRunner
 from . import convert, snapshots, wire
@@ -239,7 +240,7 @@ class ControllerNode(Node):
         convert.fill(response.in_position, rq.in_position_to_dict(cfg))
         convert.fill(response.master, rq.axis_master_to_dict(master))
         response.master_correction = master.correction
-        return convert.answer(response, Reply(Message.MPIMessageOK))
+        return convert.answer(response, Reply.of(Message.MPIMessageOK))
 
     def _on_config_set(self, k: int, request, response):
         reply, _ = self.runner.submit(Command("axis_config_set", axis=k, request={
@@ -259,7 +260,7 @@ class ControllerNode(Node):
     def _on_fault_config_get(self, k: int, response):
         message, cfg = self.runner.read(lambda ctl: ctl.axis_fault_config_get(k))
         convert.fill(response.config, rq.fault_config_to_dict(cfg))
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_fault_config_set(self, k: int, request, response):
         reply, _ = self.runner.submit(Command("axis_fault_config_set", axis=k,
@@ -281,7 +282,7 @@ class ControllerNode(Node):
     def _on_gate_get(self, request, response):
         message, closed = self.runner.read(lambda ctl: ctl.gate_get(request.gate))
         response.closed = closed
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_io_set(self, request, response):
         reply, _ = self.runner.submit(Command("io_set", request=convert.to_dict(request)))
@@ -290,9 +291,9 @@ class ControllerNode(Node):
     def _on_io_get(self, request, response):
         try:
             space = io_space(request.space)
-        except rq.RequestError as exc:
-            return convert.answer(response, Reply(exc.message))
+        except Refused as exc:
+            return convert.answer(response, Reply.of(exc.message))
         message, value = self.runner.read(lambda ctl: ctl.io_get(space, request.index))
         response.value = int(value)
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 

@@ -62,9 +62,11 @@ from ..commands import ACTION, CLIENT_LOST, MOTION_MODIFY, MOTION_START, Command
 from ..config import RosSettings
 from ..mpi.control import Controller
 from ..mpi.messages import Message
+from ..mpi.outcome import MoveEnd, Outcome
+from ..mpi.snapshot import MotionFeedback
 from ..runner import ControllerRunner, Output
 from . import convert, snapshots, wire
-from .goal_tracker import GoalBook, GoalEnd, TrackedGoal
+from .goal_tracker import GoalBook, TrackedGoal
 from .watchdog import LostClientWatchdog
 
 STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
@@ -88,17 +90,6 @@ class _RosGoal:
     action_type: type
     server: ActionServer
     executing: bool = False  # we moved it to EXECUTING (changed under the node's _transitions)
-
-
-@dataclass(frozen=True, slots=True)
-class _Facts:
-    """The supervisor when goals end, read once under the lock for their results."""
-
-    state: int
-    state_name: str
-    actual_position: list[float]
-    command_position: list[float]
-    move_id: int
 
 
 class _GoalServer(ActionServer):
@@ -187,7 +178,7 @@ class SupervisorNode(Node):
         self._shutting_down = False
         self._goal_group = ReentrantCallbackGroup()
         self._service_group = ReentrantCallbackGroup()
-        self._book = GoalBook(runner, number)
+        self._book = GoalBook(number)
         self._snapshots = snapshots.shared(runner)
         # Orders our own goal-state changes against an accepted cancel (see _mark_executing).
         self._transitions = threading.Lock()
@@ -304,14 +295,14 @@ class SupervisorNode(Node):
         if reply.accepted and reply.serial:
             goal.serial = reply.serial
         else:  # refused, or answered without a move to follow (NO_WAIT): the reply is the result
-            goal.end = GoalEnd(reply.message, reply.detail, sample)
+            goal.end = MoveEnd(0, reply.outcome, sample)
         self.runner.update(partial(self._file, goal))
         if self.watchdog is not None:
             self.watchdog.watch(key, self._feedback_topics[action_type])
 
     def _file(self, goal: TrackedGoal, ctl: Controller) -> Output | None:
         """Runner lock held: file the goal and review the book. What its move did since its
-        command is in the runner's outcomes, so the review decides it as if it had been
+        command is in the controller's move log, so the review decides it as if it had been
         filed with the command; a refused command ends it here."""
         if self._shutting_down and goal.end is None:
             goal.end = self._shutdown_end(ctl)  # accepted just before shutdown began
@@ -373,12 +364,12 @@ class SupervisorNode(Node):
         return self._ended(goals, ctl) if goals else None
 
     @staticmethod
-    def _shutdown_end(ctl: Controller) -> GoalEnd:
-        return GoalEnd(Message.MPIMotionMessageSTOPPED, "the suite is shutting down", ctl.sample)
+    def _shutdown_end(ctl: Controller) -> MoveEnd:
+        return MoveEnd(0, Outcome(Message.MPIMotionMessageSTOPPED, "the suite is shutting down"), ctl.sample)
 
     def _ended(self, goals: list[TrackedGoal], ctl: Controller) -> Output:
         """Reads what the results need now; the goals are closed after the lock."""
-        facts = _result_facts(ctl, self.number)
+        facts = ctl.motion_feedback(self.number)
         with self._closing:
             self._unfinished += len(goals)
 
@@ -403,16 +394,15 @@ class SupervisorNode(Node):
         service needs."""
         review = self._review(ctl)
         running = list(self._book.running())
-        ms = ctl.supervisor(self.number)
-        if not running or ms is None:
+        now = ctl.motion_feedback(self.number)
+        if not running or now is None:
             return review
-        current = ms.current.serial if ms.current is not None else None
         templates = {}
         sends = []
         for goal in running:
-            kind = (goal.payload.action_type, goal.serial == current)
+            kind = (goal.payload.action_type, goal.serial == now.serial)
             if kind not in templates:
-                templates[kind] = _feedback_template(ctl, ms, *kind)
+                templates[kind] = _feedback_template(now, *kind)
             head, tail = templates[kind]
             sends.append((self._feedback_pubs[kind[0]], head + goal.key + tail))
         return partial(_publish_feedback, review, sends)
@@ -434,7 +424,7 @@ class SupervisorNode(Node):
             goal.payload.handle._update_state(GoalEvent.EXECUTE)
             goal.payload.executing = True
 
-    def _close(self, goal: TrackedGoal, facts: _Facts | None) -> None:
+    def _close(self, goal: TrackedGoal, facts: MotionFeedback | None) -> None:
         """Hand an ended goal back to rclpy: its execute callback, scheduled now on the
         executor, sets the terminal state and returns the result without waiting."""
         ros = goal.payload
@@ -495,7 +485,7 @@ class SupervisorNode(Node):
     def _on_config_get(self, _request, response):
         message, config = self._read_ms(lambda ms: ms.config_get())
         convert.fill(response.config, rq.motion_config_to_dict(config))
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_config_set(self, request, response):
         return convert.answer(response, self._submit("config_set", {"config": convert.to_dict(request.config)}))
@@ -503,7 +493,7 @@ class SupervisorNode(Node):
     def _on_params_get(self, _request, response):
         message, params = self._read_ms(lambda ms: ms.params_get())
         response.params = convert.fill(MotionParamsMsg(), rq.params_to_dict(params))
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_params_set(self, request, response):
         return convert.answer(response, self._submit("params_set", {"params": convert.to_dict(request.params)}))
@@ -512,7 +502,7 @@ class SupervisorNode(Node):
         message, numbers, mapped = self._read_ms(lambda ms: (*ms.axis_list_get(), list(ms.mapped)))
         response.axis_numbers = numbers
         response.mapped_axis_numbers = mapped
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_axis_list_set(self, request, response):
         reply = self._submit("axis_list_set", {"axis_numbers": list(request.axis_numbers), "map": request.map})
@@ -527,7 +517,7 @@ class SupervisorNode(Node):
         message, actual, command = self._read_ms(lambda ms: ms.position_get())
         response.actual = [float(x) for x in actual]
         response.command = [float(x) for x in command]
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_position_set(self, request, response):
         reply = self._submit("position_set", {"actual": list(request.actual), "command": list(request.command)})
@@ -536,12 +526,12 @@ class SupervisorNode(Node):
     def _on_frame_buffer_status(self, _request, response):
         message, statuses = self._read_ms(lambda ms: ms.frame_buffer_status())
         response.axes = [FrameBufferStatusMsg(axis=s.axis, size=s.size, frame_count=s.frame_count) for s in statuses]
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_event_notify_get(self, _request, response):
         message, mask = self._read_ms(lambda ms: ms.event_notify_get())
         response.event_types = mask.names()
-        return convert.answer(response, Reply(message))
+        return convert.answer(response, Reply.of(message))
 
     def _on_event_notify_set(self, request, response):
         return convert.answer(response, self._submit("event_notify_set", {"event_types": list(request.event_types)}))
@@ -552,7 +542,7 @@ class SupervisorNode(Node):
         return convert.answer(response, reply)
 
 
-def _result(action_type, end: GoalEnd, sample: int, facts: _Facts | None):
+def _result(action_type, end: MoveEnd, sample: int, facts: MotionFeedback | None):
     """The result: the end's message and positions, the supervisor's state when it ended."""
     result = action_type.Result()
     result.message = end.message.name
@@ -561,45 +551,33 @@ def _result(action_type, end: GoalEnd, sample: int, facts: _Facts | None):
     result.end_sample = end.sample
     result.detail = end.detail
     if facts is not None:
-        result.state = facts.state
-        result.state_name = facts.state_name
+        result.state = int(facts.state)
+        result.state_name = facts.state.name
         result.actual_position = list(end.actual_position or facts.actual_position)
         result.command_position = list(end.command_position or facts.command_position)
         result.move_id = facts.move_id
     return result
 
 
-def _result_facts(ctl: Controller, number: int) -> _Facts | None:
-    ms = ctl.supervisor(number)
-    if ms is None:
-        return None
-    axes = [ctl.axes[n] for n in ms.mapped]
-    move = ms.current or ms.last_move
-    return _Facts(int(ms.state), ms.state.name, [a.actual_position for a in axes],
-                  [a.command_position for a in axes], move.id if move else 0)
-
-
-def _feedback(ctl: Controller, ms, action_type, current: bool):
+def _feedback(now: MotionFeedback, action_type, current: bool):
     """A goal's feedback; ``current``: the goal's move is the supervisor's current one."""
-    axes = [ctl.axes[n] for n in ms.mapped]
     fb = action_type.Feedback()
-    fb.sample = ctl.sample
-    fb.state = int(ms.state)
-    fb.state_name = ms.state.name
-    fb.command_position = [a.command_position for a in axes]
-    fb.actual_position = [a.actual_position for a in axes]
-    fb.command_velocity = [a.cmd_v for a in axes]
-    fb.progress = float(ms.progress()) if current and ms.current is not None else 0.0
-    move = ms.current or ms.last_move
-    fb.move_id = move.id if move else 0
-    fb.element_id = ms.element_id
+    fb.sample = now.sample
+    fb.state = int(now.state)
+    fb.state_name = now.state.name
+    fb.command_position = list(now.command_position)
+    fb.actual_position = list(now.actual_position)
+    fb.command_velocity = list(now.command_velocity)
+    fb.progress = now.progress if current else 0.0
+    fb.move_id = now.move_id
+    fb.element_id = now.element_id
     return fb
 
 
-def _feedback_template(ctl: Controller, ms, action_type, current: bool) -> tuple[bytes, bytes]:
+def _feedback_template(now: MotionFeedback, action_type, current: bool) -> tuple[bytes, bytes]:
     """A FeedbackMessage serialized, split around its goal id: (CDR header, the rest)."""
     message = action_type.Impl.FeedbackMessage()
-    message.feedback = _feedback(ctl, ms, action_type, current)
+    message.feedback = _feedback(now, action_type, current)
     data = serialize_message(message)
     return data[:4], data[4 + _GOAL_ID_SIZE:]
 

@@ -147,8 +147,9 @@ def test_no_backtrack_and_no_backtrack_hold_exclude_each_other():
     # MPIMotionAttrMaskNO_BACKTRACK / NO_BACKTRACK_HOLD: "cannot be specified with" the other one
     ctl = controller()
     ms1 = ctl.supervisor(1)
-    message, detail, _ = ms1.command(T.CAM_LINEAR, A.NO_BACKTRACK | A.NO_BACKTRACK_HOLD,
+    outcome, _ = ms1.command(T.CAM_LINEAR, A.NO_BACKTRACK | A.NO_BACKTRACK_HOLD,
                                      cam([100.0], [1.0, 1.0]), False)
+    message, detail = outcome.message, outcome.detail
     assert message is M.MPIMotionMessageATTRIBUTE_INVALID and "exclude" in detail
 
 
@@ -282,7 +283,8 @@ def test_a_slave_cannot_follow_itself_directly_or_through_other_cams():
     ctl = controller()
     ms1 = ctl.supervisor(1)
     follow(ctl, AxisMaster(S.AXIS_ACTUAL_POSITION, 2))  # axis 2 is a slave of the same cam
-    message, detail, _ = ms1.command(T.CAM_LINEAR, A.NONE, cam([100.0], [1.0, 1.0]), False)
+    outcome, _ = ms1.command(T.CAM_LINEAR, A.NONE, cam([100.0], [1.0, 1.0]), False)
+    message, detail = outcome.message, outcome.detail
     assert message is M.MPIMessagePARAM_INVALID and "itself" in detail
     # axis 3 follows axis 1; then a cam on axis 1 following axis 3 would be a loop
     _, ms2 = ctl.create_motion(2, 3)
@@ -290,7 +292,7 @@ def test_a_slave_cannot_follow_itself_directly_or_through_other_cams():
     assert ms2.start(T.CAM_LINEAR, A.NONE, cam([100.0], [1.0])).ok
     follow(ctl, AxisMaster(S.AXIS_COMMANDED_POSITION, 3), axes=(1,))
     ms1.axis_list_set([1])
-    assert ms1.command(T.CAM_LINEAR, A.NONE, cam([100.0], [1.0]), False)[0] is M.MPIMessagePARAM_INVALID
+    assert ms1.command(T.CAM_LINEAR, A.NONE, cam([100.0], [1.0]), False)[0].message is M.MPIMessagePARAM_INVALID
     assert ms1.state is MPIState.IDLE
 
 
@@ -405,7 +407,8 @@ def p(**fields):
 def test_each_validation_rule(kind, attrs, params, message, words):
     ctl = controller()
     ms1 = ctl.supervisor(1)
-    got, detail, _ = ms1.command(kind, attrs, params, False)
+    outcome, _ = ms1.command(kind, attrs, params, False)
+    got, detail = outcome.message, outcome.detail
     assert got is message and words in detail
     ctl.step(10)
     assert ms1.state is MPIState.IDLE and command(ctl, 1) == 0.0

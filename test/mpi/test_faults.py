@@ -17,6 +17,7 @@ from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIS
 from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.faults import Fault, error_samples
 from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.outcome import Outcome
 from mpi_ros.mpi.params import AxisFaultConfig
 
 GENTLE = Trajectory(4000.0, 20000.0, 20000.0, 0.0)  # about 4 counts of following error at 30 Hz
@@ -42,7 +43,11 @@ def configure(ctl: Controller, axis: int, **fields) -> None:
     assert verdict.ok, verdict.detail
 
 
-def reset(ms) -> tuple[Message, str]:
+def _split(outcome: Outcome) -> tuple[Message, str]:
+    return outcome.message, outcome.detail
+
+
+def reset(ms) -> Outcome:
     return ms.action_detail(MPIAction.RESET)
 
 
@@ -54,10 +59,9 @@ def test_a_gentle_move_does_not_trip_the_following_error(ctl, ms, run_to):
     assert fault_events(ctl) == [] and ctl.faults.names(0) == ()
 
 
-def test_a_move_too_aggressive_for_the_bandwidth_trips_at_the_exact_sample(ms, run_to):
+def test_a_move_too_aggressive_for_the_bandwidth_trips_at_the_exact_sample(ctl, ms, run_to):
     """The sample it trips at is the first at which |command - actual| has been above the
     limit for the configured time, computed from a run of the same move without the limit."""
-    ctl = ms._ctl
     free = Controller()
     _, free_ms = free.create_motion(0)
     free_ms.axis_list_set([0, 1])
@@ -86,7 +90,7 @@ def test_a_move_too_aggressive_for_the_bandwidth_trips_at_the_exact_sample(ms, r
     assert snap.faults == ("LIMIT_ERROR",) and not snap.amp_enabled and ms.last_action == "ABORT"
     assert ms.action_source.value == "CONTROLLER"
     # with the amplifier off RESET sets the command to the actual: nothing persists
-    assert reset(ms) == (Message.MPIMessageOK, "")
+    assert reset(ms) == Outcome(Message.MPIMessageOK)
     assert ms.state is MPIState.IDLE and ctl.axis_snapshot(0).faults == () and ctl.axes[0].amp_enabled
 
 
@@ -97,11 +101,11 @@ def test_a_following_error_that_persists_refuses_reset_until_the_loop_removes_it
     assert ctl.faults.names(0) == ("LIMIT_ERROR",) and ctl.axes[0].amp_enabled  # E_STOP: servo on
     # a disturbance pushes the motor 5000 counts off its command (the loop works on it)
     assert ctl.axis_actual_position_set(0, ctl.axes[0].actual_position + 5000.0).ok
-    message, detail = reset(ms)
+    message, detail = _split(reset(ms))
     assert message is Message.MPIMotionMessageERROR and ms.state is MPIState.ERROR
     assert "RESET refused" in detail and "axis 0 LIMIT_ERROR persists" in detail and "following error" in detail
     assert ctl.run_until(lambda c: abs(c.axes[0].position_error) < LIMIT, 20_000, chunk=20)
-    assert reset(ms)[0] is Message.MPIMessageOK and ctl.faults.names(0) == ()
+    assert reset(ms).message is Message.MPIMessageOK and ctl.faults.names(0) == ()
 
 
 def test_following_error_action_none_reports_and_keeps_moving(ctl, ms):
@@ -137,12 +141,12 @@ def test_a_software_limit_trips_where_the_actual_position_crosses_it(ctl, ms, ru
     assert ms.state is MPIState.STOPPING_ERROR and ms.last_action == "E_STOP"  # the default action
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
     # beyond the limit after the E_STOP's deceleration: RESET is refused, saying why
-    message, detail = reset(ms)
+    message, detail = _split(reset(ms))
     assert message is Message.MPIMotionMessageERROR and f"axis 0 {fault.value} persists" in detail
     assert ms.state is MPIState.ERROR and ctl.faults.names(0) == (fault.value,)
     # the limit moved out of the way (as an operator overrides it to drive back): cleared
     configure(ctl, 0, **{f"software_limit_{side}": 2 * target})
-    assert reset(ms)[0] is Message.MPIMessageOK and ctl.faults.names(0) == () and ms.state is MPIState.IDLE
+    assert reset(ms).message is Message.MPIMessageOK and ctl.faults.names(0) == () and ms.state is MPIState.IDLE
 
 
 def test_a_software_limit_is_recovered_by_driving_back_inside(ctl, ms, run_to):
@@ -151,17 +155,17 @@ def test_a_software_limit_is_recovered_by_driving_back_inside(ctl, ms, run_to):
     configure(ctl, 0, software_limit_positive_enabled=True, software_limit_positive=5000.0)
     start(ms, (10_000.0, 0.0))
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
-    assert reset(ms)[0] is Message.MPIMotionMessageERROR
+    assert reset(ms).message is Message.MPIMotionMessageERROR
     assert ctl.axis_command_position_set(0, 4000.0).ok
     assert ctl.run_until(lambda c: c.axes[0].actual_position <= 5000.0, 20_000, chunk=20)
-    assert reset(ms)[0] is Message.MPIMessageOK and ms.state is MPIState.IDLE
+    assert reset(ms).message is Message.MPIMessageOK and ms.state is MPIState.IDLE
 
 
 # -- amplifier fault ------------------------------------------------------------------------
 def test_an_amplifier_fault_disables_the_amplifier_and_aborts(ctl, ms, run_to):
     start(ms, (0.0, 20_000.0))
     ctl.step(400)
-    assert ctl.axis_fault_inject(1, "AMP_FAULT", True) == (Message.MPIMessageOK, "")
+    assert ctl.axis_fault_inject(1, "AMP_FAULT", True) == Outcome(Message.MPIMessageOK)
     [trip] = fault_events(ctl)
     assert trip.type is MPIEventType.AMP_FAULT and trip.axis == 1 and "AMP_FAULT" in trip.detail
     assert not ctl.axes[1].amp_enabled and ctl.axis_snapshot(1).faults == ("AMP_FAULT",)
@@ -170,11 +174,11 @@ def test_an_amplifier_fault_disables_the_amplifier_and_aborts(ctl, ms, run_to):
     velocity = abs(ctl.axes[1].act_v)
     ctl.step(400)
     assert abs(ctl.axes[1].act_v) < velocity / 2
-    message, detail = reset(ms)
+    message, detail = _split(reset(ms))
     assert message is Message.MPIMotionMessageERROR and "axis 1 AMP_FAULT persists" in detail
-    assert ctl.axis_fault_inject(1, "AMP_FAULT", False)[0].ok
+    assert ctl.axis_fault_inject(1, "AMP_FAULT", False).message.ok
     assert ctl.axis_snapshot(1).faults == ("AMP_FAULT",)  # latched until the RESET
-    assert reset(ms)[0] is Message.MPIMessageOK
+    assert reset(ms).message is Message.MPIMessageOK
     assert ctl.axes[1].amp_enabled and ctl.axes[1].command_position == ctl.axes[1].actual_position
     assert ctl.axis_snapshot(1).faults == () and ms.state is MPIState.IDLE
 
@@ -183,22 +187,22 @@ def test_an_amplifier_fault_with_action_none_lets_the_motor_coast_behind_its_com
     configure(ctl, 1, amp_fault_action="NONE")
     start(ms, (0.0, 20_000.0))
     ctl.step(400)
-    assert ctl.axis_fault_inject(1, "AMP_FAULT", True)[0].ok
+    assert ctl.axis_fault_inject(1, "AMP_FAULT", True).message.ok
     ctl.step(400)
     axis = ctl.axes[1]
     assert ms.state is MPIState.MOVING and not axis.amp_enabled
     assert axis.cmd_v > 1000.0 and abs(axis.act_v) < axis.cmd_v / 2  # the command goes on, the motor slows
     # RESET is refused in MOVING (the state table), and stays refused with the fault active
-    assert reset(ms)[0] is Message.MPIMotionMessageMOVING
+    assert reset(ms).message is Message.MPIMotionMessageMOVING
 
 
 def test_reset_in_idle_clears_a_latched_amplifier_fault(ctl, ms):
     configure(ctl, 0, amp_fault_action="NONE")
-    assert ctl.axis_fault_inject(0, "AMP_FAULT", True)[0].ok
+    assert ctl.axis_fault_inject(0, "AMP_FAULT", True).message.ok
     assert ms.state is MPIState.IDLE and not ctl.axes[0].amp_enabled
-    assert reset(ms)[0] is Message.MPIMotionMessageERROR  # refused: it persists
-    assert ctl.axis_fault_inject(0, "AMP_FAULT", False)[0].ok
-    assert reset(ms)[0] is Message.MPIMessageOK and ctl.axes[0].amp_enabled and ctl.faults.names(0) == ()
+    assert reset(ms).message is Message.MPIMotionMessageERROR  # refused: it persists
+    assert ctl.axis_fault_inject(0, "AMP_FAULT", False).message.ok
+    assert reset(ms).message is Message.MPIMessageOK and ctl.axes[0].amp_enabled and ctl.faults.names(0) == ()
 
 
 # -- encoder fault --------------------------------------------------------------------------
@@ -208,7 +212,7 @@ def test_an_encoder_fault_aborts_every_axis_that_watches_that_motor(ctl, ms, ms1
     watches motor 0; axis 1 has it disabled."""
     configure(ctl, 2, encoder_fault_motor_number=0)
     configure(ctl, 1, encoder_fault_motor_number=-1)
-    assert ctl.axis_fault_inject(0, "ENCODER_FAULT", True)[0].ok
+    assert ctl.axis_fault_inject(0, "ENCODER_FAULT", True).message.ok
     trips = fault_events(ctl)
     assert [(e.type, e.axis, e.supervisor) for e in trips] == [
         (MPIEventType.ENCODER_FAULT, 0, 0), (MPIEventType.ENCODER_FAULT, 2, 1)]
@@ -216,11 +220,11 @@ def test_an_encoder_fault_aborts_every_axis_that_watches_that_motor(ctl, ms, ms1
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
     run_to(ctl, ms1, MPIState.ERROR, chunk=50)
     assert ms.last_action == ms1.last_action == "ABORT"
-    assert ctl.axis_fault_inject(1, "ENCODER_FAULT", True)[0].ok
+    assert ctl.axis_fault_inject(1, "ENCODER_FAULT", True).message.ok
     assert fault_events(ctl) == []  # motor 1's encoder: axis 1 has the function disabled
-    assert "axis 2 ENCODER_FAULT persists" in reset(ms1)[1]
-    assert ctl.axis_fault_inject(0, "ENCODER_FAULT", False)[0].ok
-    assert reset(ms1)[0].ok and reset(ms)[0].ok
+    assert "axis 2 ENCODER_FAULT persists" in reset(ms1).detail
+    assert ctl.axis_fault_inject(0, "ENCODER_FAULT", False).message.ok
+    assert reset(ms1).message.ok and reset(ms).message.ok
     assert ms.state is ms1.state is MPIState.IDLE
 
 
@@ -239,7 +243,7 @@ def test_a_stream_that_runs_dry_trips_frame_underflow_and_its_action(ctl, ms, ru
     trips = fault_events(ctl)
     assert [(e.type, e.axis) for e in trips] == [(MPIEventType.FRAME_UNDERFLOW, 0), (MPIEventType.FRAME_UNDERFLOW, 1)]
     assert ms.last_action == "E_STOP" and ctl.faults.names(0) == ("FRAME_UNDERFLOW",)
-    assert reset(ms)[0] is Message.MPIMessageOK and ctl.faults.names(0) == ctl.faults.names(1) == ()
+    assert reset(ms).message is Message.MPIMessageOK and ctl.faults.names(0) == ctl.faults.names(1) == ()
 
 
 def test_the_default_underflow_action_none_rests_on_the_last_point_and_reports_it(ctl, ms):
@@ -266,20 +270,20 @@ def test_a_detected_fault_can_be_injected_as_a_one_off_trip(ctl, ms, run_to, fau
     configure(ctl, 1, **{"following_error_action" if fault is Fault.LIMIT_ERROR else
                          f"software_limit_{fault.value[9:].lower()}_action" if "SW" in fault.value else
                          "frame_underflow_action": "E_STOP_ABORT"})
-    assert ctl.axis_fault_inject(1, fault.value.lower(), True)[0].ok
+    assert ctl.axis_fault_inject(1, fault.value.lower(), True).ok
     [trip] = fault_events(ctl)
     assert trip.type is fault.event and trip.axis == 1 and "injected" in trip.detail
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
     assert ms.last_action == "E_STOP_ABORT" and not ctl.axes[1].amp_enabled
-    assert reset(ms)[0].ok and ctl.faults.names(1) == ()  # nothing holds it
+    assert reset(ms).message.ok and ctl.faults.names(1) == ()  # nothing holds it
 
 
 def test_bad_injections_are_refused_and_change_nothing(ctl, ms):
-    message, detail = ctl.axis_fault_inject(0, "OVERHEAT", True)
+    message, detail = _split(ctl.axis_fault_inject(0, "OVERHEAT", True))
     assert message is Message.MPIMessagePARAM_INVALID and "unknown fault 'OVERHEAT'" in detail
-    message, detail = ctl.axis_fault_inject(0, "LIMIT_ERROR", False)
+    message, detail = _split(ctl.axis_fault_inject(0, "LIMIT_ERROR", False))
     assert message is Message.MPIMessagePARAM_INVALID and "trips once" in detail
-    assert ctl.axis_fault_inject(9, "AMP_FAULT", True)[0] is Message.MPIAxisMessageAXIS_INVALID
+    assert ctl.axis_fault_inject(9, "AMP_FAULT", True).message is Message.MPIAxisMessageAXIS_INVALID
     assert ctl.drain_events() == [] and ms.state is MPIState.IDLE and ctl.faults.names(0) == ()
 
 

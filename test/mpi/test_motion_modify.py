@@ -142,16 +142,15 @@ def test_a_velocity_modify_reaches_its_velocity_at_the_end_of_its_own_ramp(param
     ctl, ms = rig()
     ms.start(T.VELOCITY, params=params((), velocity=200.0, acceleration=5000.0))
     ctl.step(200)
-    first = [end for end in ms.move_ends]
+    first = ctl.move_log.recent(ms.number)
     assert [(e.message, e.detail) for e in first] == [(Message.MPIMessageOK, "at velocity")]
-    ms.move_ends.clear()
     modified = ctl.effective_sample
     assert ms.modify(T.VELOCITY, params=params((), velocity=-300.0, acceleration=5000.0)).ok
     ramp = 500.0 / 5000.0 * RATE  # samples from +200 to -300 counts/s
     ctl.step(int(ramp) - 2)
-    assert ms.move_ends == [] and ctl.axes[0].cmd_v > -300.0  # still ramping through zero
+    assert ctl.move_log.recent(ms.number) == first and ctl.axes[0].cmd_v > -300.0  # still ramping through zero
     ctl.step(200)
-    (end,) = ms.move_ends
+    (end,) = ctl.move_log.recent(ms.number)[len(first):]
     assert end.message is Message.MPIMessageOK and end.serial == first[0].serial
     assert end.sample >= modified + ramp - 1
     assert ctl.axes[0].cmd_v == pytest.approx(-300.0)

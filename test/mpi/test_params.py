@@ -16,6 +16,7 @@ import pytest
 
 from mpi_ros.mpi import Controller, MPIAction, MPIState
 from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.outcome import Outcome
 from mpi_ros.mpi.params import (
     FEEDRATE_MAX,
     FEEDRATE_MIN,
@@ -34,7 +35,6 @@ from mpi_ros.mpi.params import (
     PlantConfig,
     Trajectory,
     UserFrame,
-    Verdict,
     check_duration,
     check_position,
     check_settling_reachable,
@@ -45,7 +45,7 @@ M = Message
 NOT_NUMBERS = [math.nan, math.inf, -math.inf, True, "1.0", None, 10**400]
 
 
-def refused(verdict: Verdict, field: str) -> bool:
+def refused(verdict: Outcome, field: str) -> bool:
     """Refused with PARAM_INVALID, the detail naming ``field`` first."""
     return verdict.message is M.MPIMessagePARAM_INVALID and verdict.detail.startswith(field + ":")
 

@@ -45,7 +45,8 @@ def test_no_wait_answers_ok_for_what_the_controller_refuses(ctl, notified):
     ctl.step(10)
     events(ctl)
     before = [a.cmd_p for a in ctl.axes]
-    message, detail, serial = notified.command(T.PT, A.NO_WAIT, MotionParams(position=[0.0, 0.0], time=[0.1]), False)
+    outcome, serial = notified.command(T.PT, A.NO_WAIT, MotionParams(position=[0.0, 0.0], time=[0.1]), False)
+    message, detail = outcome.message, outcome.detail
     assert message is M.MPIMessageOK and detail.startswith("NO_WAIT") and serial == 0
     ctl.step(1)
     assert events(ctl) == []  # refused (MOVING): no MOTION_START
@@ -60,8 +61,9 @@ def test_no_wait_still_answers_what_the_library_checks(ms):
 
 
 def test_no_wait_that_starts_sends_motion_start(ctl, notified):
-    message, _, serial = notified.command(T.PVT, A.NO_WAIT | A.NO_HANDSHAKE,
+    outcome, serial = notified.command(T.PVT, A.NO_WAIT | A.NO_HANDSHAKE,
                                           MotionParams(**PATH, point_velocity=[0.0] * 4), False)
+    message = outcome.message
     assert message is M.MPIMessageOK and serial == 0
     assert notified.snapshot().state is MPIState.IDLE  # NO_WAIT includes NO_HANDSHAKE
     ctl.step(1)
@@ -231,13 +233,14 @@ def test_a_modify_that_replaces_an_open_path_ends_its_appends(ctl, ms):
     open_path = MotionParams(position=[100.0, 0.0], point_velocity=[0.0, 0.0], time=[0.5], final=False,
                              empty_count=0)
     assert ms.start(T.PVT, A.NONE, open_path).ok
-    _, _, appended = ms.command(T.PVT, A.APPEND, MotionParams(position=[200.0, 0.0], point_velocity=[0.0, 0.0],
+    outcome, appended = ms.command(T.PVT, A.APPEND, MotionParams(position=[200.0, 0.0], point_velocity=[0.0, 0.0],
                                                               time=[0.5], final=False, empty_count=0), True)
     ctl.step(100)
     replaced = MotionParams(position=[50.0, 50.0], point_velocity=[0.0, 0.0], time=[0.2])
-    message, _, serial = ms.command(T.PVT, A.NONE, replaced, True)
+    outcome, serial = ms.command(T.PVT, A.NONE, replaced, True)
+    message = outcome.message
     assert message.ok and serial != appended
-    ends = {end.serial: (end.message, end.detail) for end in ms.move_ends}
+    ends = {end.serial: (end.message, end.detail) for end in ctl.move_log.recent(ms.number)}
     assert ends[appended] == (M.MPIMotionMessageSTOPPED, "replaced by a modify")
     ctl.run_until(lambda c: ms.state is MPIState.IDLE, 10_000)
     assert [a.command_position for a in ms.axes] == [50.0, 50.0]

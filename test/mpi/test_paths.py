@@ -7,7 +7,7 @@ validation; STOP/RESUME and E_STOP on a path.
 The per-type mathematics (profiles/path.py) is tested against scipy in
 test/mpi/profiles/test_path.py; here the expected path is path_segments() of the points the
 controller was given, evaluated at the sample times, and everything goes through the public API
-(start/modify/command, step, snapshots, events, move_ends, the I/O image). Nothing sleeps.
+(start/modify/command, step, snapshots, events, the move log, the I/O image). Nothing sleeps.
 """
 
 from __future__ import annotations
@@ -149,8 +149,8 @@ def run_idle(ctl, ms, limit=20_000, chunk=10):
     assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, limit, chunk=chunk), ms.state
 
 
-def ends_of(ms, serial):
-    return [end for end in ms.move_ends if end.serial == serial]
+def ends_of(ctl, serial):
+    return list(ctl.move_log.ends(serial))
 
 
 PEAK_RE = re.compile(r"axis (\d+): \|v\| ([0-9.e+-]+) counts/s, \|a\| ([0-9.e+-]+) counts/s\^2")
@@ -187,8 +187,8 @@ def test_every_path_type_runs_its_segments_at_every_sample(kind, relative):
     run_idle(ctl, ms)
     events = ctl.drain_events()
     assert [e.type for e in events] == [E.MOTION_DONE]
-    assert not ms.current and len(ms.move_ends) == 1
-    end = ms.move_ends[0]
+    assert not ms.current and len(ctl.move_log.recent(ms.number)) == 1
+    end = ctl.move_log.recent(ms.number)[0]
     assert end.message is M.MPIMessageOK and end.sample == events[0].sample > s0 + point_samples[-1]
     assert end.detail.startswith("motion done; path peaks")
     reported = {int(n): (float(v), float(a)) for n, v, a in PEAK_RE.findall(end.detail)}
@@ -222,7 +222,7 @@ def test_frame_move_runs_the_user_frames_as_given():
     assert np.allclose([ctl.axes[n].command_position for n in (0, 1)], ends, rtol=0.0, atol=TOL)
     run_idle(ctl, ms)
     assert [e.type for e in ctl.drain_events()] == [E.MOTION_DONE]
-    assert ms.move_ends[-1].message is M.MPIMessageOK
+    assert ctl.move_log.recent(ms.number)[-1].message is M.MPIMessageOK
 
 
 # ------------------------------------------------------------------ 3. batching ----
@@ -268,7 +268,8 @@ def _run_batched(batch: int, end: int = 2200):
         seen[ctl.sample] = (ms.state, ms.snapshot().element_id, ctl.io_get(IoSpace.IO, 4)[1],
                             tuple((a.cmd_p, a.cmd_v, a.cmd_a, a.act_p, a.act_v) for a in ctl.axes))
     events = [(e.sample, e.type, e.axis, e.move_id, e.element_id, e.detail) for e in ctl.drain_events()]
-    ends = [(m.message, m.sample, m.detail, m.command_position, m.actual_position) for m in ms.move_ends]
+    ends = [(m.message, m.sample, m.detail, m.command_position, m.actual_position)
+            for m in ctl.move_log.recent(ms.number)]
     return seen, events, ends
 
 
@@ -303,16 +304,19 @@ def test_append_extends_an_open_pvt_path_without_a_gap():
     points, velocities = _smooth(13)
     velocities[-1] = 0.0  # the path ends at rest (from its end on the command holds the last point)
     first = path_params(T.PVT, points[:6], [0.01] * 6, velocities[:6], final=False, empty_count=0)
-    message, _, path_serial = ms.command(T.PVT, A.NONE, first, False)
+    outcome, path_serial = ms.command(T.PVT, A.NONE, first, False)
+    message = outcome.message
     assert message.ok
     s0 = ctl.sample
     ctl.step(30)
     second = path_params(T.PVT, points[6:10], [0.01] * 4, velocities[6:10], final=False, empty_count=0)
-    message, _, serial_1 = ms.command(T.PVT, A.APPEND, second, False)  # mpiMotionStart with APPEND
+    outcome, serial_1 = ms.command(T.PVT, A.APPEND, second, False)  # mpiMotionStart with APPEND
+    message = outcome.message
     assert message.ok
     ctl.step(10)
     third = path_params(T.PVT, points[10:], [0.01] * 3, velocities[10:], final=True)
-    message, _, serial_2 = ms.command(T.PVT, A.APPEND, third, True)  # mpiMotionModify with APPEND
+    outcome, serial_2 = ms.command(T.PVT, A.APPEND, third, True)  # mpiMotionModify with APPEND
+    message = outcome.message
     assert message.ok
     assert len({path_serial, serial_1, serial_2}) == 3
     # one path from the start through all 13 points: PVT pieces depend only on their two points
@@ -332,14 +336,14 @@ def test_append_extends_an_open_pvt_path_without_a_gap():
             assert np.allclose(raw(ctl), points[i], rtol=0.0, atol=1e-8)
             assert np.allclose(v, velocities[i], rtol=0.0, atol=1e-6)
         # each append is done when its last point is reached; the path goes on
-        assert [e.sample for e in ends_of(ms, serial_1)] == ([s0 + 200] if k >= 200 else [])
-        assert [e.sample for e in ends_of(ms, serial_2)] == ([s0 + 260] if k >= 260 else [])
+        assert [e.sample for e in ends_of(ctl, serial_1)] == ([s0 + 200] if k >= 200 else [])
+        assert [e.sample for e in ends_of(ctl, serial_2)] == ([s0 + 260] if k >= 260 else [])
     for serial in (serial_1, serial_2):
-        (end,) = ends_of(ms, serial)
+        (end,) = ends_of(ctl, serial)
         assert (end.message, end.detail) == (M.MPIMessageOK, "points executed")
-    assert not ends_of(ms, path_serial) and ms.state is MPIState.MOVING
+    assert not ends_of(ctl, path_serial) and ms.state is MPIState.MOVING
     run_idle(ctl, ms)
-    (end,) = ends_of(ms, path_serial)
+    (end,) = ends_of(ctl, path_serial)
     assert end.message is M.MPIMessageOK and end.detail.startswith("motion done; path peaks")
     assert of_type(ctl.drain_events(), E.FRAMES_EMPTY, E.E_STOP) == []  # fed in time: never starved
 
@@ -350,20 +354,22 @@ def test_an_append_of_zero_points_with_final_closes_the_path():
     ctl, ms = new_supervisor()
     n = int(round(EXACT_DT * RATE))
     points = np.stack([np.arange(1.0, 41.0), -np.arange(1.0, 41.0)], axis=1)
-    message, _, path_serial = ms.command(T.PT, A.NONE, path_params(T.PT, points, [EXACT_DT] * 40, final=False),
+    outcome, path_serial = ms.command(T.PT, A.NONE, path_params(T.PT, points, [EXACT_DT] * 40, final=False),
                                          False)
+    message = outcome.message
     assert message.ok
     s0 = ctl.sample
     ctl.step(4)
-    message, _, serial = ms.command(T.PT, A.APPEND, MotionParams(final=True), False)
+    outcome, serial = ms.command(T.PT, A.APPEND, MotionParams(final=True), False)
+    message = outcome.message
     assert message.ok and serial != path_serial
     run_idle(ctl, ms, limit=10_000, chunk=50)
     assert [e.type for e in ctl.drain_events()] == [E.MOTION_DONE]
     assert [ctl.axes[n].command_position for n in (0, 1)] == pytest.approx([40.0, -40.0], abs=TOL)
-    (closing,) = ends_of(ms, serial)
+    (closing,) = ends_of(ctl, serial)
     assert (closing.message, closing.detail) == (M.MPIMessageOK, "points executed")
     assert closing.sample == s0 + 40 * n  # done with the path's last point
-    assert ends_of(ms, path_serial)[0].detail.startswith("motion done")
+    assert ends_of(ctl, path_serial)[0].detail.startswith("motion done")
 
 
 def test_a_closed_path_of_fewer_points_than_empty_count_runs_to_its_end():
@@ -375,7 +381,7 @@ def test_a_closed_path_of_fewer_points_than_empty_count_runs_to_its_end():
     assert ms.start(T.PT, A.NONE, closed).ok
     run_idle(ctl, ms)
     assert [e.type for e in ctl.drain_events()] == [E.MOTION_DONE]
-    assert ms.move_ends[-1].message is M.MPIMessageOK
+    assert ctl.move_log.recent(ms.number)[-1].message is M.MPIMessageOK
 
 
 def test_a_10000_point_path_streamed_in_chunks_of_50_runs_without_a_gap():
@@ -389,7 +395,8 @@ def test_a_10000_point_path_streamed_in_chunks_of_50_runs_without_a_gap():
         x = np.arange(a + 1, b + 1, dtype=float)
         return path_params(T.PT, np.stack([x, -0.5 * x], axis=1), [0.001] * (b - a), final=final)
 
-    message, _, path_serial = ms.command(T.PT, A.NONE, chunk(0, size, False), False)
+    outcome, path_serial = ms.command(T.PT, A.NONE, chunk(0, size, False), False)
+    message = outcome.message
     assert message.ok
     s0 = ctl.sample
     sent, appends = size, []  # (serial, number of its last point)
@@ -397,7 +404,8 @@ def test_a_10000_point_path_streamed_in_chunks_of_50_runs_without_a_gap():
         assert ctl.frame_count(0) <= 128
         if sent < total and ctl.frame_count(0) < 64:
             b = min(total, sent + size)
-            message, _, serial = ms.command(T.PT, A.APPEND, chunk(sent, b, b == total), False)
+            outcome, serial = ms.command(T.PT, A.APPEND, chunk(sent, b, b == total), False)
+            message = outcome.message
             assert message.ok
             appends.append((serial, b))
             sent = b
@@ -412,12 +420,12 @@ def test_a_10000_point_path_streamed_in_chunks_of_50_runs_without_a_gap():
     events = ctl.drain_events()
     assert of_type(events, E.E_STOP, E.FRAMES_EMPTY) == [] and of_type(events, E.MOTION_DONE)
     assert len(appends) == total // size - 1 and len({s for s, _ in appends} | {path_serial}) == total // size
-    (end,) = ends_of(ms, path_serial)
+    (end,) = ends_of(ctl, path_serial)
     assert end.message is M.MPIMessageOK and end.detail.startswith("motion done")
     # every append ends (OK, "points executed") at the sample its last point is reached: 2 per point
     late = []
     for serial, last_point in appends:
-        (done,) = ends_of(ms, serial)
+        (done,) = ends_of(ctl, serial)
         assert (done.message, done.detail) == (M.MPIMessageOK, "points executed")
         if done.sample != s0 + 2 * last_point:
             late.append((last_point, done.sample - s0))
@@ -455,8 +463,9 @@ def test_frames_low_then_empty_count_e_stop_at_their_exact_samples(dt):
     ctl, ms = new_supervisor()
     n = int(round(dt * RATE))
     points = np.stack([np.arange(1.0, 41.0), np.zeros(40)], axis=1)
-    message, _, serial = ms.command(T.PT, A.ELEMENT_ID, path_params(T.PT, points, [dt] * 40, final=False,
+    outcome, serial = ms.command(T.PT, A.ELEMENT_ID, path_params(T.PT, points, [dt] * 40, final=False,
                                                                   element_id=list(range(1, 41))), False)
+    message = outcome.message
     assert message.ok
     s0 = ctl.sample
     ctl.step(36 * n - 1)
@@ -469,7 +478,7 @@ def test_frames_low_then_empty_count_e_stop_at_their_exact_samples(dt):
     assert "emptyCount" in stop.detail and stop.element_id == 37
     assert ms.state is MPIState.STOPPING_ERROR and ms.snapshot().last_action == "E_STOP"
     assert ctl.run_until(lambda c: ms.state is MPIState.ERROR, 400)
-    (end,) = ends_of(ms, serial)
+    (end,) = ends_of(ctl, serial)
     assert end.message is M.MPIMotionMessageERROR
 
 
@@ -515,7 +524,7 @@ def test_without_empty_count_the_path_rests_on_its_last_point_and_an_append_resu
     assert ctl.sample == resumed + 2 * n and raw(ctl) == pytest.approx(more[-1], abs=TOL)
     run_idle(ctl, ms)
     assert [e.type for e in of_type(ctl.drain_events(), E.MOTION_DONE, E.E_STOP, E.FRAMES_EMPTY)] == [E.MOTION_DONE]
-    assert ms.move_ends[-1].message is M.MPIMessageOK
+    assert ctl.move_log.recent(ms.number)[-1].message is M.MPIMessageOK
 
 
 def test_a_closed_path_never_signals_the_buffer_nor_e_stops():
@@ -713,7 +722,7 @@ def _observe(ctl, ms, samples=600):
         ctl.step(50)
         trace.append((ms.state, ms.snapshot().element_id, tuple((a.cmd_p, a.act_p) for a in ctl.axes)))
     events = [(e.sample, e.type, e.supervisor, e.axis, e.move_id, e.element_id) for e in ctl.drain_events()]
-    ends = [(m.message, m.sample, m.detail) for m in ms.move_ends]
+    ends = [(m.message, m.sample, m.detail) for m in ctl.move_log.recent(ms.number)]
     return trace, events, ends, len(ms.queue), ms.stored_params
 
 
@@ -805,7 +814,8 @@ def test_a_refused_path_command_changes_nothing(name, setup, modify, kind, attrs
     # MPI 000, Returns for mpiMotionStart and mpiMotionModify; DESIGN.md: "bad input gets the spec's message
     # and changes nothing" (as test_validate.py, test_a_refused_command_changes_nothing)
     (ctl_a, ms_a), (ctl_b, ms_b) = _twins(setup)
-    message, _, _ = ms_b.command(kind, attrs, params, modify)
+    outcome, _ = ms_b.command(kind, attrs, params, modify)
+    message = outcome.message
     assert message is expected
     assert _observe(ctl_a, ms_a) == _observe(ctl_b, ms_b)
 
@@ -828,14 +838,16 @@ def test_a_modify_with_append_adds_points_and_modifies_nothing(kind):
     # points already given run unchanged)
     ctl, ms = new_supervisor()
     first = np.array([[20.0, 10.0], [50.0, 30.0], [60.0, 70.0], [90.0, 80.0]])
-    message, _, path_serial = ms.command(kind, A.NONE, path_params(kind, first, [EXACT_DT] * 4, final=False,
+    outcome, path_serial = ms.command(kind, A.NONE, path_params(kind, first, [EXACT_DT] * 4, final=False,
                                                                    empty_count=0), False)
+    message = outcome.message
     assert message.ok
     expected = Expected.of(kind, (0.0, 0.0), first, [EXACT_DT] * 4,
                            np.zeros((4, 2)) if kind in WITH_VELOCITY else None)
     ctl.step(10)
     more = np.array([[120.0, 60.0], [150.0, 40.0], [170.0, 20.0]])
-    message, _, serial = ms.command(kind, A.APPEND, path_params(kind, more, [EXACT_DT] * 3, final=True), True)
+    outcome, serial = ms.command(kind, A.APPEND, path_params(kind, more, [EXACT_DT] * 3, final=True), True)
+    message = outcome.message
     assert message.ok and serial != path_serial
     n = int(round(EXACT_DT * RATE))
     for k in range(11, 4 * n + 1):
@@ -843,9 +855,9 @@ def test_a_modify_with_append_adds_points_and_modifies_nothing(kind):
         assert np.allclose(raw(ctl), expected.at(k / RATE), rtol=0.0, atol=TOL), k
     run_idle(ctl, ms)
     assert raw(ctl) == pytest.approx(more[-1], abs=TOL)
-    (done,) = ends_of(ms, serial)
+    (done,) = ends_of(ctl, serial)
     assert (done.message, done.detail, done.sample) == (M.MPIMessageOK, "points executed", 7 * n)
-    assert ends_of(ms, path_serial)[0].message is M.MPIMessageOK
+    assert ends_of(ctl, path_serial)[0].message is M.MPIMessageOK
 
 
 @pytest.mark.parametrize("kind", [T.PT, T.PVT], ids=["PT", "PVT"])
@@ -853,16 +865,18 @@ def test_a_pt_or_pvt_modify_replaces_the_path_from_the_command_position(kind):
     # MPI 000, mpiMotionModify: PT and PVT "can be modified while moving": the new points run from where
     # the axes are (PVT: from their velocity too), the move keeps its identity
     ctl, ms = new_supervisor()
-    message, _, serial = ms.command(kind, A.NONE, path_params(kind, [[100.0, 50.0], [200.0, 100.0], [300.0, 150.0]],
+    outcome, serial = ms.command(kind, A.NONE, path_params(kind, [[100.0, 50.0], [200.0, 100.0], [300.0, 150.0]],
                                                               [0.02] * 3, [[5000.0, 2000.0]] * 2 + [[0.0, 0.0]]),
                                     False)
+    message = outcome.message
     assert message.ok
     ctl.step(15)
     here = raw(ctl)
     velocity = (ctl.axes[0].cmd_v, ctl.axes[1].cmd_v)
     assert abs(velocity[0]) > 100.0
     new_points, new_times, new_velocities = [[150.0, 0.0], [160.0, -10.0]], [0.01, 0.02], [[0.0, -500.0], [0.0, 0.0]]
-    message, _, modified = ms.command(kind, A.NONE, path_params(kind, new_points, new_times, new_velocities), True)
+    outcome, modified = ms.command(kind, A.NONE, path_params(kind, new_points, new_times, new_velocities), True)
+    message = outcome.message
     assert message.ok and modified == serial
     expected = Expected.of(kind, here, new_points, new_times, new_velocities if kind is T.PVT else None,
                            start_velocity=velocity)
@@ -870,7 +884,7 @@ def test_a_pt_or_pvt_modify_replaces_the_path_from_the_command_position(kind):
         ctl.step(1)
         assert np.allclose(raw(ctl), expected.at(k / RATE), rtol=0.0, atol=TOL), k
     run_idle(ctl, ms)
-    assert [(e.serial, e.message) for e in ms.move_ends] == [(serial, M.MPIMessageOK)]
+    assert [(e.serial, e.message) for e in ctl.move_log.recent(ms.number)] == [(serial, M.MPIMessageOK)]
 
 
 # ------------------------------------------------------------------ 10. STOP, RESUME, E_STOP ----
@@ -893,7 +907,8 @@ def test_stop_decelerates_along_the_path_and_resume_continues_it():
     # the path's time slows to a stop; its positions stay on the path's curve, and RESUME goes on from there
     ctl, ms = new_supervisor()
     points, times, expected = _line_and_curve(T.SPLINE, 20)
-    message, _, serial = ms.command(T.SPLINE, A.NONE, path_params(T.SPLINE, points, times), False)
+    outcome, serial = ms.command(T.SPLINE, A.NONE, path_params(T.SPLINE, points, times), False)
+    message = outcome.message
     assert message.ok
     ctl.step(300)
     assert ms.action(MPIAction.STOP).ok
@@ -915,7 +930,7 @@ def test_stop_decelerates_along_the_path_and_resume_continues_it():
     assert worst < 1e-6
     run_idle(ctl, ms)
     assert raw(ctl) == pytest.approx(points[-1], abs=TOL)
-    assert [(e.serial, e.message) for e in ms.move_ends] == [(serial, M.MPIMessageOK)]
+    assert [(e.serial, e.message) for e in ctl.move_log.recent(ms.number)] == [(serial, M.MPIMessageOK)]
 
 
 def test_e_stop_decelerates_along_the_path_and_ends_its_goals_with_error():
@@ -923,10 +938,12 @@ def test_e_stop_decelerates_along_the_path_and_ends_its_goals_with_error():
     # MPI 000, MPIMotionMessageERROR: the motion (and every append to it) ends in error
     ctl, ms = new_supervisor()
     points, times, expected = _line_and_curve(T.PT, 30)
-    message, _, serial = ms.command(T.PT, A.NONE, path_params(T.PT, points[:20], times[:20], final=False), False)
+    outcome, serial = ms.command(T.PT, A.NONE, path_params(T.PT, points[:20], times[:20], final=False), False)
+    message = outcome.message
     assert message.ok
-    message, _, appended = ms.command(T.PT, A.APPEND, path_params(T.PT, points[20:], times[20:], final=False),
+    outcome, appended = ms.command(T.PT, A.APPEND, path_params(T.PT, points[20:], times[20:], final=False),
                                       False)
+    message = outcome.message
     assert message.ok
     ctl.step(500)
     assert ms.action(MPIAction.E_STOP).ok
@@ -935,6 +952,6 @@ def test_e_stop_decelerates_along_the_path_and_ends_its_goals_with_error():
         ctl.step(1)
         worst = max(worst, _off_the_curve(ctl, expected))
     assert ms.state is MPIState.ERROR and worst < 1e-6
-    assert sorted((e.serial, e.message) for e in ms.move_ends) == [(serial, M.MPIMotionMessageERROR),
+    assert sorted((e.serial, e.message) for e in ctl.move_log.recent(ms.number)) == [(serial, M.MPIMotionMessageERROR),
                                                                     (appended, M.MPIMotionMessageERROR)]
-    assert all(e.detail.startswith("E_STOP") for e in ms.move_ends)
+    assert all(e.detail.startswith("E_STOP") for e in ctl.move_log.recent(ms.number))

@@ -9,7 +9,8 @@ import pytest
 from mpi_ros.mpi import Hold, HoldType, MotionAttr, MotionParams, MPIMotionType, Output, OutputType, Trajectory
 from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.planner import AxisStart, PlanError, compile_move
+from mpi_ros.mpi.outcome import Refused
+from mpi_ros.mpi.planner import AxisStart, compile_move
 
 A = MotionAttr
 T = MPIMotionType
@@ -81,7 +82,7 @@ def test_delay_prepends_a_wait_frame_per_axis():
 
 def test_illegal_delay_only_while_moving():
     # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "non-zero delay value ... while in motion"
-    with pytest.raises(PlanError) as refused:
+    with pytest.raises(Refused) as refused:
         compile_(A.DELAY, moving=True, delay=[0.0, 0.1])
     assert refused.value.message is Message.MPIMotionMessageILLEGAL_DELAY
     compile_(A.DELAY, moving=True, delay=[0.0, 0.0])
@@ -165,7 +166,7 @@ def test_final_velocity_plans_end_moving():
 
 def test_final_velocity_off_the_vector_line():
     # planner.py: "final velocities of a vector move must lie along the move"
-    with pytest.raises(PlanError) as refused:
+    with pytest.raises(Refused) as refused:
         compile_(A.FINAL_VEL, final_velocity=[100.0, 0.0])
     assert refused.value.message is Message.MPIMessagePARAM_INVALID
     move, _ = compile_(A.FINAL_VEL, final_velocity=[60.0, 80.0])
@@ -176,7 +177,7 @@ def test_no_reversal():
     # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "when the NO_REVERSAL attribute mask is specified, but the
     # specified target position is in the reverse direction"
     moving = [AxisStart(0, 0.0, 1000.0)]
-    with pytest.raises(PlanError) as refused:
+    with pytest.raises(Refused) as refused:
         compile_(A.NO_REVERSAL, position=(-10.0,), starts=moving, moving=True)
     assert refused.value.message is Message.MPIMotionMessagePROFILE_ERROR
     compile_(A.NO_REVERSAL, position=(1000.0,), starts=moving, moving=True)

@@ -216,7 +216,8 @@ def test_a_start_may_not_take_an_axis_out_of_a_stopped_vector(ctl):
     # 1 is refused with the state it shows, and says which supervisor holds the axis.
     a, b = sharing_axis_1(ctl)
     stopped_mid_move(ctl, a)
-    message, detail, _ = b.command(T.TRAPEZOIDAL, MotionAttr.NONE, make_params((10.0, 10.0)), modify=False)
+    outcome, _ = b.command(T.TRAPEZOIDAL, MotionAttr.NONE, make_params((10.0, 10.0)), modify=False)
+    message, detail = outcome.message, outcome.detail
     assert message is Message.MPIMotionMessageSTOPPED and "supervisor 0" in detail
     assert a.action(A.RESUME).ok
     ctl.step(500)

@@ -200,7 +200,7 @@ def test_start_from_stopped_drops_the_pending_profile(prepared):
     assert ms.start(T.TRAPEZOIDAL, params=p2p(OTHER)).ok
     assert ctl.run_until(lambda c: ms.state is S.IDLE, 20_000, chunk=100)
     assert [a.command_position for a in ms.axes] == list(OTHER)
-    ended = {end.serial: end.message for end in ms.move_ends}
+    ended = {end.serial: end.message for end in ctl.move_log.recent(ms.number)}
     assert ended[serial] is STOPPED  # the dropped move ended with the state it was dropped in
     assert ms.action(MPIAction.RESUME) is IDLE  # nothing pending any more
 

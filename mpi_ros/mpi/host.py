@@ -1,0 +1,63 @@
+"""What a motion supervisor needs of its controller, and nothing more.
+
+A supervisor and its collaborators (axis_list.py, moves.py, supervisor_actions.py,
+supervisor_stepping.py) are given a :class:`SupervisorHost`, never the Controller itself:
+the controller's time, its axes and I/O, its events and move outcomes, and the answers
+that concern other supervisors (who commands an axis, in what state, on what clock).
+Questions across supervisors are the controller's to answer; a supervisor does not reach
+into another one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    from .axis import Axis
+    from .clock import ProfileClock
+    from .events import MPIEventType
+    from .faults import FaultMonitor
+    from .io import IoImage
+    from .masters import Sources
+    from .outcome import MoveEnd, Outcome
+    from .params import ControllerConfig
+    from .snapshot import AxisSnapshot
+    from .types import ActionSource, MPIAction, MPIState
+
+
+class SupervisorHost(Protocol):
+    """The controller as a supervisor sees it (Controller implements it)."""
+
+    @property
+    def axes(self) -> Sequence[Axis]: ...
+    @property
+    def config(self) -> ControllerConfig: ...
+    @property
+    def io(self) -> IoImage: ...
+    @property
+    def faults(self) -> FaultMonitor: ...
+    @property
+    def rate(self) -> float: ...
+    @property
+    def sample(self) -> int: ...
+    @property
+    def time(self) -> float: ...
+
+    # -- this supervisor's own bookkeeping, kept by the controller
+    def next_serial(self) -> int: ...
+    def record_end(self, end: MoveEnd) -> None: ...
+    def clock_changed(self, supervisor: int, clock: ProfileClock) -> None: ...
+    def emit(self, kind: MPIEventType, supervisor: int = -1, axis: int = -1, move_id: int = 0,
+             element_id: int = 0, detail: str = "", extra_mask: MPIEventType = ..., sample: int | None = None
+             ) -> None: ...
+
+    # -- reads of the controller
+    def master_sources(self) -> Sources: ...
+    def axis_snapshot(self, number: int) -> AxisSnapshot: ...
+    def frame_count(self, number: int) -> int: ...
+
+    # -- other supervisors, as the controller answers for them
+    def own_state_of(self, supervisor: int) -> MPIState | None: ...
+    def clock_of(self, supervisor: int) -> ProfileClock | None: ...
+    def act_on(self, supervisor: int, action: MPIAction, source: ActionSource) -> Outcome: ...
