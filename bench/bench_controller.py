@@ -1,6 +1,6 @@
 """Controller stepping speed: axis-samples per second, and the multiple of real time.
 
-Targets (DESIGN.md, issue 10): stepping in real-time-sized batches (20 samples, what the
+Targets (docs/quality.md, "Fast"; issue 10): stepping in real-time-sized batches (20 samples, what the
 clock thread steps every 10 ms) at 32 axes >= 1,000,000 axis-samples/s; with large batches
 (4096, as replay and fast runs step) >= 20,000,000. Every axis runs a VELOCITY move (the
 command and the servo are computed every sample), one supervisor per axis for 1, 4 and 8

@@ -1,6 +1,6 @@
 """Planning time of a start: S-curve, trapezoid and S_CURVE_JERK, one axis and a 2-axis vector.
 
-Targets: planning an S-curve < 100 us median (DESIGN.md); within 10x of ruckig's calculate()
+Targets (docs/quality.md, "Fast"): planning an S-curve < 100 us median; within 10x of ruckig's calculate()
 for the equivalent problem, timed side by side in the same run (issue 10: a modify is planned
 while the command waits for its sample, so planning is command latency).
 

@@ -1,7 +1,7 @@
 """ROS-level figures of the suite in real time (time scale 1), in one process:
 
 - E_STOP latency: samples between the sample due when the client sends the E_STOP service
-  request and the sample at which the controller applied it (DESIGN.md target: within one
+  request and the sample at which the controller applied it (docs/quality.md, "Fast": within one
   sample of the request arriving). Includes DDS transport and executor scheduling.
 - status rate: MotionStatus messages per wall-clock second at 100 Hz and 1 kHz (target: within 2 %).
 - idle CPU of the suite (all threads), as a share of one core.

@@ -13,7 +13,7 @@ cd "$repo/bench"
     echo "Measured with \`bench/run.sh\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $(uname -m), Python $("$py" -c 'import platform; print(platform.python_version())'))."
     echo "Load on the machine during the run: $(cut -d' ' -f1-3 /proc/loadavg) (1/5/15 min)."
     echo
-    echo "Targets (DESIGN.md, issue 10): stepping 32 axes in 20-sample batches (what the real-time clock"
+    echo "Targets (docs/quality.md, issue 10): stepping 32 axes in 20-sample batches (what the real-time clock"
     echo "thread steps every 10 ms) >= 1,000,000 axis-samples/s, in batches of 4096 (how replay and fast"
     echo "runs step) >= 20,000,000, each measured beside the core before the rebuild; planning an"
     echo "S-curve < 100 us median; E_STOP within one sample of the request arriving; status rates within"

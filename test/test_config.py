@@ -13,7 +13,7 @@ from mpi_ros.mpi.types import MPIState
 
 def test_default_config_builds_the_documented_controller():
     cfg = config.load()
-    # DESIGN.md: config/default.yaml: 4 axes, 2 supervisors, ms0 on axes 0 and 1, ms1 on 2 and 3.
+    # README.md, "Configuration": 4 axes, 2 supervisors, ms0 on axes 0 and 1, ms1 on 2 and 3.
     assert cfg.axis_count == 4
     assert [(s.number, s.axes) for s in cfg.supervisors] == [(0, [0, 1]), (1, [2, 3])]
     ctl = cfg.build_controller()

@@ -37,7 +37,8 @@ def test_a_command_takes_effect_at_the_next_sample_and_listeners_see_it():
     runner.on_command(lambda sample, command, reply: log.append((sample, command.operation, reply.message.name)))
     runner.step(37)
     reply, sample = runner.submit(Command("motion_start", 0, request=GOAL))
-    # DESIGN.md: "a command is applied at the first sample after the controller's current one"
+    # docs/decisions.md, "Samples, commands and replay": a command is applied at the first sample after
+    # the controller's current one
     assert sample == 38 and log == [(38, "motion_start", "MPIMessageOK")]
     runner.step(2000)
     assert [end.message.name for end in runner.ctl.move_log.ends(reply.serial)] == ["MPIMessageOK"]

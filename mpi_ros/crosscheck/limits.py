@@ -1,8 +1,9 @@
 """Does the controller's profile respect every limit of its request?
 
 Checked on the profile's constant-jerk segments, independently of how the controller
-planned them (DESIGN.md "Quality bars", line 163: |v| <= velocity, |a| <= acceleration /
-deceleration, jerk as configured; lines 221-227 for the S-curve's shape):
+planned them (docs/quality.md, "Correct motion": |v| <= velocity, |a| <= acceleration /
+deceleration, jerk as configured; docs/profiles.md, "The trapezoid and the S-curve" for the
+S-curve's shape):
 
 * the profile is continuous in position and velocity, starts at the plan's start position
   and velocity (with zero acceleration when f > 0: checked per ramp below; a trapezoid steps),

@@ -1,6 +1,6 @@
 """How a controller request maps to a ruckig problem (a 1-DoF ``InputParameter``).
 
-The controller's profiles (DESIGN.md lines 221-233): the trapezoid is built from velocity V,
+The controller's profiles (docs/profiles.md, "The trapezoid and the S-curve"): the trapezoid is built from velocity V,
 acceleration A and deceleration D (a ramp raising |v| uses A, one lowering |v| uses D; A and
 D are the ramps' *average* accelerations), then each ramp is reshaped keeping its duration Ta:
 with f = jerkPercent/100 each jerk phase lasts f*Ta/2 and the peak acceleration is A/(1-f/2).
@@ -8,16 +8,17 @@ A ramp changing the velocity by dv at rate R therefore has jerk
 
     J = peak / (f*Ta/2) = 4 R^2 / (f (2-f) |dv|)        (infinite at f = 0: a trapezoid)
 
-so its jerk depends on the ramp's own velocity change. ruckig (DESIGN.md lines 234-238)
-reproduces the profile exactly when every ramp shares one peak and one jerk, given
+so its jerk depends on the ramp's own velocity change. ruckig (docs/profiles.md, "The cross-check
+against ruckig") reproduces the profile exactly when every ramp shares one peak and one jerk, given
 
 * ``max_velocity``      = V
 * ``max_acceleration``  = A/(1-f/2), ``min_acceleration`` = -D/(1-f/2) for a move in the
   positive direction (the signs swap for a negative move: there the raising ramps
   accelerate negatively), ±A/(1-f/2) when A = D
 * ``max_jerk``          = 4 A^2 / (f (2-f) w), w the peak velocity actually reached
-  (w = V, or sqrt(2|x|AD/(A+D)) for a move too short to reach V; DESIGN.md lines 236-237);
-  ``inf`` at f = 0 (never left at ruckig's default by accident: DESIGN.md line 240), and
+  (w = V, or sqrt(2|x|AD/(A+D)) for a move too short to reach V);
+  ``inf`` at f = 0 (never left at ruckig's default by accident: docs/profiles.md, "ruckig's
+  pitfalls"), and
   when the jerk phases f*Ta/2 are shorter than the time resolution of the comparison
   (TIME_RESOLUTION of the duration: a jerkPercent like 1e-200 gives a jerk ruckig cannot
   handle, and a profile indistinguishable from the trapezoid).
@@ -32,7 +33,7 @@ The models coincide (an *exact* mapping, compared tightly) for
   ignored), with ``control_interface = Velocity``, ±A/(1-f/2) and J = 4A^2/(f(2-f)|v-v0|).
 
 Standard types start from zero acceleration: the ruckig problem starts from (p, v, 0), the
-state the controller plans from (DESIGN.md lines 227-231); a non-zero current acceleration
+state the controller plans from (docs/profiles.md, "Modify: from the current state"); a non-zero current acceleration
 is :attr:`Reason.ACCELERATION_STEP`.
 
 Elsewhere (:class:`~mpi_ros.crosscheck.result.Reason`) there is no exact ruckig equivalent and
@@ -41,8 +42,8 @@ max(V, |v0|), the signed peaks, and the largest jerk of the controller's ramps �
 its jerk phases is shorter than the time resolution, or if ruckig fails on the finite jerk),
 so ruckig's time-optimal duration is a lower bound on the controller's.
 
-Never used: intermediate waypoints (DESIGN.md lines 242-244); ruckig's position extrema
-(line 242) — profiles are sampled instead.
+Never used (docs/profiles.md, "ruckig's pitfalls"): intermediate waypoints; ruckig's position
+extrema — profiles are sampled instead.
 """
 
 from __future__ import annotations

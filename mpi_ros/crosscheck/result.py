@@ -2,17 +2,18 @@
 
 Verdicts:
 
-* ``AGREE`` — the two models coincide for this request (DESIGN.md lines 234-236): the
-  durations agree to :data:`DURATION_RTOL` relative, the final position and velocity and
-  the sampled states (acceleration away from its steps) to :data:`STATE_RTOL` of their
-  scales (plus what double-precision time, :data:`TIME_RESOLUTION` of the duration,
-  allows), and the controller's profile respects every limit.
+* ``AGREE`` — the two models coincide for this request (docs/profiles.md, "The cross-check
+  against ruckig"): the durations agree to :data:`DURATION_RTOL` relative, the final
+  position and velocity and the sampled states (acceleration away from its steps) to
+  :data:`STATE_RTOL` of their scales (plus what double-precision time,
+  :data:`TIME_RESOLUTION` of the duration, allows), and the controller's profile respects
+  every limit.
 * ``DIFFER_EXPLAINED`` — the models legitimately differ (each :class:`Reason` says why,
-  DESIGN.md lines 221-238); the controller's profile still respects every limit, reaches
-  the same final position and velocity, and is never faster than ruckig's time-optimal
-  profile for limits the controller's profile satisfies (ruckig is a lower bound). Where
-  the only reason is :attr:`Reason.ACCELERATION_STEP`, the tight comparison of ``AGREE``
-  is made as well.
+  docs/profiles.md, "The cross-check against ruckig"); the controller's profile still
+  respects every limit, reaches the same final position and velocity, and is never faster
+  than ruckig's time-optimal profile for limits the controller's profile satisfies (ruckig
+  is a lower bound). Where the only reason is :attr:`Reason.ACCELERATION_STEP`, the tight
+  comparison of ``AGREE`` is made as well.
 * ``DISAGREE`` — anything else; ``problems`` lists what failed.
 
 Tolerances are constants here and never widened per case: a case that does not meet them

@@ -1,10 +1,10 @@
 """Running ruckig on a :class:`~mpi_ros.crosscheck.result.RuckigLimits` problem.
 
-Every limit is set explicitly (ruckig's max_velocity defaults to 0 and max_jerk to infinity,
-DESIGN.md line 240), lists have exactly one element (lengths are not checked, an empty
-list crashes the process: line 241), intermediate waypoints are never used (lines 242-244),
-and ruckig's errors — it raises ``RuckigError`` rather than returning a code (line 239) —
-become :class:`RuckigFailed`. The result is ruckig's own profile as constant-jerk segments
+ruckig's pitfalls (docs/profiles.md, "ruckig's pitfalls") are avoided: every limit is set
+explicitly (ruckig's max_velocity defaults to 0 and max_jerk to infinity), lists have exactly
+one element (lengths are not checked, an empty list crashes the process), intermediate
+waypoints are never used, and ruckig's errors — it raises ``RuckigError`` rather than
+returning a code — become :class:`RuckigFailed`. The result is ruckig's own profile as constant-jerk segments
 (its brake pre-trajectory, then its seven phases), so both models are sampled alike.
 """
 

@@ -84,7 +84,7 @@ def test_rosbags_reads_every_message(bag):
     info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
     claimed = {t["topic_metadata"]["name"]: t["message_count"] for t in info["topics_with_message_count"]}
     counted = rosbags_reads_every_message(bag)
-    # count what was read, not what the metadata claims (DESIGN.md)
+    # count what was read, not what the metadata claims (docs/recording.md, "Reading: count what was read")
     assert counted == claimed == BagReader(bag).counts()
     assert sum(counted.values()) == info["message_count"]
     assert counted["/mpi/commands"] > 0 and counted["/joint_states"] > 0 and counted["/mpi/configuration"] == 1

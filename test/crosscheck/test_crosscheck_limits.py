@@ -1,7 +1,7 @@
 """check_plan on plans as the controller compiles them (waits, vector shares, truncation) and
 on deliberately wrong plans: every broken limit is a DISAGREE with the problem named.
-Limits: DESIGN.md line 163 ("|v| <= velocity, |a| <= acceleration/deceleration, jerk as
-configured"), the S-curve's shape lines 221-227."""
+Limits: docs/quality.md, "Correct motion" (|v| <= velocity, |a| <= acceleration/deceleration, jerk
+as configured); the S-curve's shape: docs/profiles.md, "The trapezoid and the S-curve"."""
 
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 number of samples (often mid-ramp, so the axes carry an acceleration), modify it with a
 random request, and check every plan of both moves with the run-time monitor.
 
-DESIGN.md lines 227-231: a modify of S_CURVE/TRAPEZOIDAL/VELOCITY restarts from the current
+docs/profiles.md, "Modify: from the current state": a modify of S_CURVE/TRAPEZOIDAL/VELOCITY restarts from the current
 position and velocity with zero acceleration; the plans record that start state
 (start_velocity, start_acceleration), and vector moves record each axis' share of the
 limits (planner.py). Seeded numpy generator: reproducible."""

@@ -1,5 +1,5 @@
 """How requests map to ruckig problems (mpi_ros/crosscheck/mapping.py) and how ruckig is run
-(solver.py). DESIGN.md lines cited per test."""
+(solver.py). docs/profiles.md sections cited per test."""
 
 from __future__ import annotations
 
@@ -26,17 +26,17 @@ from mpi_ros.mpi.types import MPIMotionType
 
 
 def test_peak_acceleration_is_100_133_200_percent():
-    # DESIGN.md lines 224-225: "100 % / 133 % / 200 % of A at f = 0 / 0.5 / 1"
+    # docs/profiles.md, "The trapezoid and the S-curve": the peak is A, 4/3 A, 2 A at f = 0, 0.5, 1
     assert peak_acceleration(3000.0, 0.0) == 3000.0
     assert peak_acceleration(3000.0, 0.5) == pytest.approx(4000.0)
     assert peak_acceleration(3000.0, 1.0) == 6000.0
 
 
 def test_jerk_is_4A2_over_f_2minusf_v_and_infinite_at_f0():
-    # DESIGN.md lines 234-235: max_jerk = 4*A^2/(f*(2-f)*v) (infinite at f = 0)
+    # docs/profiles.md, "The cross-check against ruckig": max_jerk = 4*A^2/(f*(2-f)*v) (infinite at f = 0)
     assert ramp_jerk(5000.0, 0.5, 500.0) == pytest.approx(4 * 5000.0**2 / (0.5 * 1.5 * 500.0))
     assert ramp_jerk(5000.0, 0.0, 500.0) == math.inf
-    # the jerk phase f*Ta/2 (line 223) reaches the peak A/(1-f/2) at that jerk
+    # the jerk phase f*Ta/2 (docs/profiles.md, "The trapezoid and the S-curve") reaches the peak A/(1-f/2) at that jerk
     a, f, v = 5000.0, 0.3, 400.0
     assert peak_acceleration(a, f) / ramp_jerk(a, f, v) == pytest.approx(f * (v / a) / 2)
 
@@ -44,15 +44,16 @@ def test_jerk_is_4A2_over_f_2minusf_v_and_infinite_at_f0():
 def test_long_symmetric_scurve_maps_exactly():
     m = map_point_to_point(0.0, 0.0, 0.0, 1000.0, 0.0, 500.0, 5000.0, 5000.0, 50.0)
     assert m.exact and not m.reasons
-    assert m.limits.max_velocity == 500.0  # set explicitly: ruckig's default is 0 (line 240)
+    # set explicitly: ruckig's default is 0 (docs/profiles.md, "ruckig's pitfalls")
+    assert m.limits.max_velocity == 500.0
     assert m.limits.max_acceleration == pytest.approx(5000.0 / 0.75)
     assert m.limits.min_acceleration == -m.limits.max_acceleration
     assert m.limits.max_jerk == pytest.approx(4 * 5000.0**2 / (0.5 * 1.5 * 500.0))
 
 
 def test_short_move_takes_the_jerk_from_the_velocity_reached():
-    # DESIGN.md lines 236-237: "Short moves that never reach v need the jerk from the velocity
-    # actually reached"
+    # docs/profiles.md, "The cross-check against ruckig": a short move that never reaches v takes the jerk from the
+    # velocity it actually reaches
     m = map_point_to_point(0.0, 0.0, 0.0, 10.0, 0.0, 500.0, 5000.0, 5000.0, 50.0)
     w = math.sqrt(5000.0 * 10.0)
     assert reached_velocity(10.0, 500.0, 5000.0, 5000.0) == pytest.approx(w)
@@ -101,9 +102,9 @@ def test_reasons_of_each_legitimate_difference():
 
 
 def test_modify_with_acceleration_is_compared_from_zero_acceleration():
-    # DESIGN.md lines 227-231: a modify of S_CURVE/TRAPEZOIDAL/VELOCITY restarts from the current
-    # position and velocity with zero acceleration; ruckig gets that state, and the full-state
-    # duration is reported for information.
+    # docs/profiles.md, "Modify: from the current state": a modify of S_CURVE/TRAPEZOIDAL/VELOCITY
+    # restarts from the current position and velocity with zero acceleration; ruckig gets that
+    # state, and the full-state duration is reported for information.
     result = check_request(ProfileRequest(MPIMotionType.TRAPEZOIDAL, 500.0, 5000.0, target=1000.0,
                                           start_velocity=200.0, start_acceleration=3000.0))
     assert result.verdict is Verdict.DIFFER_EXPLAINED and result.reasons == (Reason.ACCELERATION_STEP,)
@@ -140,7 +141,7 @@ def test_solver_segments_match_ruckigs_own_sampling():
 
 
 def test_solver_turns_ruckig_errors_into_ruckig_failed():
-    # DESIGN.md line 239: "invalid input raises RuckigError"
+    # docs/profiles.md, "ruckig's pitfalls": invalid input raises RuckigError
     bad = RuckigLimits("position", 0.0, 0.0, 0.0, 10.0, 0.0, 100.0, 0.0, -100.0, math.inf)
     with pytest.raises(RuckigFailed):
         solve(bad)
@@ -165,7 +166,7 @@ def test_solver_changes_units_where_ruckig_fails_in_others():
 @given(distance=st.floats(1e-3, 1e6), velocity=st.floats(1.0, 1e5), acceleration=st.floats(10.0, 1e7),
        jerk_percent=st.one_of(st.floats(0.0, 100.0), st.floats(1e-300, 1e-3)), backwards=st.booleans())
 def test_symmetric_scurve_from_rest_always_agrees(distance, velocity, acceleration, jerk_percent, backwards):
-    # the case DESIGN.md lines 234-236 measured: "it agreed to 1e-15 s in duration here"
+    # docs/profiles.md, "The cross-check against ruckig": a symmetric S-curve from rest to rest maps exactly
     assume(distance / velocity < 4000.0)  # longer cruises hit the 16,384,000-sample frame limit
     request = ProfileRequest(MPIMotionType.S_CURVE, velocity, acceleration, jerk_percent=jerk_percent,
                              target=-distance if backwards else distance)

@@ -1,11 +1,11 @@
 """Thousands of seeded random requests, each checked against ruckig (issue 5).
 
-Where the models coincide (DESIGN.md lines 234-236: ruckig reproduces the S-curve "when
-given max_acceleration = A/(1 - f/2) and max_jerk = 4*A^2/(f*(2-f)*v)"), the durations
+Where the models coincide (docs/profiles.md, "The cross-check against ruckig": ruckig reproduces
+the S-curve given max_acceleration = A/(1 - f/2) and max_jerk = 4*A^2/(f*(2-f)*v)), the durations
 agree to 1e-6 relative and the sampled states to STATE_RTOL of their scales; where they do
-not (lines 236-238: short moves, accel != decel; lines 227-231: a modify restarts from zero
-acceleration), the controller's profile respects every limit (line 163) and is never
-faster than ruckig's time-optimal profile for limits it satisfies.
+not (the same section: accel != decel; "Modify: from the current state": a modify restarts from
+zero acceleration), the controller's profile respects every limit (docs/quality.md, "Correct
+motion") and is never faster than ruckig's time-optimal profile for limits it satisfies.
 
 The draws come from numpy's default_rng with fixed seeds (mpi_ros.crosscheck.survey), so
 a failure names a reproducible request. ``mpi-ros crosscheck --random N --seed S`` prints

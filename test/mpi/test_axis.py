@@ -57,7 +57,7 @@ def test_origin_offsets_every_reported_position(ctl, ms, params, run_to):
 
 
 def test_origin_must_be_finite(ctl):
-    # MPI 000, MPIMessagePARAM_INVALID / DESIGN.md "bad input gets the spec's message and changes nothing"
+    # MPI 000, MPIMessagePARAM_INVALID / docs/quality.md, "Robust": bad input changes nothing
     assert ctl.axis_origin_set(0, float("nan")) is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].origin == 0.0
 
@@ -122,7 +122,7 @@ def test_axis_invalid_out_of_range(ctl, number):
 
 
 def test_non_finite_positions_are_refused(ctl):
-    # MPI 000, MPIMessagePARAM_INVALID / DESIGN.md: bad input changes nothing
+    # MPI 000, MPIMessagePARAM_INVALID / docs/quality.md, "Robust": bad input changes nothing
     assert ctl.axis_command_position_set(0, float("inf")) is M.MPIMessagePARAM_INVALID
     assert ctl.axis_actual_position_set(0, float("nan")) is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].cmd_p == 0.0 and ctl.axes[0].act_p == 0.0
@@ -195,7 +195,7 @@ def test_axis_snapshot_reports_the_owner_and_frames(ctl, ms, ms1, params):
 
 
 def test_the_plant_is_deterministic(params):
-    # DESIGN.md "The controller is deterministic"
+    # docs/decisions.md, "Samples, commands and replay": the controller is deterministic
     def run():
         ctl = Controller(ControllerConfig(axis_count=2, supervisor_count=1))
         _, ms = ctl.create_motion(0)

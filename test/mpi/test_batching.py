@@ -1,8 +1,8 @@
 """The controller gives the same result however its samples are batched.
 
-DESIGN.md: "Every command takes effect at a sample boundary and is recorded with that sample's
-index, which is what makes replay exact." A live run steps in wall-clock batches, a replay
-in others; every value at every sample must agree to the bit. Random scripts of starts,
+docs/decisions.md, "Samples, commands and replay": every command takes effect at a sample boundary
+and is recorded with that sample's index, which is what makes replay exact. A live run steps in
+wall-clock batches, a replay in others; every value at every sample must agree to the bit. Random scripts of starts,
 modifies, appends, holds and every action, with the settle-on-stop variants.
 """
 

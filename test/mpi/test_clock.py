@@ -1,5 +1,5 @@
 """The feedrate clock (mpi_ros/mpi/clock.py): profile time runs at feedrate x real time; a
-STOP ramps the feedrate linearly (DESIGN.md), so tau(t) is piecewise quadratic."""
+STOP ramps the feedrate linearly (docs/decisions.md, "Stopping"), so tau(t) is piecewise quadratic."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def test_a_steady_clock_is_real_time_times_the_feedrate():
 
 
 def test_ramp_to_zero_over_the_stop_time():
-    # DESIGN.md: "STOP ramps the feedrate to pauseFeedrate over decelTime.stop"
+    # docs/decisions.md, "Stopping": STOP ramps the feedrate to pauseFeedrate over decelTime.stop
     clock = ProfileClock().ramp_to(1.0, 0.0, 0.5)
     assert clock.feedrate(1.0) == 1.0 and clock.feedrate(1.25) == 0.5 and clock.feedrate(1.5) == 0.0
     assert clock.tau_at(1.5) == pytest.approx(1.0 + 0.25)  # the area under the ramp

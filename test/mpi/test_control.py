@@ -16,7 +16,7 @@ M = Message
 
 def test_defaults():
     # issue 3: "sample rate (default 2000 Hz) ... frame buffer size (128)"; MPI 000, mpiMotionStart "With the
-    # sample rate configured for 2000 (default)"; DESIGN.md config/default.yaml 4 axes, 2 supervisors
+    # sample rate configured for 2000 (default)"; README.md, "Configuration": 4 axes, 2 supervisors
     ctl = Controller()
     assert ctl.rate == 2000.0 and ctl.config.frame_buffer_size == 128
     assert len(ctl.axes) == 4 and ctl.config.supervisor_count == 2 and not ctl.config.firmware_option_21
@@ -72,8 +72,8 @@ def test_delete_while_moving(ctl, ms, bring):
 
 
 def test_a_command_takes_effect_at_the_next_sample(ctl, ms, params):
-    # DESIGN.md: "A command ... is applied at the first sample after the controller's current one
-    # and recorded with that sample's index"
+    # docs/decisions.md, "Samples, commands and replay": a command is applied at the first sample after
+    # the controller's current one and recorded with that sample's index
     ctl.step(17)
     assert ctl.effective_sample == 18
     ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0)))
@@ -84,7 +84,7 @@ def test_a_command_takes_effect_at_the_next_sample(ctl, ms, params):
 
 
 def test_step_counts_samples(ctl):
-    # DESIGN.md: "it advances in whole samples"
+    # docs/decisions.md, "Samples, commands and replay": the controller advances in whole samples
     ctl.step(0)
     assert ctl.sample == 0
     ctl.step(12_345)
@@ -131,7 +131,7 @@ def test_supervisors_are_listed_by_number(ctl):
 
 
 def test_drain_events_empties_the_queue(ctl, ms, params):
-    # DESIGN.md /mpi/events: each event is delivered once
+    # docs/decisions.md, "Samples, commands and replay": each event reaches a listener once
     ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0)))
     assert ctl.drain_events()
     assert ctl.drain_events() == []
@@ -150,7 +150,7 @@ def test_motion_snapshot(ctl, ms, params, run_to):
 
 
 def test_settling_at_rest_does_not_depend_on_how_samples_are_batched():
-    # DESIGN.md "replaying a recording reproduces it exactly": the loop settling onto a resting
+    # docs/decisions.md, "Samples, commands and replay" (replay is exact): the loop settling onto a resting
     # command (where the servo model counts it as settled exactly) must fall on the same sample
     # whether the controller steps one sample at a time or in large batches.
     from mpi_ros.mpi import MotionParams, MPIAction, MPIMotionType, Trajectory

@@ -37,7 +37,7 @@ def test_axis_events_carry_the_move_id(ctl, ms, params, run_to):
 
 
 def test_event_samples_are_where_the_bits_rose(params):
-    # DESIGN.md: every event "is recorded with that sample's index" (independent of batching)
+    # docs/decisions.md, "Samples, commands and replay": events carry their sample (independent of batching)
     def run(chunk):
         ctl = Controller()
         _, ms = ctl.create_motion(0)
@@ -166,7 +166,7 @@ def test_shared_axis_state_and_only_one_commander(ctl, params):
 
 
 def test_events_reach_listeners_in_order(ctl, ms, params, run_to):
-    # DESIGN.md /mpi/events topic: listeners receive each event as it is delivered
+    # docs/decisions.md, "Samples, commands and replay": listeners receive each event as it is delivered
     heard = []
     ctl.listeners.append(heard.append)
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 0.0)))
@@ -176,6 +176,6 @@ def test_events_reach_listeners_in_order(ctl, ms, params, run_to):
 
 
 def test_event_type_names():
-    # DESIGN.md MotionEvent "string type (the MPIEventType name without prefix: MOTION_DONE, ...)"
+    # docs/decisions.md, "The ROS contract": event types are MPIEventType names without prefix (MOTION_DONE, ...)
     assert Event(0, E.MOTION_DONE).type_name == "MOTION_DONE"
     assert Event(0, E.NONE).type_name == "NONE"

@@ -1,5 +1,6 @@
 """Frames and the frame buffer (mpi_ros/mpi/frames.py): per-axis constant-jerk frames, the
-128-frame buffer and the refusal of an append that would overflow it (DESIGN.md)."""
+128-frame buffer and the refusal of an append that would overflow it (docs/decisions.md, "Motion",
+frame buffer overflow)."""
 
 from __future__ import annotations
 
@@ -34,8 +35,8 @@ def test_each_axis_has_a_128_frame_buffer(ctl, ms):
 
 def test_an_append_that_overflows_is_refused(ctl, ms, params):
     # MPI 000, mpiMotionStart "No provision has been made to check if the new frames will overwrite the
-    # currently executing frames"; DESIGN.md: "Here the append is refused with a clear message and
-    # nothing moves unexpectedly"; MPI 000, MPIMotionMessageFRAME_BUFFER_TOO_SMALL FRAME_BUFFER_TOO_SMALL
+    # currently executing frames"; docs/decisions.md, "Motion": such an append is refused and nothing moves
+    # unexpectedly; MPI 000, MPIMotionMessageFRAME_BUFFER_TOO_SMALL FRAME_BUFFER_TOO_SMALL
     count, refusal = fill(ctl, ms, params)
     assert refusal is Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
     assert ctl.frame_count(0) <= 128 and ctl.frame_count(0) + 8 > 128  # an S-curve move is 7 + 1 frames
@@ -45,7 +46,7 @@ def test_an_append_that_overflows_is_refused(ctl, ms, params):
 
 
 def test_the_refusal_changes_nothing(params):
-    # DESIGN.md: refused "and nothing moves unexpectedly"; "bad input ... changes nothing"
+    # docs/decisions.md, "Motion" (frame buffer overflow) and docs/quality.md, "Robust": the refusal changes nothing
     def run(extra):
         ctl = Controller()
         _, ms = ctl.create_motion(0)
@@ -134,7 +135,7 @@ def test_frames_needed_counts_per_axis():
 
 
 def test_frame_count_after_abort_and_reset(ctl, ms, bring):
-    # DESIGN.md: "RESET ... pending dropped": nothing is left in the buffer but the resting frame
+    # docs/state-machine.md: RESET drops the pending profile; nothing is left in the buffer but the resting frame
     bring(MPIState.ERROR)
     ms.action(MPIAction.RESET)
     assert ctl.frame_count(0) == 0

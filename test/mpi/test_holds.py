@@ -89,8 +89,8 @@ def test_motor_io_hold(ctl, ms, params, kind, space):
 
 def test_user_address_hold(ctl, ms, params):
     # MPI 000, MEIMotionAttrHoldTypeUSER_ADDRESS "Motion hold input trigger from a user specifiable controller memory
-    # address"; MPI 000, MEIMotionAttrHoldSource, user.address address, mask, pattern (DESIGN.md: address = an I/O word
-    # index)
+    # address"; MPI 000, MEIMotionAttrHoldSource, user.address address, mask, pattern (docs/decisions.md, "The ROS
+    # contract": address = an I/O word index)
     held_start(ms, params, Hold(type=HoldType.USER_ADDRESS, address=60, mask=-1, pattern=7))
     assert still(ctl)
     ctl.io_set(IoSpace.IO, 60, 7)
@@ -170,7 +170,7 @@ def test_hold_less_already_true_releases_at_once(ctl, params):
 def test_timeout_starts_the_move_anyway(ctl, ms, params):
     # MPI 000, MEIMotionAttrHOLD "The timeout field of MEIMotionAttrHold{} will cause the motion to start after the
     # specified timeout period (in seconds), even if the other hold criteria have not been
-    # satisfied"; DESIGN.md: "timeout in seconds ... seconds it is"
+    # satisfied"; docs/decisions.md, "Motion", HOLD: the timeout is in seconds
     ctl.gate_set(1, True)
     k = ctl.sample
     held_start(ms, params, Hold(type=HoldType.GATE, gate=1, timeout=0.1))
@@ -255,7 +255,7 @@ def test_the_hold_frame_is_in_the_buffer(ctl, ms, params):
 
 
 def test_e_stop_while_holding_drops_the_move(ctl, ms, params, run_to):
-    # MPI 000, mpiMotionAction E_STOP then ERROR; DESIGN.md: from ERROR only RESET leaves (nothing pending)
+    # MPI 000, mpiMotionAction E_STOP then ERROR; docs/state-machine.md: only RESET leaves ERROR (nothing pending)
     ctl.gate_set(3, True)
     held_start(ms, params, Hold(type=HoldType.GATE, gate=3))
     ms.action(MPIAction.E_STOP)

@@ -29,7 +29,7 @@ def test_log_records_every_sample_up_to_max_entries(ctl, ms, params):
 
 
 def test_log_is_the_same_in_any_batches(params):
-    # DESIGN.md: the controller advances in whole samples; batching changes nothing
+    # docs/decisions.md, "Samples, commands and replay": whole samples; batching changes nothing
     def logged(batch):
         ctl = Controller()
         _, ms = ctl.create_motion(0)

@@ -7,8 +7,8 @@ import pytest
 from mpi_ros.mpi.messages import OK, STATE_MESSAGES, Message
 from mpi_ros.mpi.types import MPIState
 
-# MPI 000, MPIMotionMessage, the MPIMotionMessage enum listing, in order (DESIGN.md: the listing's
-# "Type_INVALID" / "Attribute_INVALID" are typos for the upper-case names of the descriptions).
+# MPI 000, MPIMotionMessage, the MPIMotionMessage enum listing, in order (docs/decisions.md, "The ROS
+# contract": the listing's "Type_INVALID" / "Attribute_INVALID" are typos for the descriptions' upper-case names).
 MOTION_MESSAGES = [
     "MOTION_INVALID", "AXIS_NOT_FOUND", "AXIS_COUNT", "AXIS_FRAME_COUNT", "TYPE_INVALID",
     "ATTRIBUTE_INVALID", "IDLE", "MOVING", "STOPPING", "STOPPED", "STOPPING_ERROR", "ERROR",
@@ -34,8 +34,8 @@ def test_motion_messages_keep_the_order_of_the_spec_listing():
 
 
 def test_the_typo_spellings_of_the_enum_listing_are_not_names():
-    # DESIGN.md: "MPIMotionMessageTYPE_INVALID and MPIMotionMessageATTRIBUTE_INVALID (the enum
-    # listing's Type_INVALID/Attribute_INVALID is a typo)"
+    # docs/decisions.md, "The ROS contract": MPIMotionMessageTYPE_INVALID and MPIMotionMessageATTRIBUTE_INVALID
+    # (the enum listing's Type_INVALID/Attribute_INVALID is a typo)
     for typo in ("MPIMotionMessageType_INVALID", "MPIMotionMessageAttribute_INVALID"):
         with pytest.raises(KeyError):
             Message.from_name(typo)
@@ -59,7 +59,7 @@ def test_list_message_element_not_found_exists():
 
 
 def test_ok_is_code_zero_and_the_only_ok():
-    # DESIGN.md: "code is 0 for MPIMessageOK and a stable number per message otherwise"
+    # docs/decisions.md, "The ROS contract": code is 0 for MPIMessageOK and a fixed number per message otherwise
     assert OK is Message.MPIMessageOK
     assert Message.MPIMessageOK.code == 0
     assert Message.MPIMessageOK.ok
@@ -68,12 +68,12 @@ def test_ok_is_code_zero_and_the_only_ok():
 
 
 def test_codes_are_unique():
-    # DESIGN.md: "a stable number per message" (an IntEnum alias would hide a name)
+    # docs/decisions.md, "The ROS contract": one name per number (an IntEnum alias would hide a name)
     assert len({m.code for m in Message}) == len(Message.__members__)
 
 
 def test_from_name_round_trips_every_message():
-    # DESIGN.md: "string message is the spec's name exactly" and tools read the names
+    # docs/decisions.md, "The ROS contract": message is the reference's name exactly; tools read the names
     for message in Message:
         assert Message.from_name(message.name) is message
 

@@ -40,7 +40,8 @@ def record(ctl, ms, samples):
 
 def test_stop_decelerates_to_zero_over_the_stop_time(params):
     # MPI 000, MPIActionSTOP STOP "decelerates the axis (or axes) to a stop in the time specified by the stop
-    # time"; MPI 000, MPIMotionDecelTime, stop stop = 0.5 s; DESIGN.md "STOP ramps the feedrate to pauseFeedrate"
+    # time"; MPI 000, MPIMotionDecelTime, stop stop = 0.5 s; docs/decisions.md, "Stopping": STOP ramps the feedrate to
+    # pauseFeedrate
     ctl, ms = two_axes()
     ms.start(T.S_CURVE, params=params((30_000.0, 40_000.0), jerk_percent=50.0))
     ctl.step(1000)
@@ -53,8 +54,9 @@ def test_stop_decelerates_to_zero_over_the_stop_time(params):
 
 
 def test_stop_stays_on_the_path_and_resume_continues_it(params):
-    # DESIGN.md: "STOP ramps the feedrate to pauseFeedrate over the stop time so RESUME continues on
-    # the same path"; MPI 000, MPIActionRESUME RESUME "the Motion will resume if it was stopped by a prior call"
+    # docs/decisions.md, "Stopping": STOP ramps the feedrate to pauseFeedrate over the stop time, so
+    # RESUME continues on the same path; MPI 000, MPIActionRESUME RESUME "the Motion will resume if it
+    # was stopped by a prior call"
     ctl, ms = two_axes()
     ms.log_open(1_000_000)
     ms.start(T.S_CURVE, params=params((3000.0, 4000.0), jerk_percent=60.0))
@@ -74,7 +76,8 @@ def test_stop_stays_on_the_path_and_resume_continues_it(params):
 
 
 def test_resume_ramps_the_feedrate_back_over_the_stop_time(params):
-    # DESIGN.md: feedrate ramps (clock.py "RESUME back"); MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate
+    # docs/decisions.md, "Stopping": RESUME ramps the feedrate back; MPI 000, MPIMotionConfig,
+    # normalFeedrate normalFeedrate
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
     ctl.step(1000)
@@ -116,7 +119,7 @@ def test_e_stop_ramps_to_zero_over_the_e_stop_time(params):
 
 
 def test_e_stop_stays_on_the_path(params):
-    # DESIGN.md: "E_STOP ramps it to zero over decelTime.eStop" (the feedrate, so the path is kept)
+    # docs/decisions.md, "Stopping": E_STOP ramps the feedrate to zero over decelTime.eStop (the path is kept)
     ctl, ms = two_axes()
     ms.start(T.S_CURVE, params=params((3000.0, 4000.0), jerk_percent=50.0))
     ctl.step(500)
@@ -225,7 +228,7 @@ def test_velocity_move_stops_and_resumes(params):
 
 def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
     # MPI 000, MPIMotionConfig, pauseFeedrate pauseFeedrate "the feed speed rate for the Stop action": with 0.5 the axes
-    # still move when STOPPED; DESIGN.md "A new start from STOPPED discards the pending profile": the new
+    # still move when STOPPED; docs/state-machine.md: a new start from STOPPED drops the pending profile; the new
     # move must start from the velocity the axes have (limits never exceeded)
     ctl, ms = two_axes()
     config = ms.config_get()[1]
@@ -245,7 +248,7 @@ def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(par
     # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL "a non-zero target velocity": the axis leaves the move at that
     # velocity, so the supervisor stays MOVING (docs/decisions.md: never DONE, never IDLE while
     # the axis moves) and the next command is a modify that continues from the velocity
-    # (limits never exceeded, DESIGN.md).
+    # (limits never exceeded, docs/quality.md, "Correct motion").
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
     assert ctl.run_until(lambda c: c.axes[0].command_position > 1000.0, 10_000, chunk=10)

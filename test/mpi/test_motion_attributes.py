@@ -152,7 +152,7 @@ def test_delay_with_velocity_move(ctl, ms, params):
                                           (70000, 4464), (-40000, 25536)])
 def test_id_is_16_bit(ctl, ms, params, given, stored):
     # MPI 000, MPIMotionAttributes, id id "The id is limited to 16-bit resolution by the controller firmware";
-    # DESIGN.md quirks are "reproduced and reported as events"
+    # docs/decisions.md, "Motion": documented quirks are reproduced and reported as events
     assert ms.start(T.TRAPEZOIDAL, A.ID, params((10.0, 0.0), id=given)).ok
     assert ms.snapshot().move_id == stored and ctl.axes[0].move_id == stored
     truncated = events_of(ctl, E.ID_TRUNCATED)
@@ -186,7 +186,7 @@ def test_relative_move(ctl, ms, params):
 
 def test_relative_fraction_is_truncated(ctl, ms, params):
     # MPI 000, mpiMotionStart "When successive non-integer length relative motions are commanded, the
-    # fractional portion is truncated and discarded"; DESIGN.md: reported as an event
+    # fractional portion is truncated and discarded"; docs/decisions.md, "Motion": reported as an event
     for _ in range(4):
         ms.start(T.TRAPEZOIDAL, A.RELATIVE, params((10.75, -2.5)))
         run_idle(ctl, ms)
@@ -390,8 +390,8 @@ def test_velocity_jerk_with_the_option(params):
 def test_velocity_frame_stops_after_16384000_samples():
     # MPI 000, mpiMotionStart "The XMP firmware velocity frame execution time ... cannot exceed 16,384,000
     # samples ... the axes will stop abruptly after 16,384,000 samples. The motors will still
-    # maintain servo control and no errors are reported"; DESIGN.md: reproduced and reported as an
-    # event. At 100 Hz the ramp takes 10 samples, then the velocity frame runs its limit.
+    # maintain servo control and no errors are reported"; docs/decisions.md, "Motion": reproduced and
+    # reported as an event. At 100 Hz the ramp takes 10 samples, then the velocity frame runs its limit.
     ctl = Controller(ControllerConfig(sample_rate=100.0, axis_count=1, supervisor_count=1))
     _, ms = ctl.create_motion(0)
     ms.axis_list_set([0])

@@ -66,7 +66,7 @@ def test_config_set_cannot_change_the_mapping(ms):
 ])
 def test_config_set_refuses_bad_values(ms, change):
     # MPI 000, MEIMotionConfig, userLabel userLabel 16 characters; MPI 000, MEIMotionConfig, blendLimit blendLimit from
-    # -1.0 to 1.0; the times are durations and the feedrates fractions (DESIGN.md: bad input changes nothing)
+    # -1.0 to 1.0; the times are durations and the feedrates fractions (docs/quality.md, "Robust")
     config = ms.config_get()[1]
     change(config)
     assert ms.config_set(config) is M.MPIMessagePARAM_INVALID

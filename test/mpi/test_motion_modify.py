@@ -93,9 +93,9 @@ def test_modify_lowers_the_velocity_with_the_deceleration(params):
 
 
 def test_s_curve_modify_restarts_the_acceleration_from_zero(params):
-    # DESIGN.md: "a modify of S_CURVE (or TRAPEZOIDAL/VELOCITY) during a ramp restarts from the
-    # current position and velocity with zero acceleration (a step in acceleration, as the real
-    # firmware does)"
+    # docs/profiles.md, "Modify: from the current state": a modify of S_CURVE (or TRAPEZOIDAL/VELOCITY)
+    # during a ramp restarts from the current position and velocity with zero acceleration (a step in
+    # acceleration, as the real firmware does)
     ctl, ms = rig()
     ms.start(T.S_CURVE, params=params((10_000.0,), jerk_percent=50.0))
     ctl.step(100)  # mid-ramp, at the peak acceleration 13333
@@ -108,8 +108,8 @@ def test_s_curve_modify_restarts_the_acceleration_from_zero(params):
 
 
 def test_s_curve_jerk_modify_keeps_the_acceleration(params):
-    # DESIGN.md: "only S_CURVE_JERK / VELOCITY_JERK (firmware option) plan from the full state with
-    # jerk limits"
+    # docs/profiles.md, "Modify: from the current state": only S_CURVE_JERK / VELOCITY_JERK (firmware
+    # option 21) plan from the full state with jerk limits
     ctl, ms = rig(firmware_option_21=True)
     jerk = [Trajectory(1000.0, 10_000.0, 10_000.0, 0.0, 2e5, 2e5)]
     ms.start(T.S_CURVE_JERK, params=params((10_000.0,), trajectory=jerk))
@@ -235,8 +235,8 @@ def test_vector_modify_off_the_line_stops_then_goes_straight_within_the_vector_l
 
 
 def test_modify_during_the_resume_ramp(params):
-    # DESIGN.md feedrate: the modify plans in profile time from the current state while the feedrate
-    # still ramps up after RESUME; the motion stays continuous
+    # docs/decisions.md, "Stopping" (feedrate ramps): the modify plans in profile time from the
+    # current state while the feedrate still ramps up after RESUME; the motion stays continuous
     ctl, ms = rig()
     ms.start(T.TRAPEZOIDAL, params=params((100_000.0,)))
     ctl.step(1000)

@@ -53,7 +53,7 @@ def refused(verdict: Outcome, field: str) -> bool:
 # ------------------------------------------------------------------ the helpers ----
 @pytest.mark.parametrize("value", NOT_NUMBERS)
 def test_only_finite_numbers_pass_a_range(value):
-    # DESIGN.md "Robust": bad input gets the spec's message; a bool, a string or an int past
+    # docs/decisions.md, "Validation and ranges": every value must be a finite number; a bool, a string or an int past
     # every double is not a number a C double could hold
     assert refused(check_position("p", value), "p")
     assert refused(check_duration("d", value), "d")
@@ -267,9 +267,9 @@ def test_ids_are_c_longs():
 # ------------------------------------------------------------------ emptyCount ----
 @pytest.mark.parametrize("empty_count,disabled", [(-1, True), (0, True), (-7, True), (1, False), (5, False)])
 def test_empty_count_at_or_below_zero_disables(empty_count, disabled):
-    # spec 000 MPIMotionPoint: "When emptyCount is (-1), the buffer low trigger is disabled";
-    # spec 001 MPIMotionPathAttrMask EMPTY_COUNT: "To disable path-based deceleration, set the
-    # value to zero". Both disable, and so does anything below (DESIGN.md decision).
+    # MPI 000, MPIMotionPoint: "When emptyCount is (-1), the buffer low trigger is disabled";
+    # MPI 001, MPIMotionPathAttrMask EMPTY_COUNT: "To disable path-based deceleration, set the
+    # value to zero". Both disable, and so does anything below (docs/decisions.md, "emptyCount <= 0 disables").
     params = MotionParams(empty_count=empty_count)
     assert params.empty_count_disabled is disabled
     assert params.validate().ok  # every value disables or counts: none is refused

@@ -148,7 +148,7 @@ def test_velocity_move_cruises_for_the_frame_limit():
 
 
 def test_velocity_move_per_axis_trajectories():
-    # DESIGN.md array lengths: a VELOCITY move may give one trajectory per axis
+    # docs/decisions.md, "The ROS contract" (array lengths): a VELOCITY move may give one trajectory per axis
     trajectories = (Trajectory(100.0, 1000.0), Trajectory(-50.0, 1000.0))
     move, _ = compile_(kind=T.VELOCITY, position=(), starts=[AxisStart(0, 0.0), AxisStart(1, 0.0)],
                        trajectory=trajectories)

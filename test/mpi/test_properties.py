@@ -75,7 +75,7 @@ def logged(ms) -> np.ndarray:
 
 
 def peak(rate: float, jerk_percent: float) -> float:
-    """Peak acceleration of an S-curve ramp of average rate ``rate`` (DESIGN.md: A/(1 - f/2))."""
+    """Peak acceleration of an S-curve ramp of average rate ``rate`` (docs/profiles.md: A/(1 - f/2))."""
     return rate / (1.0 - jerk_percent / 200.0)
 
 
@@ -119,8 +119,8 @@ def check_segment_limits(plan, v_max: float, up: float, down: float) -> None:
 @settings(max_examples=150, **SETTINGS)
 @given(kind=st.sampled_from([T.TRAPEZOIDAL, T.S_CURVE]), data=st.data(), distance=distances)
 def test_point_to_point_limits_and_target(kind, data, distance):
-    # DESIGN.md quality bar: "limits never exceeded (|v| <= velocity, |a| <= acceleration/
-    # deceleration, jerk as configured, within float tolerance)"; MPI 002, Configuration of IN_POSITION and DONE Events
+    # docs/quality.md, "Correct motion": limits never exceeded (|v| <= velocity, |a| <= acceleration/
+    # deceleration, jerk as configured, within float tolerance); MPI 002, Configuration of IN_POSITION and DONE Events
     # after STOP or E-STOP Events, AT_TARGET "command = target"
     traj = data.draw(trajectories(kind))
     ctl, ms = rig()
@@ -137,8 +137,8 @@ def test_point_to_point_limits_and_target(kind, data, distance):
 @settings(max_examples=100, **SETTINGS)
 @given(data=st.data(), distance=distances)
 def test_s_curve_jerk_within_the_profile_jerk(data, distance):
-    # DESIGN.md: ruckig reproduces the S-curve with "max_jerk = 4*A^2/(f*(2-f)*v)"; "Short moves that
-    # never reach v need the jerk from the velocity actually reached"
+    # docs/profiles.md, "The cross-check against ruckig": max_jerk = 4*A^2/(f*(2-f)*w), w the peak
+    # velocity the move actually reaches (short moves never reach v)
     traj = data.draw(trajectories(T.S_CURVE))
     f = traj.jerk_percent / 100.0
     ctl, ms = rig()
@@ -304,8 +304,9 @@ def play(kind, ops, batches, tail=1500):
 @settings(max_examples=25, **SETTINGS)
 @given(scenario=scenarios(), sizes=st.lists(st.integers(1, 700), min_size=1, max_size=20))
 def test_stepping_is_chunk_invariant(scenario, sizes):
-    # controller: "the result does not depend on how the samples are batched"; DESIGN.md: replay
-    # reproduces a run exactly. One sample at a time vs random batches: bit-identical.
+    # controller: "the result does not depend on how the samples are batched"; docs/decisions.md,
+    # "Samples, commands and replay": replay reproduces a run exactly. One sample at a time vs
+    # random batches: bit-identical.
     kind, ops = scenario
 
     def ones():

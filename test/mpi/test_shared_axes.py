@@ -186,7 +186,7 @@ SHARED = [(state, name, *SHARED_CELLS.get((state, name), (message, after))) for 
 
 @pytest.mark.parametrize("state,name,message,after", SHARED, ids=[f"{c[0].name}-{c[1]}" for c in SHARED])
 def test_cell_from_the_supervisor_sharing_an_axis(state, name, message, after):
-    # DESIGN.md's state x action table holds for a supervisor in the state its axes show: a command
+    # docs/state-machine.md's state x action table holds for a supervisor in the state its axes show: a command
     # to supervisor 1 answers as the table says for that state, and both supervisors then show the
     # table's state (an action acts on the motion that holds the shared axis; a start or modify
     # may not take an axis out of another supervisor's motion).

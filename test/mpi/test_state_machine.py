@@ -1,5 +1,5 @@
-"""The supervisor state machine (mpi_ros/mpi/motion.py): every cell of DESIGN.md's state x
-action table, with the message the spec gives, and the transitions between the states.
+"""The supervisor state machine (mpi_ros/mpi/motion.py): every cell of the state x
+action table of docs/state-machine.md, with the message the spec gives, and the transitions between the states.
 
 A cell that refuses ("msg X") must change nothing: the refused command is given to one of
 two identical controllers and both must then move, report and change state identically.
@@ -54,7 +54,7 @@ CELLS = [
     (S.IDLE, "RESUME", IDLE, S.IDLE),  # MPI 000, MPIMotionMessageIDLE "... or RESUME is commanded when ... IDLE"
     (S.IDLE, "RESET", OK, S.IDLE),  # docs/state-machine.md: RESET in IDLE "OK, no change"
     (S.IDLE, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction E_STOP -> STOPPING_ERROR -> ERROR
-    (S.IDLE, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction; DESIGN.md "Safety actions are never refused"
+    (S.IDLE, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction; docs/state-machine.md: never refused
     (S.IDLE, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
     (S.IDLE, "MAP", OK, S.IDLE),  # MPI 000, MEIActionMAP MAP writes the axis mapping
     # MOVING
@@ -78,12 +78,12 @@ CELLS = [
     (S.STOPPING, "RESUME", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING "RESUME or RESET ... STOPPING
                                                    # state"
     (S.STOPPING, "RESET", STOPPING, S.STOPPING),  # MPI 000, MPIMotionMessageSTOPPING
-    (S.STOPPING, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction; DESIGN.md never refused
+    (S.STOPPING, "E_STOP", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction; docs/state-machine.md: never refused
     (S.STOPPING, "ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
     (S.STOPPING, "E_STOP_ABORT", OK, S.STOPPING_ERROR),  # MPI 000, mpiMotionAction
     (S.STOPPING, "MAP", STOPPING, S.STOPPING),  # MPI 000, Motion Objects, introduction (axes still moving)
     # STOPPED
-    (S.STOPPED, "start", OK, S.MOVING),  # DESIGN.md: "A new start from STOPPED discards the pending profile"
+    (S.STOPPED, "start", OK, S.MOVING),  # docs/state-machine.md: a start from STOPPED drops the pending profile
     (S.STOPPED, "modify", STOPPED, S.STOPPED),  # docs/state-machine.md: modify in STOPPED "msg STOPPED"
     (S.STOPPED, "STOP", STOPPED, S.STOPPED),  # MPI 000, MPIMotionMessageSTOPPED STOPPED "when a STOP ... already
                                               # STOPPED"
@@ -121,7 +121,7 @@ CELLS = [
 
 
 def test_the_table_has_every_cell():
-    # DESIGN.md: "The whole table" of 6 states x (start, modify, 7 actions)
+    # docs/state-machine.md: the whole table of 6 states x (start, modify, 7 actions)
     cells = {(state, name) for state, name, _, _ in CELLS}
     names = ["start", "modify", "STOP", "RESUME", "RESET", "E_STOP", "ABORT", "E_STOP_ABORT", "MAP"]
     assert cells == {(state, name) for state in S if state is not S.INVALID for name in names}
@@ -194,7 +194,7 @@ def test_modify_auto_start_while_moving_is_a_plain_modify(prepared):
 
 
 def test_start_from_stopped_drops_the_pending_profile(prepared):
-    # DESIGN.md: "A new start from STOPPED discards the pending profile"
+    # docs/state-machine.md: a new start from STOPPED throws the pending profile away
     ctl, ms = prepared(S.STOPPED)
     serial = ms.current.serial
     assert ms.start(T.TRAPEZOIDAL, params=p2p(OTHER)).ok
@@ -232,7 +232,7 @@ def test_resume_from_stopped_finishes_the_move():
 
 def test_stop_completes_to_stopped_after_the_stop_time(prepared):
     # MPI 000, MPIActionSTOP STOP "decelerates the axis (or axes) to a stop in the time specified by the
-    # stop time"; DESIGN.md: MOVING -> STOPPING (decelerate over decelTime.stop) -> STOPPED
+    # stop time"; docs/state-machine.md: MOVING -> STOPPING (decelerate over decelTime.stop) -> STOPPED
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
     assert ms.action(MPIAction.STOP).ok
@@ -256,7 +256,7 @@ def test_e_stop_completes_to_error_after_the_e_stop_time(prepared):
 
 def test_abort_reaches_error_at_the_next_sample(prepared):
     # MPI 000, MPIActionABORT ABORT "After the abort completes, the Motion will be set to the ERROR state";
-    # DESIGN.md "ABORT disables the servo at once"
+    # docs/decisions.md, "Stopping": ABORT turns the amplifier off at once
     ctl, ms = prepared(S.MOVING)
     assert ms.action(MPIAction.ABORT).ok
     assert ms.state is S.STOPPING_ERROR
@@ -330,7 +330,7 @@ def test_stop_records_stop_until_stopped(prepared):
 @pytest.mark.parametrize("action,event", [("STOP", MPIEventType.STOP), ("E_STOP", MPIEventType.E_STOP),
                                           ("ABORT", MPIEventType.ABORT)])
 def test_actions_emit_their_event_at_the_command_sample(action, event, prepared):
-    # MPI 000, mpiMotionAction "How STOP Events Work"; DESIGN.md: every command is recorded with its sample
+    # MPI 000, mpiMotionAction "How STOP Events Work"; docs/decisions.md, "Samples, commands and replay"
     ctl, ms = prepared(S.MOVING)
     k = ctl.sample
     ms.action(MPIAction[action])

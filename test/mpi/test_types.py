@@ -17,8 +17,8 @@ from mpi_ros.mpi.types import (
 
 
 def test_state_numbers_are_the_ros_contract():
-    # DESIGN.md: "state numbers: 0 INVALID, 1 IDLE, 2 MOVING, 3 STOPPING, 4 STOPPED,
-    # 5 STOPPING_ERROR, 6 ERROR"
+    # docs/decisions.md, "The ROS contract": state numbers 0 INVALID, 1 IDLE, 2 MOVING, 3 STOPPING,
+    # 4 STOPPED, 5 STOPPING_ERROR, 6 ERROR
     assert [(s.name, int(s)) for s in MPIState] == [
         ("INVALID", 0), ("IDLE", 1), ("MOVING", 2), ("STOPPING", 3), ("STOPPED", 4),
         ("STOPPING_ERROR", 5), ("ERROR", 6)]
@@ -50,7 +50,7 @@ def test_attribute_masks_mpi_then_mei_in_spec_order():
 
 
 def test_attribute_parse_accepts_names_and_rejects_unknown():
-    # DESIGN.md: "string[] attributes — attribute names without prefix"
+    # docs/decisions.md, "The ROS contract": attribute names go without their prefix
     assert MotionAttr.parse(["APPEND", " hold ", "ID"]) == MotionAttr.APPEND | MotionAttr.HOLD | MotionAttr.ID
     assert MotionAttr.parse([]) == MotionAttr.NONE
     assert MotionAttr.parse(["APPEND", "NOT_AN_ATTRIBUTE"]) is None

@@ -1,6 +1,7 @@
 """Validation of start/modify (mpi_ros/mpi/validate.py): spec 000's return table
 (MPI 000, Returns for mpiMotionStart and mpiMotionModify), the ATTRIBUTE_INVALID causes
-(MPI 000, MPIMotionMessageATTRIBUTE_INVALID) and DESIGN.md's array rules.
+(MPI 000, MPIMotionMessageATTRIBUTE_INVALID) and the array lengths of docs/decisions.md
+("The ROS contract: names, numbers, arrays").
 A refused command answers the spec's message and changes nothing."""
 
 from __future__ import annotations
@@ -57,7 +58,7 @@ def test_jerk_types_without_firmware_option_21_are_not_supported(kind, modify):
     # MPI 000, MPIMotionMessagePROFILE_NOT_SUPPORTED PROFILE_NOT_SUPPORTED "returned by mpiMotionStart or
     # mpiMotionModify when an S_CURVE_JERK or VELOCITY_JERK motion type is commanded, but not supported by the firmware"
     assert check_type(kind, modify, False).message is M.MPIMotionMessagePROFILE_NOT_SUPPORTED
-    # DESIGN.md: "on by configuration"
+    # docs/profiles.md, "Modify": firmware option 21 is turned on by configuration
     assert check_type(kind, modify, True).ok
 
 
@@ -159,7 +160,7 @@ def test_no_backtrack_and_no_backtrack_hold_exclude_each_other():
 ])
 def test_attribute_with_null_data_is_attribute_invalid(attr, field):
     # MPI 000, MPIMotionMessageATTRIBUTE_INVALID "<attribute> specified and attributes <field> address is NULL"
-    # (DESIGN.md: a NULL pointer is an empty array here)
+    # (docs/decisions.md, "The ROS contract": a NULL pointer is an empty array here)
     params = full_params()
     setattr(params, field, [])
     assert check_attributes(T.TRAPEZOIDAL, attr, params, False).message is M.MPIMotionMessageATTRIBUTE_INVALID
@@ -196,7 +197,8 @@ def test_arg_invalid_past_max_coord_axes():
 
 def test_one_trajectory_without_sync():
     # MPI 000, MPIMotionAttrMaskNO_BACKTRACK_HOLD, remarks "if neither SYNC_START nor SYNC_END are specified, then only
-    # one MPITrajectory structure will be used"; DESIGN.md: anything else is MPIMessagePARAM_INVALID
+    # one MPITrajectory structure will be used"; docs/decisions.md, "The ROS contract" (array lengths):
+    # anything else is MPIMessagePARAM_INVALID
     assert params_verdict(p2p(trajectory=[TRAJ])).ok
     assert params_verdict(p2p(trajectory=[TRAJ, TRAJ])).message is M.MPIMessagePARAM_INVALID
     assert params_verdict(p2p(trajectory=[])).message is M.MPIMessagePARAM_INVALID
@@ -210,7 +212,8 @@ def test_sync_needs_one_trajectory_per_axis(attr):
 
 
 def test_position_has_one_value_per_axis():
-    # MPI 000, MPIMotionSCurve "Each position value specifies the target for each axis"; DESIGN.md array lengths
+    # MPI 000, MPIMotionSCurve "Each position value specifies the target for each axis"; docs/decisions.md,
+    # "The ROS contract" (array lengths)
     assert params_verdict(p2p([1.0])).message is M.MPIMessagePARAM_INVALID
     assert params_verdict(p2p([1.0, 2.0, 3.0])).message is M.MPIMessagePARAM_INVALID
 
@@ -281,7 +284,7 @@ def test_per_axis_attribute_arrays(attr, field, value):
     (Hold(type=HoldType.GATE, gate=32), False),  # MPI 000, MEIMotionAttrHoldSource, gate gate "between 0 and 31"
     (Hold(type=HoldType.GATE, gate=-1), False),
     (Hold(type=HoldType.INPUT, address=63), True),
-    (Hold(type=HoldType.INPUT, address=64), False),  # DESIGN.md: address = index of an I/O word
+    (Hold(type=HoldType.INPUT, address=64), False),  # docs/decisions.md, "The ROS contract": an I/O word index
     (Hold(type=HoldType.MOTOR_GENERAL_IO, number=3), True),
     (Hold(type=HoldType.MOTOR_DEDICATED_IO, number=4), False),
     (Hold(type=HoldType.AXIS_POSITION_ACTUAL, number=4), False),  # MPI 000, MEIMotionAttrHoldSource, axis.number an
@@ -298,7 +301,7 @@ def test_hold_sources(hold, ok):
 
 @pytest.mark.parametrize("output,ok", [
     (Output(type=OutputType.OUTPUT, address=0, on_mask=1), True),
-    (Output(type=OutputType.OUTPUT, address=64), False),  # DESIGN.md: an I/O word index
+    (Output(type=OutputType.OUTPUT, address=64), False),  # docs/decisions.md, "The ROS contract"
     (Output(type=OutputType.MOTOR, motor=3), True),  # MPI 000, MEIMotionAttrOutput, motor motor number
     (Output(type=OutputType.MOTOR, motor=4), False),
     (Output(type=OutputType.INVALID), False),
@@ -339,8 +342,8 @@ def test_values_no_controller_holds_are_param_invalid(attrs, params):
 
 @pytest.mark.parametrize("empty_count", [-1, 0, -100, 1, 5])
 def test_every_empty_count_is_accepted(empty_count):
-    # spec 000 MPIMotionPoint: -1 disables; spec 001 EMPTY_COUNT: zero disables; DESIGN.md: both
-    # do (<= 0), so neither is refused
+    # MPI 000, MPIMotionPoint: -1 disables; MPI 001, MPIMotionPathAttrMask EMPTY_COUNT: zero disables;
+    # docs/decisions.md, "emptyCount <= 0 disables": both do, so neither is refused
     assert params_verdict(p2p(empty_count=empty_count)).ok
 
 
@@ -432,7 +435,7 @@ REFUSED = [
 
 @pytest.mark.parametrize("name,modify,kind,attrs,request_params,expected", REFUSED, ids=[r[0] for r in REFUSED])
 def test_a_refused_command_changes_nothing(name, modify, kind, attrs, request_params, expected):
-    # DESIGN.md: "bad input gets the spec's message and changes nothing"; validate.py: "the first
+    # docs/quality.md, "Robust": bad input gets the reference's message and changes nothing; validate.py: "the first
     # failing check wins and nothing is changed"
     def setup(ctl, ms):
         start_moving(ctl, ms)
@@ -457,8 +460,8 @@ EXTREME = [
 
 @pytest.mark.parametrize("kind,traj", EXTREME)
 def test_extreme_valid_values_never_crash(ctl, ms, kind, traj):
-    # DESIGN.md "Robust: no input can crash a node or leave it inconsistent; bad input gets the spec's
-    # message and changes nothing": finite positive limits at the ends of the float range
+    # docs/quality.md, "Robust": no input can crash a node or leave it inconsistent; bad input gets the
+    # reference's message and changes nothing. Finite positive limits at the ends of the float range
     message = ms.start(kind, params=p2p((1e6, -1.0), trajectory=[traj]))
     assert isinstance(message, M)
     for _ in range(5):

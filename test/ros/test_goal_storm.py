@@ -1,7 +1,7 @@
 """Goals hold no executor thread: with far more goals in flight than executor threads (32),
 goal responses, gate_set and E_STOP are still answered at once, and every goal ends
-(issue 9, "E_STOP starvation"; DESIGN.md quality bar: "E_STOP applied at the sample after
-the request arrives, however many goals are in flight")."""
+(issue 9, "E_STOP starvation"; docs/quality.md, "Fast": an E_STOP is applied at the sample after
+its request arrives, however many goals are in flight)."""
 
 from __future__ import annotations
 
@@ -300,7 +300,7 @@ def test_cancel_of_a_queued_goal_stops_and_ends_it_canceled(suite, sender, drive
     assert [bytes(g.goal_id.uuid) for g in answer[0].goals_canceling] == [bytes(handles[1].goal_id.uuid)]
     drive(lambda: all(i in sender.results for i in goals))
     results = sender.wait_results(goals)
-    # Cancel = STOP (DESIGN.md): every move of the supervisor decelerates and stops.
+    # Cancel = STOP (docs/decisions.md, "The ROS goals"): every move of the supervisor decelerates and stops.
     assert [(r.status, r.result.message) for r in results] == [
         (GoalStatus.STATUS_ABORTED, "MPIMotionMessageSTOPPED"), (GoalStatus.STATUS_CANCELED, "MPIMotionMessageSTOPPED")]
 

@@ -115,7 +115,8 @@ def test_pvt_goal_from_send_goal_yaml_ends_ok_at_its_last_point(suite, client, a
     begin = started(applied)
     drive(lambda: running.done, chunk=40)
     result = running.wait()
-    # DESIGN.md: the goal ends when the path is done, with MPIMessageOK and its peaks
+    # docs/decisions.md, "The ROS goals": the goal ends when the path is done, with MPIMessageOK and its
+    # peaks (docs/paths.md, "Limits")
     assert running.handle.status == GoalStatus.STATUS_SUCCEEDED
     assert (result.message, result.state_name) == ("MPIMessageOK", "IDLE")
     assert result.detail.startswith("motion done; path peaks axis 0: |v| ")
@@ -214,7 +215,8 @@ def test_starving_open_path_is_e_stopped(suite, client, applied, drive, events):
 
 
 def test_empty_count_zero_rests_on_the_last_point_until_an_empty_final_append(suite, client, applied, drive, events):
-    # emptyCount <= 0 disables the E_STOP (DESIGN.md); an append without points closes the path.
+    # emptyCount <= 0 disables the E_STOP (docs/decisions.md, "emptyCount <= 0 disables"); an append
+    # without points closes the path.
     running = client.start({"type": "PT", "position": line(1, 10), "time": [0.005] * 10, "final": False,
                             "empty_count": 0})
     started(applied)

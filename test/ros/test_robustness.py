@@ -84,7 +84,7 @@ def test_random_action_interleavings_keep_the_state_machine_consistent(script):
             assert reply.accepted == (state in (MPIState.IDLE, MPIState.STOPPED))
         else:
             reply = apply(ctl, Command("action", 0, request={"action": what}))
-            # DESIGN.md: safety actions are never refused
+            # docs/state-machine.md: the safety actions are never refused
             if what in ("E_STOP", "ABORT", "E_STOP_ABORT"):
                 assert reply.message is Message.MPIMessageOK
         ctl.step(samples)

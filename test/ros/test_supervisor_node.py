@@ -29,7 +29,7 @@ def test_move_reaches_target_and_succeeds_with_ok(suite, client, applied, drive)
     assert command.operation == "motion_start" and reply.message.name == "MPIMessageOK"
     drive(lambda: goal.done)
     result = goal.wait()
-    # DESIGN.md: the goal succeeds when the motion is DONE, with the spec's MPIMessageOK.
+    # docs/decisions.md, "The ROS goals": the goal succeeds when the motion is DONE, with MPIMessageOK.
     assert goal.handle.status == GoalStatus.STATUS_SUCCEEDED
     assert (result.message, result.code, result.state_name) == ("MPIMessageOK", 0, "IDLE")
     assert list(result.command_position) == [1000.0, -250.0]  # exactly on target
@@ -88,7 +88,8 @@ def test_stop_ends_goal_stopped_and_resume_completes_the_move(suite, client, app
     assert client.stop().state_name == "STOPPING"
     drive(lambda: goal.done)
     result = goal.wait(raise_on_error=False)
-    # DESIGN.md: STOP -> STOPPING -> STOPPED; the goal ends with the stopping message.
+    # docs/state-machine.md: STOP -> STOPPING -> STOPPED; docs/decisions.md, "The ROS goals": the goal
+    # ends with MPIMotionMessageSTOPPED.
     assert result.message == "MPIMotionMessageSTOPPED" and result.state_name == "STOPPED"
     stopped_at = suite.runner.ctl.axes[0].command_position
     assert stopped_at < 8000.0

@@ -47,7 +47,7 @@ def test_point_to_point_jerk_ends_on_target_at_rest(v0, a0, target):
     p, v, a = segments[-1].end_state()
     assert p == pytest.approx(target, abs=1e-6) and v == pytest.approx(0.0, abs=1e-6)
     assert a == pytest.approx(0.0, abs=1e-6)
-    assert segments[0].a == a0  # from the full state (DESIGN.md)
+    assert segments[0].a == a0  # from the full state (docs/profiles.md, "Modify")
     assert all(abs(s.j) in (0.0, 2e5, 1e5) for s in segments)
     peak_v = max(abs(s.v) for s in segments)
     assert peak_v <= max(1000.0, abs(v0)) * (1 + 1e-9)

@@ -1,5 +1,5 @@
 """S-curve reshaping (mpi_ros/mpi/profiles/scurve.py): each trapezoid ramp keeps its duration
-(DESIGN.md "Facts about the libraries"), cross-checked against ruckig."""
+(docs/profiles.md, "The trapezoid and the S-curve"), cross-checked against ruckig."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from mpi_ros.mpi.profiles.scurve import ramp_pieces, reshape
 
 
 def test_jerk_phases_and_peak():
-    # DESIGN.md: "each jerk phase lasts f*Ta/2, the constant-acceleration phase (1-f)*Ta, and the
-    # peak acceleration is A/(1 - f/2)"
+    # docs/profiles.md, "The trapezoid and the S-curve": jerk phases of f*Ta/2, constant acceleration
+    # for (1-f)*Ta, peak acceleration A/(1 - f/2)
     ramp = Ramp(0.1, 0.0, 1000.0)  # A = 10000
     (t1, a1, j1), (t2, a2, j2), (t3, a3, j3) = ramp_pieces(ramp, 0.5)
     assert (t1, t2, t3) == pytest.approx((0.025, 0.05, 0.025))
@@ -24,7 +24,7 @@ def test_jerk_phases_and_peak():
 
 @pytest.mark.parametrize("percent,peak", [(0.0, 1.0), (50.0, 4.0 / 3.0), (100.0, 2.0)])
 def test_peak_acceleration_100_133_200_percent(percent, peak):
-    # DESIGN.md: "(100 % / 133 % / 200 % of A at f = 0 / 0.5 / 1)"
+    # docs/profiles.md: the peak is A, 4/3 A, 2 A at f = 0, 0.5, 1
     segments = reshape([Ramp(0.1, 0.0, 1000.0)], 0.0, percent)
     accelerations = [s.a for s in segments] + [s.end_state()[2] for s in segments]
     assert max(abs(a) for a in accelerations) == pytest.approx(10_000.0 * peak)
@@ -32,8 +32,8 @@ def test_peak_acceleration_100_133_200_percent(percent, peak):
 
 @pytest.mark.parametrize("percent", [0.0, 10.0, 50.0, 90.0, 100.0])
 def test_each_ramp_keeps_its_duration_and_distance(percent):
-    # DESIGN.md: "reshapes each ramp keeping its duration, so an S-curve move takes exactly as long
-    # as the trapezoid with the same limits"
+    # docs/profiles.md: each ramp is reshaped keeping its duration, so an S-curve move takes exactly as
+    # long as the trapezoid with the same limits
     plan = plan_point_to_point(5000.0, 0.0, 0.0, 1000.0, 10_000.0, 4_000.0)
     segments = reshape(plan, 0.0, percent)
     assert sum(s.duration for s in segments) == pytest.approx(sum(r.duration for r in plan))
@@ -45,8 +45,8 @@ def test_each_ramp_keeps_its_duration_and_distance(percent):
 
 @pytest.mark.parametrize("percent", [10.0, 50.0, 100.0])
 def test_jerk_is_4a2_over_f_2_minus_f_v(percent):
-    # DESIGN.md: ruckig reproduces the S-curve "when given max_acceleration = A/(1 - f/2) and
-    # max_jerk = 4*A^2/(f*(2-f)*v)"
+    # docs/profiles.md, "The cross-check against ruckig": the equivalent problem has
+    # max_acceleration = A/(1 - f/2) and max_jerk = 4*A^2/(f*(2-f)*v)
     f, acc, v = percent / 100.0, 10_000.0, 1000.0
     segments = point_to_point(0.0, 0.0, 20_000.0, 0.0, v, acc, acc, percent)
     jerk = max(abs(s.j) for s in segments)
@@ -61,7 +61,7 @@ def test_zero_percent_is_the_trapezoid():
 
 
 def test_every_ramp_starts_from_zero_acceleration():
-    # DESIGN.md: "The standard S-curve algorithm always starts from acceleration 0"
+    # docs/profiles.md, "Modify: from the current state": the standard S-curve starts from acceleration 0
     segments = point_to_point(0.0, 500.0, 3000.0, 0.0, 1000.0, 10_000.0, 10_000.0, 40.0)
     assert segments[0].a == 0.0
 
@@ -75,8 +75,8 @@ def test_jerk_percent_range(percent):
 @pytest.mark.parametrize("percent,distance", [(0.0, 10_000.0), (30.0, 10_000.0), (50.0, 5000.0),
                                               (100.0, 3000.0), (75.0, 20_000.0)])
 def test_duration_equals_ruckig(percent, distance):
-    # DESIGN.md quality bar: "S-curve/trapezoid durations equal ruckig's time-optimal duration for
-    # the equivalent limits wherever the two models coincide" (long moves, accel = decel)
+    # docs/quality.md, "Correct motion": S-curve/trapezoid durations equal ruckig's time-optimal duration
+    # for the equivalent limits wherever the two models coincide (long moves, accel = decel)
     import ruckig
     f, acc, v = percent / 100.0, 10_000.0, 1000.0
     inp = ruckig.InputParameter(1)
@@ -93,7 +93,7 @@ def test_duration_equals_ruckig(percent, distance):
 
 @pytest.mark.parametrize("percent", [5e-324, 1e-310, 3.086571890462606e-308, 1e-200])
 def test_tiny_jerk_percent_stays_finite(percent):
-    # DESIGN.md "Robust: no input can crash a node or leave it inconsistent": a jerk phase too short
+    # docs/quality.md, "Robust": no input can crash a node or leave it inconsistent; a jerk phase too short
     # to represent must not make the jerk infinite (and the positions NaN); it is a trapezoid ramp
     segments = point_to_point(0.0, 0.0, 10.0, 0.0, 50.0, 500.0, 500.0, percent)
     for seg in segments:
@@ -104,7 +104,7 @@ def test_tiny_jerk_percent_stays_finite(percent):
 @pytest.mark.parametrize("ramp,percent", [(Ramp(0.0, 0.0, 5e-324), 100.0), (Ramp(5e-324, 0.0, 1e-300), 100.0),
                                           (Ramp(1e-300, 0.0, 1e-290), 1e-20)])
 def test_ramp_too_short_to_reshape(ramp, percent):
-    # DESIGN.md "Robust: no input can crash": a ramp whose duration underflows (a VELOCITY move to
+    # docs/quality.md, "Robust" (no input can crash): a ramp whose duration underflows (a VELOCITY move to
     # 5e-324 counts/s) is kept as the trapezoid's ramp instead of dividing by zero
     for duration, acceleration, jerk in ramp_pieces(ramp, percent / 100.0):
         assert math.isfinite(duration) and math.isfinite(acceleration) and math.isfinite(jerk)
