@@ -29,7 +29,7 @@ from . import requests as rq
 from .mpi.control import Controller
 from .mpi.events import MPIEventType
 from .mpi.messages import Message
-from .mpi.outcome import Outcome, Refused
+from .mpi.outcome import CarriesOutcome, Outcome, Refused
 from .mpi.params import check_position, check_settling_reachable, first_refusal, shown
 from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
 
@@ -72,7 +72,7 @@ class Command:
 
 
 @dataclass(frozen=True, slots=True)
-class Reply:
+class Reply(CarriesOutcome):
     """The controller's answer to a command: its outcome, with what the command made."""
 
     outcome: Outcome
@@ -84,14 +84,6 @@ class Reply:
     def of(cls, message: Message, detail: str = "", serial: int = 0, state: MPIState = MPIState.INVALID,
            value: Any = None) -> Reply:
         return cls(Outcome(message, detail), serial, state, value)
-
-    @property
-    def message(self) -> Message:
-        return self.outcome.message
-
-    @property
-    def detail(self) -> str:
-        return self.outcome.detail
 
     @property
     def accepted(self) -> bool:

@@ -1,8 +1,8 @@
 """Message definitions as rosbag2 stores them in MCAP (schema encoding ``ros2msg``).
 
 A schema is the type's .msg text, then for each nested type (depth first, each once) a
-line of 80 ``=``, ``MSG: pkg/Type`` and that type's .msg text (DESIGN.md, "Facts about
-the libraries"). The .msg files and the RIHS01 type hashes come from the packages'
+line of 80 ``=``, ``MSG: pkg/Type`` and that type's .msg text (docs/recording.md, "The MCAP
+file"). The .msg files and the RIHS01 type hashes come from the packages'
 installed share/ folders.
 """
 

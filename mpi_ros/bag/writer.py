@@ -1,6 +1,6 @@
 """Write a rosbag2-compatible bag directory: metadata.yaml beside one .mcap file.
 
-MCAP as rosbag2 writes it (DESIGN.md): profile ``ros2``; schema ``pkg/msg/Type`` with
+MCAP as rosbag2 writes it (docs/recording.md, "The MCAP file"): profile ``ros2``; schema ``pkg/msg/Type`` with
 encoding ``ros2msg``; channels with message encoding ``cdr`` and the metadata
 ``offered_qos_profiles`` (a YAML string) and ``topic_type_hash``; log and publish times
 in nanoseconds; a ``rosbag2`` metadata record carrying the bag information. The mcap

@@ -1,7 +1,7 @@
 """Feedrate: a supervisor's profile time tau runs at feedrate x real time.
 
 STOP ramps the feedrate to pauseFeedrate over decelTime.stop, so the axes slow down
-along their path and RESUME continues on the same path (DESIGN.md); E_STOP ramps it to
+along their path and RESUME continues on the same path (docs/decisions.md, "Stopping"); E_STOP ramps it to
 zero over decelTime.eStop. Frames are written in profile time; the executor reads them
 at tau(t). The feedrate ramps linearly, so tau(t) is piecewise quadratic:
 

@@ -1,8 +1,9 @@
 """Message codes: every MPI/MEI message the simulated controller can answer.
 
 Member names are the spec's names exactly (``MPIMotionMessageIDLE``, ...). The enum
-listing in spec 000 spells two of them ``Type_INVALID`` and ``Attribute_INVALID``; the
-descriptions (and DESIGN.md) spell them upper case, which is what is used here.
+listing in MPI 000 spells two of them ``Type_INVALID`` and ``Attribute_INVALID``; the
+descriptions spell them upper case, which is what is used here (docs/decisions.md, "The ROS
+contract: names, numbers, arrays").
 
 Codes are stable numbers: 0 for ``MPIMessageOK``, and for the others a module base
 (as the MPI groups messages by module) plus the position in the spec's enum listing.

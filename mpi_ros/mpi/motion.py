@@ -455,7 +455,8 @@ class MotionSupervisor:
         if held:
             # A start or modify would take the axis out of the other supervisor's vector (its
             # motion, running or stopped, keeps it until it ends or is RESET): answered with the
-            # state the axes show (DESIGN: a supervisor's state includes its axes' commanders).
+            # state the axes show (docs/decisions.md, "Supervisors and axes": a supervisor's state
+            # includes its axes' commanders).
             axis, other, other_state = held[0]
             return Outcome(STATE_MESSAGES[state.name], (f"axis {axis} is in the {other_state.name} motion of "
                                                         f"supervisor {other}: command it there, or RESET it"))

@@ -33,13 +33,13 @@ class Outcome:
 VALID = Outcome(Message.MPIMessageOK)
 
 
-class Refused(Exception):
-    """An outcome that is not OK, raised where it cannot be returned (the planner, a request
-    being read); caught where the answer is given."""
+class CarriesOutcome:
+    """What carries an outcome with more around it (a raised refusal, a move's end, a
+    command's reply) reads its message and detail through to it: ``outcome`` is the one
+    attribute a subclass provides."""
 
-    def __init__(self, message: Message, detail: str):
-        super().__init__(detail)
-        self.outcome = Outcome(message, detail)
+    __slots__ = ()
+    outcome: Outcome
 
     @property
     def message(self) -> Message:
@@ -50,8 +50,17 @@ class Refused(Exception):
         return self.outcome.detail
 
 
+class Refused(CarriesOutcome, Exception):
+    """An outcome that is not OK, raised where it cannot be returned (the planner, a request
+    being read); caught where the answer is given."""
+
+    def __init__(self, message: Message, detail: str):
+        super().__init__(detail)
+        self.outcome = Outcome(message, detail)
+
+
 @dataclass(frozen=True, slots=True)
-class MoveEnd:
+class MoveEnd(CarriesOutcome):
     """An outcome of a move at a sample, with the supervisor's axis positions then: how the
     move ended, or (a VELOCITY move) that it reached its velocity, which is what its goals
     wait for. A modify keeps the move's serial: an outcome before the modify's sample is not
@@ -63,14 +72,6 @@ class MoveEnd:
     command_position: tuple[float, ...] = ()
     actual_position: tuple[float, ...] = ()
     supervisor: int = -1
-
-    @property
-    def message(self) -> Message:
-        return self.outcome.message
-
-    @property
-    def detail(self) -> str:
-        return self.outcome.detail
 
     @property
     def succeeded(self) -> bool:

@@ -1,7 +1,8 @@
 """Parameter and configuration structs of the MPI as dataclasses (units: counts, seconds).
 
-C pointers become data (DESIGN.md): a NULL array is an empty list here, a hold or
-output is a value, an I/O address is the index of a word in the simulated I/O image.
+C pointers become data (docs/decisions.md, "The ROS contract: names, numbers, arrays"): a
+NULL array is an empty list here, a hold or output is a value, an I/O address is the index of
+a word in the simulated I/O image.
 
 Each struct has one validator, ``validate() -> Outcome``: the ranges a controller can
 hold (docs/decisions.md, "Validation and ranges"). The YAML loader, the services and

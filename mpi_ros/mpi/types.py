@@ -6,7 +6,8 @@ from enum import Enum, IntEnum, IntFlag
 
 
 class MPIState(IntEnum):
-    """MPIState; the numbers are the ones of the ROS contract (DESIGN.md)."""
+    """MPIState; the numbers are the ones of the ROS contract (docs/decisions.md, "The ROS contract: names,
+    numbers, arrays")."""
 
     INVALID = 0
     IDLE = 1

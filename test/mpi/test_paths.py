@@ -274,8 +274,8 @@ def _run_batched(batch: int, end: int = 2200):
 
 
 def test_a_path_gives_bit_identical_samples_however_it_is_batched():
-    # DESIGN.md: "Every command takes effect at a sample boundary and is recorded with that sample's index,
-    # which is what makes replay exact" (as test_batching.py for point-to-point moves)
+    # docs/decisions.md, "Samples, commands and replay": every command takes effect at a sample boundary,
+    # which is what makes replay exact (as test_batching.py for point-to-point moves)
     fine, fine_events, fine_ends = _run_batched(1)
     assert fine[2200][0] is MPIState.IDLE  # the script ran to its end
     assert any(t is E.FRAMES_EMPTY for _, t, *_ in fine_events)  # the path ran out, and resumed
@@ -613,7 +613,7 @@ def test_points_appended_without_element_ids_leave_the_later_ids_in_place():
 def test_axis_events_carry_the_element_id_of_their_sample(batch):
     # MPI 000, MPIMotionAttributes, elementId: every event of the path carries the element it runs toward
     # at the event's sample (IN_COARSE_POSITION, AT_TARGET, ... of spec 002 included), however the
-    # controller's samples are batched (DESIGN.md: replay is exact)
+    # controller's samples are batched (docs/decisions.md, "Samples, commands and replay")
     ctl, ms = new_supervisor(notify=E.IN_COARSE_POSITION | E.AT_TARGET | E.DONE | E.MOTION_DONE)
     points = [[100.0, 50.0], [3000.0, 10.0], [3100.0, 30.0], [3200.0, 40.0]]
     times = [0.01] * 4
@@ -811,8 +811,8 @@ REFUSED = [
 
 @pytest.mark.parametrize("name,setup,modify,kind,attrs,params,expected", REFUSED, ids=[r[0] for r in REFUSED])
 def test_a_refused_path_command_changes_nothing(name, setup, modify, kind, attrs, params, expected):
-    # MPI 000, Returns for mpiMotionStart and mpiMotionModify; DESIGN.md: "bad input gets the spec's message
-    # and changes nothing" (as test_validate.py, test_a_refused_command_changes_nothing)
+    # MPI 000, Returns for mpiMotionStart and mpiMotionModify; docs/quality.md, "Robust": bad input gets
+    # the reference's message and changes nothing (as test_validate.py, test_a_refused_command_changes_nothing)
     (ctl_a, ms_a), (ctl_b, ms_b) = _twins(setup)
     outcome, _ = ms_b.command(kind, attrs, params, modify)
     message = outcome.message
