@@ -9,8 +9,8 @@ any recorder of the graph (``ros2 bag record -a``) captures along with the comma
 Stamps are compared too when the bag knows the epoch they count from. Statuses recorded at sample k are
 compared once the new controller is at k; commands recorded with effective sample k are
 applied when it is at k-1 (docs/decisions.md, "Samples, commands and replay": a command is
-applied at the first sample after the controller's current one). Identical runs report zero differences; otherwise the report
-names the first divergence: where, which field, by how much.
+applied at the first sample after the controller's current one). Identical runs report zero
+differences; otherwise the report names the first divergence: where, which field, by how much.
 """
 
 from __future__ import annotations
