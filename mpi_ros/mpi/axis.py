@@ -31,7 +31,7 @@ from .clock import ProfileClock
 from .frames import AxisPlan
 from .messages import Message
 from .params import AxisInPosition, AxisMaster, PlantConfig, check_position
-from .plant import Forced, Plant, PlantState, compose
+from .plant import Forced, Plant, PlantState, compose, servo_effort
 from .status import AxisStatusBits, StatusMode, bits_of, column_of
 from .types import MPIState
 
@@ -313,6 +313,14 @@ class Axis:
         if plan is None:
             return self._held_feedforward
         return plan.feedforward_at(self.rel, self._held_feedforward)
+
+    def servo_effort(self) -> float:
+        """The simulated servo's control effort now, counts/s^2 (plant.servo_effort); 0 while
+        the amplifier is off (after ABORT the motor coasts)."""
+        if not self.amp_enabled:
+            return 0.0
+        return servo_effort(self.plant.config, self.cmd_p - self.act_p, self.cmd_v, self.act_v, self.cmd_a,
+                            self.feedforward)
 
     def _hold_feedforward(self) -> None:
         """Before the plan changes: keep the feedforward it has reached."""

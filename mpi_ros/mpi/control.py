@@ -342,6 +342,12 @@ class Controller:
             count += owner.frames_queued(number)
         return min(count, self.config.frame_buffer_size)
 
+    def joint_values(self) -> tuple[list[float], list[float], list[float]]:
+        """Every axis' actual position (user units), actual velocity and servo effort
+        (counts/s^2, plant.servo_effort): the axes as joints, read at once."""
+        axes = self.axes
+        return ([a.actual_position for a in axes], [a.act_v for a in axes], [a.servo_effort() for a in axes])
+
     def axis_snapshot(self, number: int) -> AxisSnapshot:
         """mpiAxisStatus."""
         axis = self.axes[number]
@@ -374,6 +380,7 @@ class Controller:
             supervisor=axis.owner,
             feedforward=axis.feedforward,
             faults=self.faults.names(number),
+            servo_effort=axis.servo_effort(),
         )
 
     # -- gates and I/O -------------------------------------------------------------------

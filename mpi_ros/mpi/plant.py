@@ -273,6 +273,22 @@ class Plant:
         return np.floor(y / self._resolution + 0.5) * self._resolution
 
 
+def servo_effort(config: PlantConfig, error: float, cmd_v: float, act_v: float, cmd_a: float,
+                 feedforward: float) -> float:
+    """The position loop's control effort, in counts/s^2: ``w^2 (u - y) + 2 zeta w (kv u' -
+    y') + ka u''`` (u the command, y the motor; w, zeta, kv, ka the bandwidth, damping and
+    feed-forwards), the acceleration it demands of a motor of unit inertia, which is what the
+    simulated motor then does; a PTF/PVTF feedforward adds its DAC counts times
+    ``dac_acceleration``. Computed as a real servo computes it: from the encoder's reading of
+    the position (``error``, so it carries the encoder's quantisation) and the actual velocity."""
+    w = 2.0 * math.pi * config.bandwidth_hz
+    effort = (w * w * error + 2.0 * config.damping * w * (config.velocity_feedforward * cmd_v - act_v)
+              + config.acceleration_feedforward * cmd_a)
+    if feedforward:
+        effort += config.dac_acceleration * feedforward
+    return effort
+
+
 def _first_sample(t: float, rate: float) -> int:
     """The first whole sample at or after time ``t``."""
     k = math.ceil(t * rate)

@@ -34,6 +34,7 @@ class AxisSnapshot:
     supervisor: int
     feedforward: float = 0.0  # PTF/PVTF feedforward (raw DAC counts)
     faults: tuple[str, ...] = ()  # the faults latched on the axis (mpi/faults.py)
+    servo_effort: float = 0.0  # the position loop's effort, counts/s^2 (plant.servo_effort; 0 with the amp off)
 
 
 @dataclass(frozen=True, slots=True)

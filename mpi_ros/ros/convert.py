@@ -206,47 +206,19 @@ def motion_status(snap: MotionSnapshot, rate: float, epoch_ns: int | None = None
     return msg
 
 
-def servo_effort(axis) -> float:
-    """The simulated servo's control effort, in counts/s^2.
-
-    The position loop (mpi_ros/mpi/plant.py) drives the motor with
-    ``w^2 (u - y) + 2 zeta w (kv u' - y') + ka u''`` (u the command, y the motor; w, zeta,
-    kv, ka the plant's bandwidth, damping and feed-forwards): the acceleration it demands
-    of a motor of unit inertia, which is what the simulated motor then does. Here it is
-    computed as a real servo computes it, from the encoder's reading of the position (so
-    it carries the encoder's quantisation: up to w^2 x resolution / 2) and the actual
-    velocity. A PTF/PVTF feedforward adds its DAC counts times ``dac_acceleration``. 0 while
-    the amplifier is off (after ABORT the motor coasts)."""
-    if not axis.amp_enabled:
-        return 0.0
-    return _effort(axis.plant.config, axis.cmd_p - axis.act_p, axis.cmd_v, axis.act_v, axis.cmd_a,
-                   axis.feedforward)
-
-
-def _effort(cfg, error: float, cmd_v: float, act_v: float, cmd_a: float, feedforward: float) -> float:
-    w = 2.0 * math.pi * cfg.bandwidth_hz
-    effort = (w * w * error
-              + 2.0 * cfg.damping * w * (cfg.velocity_feedforward * cmd_v - act_v)
-              + cfg.acceleration_feedforward * cmd_a)
-    if feedforward:
-        effort += cfg.dac_acceleration * feedforward
-    return _finite(effort)
-
-
 def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
                  ) -> tuple[list[float], list[float], list[float]]:
     """Every axis' (actual position, actual velocity, servo effort): what /joint_states
-    carries. ``snapshots``: every axis' AxisSnapshot at the controller's sample, if they
-    were taken (the same values, read once: see snapshots.py)."""
+    carries (the effort: the simulated servo's, plant.servo_effort). ``snapshots``: every
+    axis' AxisSnapshot at the controller's sample, if they were taken (see snapshots.py)."""
     if snapshots is None:
-        return ([float(a.actual_position) for a in ctl.axes], [float(a.act_v) for a in ctl.axes],
-                [servo_effort(a) for a in ctl.axes])
-    axes = [snapshots[a.number] for a in ctl.axes]
-    # snapshot values are the axis' own: position_error is cmd_p - act_p, as servo_effort reads it
-    effort = [_effort(a.plant.config, s.position_error, s.command_velocity, s.actual_velocity,
-                      s.command_acceleration, s.feedforward) if s.amp_enabled else 0.0
-              for a, s in zip(ctl.axes, axes, strict=True)]
-    return [float(s.actual_position) for s in axes], [float(s.actual_velocity) for s in axes], effort
+        position, velocity, effort = ctl.joint_values()
+    else:
+        axes = [snapshots[n] for n in range(len(ctl.axes))]
+        position = [s.actual_position for s in axes]
+        velocity = [s.actual_velocity for s in axes]
+        effort = [s.servo_effort for s in axes]
+    return [float(x) for x in position], [float(v) for v in velocity], [_finite(e) for e in effort]
 
 
 def joint_names(ctl, prefix: str = "") -> list[str]:

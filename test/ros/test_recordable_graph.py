@@ -110,20 +110,20 @@ def test_joint_effort_is_the_servo_loop_output():
     ctl.step(int(0.2 * ctl.rate))  # mid-ramp (the ramp lasts 0.4 s), transients long gone
     axis = ctl.axes[0]
     assert axis.cmd_a == 10000.0
-    assert convert.servo_effort(axis) == pytest.approx(10000.0, rel=1e-6)
-    assert convert.joint_state(ctl, 0).effort[0] == convert.servo_effort(axis)
+    assert axis.servo_effort() == pytest.approx(10000.0, rel=1e-6)
+    assert convert.joint_state(ctl, 0).effort[0] == axis.servo_effort()
     ctl.step(int(2.0 * ctl.rate))  # cruising
-    assert axis.cmd_a == 0.0 and convert.servo_effort(axis) == pytest.approx(0.0, abs=1e-3)
+    assert axis.cmd_a == 0.0 and axis.servo_effort() == pytest.approx(0.0, abs=1e-3)
     ctl.step(int(4.0 * ctl.rate))  # decelerated, done and settled
-    assert axis.cmd_v == 0.0 and convert.servo_effort(axis) == pytest.approx(0.0, abs=1e-6)
+    assert axis.cmd_v == 0.0 and axis.servo_effort() == pytest.approx(0.0, abs=1e-6)
     apply(ctl, Command("motion_start", 0, request={
         "type": "TRAPEZOIDAL", "position": [0.0, 0.0],
         "trajectory": [{"velocity": 4000.0, "acceleration": 10000.0, "deceleration": 10000.0}]}))
     ctl.step(500)
-    assert convert.servo_effort(axis) != 0.0
+    assert axis.servo_effort() != 0.0
     apply(ctl, Command("action", 0, request={"action": "ABORT"}))
     ctl.step(10)
-    assert not axis.amp_enabled and convert.servo_effort(axis) == 0.0
+    assert not axis.amp_enabled and axis.servo_effort() == 0.0
 
 
 def test_an_event_burst_is_whole_for_a_deep_subscriber_and_cut_to_5_by_the_tools_default(suite, ros_context):
