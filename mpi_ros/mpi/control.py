@@ -169,6 +169,14 @@ class Controller:
             return Outcome(Message.MPIMotionMessageMOTION_INVALID, f"no supervisor {supervisor}")
         return ms.action_detail(action, source)
 
+    def responsible_for(self, axis: int) -> list[int]:
+        """The supervisors that act on a fault of ``axis``: the one commanding it (if the
+        axis is mapped to it), else every one it is mapped to."""
+        owner = self._supervisors.get(self.axes[axis].owner)
+        if owner is not None and axis in owner.mapped:
+            return [owner.number]
+        return [ms.number for ms in self.supervisors if axis in ms.mapped]
+
     # -- queries ------------------------------------------------------------------------
     def move_end(self, supervisor: int, serial: int, since: int) -> MoveEnd | None:
         """How the goals that follow move ``serial`` of ``supervisor`` from sample ``since``

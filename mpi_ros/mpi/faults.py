@@ -37,8 +37,7 @@ from .types import ActionSource, MPIAction
 
 if TYPE_CHECKING:
     from .axis import Axis
-    from .control import Controller
-    from .motion import MotionSupervisor
+    from .host import FaultHost
     from .stretch import Stretch
 
 OK = Message.MPIMessageOK
@@ -146,10 +145,10 @@ class _Found:
 class FaultMonitor:
     """The faults of every axis of a controller."""
 
-    def __init__(self, ctl: Controller):
-        self._ctl = ctl
-        self.axes = [AxisFaults(AxisFaultConfig(encoder_fault_motor_number=n if n < ctl.config.motors else -1))
-                     for n in range(len(ctl.axes))]
+    def __init__(self, host: FaultHost):
+        self._host = host
+        self.axes = [AxisFaults(AxisFaultConfig(encoder_fault_motor_number=n if n < host.config.motors else -1))
+                     for n in range(len(host.axes))]
         self.encoder_faults: set[int] = set()  # motors whose encoder has an injected fault
         self._watched: list[int] = []  # axes with a condition checked while stepping (limits)
         self._watched_rows = _NO_ROWS
@@ -157,7 +156,7 @@ class FaultMonitor:
         # change (configuration, a trip, RESET) or when an amplifier goes off or on (the key)
         self._checks: tuple[tuple[bool, ...], dict[Fault, _Checks]] | None = None
         # samples the following error has been above its limit, per axis, at the current sample
-        self.error_runs = np.zeros(len(ctl.axes), dtype=np.int64)
+        self.error_runs = np.zeros(len(host.axes), dtype=np.int64)
         self._found: list[_Found] = []
         # the axes whose following error the last scan followed, and its runs over the stretch
         self._error_rows = _NO_ROWS
@@ -167,9 +166,9 @@ class FaultMonitor:
     def check(self, config: AxisFaultConfig) -> Outcome:
         """The struct's validator, then what only the controller knows (its motors)."""
         verdict = config.validate()
-        if verdict.ok and config.encoder_fault_motor_number >= self._ctl.config.motors:
+        if verdict.ok and config.encoder_fault_motor_number >= self._host.config.motors:
             return refuse(f"encoder_fault_motor_number: motor {shown(config.encoder_fault_motor_number)} does not "
-                          f"exist ({self._ctl.config.motors} motors)")
+                          f"exist ({self._host.config.motors} motors)")
         return verdict
 
     def config_set(self, number: int, config: AxisFaultConfig) -> Outcome:
@@ -207,7 +206,7 @@ class FaultMonitor:
 
     def _stepped(self) -> dict[Fault, _Checks]:
         """The rows that check each condition now (:class:`_Checks`), kept until they change."""
-        axes = self._ctl.axes
+        axes = self._host.axes
         amps = tuple(axes[n].amp_enabled for n in self._watched)
         if self._checks is None or self._checks[0] != amps:
             self._checks = (amps, {fault: self._rows(fault) for fault in _STEPPED})
@@ -217,7 +216,7 @@ class FaultMonitor:
         """The watched axes that check ``fault``: configured, not latched, and for the
         following error with the amplifier on (off, the command is frozen and the motor
         coasts: there is no loop to follow)."""
-        axes, faults = self._ctl.axes, self.axes
+        axes, faults = self._host.axes, self.axes
         rows = [n for n in self._watched if fault not in faults[n].latched and _configured(faults[n].config, fault)
                 and (fault is not Fault.LIMIT_ERROR or axes[n].amp_enabled)]
         configs = [faults[n].config for n in rows]
@@ -226,7 +225,7 @@ class FaultMonitor:
         else:
             limits = [_limit(c, fault) for c in configs]
         return _Checks(np.array(rows, dtype=np.int64), np.array(limits, dtype=float),
-                       np.array([error_samples(c, self._ctl.rate) for c in configs], dtype=np.int64))
+                       np.array([error_samples(c, self._host.rate) for c in configs], dtype=np.int64))
 
     def _scan_error(self, stretch: Stretch) -> None:
         """|command - actual| above the limit for longer than the configured time."""
@@ -253,7 +252,7 @@ class FaultMonitor:
         rows, limits = checks.rows, checks.limits
         if not len(rows):
             return
-        axes = self._ctl.axes
+        axes = self._host.axes
         origins = np.array([axes[n].origin for n in rows.tolist()])
         position = stretch.act_p[rows] - origins[:, None]
         beyond = position > limits[:, None] if fault is Fault.LIMIT_SW_POSITIVE else position < limits[:, None]
@@ -286,26 +285,22 @@ class FaultMonitor:
             return
         faults.latched[fault] = detail
         self._checks = None
-        axis = self._ctl.axes[number]
+        axis = self._host.axes[number]
         action = action_of(faults.config, fault)
         supervisors = self._supervisors_of(axis)
-        self._ctl.emit(fault.event, supervisor=supervisors[0].number if supervisors else -1, axis=number,
+        self._host.emit(fault.event, supervisor=supervisors[0] if supervisors else -1, axis=number,
                        move_id=axis.move_id, element_id=axis.current_element_id,
                        detail=f"{fault.value} ({_WORDS[fault]}) on axis {number}: {detail}; action {action.name}")
         if fault is Fault.AMP_FAULT and axis.amp_enabled:
-            owner = self._ctl.supervisor(axis.owner)
-            axis.amp_fault(self._ctl.time, owner.clock if owner is not None else None)
+            axis.amp_fault(self._host.time, self._host.clock_of(axis.owner) if axis.owner >= 0 else None)
         if action is not MPIAction.NONE:
-            for ms in supervisors:
-                ms.action_detail(action, ActionSource.CONTROLLER)
+            for number in supervisors:
+                self._host.act_on(number, action, ActionSource.CONTROLLER)
 
-    def _supervisors_of(self, axis: Axis) -> list[MotionSupervisor]:
+    def _supervisors_of(self, axis: Axis) -> list[int]:
         """Who acts on a fault of ``axis``: the supervisor commanding it, else every one it
         is mapped to (an action on shared axes reaches the motion that runs them)."""
-        owner = self._ctl.supervisor(axis.owner)
-        if owner is not None and axis.number in owner.mapped:
-            return [owner]
-        return [ms for ms in self._ctl.supervisors if axis.number in ms.mapped]
+        return self._host.responsible_for(axis.number)
 
     def underflow(self, numbers: Sequence[int]) -> None:
         """An open path's frame buffer ran empty on these axes while it moves."""
@@ -340,8 +335,8 @@ class FaultMonitor:
 
     def _inject_encoder(self, number: int, active: bool) -> Outcome:
         """The encoder of the axis' own motor (axis k drives motor k)."""
-        if number >= self._ctl.config.motors:
-            motors = self._ctl.config.motors
+        if number >= self._host.config.motors:
+            motors = self._host.config.motors
             return Outcome(Message.MPIMessagePARAM_INVALID, f"axis {number} has no motor ({motors} motors)")
         if not active:
             self.encoder_faults.discard(number)
@@ -368,7 +363,7 @@ class FaultMonitor:
 
     def _holds(self, number: int, fault: Fault) -> str:
         """Why the condition of ``fault`` still holds on axis ``number`` ("" if it does not)."""
-        faults, axis = self.axes[number], self._ctl.axes[number]
+        faults, axis = self.axes[number], self._host.axes[number]
         config = faults.config
         if fault is Fault.LIMIT_ERROR:
             # with the amplifier off RESET sets the command to the actual: no error is left
