@@ -1,8 +1,9 @@
 """The simulated MPI/XMP motion controller: pure Python + numpy, no ROS here.
 
-Where each spec concept lives (spec = ../shared/spec; 000 motion objects, 002 axes):
+Where each concept of the MPI reference lives (MPI 000: motion objects, 001: path attributes,
+002: axes; who owns what and how they collaborate: docs/architecture.md):
 
-| spec concept                                             | module |
+| concept                                                  | module |
 | -------------------------------------------------------- | ------ |
 | message codes (MPIMessage*, MPIMotionMessage*, MEI...)    | messages.py |
 | MPIState, MPIAction, MPIMotionType, attribute masks,      | types.py |
@@ -23,12 +24,17 @@ Where each spec concept lives (spec = ../shared/spec; 000 motion objects, 002 ax
 | status bits IN_FINE/IN_COARSE/AT_TARGET/DONE/SETTLED/...  | status.py (002 tables, NOTE 1-3) |
 | HOLD triggers and timeouts                                | holds.py |
 | I/O image, control gates (meiControlGateSet)              | io.py |
-| Motion object: create/delete/validate, config, params,    | motion.py |
+| Motion object: create/delete/validate, config, params,    | motion.py (a facade) |
 |   position, trajectory, status, events, start/modify      |   |
-| its axis list (append/insert/remove/...) and MAP          | supervisor_axis_list.py |
+| its own state, feedrate clock, stop under way             | supervisor_state.py |
+| its axis list (append/insert/remove/...) and the mapping  | axis_list.py |
+| its moves: current, queued, held; load, replace, drop     | moves.py |
 | its actions STOP/E_STOP/ABORT/RESET/RESUME/MAP            | supervisor_actions.py |
 | its state machine as the controller steps (DONE, stop     | supervisor_stepping.py |
 |   complete, ERROR, hold release at the exact sample)      |   |
+| what a supervisor may ask of the controller               | host.py |
+| the one outcome type (message + detail), a move's end     | outcome.py |
+| how moves ended, when a goal is over                      | move_log.py |
 | motion log (meiMotionLogOpen/Print/Close)                 | log.py |
 | mpiMotionStatus / mpiAxisStatus / frame buffer status     | snapshot.py |
 | Controller: sample clock, step/run_until, objects, events | control.py |
