@@ -469,17 +469,17 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
             axis = self._axis(n)
             plan = last.plan_for(n) if queued and last is not None else None
             if plan is not None:
-                starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.origin))
+                starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.turn_origin(plan.target)))
             elif moving:
                 f = self.clock.feedrate(self._ctl.time)
                 velocity = axis.cmd_v / f if f > 0.0 else 0.0
                 acceleration = axis.cmd_a / (f * f) if f > 0.0 else 0.0
-                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.origin, acceleration))
+                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.turn_origin(axis.cmd_p), acceleration))
             else:
                 # A start runs at the normal feedrate from now on. The axis may still move (STOPPED
                 # at a non-zero pauseFeedrate, or past a FINAL_VEL move): start from that velocity.
                 f = self.config.normal_feedrate
-                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.origin, axis.cmd_a / (f * f)))
+                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.turn_origin(axis.cmd_p), axis.cmd_a / (f * f)))
         return starts
 
     def _cam_masters(self) -> list[tuple[AxisMaster, float]]:
@@ -675,7 +675,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
     def _position_of(self, hold) -> float:
         """The position (user units) a position hold watches: actual or command."""
         axis = self._axis(hold.number)
-        return axis.actual_position if hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.command_position
+        return axis.unwrapped_actual if hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.unwrapped_command
 
     def _fire_outputs(self, plan) -> None:
         for output in plan.outputs:
