@@ -270,7 +270,7 @@ class Controller:
             held = owner.current.plan_for(number) if axis.holding and owner.current is not None else None
             count += held.frame_count if held is not None else 0
             count += sum(m.frame_counts.get(number, 0) for m in owner.queue)
-        return min(count, self.config.frame_buffer_size)
+        return min(count, self.config.frame_buffer_size_of(number))
 
     def axis_snapshot(self, number: int) -> AxisSnapshot:
         """mpiAxisStatus."""

@@ -264,8 +264,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         """meiMotionFrameBufferStatus for each mapped axis."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID, []
-        size = self._ctl.config.frame_buffer_size
-        return OK, [FrameBufferStatus(a.number, size, self._ctl.frame_count(a.number)) for a in self.axes]
+        size = self._ctl.config.frame_buffer_size_of
+        return OK, [FrameBufferStatus(a.number, size(a.number), self._ctl.frame_count(a.number)) for a in self.axes]
 
     # ================================================================= log ====
     def log_open(self, max_entries: int) -> Message:
@@ -420,7 +420,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         return validate.check_params(
             motion_type, attrs, params, len(self.axis_list), self._ctl.config.io_words,
             self._ctl.config.motors, len(self._ctl.axes), sample_rate=self._ctl.rate,
-            append_to=append_to, frame_buffer_size=self._ctl.config.frame_buffer_size)
+            append_to=append_to, frame_buffer_size=self.frame_buffer_size)
 
     def _command_no_wait(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
                          modify: bool) -> tuple[Message, str]:
@@ -479,7 +479,8 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
                 # A start runs at the normal feedrate from now on. The axis may still move (STOPPED
                 # at a non-zero pauseFeedrate, or past a FINAL_VEL move): start from that velocity.
                 f = self.config.normal_feedrate
-                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.turn_origin(axis.cmd_p), axis.cmd_a / (f * f)))
+                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.turn_origin(axis.cmd_p),
+                                        axis.cmd_a / (f * f)))
         return starts
 
     def _cam_masters(self) -> list[tuple[AxisMaster, float]]:
@@ -497,10 +498,10 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
     def _check_frames(self, moves: list[Move]) -> Message:
         """Do the moves fit the frame buffer? A path's points need not: the library holds
         what does not fit and loads it as the buffer drains (MPI 001, LOW_COUNT)."""
-        size = self._ctl.config.frame_buffer_size
+        size = self._ctl.config.frame_buffer_size_of
         loaded = [move for move in moves if move.stream is None]
         for n in self.axis_list:
-            if frames_needed(loaded, n) > size:
+            if frames_needed(loaded, n) > size(n):
                 return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
         return OK
 
@@ -508,7 +509,7 @@ class MotionSupervisor(AxisListMixin, ActionsMixin, SteppingMixin):
         """MPI 001 LOW_COUNT: the given count, else a quarter of the frame buffer (32 of 128)."""
         if MotionAttr.LOW_COUNT in attrs:
             return params.low_count
-        return self._ctl.config.frame_buffer_size // 4
+        return self.frame_buffer_size // 4
 
     def _open_path(self) -> Move | None:
         """The path in progress, if it is open (more points are expected)."""

@@ -49,6 +49,18 @@ class AxisListMixin:
             return Message.MPIMessageOBJECT_NOT_ENABLED
         return OK
 
+    @property
+    def frame_buffer_size(self) -> int:
+        """The frame buffer size of the supervisor's axes (one size: see :meth:`_frame_sizes_differ`)."""
+        config = self._ctl.config
+        return config.frame_buffer_size_of(self.axis_list[0]) if self.axis_list else config.frame_buffer_size
+
+    def _frame_sizes_differ(self, numbers: list[int]) -> bool:
+        """MPI 000 MPIMotionMessageAXIS_FRAME_COUNT: "All axes appended to a Motion object must
+        have the same frame buffer size". Answered where axes are appended (append, insert,
+        list set), so a list never holds two sizes and MAP and the moves need not ask."""
+        return len({self._ctl.config.frame_buffer_size_of(n) for n in numbers}) > 1
+
     def axis_append(self, number: int) -> Message:
         """mpiMotionAxisAppend."""
         return self.axis_insert(self.axis_list[-1] if self.axis_list else None, number)
@@ -64,6 +76,8 @@ class AxisListMixin:
             return Message.MPIMessageOBJECT_ON_LIST
         if len(self.axis_list) >= MAX_COORD_AXES:
             return Message.MPIMessageUNSUPPORTED
+        if self._frame_sizes_differ([*self.axis_list, number]):
+            return Message.MPIMotionMessageAXIS_FRAME_COUNT
         if after is None:
             self.axis_list.insert(0, number)
             return OK
@@ -101,6 +115,8 @@ class AxisListMixin:
             message = self._check_axis(number)
             if not message.ok:
                 return message
+        if self._frame_sizes_differ(numbers):
+            return Message.MPIMotionMessageAXIS_FRAME_COUNT
         if self.own_state not in (MPIState.IDLE, MPIState.ERROR, MPIState.STOPPED):
             return self._state_message()
         self.axis_list = list(numbers)
