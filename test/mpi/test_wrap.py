@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from mpi_ros.mpi import Controller, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState
 from mpi_ros.mpi.params import MAX_POSITION
 from mpi_ros.mpi.types import MotionAttr
 from mpi_ros.mpi.wrap import HALF, WRAP, turn_offset, wrap_position, wrap_positions
@@ -171,3 +171,26 @@ def test_the_motion_log_reports_32_bit_positions(ctl, ms):
     positions = columns[:, :2]  # axis 0: command, actual
     assert ((positions >= -HALF) & (positions < HALF)).all()
     assert positions[0, 0] == pytest.approx(HALF - 100.0, abs=0.01) and positions[-1, 0] == -HALF + 100.0
+
+
+def test_a_path_after_the_wrap_takes_its_first_point_the_short_way_in_either_turn(ctl, ms):
+    # MPI 000, MPIMotionType, Example: "With the shortest path algorithm, -2147483638 is converted to
+    # 2147483658": the first point, given in the reported (32-bit) value or in the MPI's continuous
+    # one, is taken the short way from where the axis is; the later points keep their distances
+    assert ctl.axis_command_position_set(0, HALF - 100.0).ok and ctl.axis_actual_position_set(0, HALF - 100.0).ok
+    assert ms.start(T.TRAPEZOIDAL, params=make_params((HALF + 100.0, 0.0))).ok
+    run_to_state(ctl, ms, MPIState.IDLE, 20_000)
+    assert ctl.axes[0].command_position == -HALF + 100.0
+    for first in (-HALF + 150.0, HALF + 150.0, -HALF + 150.0 + 2 * WRAP):
+        before = ctl.axes[0].unwrapped_command
+        points = MotionParams(position=[first, 0.0, first + 50.0, 0.0], time=[0.05, 0.05])
+        assert ms.start(T.PT, MotionAttr.NONE, points).ok
+        peak = 0.0
+        while ms.state is not MPIState.IDLE and ctl.sample < 100_000:
+            ctl.step(1)
+            peak = max(peak, abs(ctl.axes[0].cmd_v))
+        assert ctl.axes[0].unwrapped_command - before == pytest.approx(100.0, abs=1e-6)
+        assert peak == pytest.approx(1000.0, rel=1e-9)  # 50 counts in 0.05 s: no 2^32 jump anywhere
+        assert ctl.axes[0].command_position == wrap_position(first + 50.0)
+        assert ms.start(T.TRAPEZOIDAL, params=make_params((-HALF + 100.0, 0.0))).ok  # back for the next
+        run_to_state(ctl, ms, MPIState.IDLE, 20_000)
