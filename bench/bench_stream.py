@@ -8,7 +8,7 @@ gap only if the two agree), whether it ended OK (an open path that starves is E-
 the suite's CPU over the stream (utime + stime of its process, /proc/<pid>/stat) as a share of
 one core.
 
-    python -P bench/bench_stream.py [--points 100000] [--dt 0.001] [--chunk 100] [--ahead 4]
+    python -P bench/bench_stream.py [--points 100000] [--dt 0.001] [--chunk 500] [--ahead 4]
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=100_000)
     parser.add_argument("--dt", type=float, default=0.001)
-    parser.add_argument("--chunk", type=int, default=100)
+    parser.add_argument("--chunk", type=int, default=500)
     parser.add_argument("--ahead", type=int, default=4, help="appended chunks kept outstanding (stream's ahead)")
     args = parser.parse_args()
     env = dict(os.environ, ROS_DOMAIN_ID=str(110 + os.getpid() % 90), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
