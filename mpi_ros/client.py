@@ -817,7 +817,7 @@ class MotionClient(_Endpoint):
                velocities: Sequence[Sequence[float] | float] | None = None, chunk: int = 50, low_count: int = 32,
                feedforward: Sequence[Sequence[float] | float] | None = None, element_ids: Sequence[int] | None = None,
                attributes: Iterable[Attribute | str] = (), empty_count: int = 5,
-               timeout: float | None = None) -> MotionResult:
+               timeout: float | None = None, ahead: int = 0) -> MotionResult:
         """Stream a long path, ``chunk`` points at a time, as the controller asks for them.
 
             step = 2.0 * math.pi / 10_000  # a circle through the start (0, 0), 10,000 points 2 ms apart
@@ -833,6 +833,16 @@ class MotionClient(_Endpoint):
         controller E_STOPs an open path with fewer than ``empty_count`` points left, so
         (low_count - empty_count) points must last longer than a round trip to the suite. Not
         SPLINE: it may not be appended to.
+
+        ``ahead`` > 0 also keeps up to that many appended chunks not yet executed: a chunk is
+        sent as soon as fewer are outstanding (an append's goal ends when its last point is
+        reached). Points beyond the frame buffer wait in the library (MPI 001, LOW_COUNT), so
+        this gives a round trip about (ahead - 1) * chunk points of time, where the buffer
+        alone gives (low_count - empty_count): with 1 ms points and the default 128-frame
+        buffer that is 123 ms, which a loaded host can exceed (bench/RESULTS.md). A client
+        holding a long path in memory should also keep Python's garbage collector off it
+        (``gc.freeze()`` once the points are built): full collections over 100,000 points took
+        up to 97 ms there.
 
         Returns the MotionStart goal's result once the whole path is done. ``timeout``: the
         longest wait for a cue or an answer (None: the client's timeout plus the path's
@@ -856,7 +866,7 @@ class MotionClient(_Endpoint):
         appends: list[Goal] = []
         append_attrs = attrs if Attribute.APPEND in attrs else [*attrs, Attribute.APPEND.value]
         for number, part in enumerate(parts[1:], 2):
-            if not self._await_low(start, appends, cue, timeout):
+            if not self._await_low(start, appends, cue, timeout, ahead):
                 break  # the path ended early: its goal says why
             goal = path_goal(motion_type, **part, attributes=append_attrs, final=number == len(parts),
                              empty_count=empty_count)
@@ -870,11 +880,13 @@ class MotionClient(_Endpoint):
     def _path_timeout(self, timeout: float | None, times: Iterable[float]) -> float:
         return self.timeout + sum(times) if timeout is None else timeout
 
-    def _await_low(self, start: Goal, appends: list[Goal], cue: _BufferCue, timeout: float) -> bool:
-        """Wait for the cue to append: True; False if the path's goal ended. Appends that are
-        done leave ``appends``; one the controller refused raises its message's exception."""
+    def _await_low(self, start: Goal, appends: list[Goal], cue: _BufferCue, timeout: float, ahead: int = 0) -> bool:
+        """Wait for the cue to append (or, with ``ahead``, fewer appends outstanding): True;
+        False if the path's goal ended. Appends that are done leave ``appends``; one the
+        controller refused raises its message's exception."""
         def woken() -> bool:
-            return start.done or any(goal.done for goal in appends) or cue.low(self._status, self._frames_low_at)
+            return (start.done or len(appends) < ahead or any(goal.done for goal in appends)
+                    or cue.low(self._status, self._frames_low_at))
 
         while True:
             with self._status_event:
@@ -887,7 +899,7 @@ class MotionClient(_Endpoint):
             for goal in [goal for goal in appends if goal.done]:
                 goal.wait(timeout)  # "points executed", or raises the message of a refused append
                 appends.remove(goal)
-            if low:
+            if low or len(appends) < ahead:
                 return True
 
     def _sent(self, cue: _BufferCue) -> None:

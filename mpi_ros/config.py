@@ -35,6 +35,7 @@ from .mpi.params import (
     MotionConfig,
     PlantConfig,
     SecondaryFeedback,
+    check_frame_buffer_size,
     check_settling_reachable,
     first_refusal,
 )
@@ -241,10 +242,14 @@ def _positive(value: float, where: str) -> None:
         raise ConfigError(f"{where}: must be > 0, got {value!r}")
 
 
-def _controller(raw: dict | None, axis_count: int, supervisor_count: int) -> ControllerConfig:
+def _controller(raw: dict | None, axis_count: int, supervisor_count: int,
+                frame_buffer_sizes: dict[int, int]) -> ControllerConfig:
     raw = dict(raw or {})
+    if "axis_frame_buffer_sizes" in raw:
+        raise ConfigError("controller.axis_frame_buffer_sizes: unknown key (set axes.overrides.<n>.frame_buffer_size)")
     cfg = _dataclass(ControllerConfig, {**raw, "axis_count": axis_count, "supervisor_count": supervisor_count},
                      "controller")
+    cfg.axis_frame_buffer_sizes = dict(frame_buffer_sizes)
     _require(cfg.validate(), "controller.")
     return cfg
 
@@ -257,6 +262,7 @@ class _AxesConfig:
     masters: list[AxisMaster]
     secondary: list[SecondaryFeedback]
     faults: list[Any]  # as given (read by _faults once the motors are known)
+    frame_buffer_sizes: dict[int, int] = field(default_factory=dict)  # axes[n].frame_buffer_size, where given
 
 
 def _axis_master(raw: Any, where: str) -> AxisMaster:
@@ -290,10 +296,14 @@ def _axes(raw: dict | None) -> _AxesConfig:
     out = _AxesConfig(count, [], [], [], [], [])
     for n in range(count):
         merged = _merge(defaults, overrides.get(n, overrides.get(str(n), {})))
-        extra = set(merged) - {"in_position", "plant", "master", "secondary_feedback", "faults"}
+        extra = set(merged) - {"in_position", "plant", "master", "secondary_feedback", "faults", "frame_buffer_size"}
         if extra:
-            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: faults, in_position, master, "
-                              "plant, secondary_feedback)")
+            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: faults, frame_buffer_size, "
+                              "in_position, master, plant, secondary_feedback)")
+        if "frame_buffer_size" in merged:
+            size = merged["frame_buffer_size"]
+            _require(check_frame_buffer_size("frame_buffer_size", size), f"axes[{n}].")
+            out.frame_buffer_sizes[n] = size
         out.faults.append(merged.get("faults"))
         ip = _dataclass(AxisInPosition, merged.get("in_position"), f"axes[{n}].in_position")
         plant = _dataclass(PlantConfig, merged.get("plant"), f"axes[{n}].plant")
@@ -400,6 +410,16 @@ def _ros(raw: dict | None) -> RosSettings:
     return ros
 
 
+def _check_frame_sizes(controller: ControllerConfig, axes: list[int], where: str) -> None:
+    """MPI 000, MPIMotionMessageAXIS_FRAME_COUNT: "All axes appended to a Motion object must
+    have the same frame buffer size" (the controller answers it too; said here with the sizes)."""
+    sizes = {n: controller.frame_buffer_size_of(n) for n in axes}
+    if len(set(sizes.values())) > 1:
+        shown = ", ".join(f"axis {n}: {size}" for n, size in sizes.items())
+        raise ConfigError(f"{where}: MPIMotionMessageAXIS_FRAME_COUNT: all axes of a supervisor must have the "
+                          f"same frame buffer size ({shown})")
+
+
 def check_namespace(namespace: str, where: str = "namespace") -> str:
     """``namespace`` if it is a ROS namespace (absolute, name parts of letters, digits and
     underscores not starting with a digit: rcl's rules; no trailing slash), else ConfigError
@@ -425,7 +445,9 @@ def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
     supervisors = _supervisors(data.get("supervisors", [{"number": 0, "axes": [0]}]),
                                data.get("supervisor_defaults"), axes.count)
     supervisor_count = max(s.number for s in supervisors) + 1
-    controller = _controller(data.get("controller"), axes.count, supervisor_count)
+    controller = _controller(data.get("controller"), axes.count, supervisor_count, axes.frame_buffer_sizes)
+    for i, spec in enumerate(supervisors):
+        _check_frame_sizes(controller, spec.axes, f"supervisors[{i}].axes")
     faults = [_faults(raw, n, controller.motors) for n, raw in enumerate(axes.faults)]
     return SuiteConfig(controller, axes.in_position, axes.plant, supervisors, _ros(data.get("ros")), source,
                        copy.deepcopy(data), faults, masters=axes.masters, secondary=axes.secondary)

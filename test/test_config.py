@@ -84,6 +84,12 @@ def test_per_axis_overrides(tmp_path):
         ({"axes": {"count": 100_000}}, "axes.count"),
         ({"controller": {"sample_rate": 1e9}}, "controller.sample_rate"),
         ({"controller": {"frame_buffer_size": 10**9}}, "controller.frame_buffer_size"),
+        ({"axes": {"overrides": {2: {"frame_buffer_size": 8}}}}, "axes[2].frame_buffer_size"),
+        ({"axes": {"defaults": {"frame_buffer_size": "big"}}}, "axes[0].frame_buffer_size"),
+        ({"controller": {"axis_frame_buffer_sizes": {0: 256}}}, "controller.axis_frame_buffer_sizes"),
+        # MPI 000, MPIMotionMessageAXIS_FRAME_COUNT: one size on a supervisor's axes
+        ({"axes": {"overrides": {1: {"frame_buffer_size": 256}}}, "supervisors": [{"number": 0, "axes": [0, 1]}]},
+         "supervisors[0].axes"),
     ],
 )
 def test_values_the_controller_cannot_hold_name_the_key(data, where):
@@ -92,6 +98,20 @@ def test_values_the_controller_cannot_hold_name_the_key(data, where):
     with pytest.raises(config.ConfigError) as error:
         config.parse(data)
     assert str(error.value).startswith(where + ":")
+
+
+def test_per_axis_frame_buffer_sizes_reach_the_controller():
+    # MPI 000, MPIMotionMessageAXIS_FRAME_COUNT: "The axis frame buffer sizes are configured" per axis;
+    # the controller's frame_buffer_size stays the default of every other axis
+    cfg = config.parse({"controller": {"frame_buffer_size": 64},
+                        "axes": {"overrides": {2: {"frame_buffer_size": 512}, 3: {"frame_buffer_size": 512}}},
+                        "supervisors": [{"number": 0, "axes": [0, 1]}, {"number": 1, "axes": [2, 3]}]})
+    ctl = cfg.build_controller()
+    assert [ctl.config.frame_buffer_size_of(n) for n in range(4)] == [64, 64, 512, 512]
+    assert [s.size for s in ctl.supervisor(1).frame_buffer_status()[1]] == [512, 512]
+    with pytest.raises(config.ConfigError, match=r"supervisors\[0\]\.axes: .*AXIS_FRAME_COUNT"):
+        cfg.supervisors[0].axes = [1, 2]  # past the loader: the controller answers it
+        cfg.build_controller()
 
 
 def test_configured_values_reach_the_controller():

@@ -22,6 +22,7 @@ of run, `mpi-ros demo` for a narrated, recorded tour.
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import sys
 
@@ -101,6 +102,11 @@ def run(args) -> int:
              f"namespace {cfg.ros.namespace}, discovery {reach} ({told_by}"
              + (f", static peers {os.environ['ROS_STATIC_PEERS']}" if os.environ.get("ROS_STATIC_PEERS") else "")
              + ")")
+    # What start-up built (rclpy, numpy, the suite) lives as long as the process: frozen, a full
+    # collection no longer walks it. Unfrozen, such collections took up to 111 ms during a
+    # 100,000-point stream (bench/RESULTS.md), a stall the 128-frame buffer (128 ms of 1 ms
+    # points) cannot ride out: the clock then caught up in one batch and the path starved.
+    gc.freeze()
     suite.start(spin_in_thread=False)
     try:
         suite.spin()

@@ -34,6 +34,7 @@ from .params import AxisInPosition, AxisMaster, PlantConfig, check_position
 from .plant import Forced, Plant, PlantState, compose, servo_effort
 from .status import AxisStatusBits, StatusMode, bits_of, column_of
 from .types import MPIState
+from .wrap import turn_offset, wrap_position
 
 
 @dataclass(slots=True)
@@ -174,13 +175,25 @@ class Axis:
         self._bank.bits[:, self.number] = column_of(bits)
 
     # -- positions (user coordinates) ------------------------------------------------
+    # What the controller reports is 32-bit (wrap.py): the command_/actual_/target_position
+    # getters wrap; faults, holds and cam masters follow the continuous unwrapped_ values.
     @property
-    def command_position(self) -> float:
+    def unwrapped_command(self) -> float:
         return self.cmd_p - self.origin
 
     @property
-    def actual_position(self) -> float:
+    def unwrapped_actual(self) -> float:
         return self.act_p - self.origin
+
+    @property
+    def command_position(self) -> float:
+        """mpiAxisCommandPositionGet: in [-2^31, 2^31)."""
+        return wrap_position(self.cmd_p - self.origin)
+
+    @property
+    def actual_position(self) -> float:
+        """mpiAxisActualPositionGet: in [-2^31, 2^31)."""
+        return wrap_position(self.act_p - self.origin)
 
     @property
     def position_error(self) -> float:
@@ -188,7 +201,14 @@ class Axis:
 
     @property
     def target_position(self) -> float:
-        return self.target - self.origin
+        return wrap_position(self.target - self.origin)
+
+    def turn_origin(self, raw: float) -> float:
+        """The origin an absolute position of a move starting at ``raw`` is read with: the
+        axis' origin plus the turns (multiples of 2^32) the command has made, so that the
+        distance of a move is its target minus the position the controller reports."""
+        offset = turn_offset(raw - self.origin)
+        return self.origin if offset == 0.0 else self.origin + offset
 
     def set_origin(self, origin: float) -> Message:
         """mpiAxisOriginSet: reported positions are raw positions minus the origin."""

@@ -17,6 +17,7 @@ from .types import MPIState
 
 if TYPE_CHECKING:
     from .axis import Axis
+    from .params import ControllerConfig
 
 OK = Message.MPIMessageOK
 
@@ -25,10 +26,23 @@ class AxisList:
     """mpiMotionAxisAppend/Insert/Remove/ListSet/ListGet/Count/Index/First/Next/... over the
     controller's ``axes``."""
 
-    def __init__(self, axes: Sequence[Axis]):
+    def __init__(self, axes: Sequence[Axis], config: ControllerConfig):
         self._axes = axes
+        self._config = config  # the axes' frame buffer sizes
         self.listed: list[int] = []
         self.mapped: list[int] = []
+
+    @property
+    def frame_buffer_size(self) -> int:
+        """The frame buffer size of the listed axes (one size: see :meth:`_frame_sizes_differ`)."""
+        config = self._config
+        return config.frame_buffer_size_of(self.listed[0]) if self.listed else config.frame_buffer_size
+
+    def _frame_sizes_differ(self, numbers: list[int]) -> bool:
+        """MPI 000, MPIMotionMessageAXIS_FRAME_COUNT: "All axes appended to a Motion object must
+        have the same frame buffer size". Answered where axes are appended (append, insert,
+        list set), so a list never holds two sizes and MAP and the moves need not ask."""
+        return len({self._config.frame_buffer_size_of(n) for n in numbers}) > 1
 
     def _check_axis(self, number: int) -> Message:
         if not 0 <= number < len(self._axes):
@@ -50,6 +64,8 @@ class AxisList:
             return Message.MPIMessageOBJECT_ON_LIST
         if len(self.listed) >= MAX_COORD_AXES:
             return Message.MPIMessageUNSUPPORTED
+        if self._frame_sizes_differ([*self.listed, number]):
+            return Message.MPIMotionMessageAXIS_FRAME_COUNT
         if after is None:
             self.listed.insert(0, number)
             return OK
@@ -83,6 +99,8 @@ class AxisList:
             message = self._check_axis(number)
             if not message.ok:
                 return message
+        if self._frame_sizes_differ(numbers):
+            return Message.MPIMotionMessageAXIS_FRAME_COUNT
         if own_state not in (MPIState.IDLE, MPIState.ERROR, MPIState.STOPPED):
             return refusal
         self.listed = list(numbers)

@@ -45,6 +45,7 @@ from .snapshot import AxisSnapshot, MotionFeedback
 from .status import BITS, EVENT_BITS, StretchStatus, compute, rising_edges
 from .stretch import Stretch
 from .types import ActionSource, IoSpace, MPIAction, MPIState
+from .wrap import wrap_positions
 
 MAX_STRETCH = 4096  # samples computed at once
 # Elements (axes x samples) of a stretch at most: its arrays stay a few megabytes (they live in
@@ -348,7 +349,7 @@ class Controller:
         owner = self.supervisor(axis.owner)
         if owner is not None:
             count += owner.frames_queued(number)
-        return min(count, self.config.frame_buffer_size)
+        return min(count, self.config.frame_buffer_size_of(number))
 
     def joint_values(self) -> tuple[list[float], list[float], list[float]]:
         """Every axis' actual position (user units), actual velocity and servo effort
@@ -507,8 +508,8 @@ class Controller:
         for ms in supervisors:
             if ms.log is not None and not ms.log.full:
                 ms.log.record(stretch.samples[: stop + 1], ms.state.name,
-                              [(stretch.cmd_p[n, : stop + 1] - self.axes[n].origin,
-                                stretch.act_p[n, : stop + 1] - self.axes[n].origin,
+                              [(wrap_positions(stretch.cmd_p[n, : stop + 1] - self.axes[n].origin),
+                                wrap_positions(stretch.act_p[n, : stop + 1] - self.axes[n].origin),
                                 stretch.cmd_v[n, : stop + 1]) for n in ms.mapped])
 
     def _commit(self, stop: int, stretch: Stretch, status: StretchStatus) -> None:

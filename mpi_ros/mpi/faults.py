@@ -372,11 +372,11 @@ class FaultMonitor:
             held = limit > 0.0 and axis.amp_enabled and error > limit
             return f"following error {error:.1f} > {limit:g} counts" if held else ""
         if fault is Fault.LIMIT_SW_POSITIVE:
-            held = config.software_limit_positive_enabled and axis.actual_position > config.software_limit_positive
-            return f"actual position {axis.actual_position:.1f} > {config.software_limit_positive:g}" if held else ""
+            held = config.software_limit_positive_enabled and axis.unwrapped_actual > config.software_limit_positive
+            return f"actual position {axis.unwrapped_actual:.1f} > {config.software_limit_positive:g}" if held else ""
         if fault is Fault.LIMIT_SW_NEGATIVE:
-            held = config.software_limit_negative_enabled and axis.actual_position < config.software_limit_negative
-            return f"actual position {axis.actual_position:.1f} < {config.software_limit_negative:g}" if held else ""
+            held = config.software_limit_negative_enabled and axis.unwrapped_actual < config.software_limit_negative
+            return f"actual position {axis.unwrapped_actual:.1f} < {config.software_limit_negative:g}" if held else ""
         if fault is Fault.AMP_FAULT:
             return "the amplifier fault is still active" if faults.amp_fault else ""
         if fault is Fault.ENCODER_FAULT:

@@ -67,7 +67,7 @@ class MotionSupervisor:
         self._state = SupervisorState(number, config.copy(),
                                       ProfileClock(t, t, config.normal_feedrate, config.normal_feedrate, t),
                                       host.clock_changed)
-        self._axis_list = AxisList(host.axes)
+        self._axis_list = AxisList(host.axes, host.config)
         self._moves = Moves(host, self._state, self._axis_list)
         self._actions = Actions(host, self._state, self._moves, self._axis_list)
         self._transitions = Transitions(host, self._state, self._moves, self._actions)
@@ -105,6 +105,11 @@ class MotionSupervisor:
     def axis_list(self) -> list[int]:
         """The axis list as the host holds it (a copy: change it with the axis calls)."""
         return list(self._axis_list.listed)
+
+    @property
+    def frame_buffer_size(self) -> int:
+        """The frame buffer size of the supervisor's axes (they all have the same: AXIS_FRAME_COUNT)."""
+        return self._axis_list.frame_buffer_size
 
     @property
     def mapped(self) -> list[int]:
@@ -376,8 +381,8 @@ class MotionSupervisor:
         """meiMotionFrameBufferStatus for each mapped axis."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID, []
-        size = self._host.config.frame_buffer_size
-        return OK, [FrameBufferStatus(a.number, size, self._host.frame_count(a.number)) for a in self.axes]
+        size = self._host.config.frame_buffer_size_of
+        return OK, [FrameBufferStatus(a.number, size(a.number), self._host.frame_count(a.number)) for a in self.axes]
 
     # ================================================================= log ====
     def log_open(self, max_entries: int) -> Message:
@@ -534,7 +539,7 @@ class MotionSupervisor:
         return validate.check_params(
             motion_type, attrs, params, len(self._axis_list.listed), self._host.config.io_words,
             self._host.config.motors, len(self._host.axes), sample_rate=self._host.rate,
-            append_to=append_to, frame_buffer_size=self._host.config.frame_buffer_size)
+            append_to=append_to, frame_buffer_size=self._axis_list.frame_buffer_size)
 
     def _command_no_wait(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
                          modify: bool) -> Outcome:
@@ -567,17 +572,18 @@ class MotionSupervisor:
             axis = self._axis(n)
             plan = last.plan_for(n) if queued and last is not None else None
             if plan is not None:
-                starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.origin))
+                starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.turn_origin(plan.target)))
             elif moving:
                 f = self._state.clock.feedrate(self._host.time)
                 velocity = axis.cmd_v / f if f > 0.0 else 0.0
                 acceleration = axis.cmd_a / (f * f) if f > 0.0 else 0.0
-                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.origin, acceleration))
+                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.turn_origin(axis.cmd_p), acceleration))
             else:
                 # A start runs at the normal feedrate from now on. The axis may still move (STOPPED
                 # at a non-zero pauseFeedrate, or past a FINAL_VEL move): start from that velocity.
                 f = self._state.config.normal_feedrate
-                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.origin, axis.cmd_a / (f * f)))
+                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.turn_origin(axis.cmd_p),
+                                        axis.cmd_a / (f * f)))
         return starts
 
     def _cam_masters(self) -> list[tuple[AxisMaster, float]]:
@@ -595,10 +601,10 @@ class MotionSupervisor:
     def _check_frames(self, moves: list[Move]) -> Message:
         """Do the moves fit the frame buffer? A path's points need not: the library holds
         what does not fit and loads it as the buffer drains (MPI 001, LOW_COUNT)."""
-        size = self._host.config.frame_buffer_size
+        size = self._host.config.frame_buffer_size_of
         loaded = [move for move in moves if move.stream is None]
         for n in self._axis_list.listed:
-            if frames_needed(loaded, n) > size:
+            if frames_needed(loaded, n) > size(n):
                 return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
         return OK
 
@@ -606,7 +612,7 @@ class MotionSupervisor:
         """MPI 001 LOW_COUNT: the given count, else a quarter of the frame buffer (32 of 128)."""
         if MotionAttr.LOW_COUNT in attrs:
             return params.low_count
-        return self._host.config.frame_buffer_size // 4
+        return self._axis_list.frame_buffer_size // 4
 
     def _append_points(self, move: Move, motion_type: MPIMotionType, attrs: MotionAttr,
                        params: MotionParams) -> Outcome:

@@ -142,9 +142,10 @@ class Moves:
         return self._host.clock_of(axis.owner) if axis.owner >= 0 else None
 
     def position_of(self, hold: Hold) -> float:
-        """The position (user units) a position hold watches: actual or command."""
+        """The position (user units, continuous: not wrapped at 32 bits) a position hold watches:
+        actual or command."""
         axis = self.axis(hold.number)
-        return axis.actual_position if hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.command_position
+        return axis.unwrapped_actual if hold.type is HoldType.AXIS_POSITION_ACTUAL else axis.unwrapped_command
 
     # -- events and ends ---------------------------------------------------------------------
     def emit(self, kind: MPIEventType, axis: int = -1, move: Move | None = None, detail: str = "",

@@ -119,6 +119,11 @@ def check_range(name: str, value: object, low: float, high: float, above_low: bo
     return refuse(f"{name}: must be a finite number {lower} and <= {high:g}, got {shown(value)}")
 
 
+def check_frame_buffer_size(name: str, value: object) -> Outcome:
+    """Frames per axis (MPI 000 mpiMotionStart: 128 by default)."""
+    return check_integer(name, value, FRAME_BUFFER_MIN, FRAME_BUFFER_MAX)
+
+
 def check_integer(name: str, value: object, low: int, high: int) -> Outcome:
     if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= int(value) <= high:
         return VALID
@@ -590,23 +595,41 @@ class ControllerConfig:
     sample_rate: float = 2000.0
     axis_count: int = 4
     supervisor_count: int = 2
-    frame_buffer_size: int = 128
+    frame_buffer_size: int = 128  # frames per axis, for every axis not in axis_frame_buffer_sizes
     firmware_option_21: bool = False
     io_words: int = 64
     motor_count: int = -1  # -1: one motor per axis
     event_notify: MPIEventType = MASK_ALL
+    # axis number -> its frame buffer size (MPI 000 MPIMotionMessageAXIS_FRAME_COUNT: "The axis
+    # frame buffer sizes are configured with ... mpiControlConfigSet")
+    axis_frame_buffer_sizes: dict[int, int] = field(default_factory=dict)
 
     @property
     def motors(self) -> int:
         return self.axis_count if self.motor_count < 0 else self.motor_count
+
+    def frame_buffer_size_of(self, axis: int) -> int:
+        return self.axis_frame_buffer_sizes.get(axis, self.frame_buffer_size)
+
+    def _check_axis_frame_buffer_sizes(self) -> Outcome:
+        sizes = self.axis_frame_buffer_sizes
+        if not isinstance(sizes, dict):
+            return refuse(f"axis_frame_buffer_sizes: must be a mapping of axis number -> size, got {shown(sizes)}")
+        axes = self.axis_count if isinstance(self.axis_count, int) else MAX_OBJECTS
+        return first_refusal(
+            first_refusal((check_integer("axis_frame_buffer_sizes: axis", axis, 0, axes - 1),
+                           check_frame_buffer_size(f"axis_frame_buffer_sizes[{axis}]", size)))
+            for axis, size in sizes.items()
+        )
 
     def validate(self) -> Outcome:
         return first_refusal((
             check_range("sample_rate", self.sample_rate, SAMPLE_RATE_MIN, SAMPLE_RATE_MAX),
             check_integer("axis_count", self.axis_count, 1, MAX_OBJECTS),
             check_integer("supervisor_count", self.supervisor_count, 1, MAX_OBJECTS),
-            check_integer("frame_buffer_size", self.frame_buffer_size, FRAME_BUFFER_MIN, FRAME_BUFFER_MAX),
+            check_frame_buffer_size("frame_buffer_size", self.frame_buffer_size),
             check_bool("firmware_option_21", self.firmware_option_21),
             check_integer("io_words", self.io_words, 1, IO_WORDS_MAX),
             check_integer("motor_count", self.motor_count, -1, MAX_OBJECTS),  # -1: one per axis
+            self._check_axis_frame_buffer_sizes(),
         ))

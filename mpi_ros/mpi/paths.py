@@ -29,9 +29,9 @@ from .params import MotionParams, Output
 from .profiles.path import PathKind, path_segments, peaks
 from .profiles.segment import Segment
 from .types import HOLD_ATTRS, MotionAttr, MPIMotionType
+from .wrap import WRAP
 
 A = MotionAttr
-WRAP = 2.0**32  # the controller's 32-bit position register
 
 KINDS: dict[MPIMotionType, PathKind] = {
     MPIMotionType.PT: PathKind.PT,

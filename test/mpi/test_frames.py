@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mpi_ros.mpi import Controller, ControllerConfig, MotionAttr, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi import Controller, ControllerConfig, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi.events import MPIEventType
 from mpi_ros.mpi.frames import AxisPlan, Move, frames_needed
 from mpi_ros.mpi.messages import Message
 from mpi_ros.mpi.profiles.segment import Segment
@@ -139,3 +140,91 @@ def test_frame_count_after_abort_and_reset(ctl, ms, bring):
     bring(MPIState.ERROR)
     ms.action(MPIAction.RESET)
     assert ctl.frame_count(0) == 0
+
+
+# ------------------------------------------------------- per-axis frame buffer sizes ----
+def _two_sizes() -> Controller:
+    """Axes 0 and 1 with 256-frame buffers, axes 2 and 3 with the default 128."""
+    return Controller(ControllerConfig(axis_frame_buffer_sizes={0: 256, 1: 256}))
+
+
+def test_each_axis_reports_its_own_frame_buffer_size():
+    # MPI 000, MEIMotionFrameBufferStatus, size: "the size of the controller's frame buffer", per axis;
+    # MPI 000, MPIMotionMessageAXIS_FRAME_COUNT: "The axis frame buffer sizes are configured" per axis
+    ctl = _two_sizes()
+    _, ms = ctl.create_motion(0)
+    _, ms1 = ctl.create_motion(1)
+    for sup, axes in ((ms, [0, 1]), (ms1, [2, 3])):
+        assert sup.axis_list_set(axes).ok and sup.action(MPIAction.MAP).ok
+    assert [(s.axis, s.size) for s in ms.frame_buffer_status()[1]] == [(0, 256), (1, 256)]
+    assert [(s.axis, s.size) for s in ms1.frame_buffer_status()[1]] == [(2, 128), (3, 128)]
+    assert ms.frame_buffer_size == 256 and ms1.frame_buffer_size == 128
+
+
+@pytest.mark.parametrize("edit", ["append", "insert", "list_set"])
+def test_an_axis_of_another_frame_buffer_size_is_refused_and_nothing_changes(edit):
+    # MPI 000, MPIMotionMessageAXIS_FRAME_COUNT: "All axes appended to a Motion object must have the same
+    # frame buffer size": answered where the axis is appended (docs/paths.md)
+    ctl = _two_sizes()
+    _, ms = ctl.create_motion(0)
+    assert ms.axis_list_set([0, 1]).ok and ms.action(MPIAction.MAP).ok
+    answer = {"append": lambda: ms.axis_append(2), "insert": lambda: ms.axis_insert(None, 3),
+              "list_set": lambda: ms.axis_list_set([0, 2])}[edit]()
+    assert answer is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_list_get() == (Message.MPIMessageOK, [0, 1]) and ms.mapped == [0, 1]
+    assert ms.axis_list_set([2, 3]).ok and ms.axis_append(1) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+
+
+def test_an_empty_list_takes_any_size_and_same_sizes_mix():
+    ctl = Controller(ControllerConfig(frame_buffer_size=64, axis_frame_buffer_sizes={3: 64, 0: 512}))
+    _, ms = ctl.create_motion(0)
+    assert ms.axis_append(1).ok and ms.axis_append(3).ok  # 64 and 64 (the default and an equal override)
+    assert ms.axis_append(2).ok and ms.axis_append(0) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_list_set([0]).ok and ms.frame_buffer_size == 512
+
+
+def test_each_axis_buffer_bounds_its_own_appends(params):
+    # MPI 000, MPIMotionMessageFRAME_BUFFER_TOO_SMALL, per axis: 16 S-curves fit 128 frames, 32 fit 256
+    ctl = _two_sizes()
+    _, ms = ctl.create_motion(0)
+    _, ms1 = ctl.create_motion(1)
+    assert ms.axis_list_set([0, 1]).ok and ms1.axis_list_set([2, 3]).ok
+    assert fill(ctl, ms, params) == (32, Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL)
+    assert fill(ctl, ms1, params) == (16, Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL)
+    assert ctl.frame_count(0) <= 256 and ctl.frame_count(2) <= 128 and ctl.frame_count(0) > 128
+
+
+def test_low_count_defaults_to_a_quarter_of_the_axes_buffer_and_is_bounded_by_it():
+    # MPI 001, MPIMotionPathAttrMask, LOW_COUNT: a quarter of the buffer by default (256 -> 64); a given
+    # lowCount beyond the axes' buffer is PARAM_INVALID (validate.py), on each supervisor's own size
+    ctl = _two_sizes()
+    _, ms = ctl.create_motion(0)
+    _, ms1 = ctl.create_motion(1)
+    for sup, axes in ((ms, [0, 1]), (ms1, [2, 3])):
+        assert sup.axis_list_set(axes).ok and sup.action(MPIAction.MAP).ok
+        assert sup.event_notify_set(MPIEventType.FRAMES_LOW).ok
+    ctl.drain_events()
+    x = np.arange(1.0, 101.0)
+    points = MotionParams(position=list(np.stack([x, x], axis=1).ravel()), time=[0.01] * 100, final=False,
+                          empty_count=0)
+    assert ms.start(T.PT, A.NONE, points).ok and ms1.start(T.PT, A.NONE, points).ok
+    s0 = ctl.sample
+    ctl.step(80 * 20)  # 20 samples a point: 80 points reached
+    lows = [(e.supervisor, (e.sample - s0) // 20) for e in ctl.drain_events() if e.type is MPIEventType.FRAMES_LOW]
+    assert sorted(lows) == [(0, 100 - 63), (1, 100 - 31)]  # fewer than 64 / 32 left
+    big = MotionParams(position=[1.0, 1.0], time=[0.01], final=False, low_count=200)
+    assert ms.start(T.PT, A.APPEND | A.LOW_COUNT, big).ok
+    assert ms1.start(T.PT, A.APPEND | A.LOW_COUNT, big) is Message.MPIMessagePARAM_INVALID
+
+
+@pytest.mark.parametrize(("sizes", "field"), [({0: 8}, "axis_frame_buffer_sizes[0]"),
+                                              ({0: 70_000}, "axis_frame_buffer_sizes[0]"),
+                                              ({4: 128}, "axis_frame_buffer_sizes: axis"),
+                                              ({-1: 128}, "axis_frame_buffer_sizes: axis"),
+                                              ({0: 128.0}, "axis_frame_buffer_sizes[0]"),
+                                              ([128], "axis_frame_buffer_sizes")])
+def test_a_bad_axis_frame_buffer_size_is_refused_by_the_one_validator(sizes, field):
+    verdict = ControllerConfig(axis_frame_buffer_sizes=sizes).validate()
+    assert not verdict.ok and verdict.detail.startswith(field)
+    with pytest.raises(ValueError, match=r"config\.axis_frame_buffer_sizes"):
+        Controller(ControllerConfig(axis_frame_buffer_sizes=sizes))

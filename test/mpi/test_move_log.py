@@ -73,5 +73,5 @@ def test_each_controller_numbers_its_own_moves():
             assert ms.start(MPIMotionType.TRAPEZOIDAL, params=MotionParams(
                 position=[target], trajectory=[Trajectory(1e5, 1e6, 1e6)])).ok
             numbered.append(ctl.current_serial(0))
-            assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000, chunk=10)
+            assert ctl.run_until(lambda c: c.supervisor(0).state is MPIState.IDLE, 20_000, chunk=10)
     assert numbered == [1, 2, 1, 2]

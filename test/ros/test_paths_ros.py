@@ -296,6 +296,38 @@ def test_client_stream_keeps_a_10000_point_path_going(suite, client, events, cue
     assert not [e for e in events.messages if e.type in ("E_STOP", "FRAMES_EMPTY")]
 
 
+def test_client_stream_ahead_keeps_chunks_queued_beyond_the_buffer_cue(suite, client, events, applied):
+    # MPI 001, MPIMotionPathAttrMask, LOW_COUNT: points that do not fit the buffer wait in the library,
+    # so a client may append before the controller asks. ahead=3: the start and 3 appends at once;
+    # then one append each time an append's last point is reached (its goal ends "points executed").
+    count, chunk = 1000, 100
+    points = [(float(k), 0.0) for k in range(1, count + 1)]
+    outcome = {}
+
+    def run():
+        try:
+            outcome["result"] = client.stream(MotionType.PT, points, [1.0 / RATE] * count, chunk=chunk,
+                                              timeout=WAIT, ahead=3)
+        except Exception as exc:  # noqa: BLE001 - reported by the test
+            outcome["error"] = exc
+
+    streaming = threading.Thread(target=run)
+    streaming.start()
+    applied.wait(4)  # nothing stepped: no FRAMES_LOW cue, the client sent ahead
+    runner = suite.runner
+    runner.step(150)  # one point a sample: the start's chunk done, the first append's half
+    assert len(applied.commands) == 4 and not outcome
+    runner.step(60)  # the first append's last point (sample 200) reached: its goal ends, one more goes
+    applied.wait(5)
+    step_gated(suite, applied, streaming, closing=count // chunk)
+    streaming.join(WAIT)
+    assert "error" not in outcome, outcome
+    assert outcome["result"].message == "MPIMessageOK" and outcome["result"].command_position[0] == count
+    sends = [(c.operation, c.request["final"]) for _, c, _ in applied.commands]
+    assert sends == [("motion_start", False)] + [("motion_modify", False)] * 8 + [("motion_modify", True)]
+    assert not [e for e in events.messages if e.type in ("E_STOP", "FRAMES_EMPTY")]
+
+
 def step_gated(suite, applied, streaming: threading.Thread, closing: int, keep: int = 8, most: int = 100) -> None:
     """Step while ``streaming`` runs; until the ``closing``-th command (the final append) has
     been applied, never so far that fewer than ``keep`` frames would be left in axis 0's
