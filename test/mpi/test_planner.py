@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 from mpi_ros.mpi import Hold, HoldType, MotionAttr, MotionParams, MPIMotionType, Output, OutputType, Trajectory
 from mpi_ros.mpi.events import MPIEventType
+from mpi_ros.mpi.frames import AxisPlan, ScaledAxisPlan
 from mpi_ros.mpi.messages import Message
 from mpi_ros.mpi.planner import AxisStart, PlanError, compile_move
 
@@ -217,3 +220,34 @@ def test_hold_and_outputs_go_to_the_plans():
     move, _ = compile_(A.HOLD | A.OUTPUT, hold=holds, output=[output])
     assert [p.hold.gate for p in move.plans] == [1, 2]
     assert move.plans[0].outputs == [output] and move.plans[1].outputs == []
+
+
+def _eager(plan: AxisPlan) -> AxisPlan:
+    """The same plan as a plain AxisPlan, its segments made now."""
+    return AxisPlan(**{f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.init})
+
+
+@pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
+@pytest.mark.parametrize("moving", [False, True])
+def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving):
+    trajectory = (Trajectory(1000.0, 10_000.0, 5_000.0, 40.0, 1e6, 2e6),)
+    speed = 100.0 if moving else 0.0  # along the line to the targets
+    starts = [AxisStart(0, 30.0, 0.6 * speed), AxisStart(1, -40.0, -0.8 * speed)]
+    move, _ = compile_(position=(3000.0, -4000.0), kind=kind, trajectory=trajectory, starts=starts)
+    times = np.linspace(-0.1, 8.0, 50)
+    for plan in move.plans:
+        assert isinstance(plan, ScaledAxisPlan)
+        frames = plan.frame_count  # counted from the line, before the segments are made
+        eager = _eager(plan)
+        assert (frames, plan.duration) == (eager.frame_count, eager.duration)
+        assert plan.segments == eager.segments and len(plan.segments) == frames - 1
+        for mine, theirs in zip(plan.evaluate(times), eager.evaluate(times), strict=True):
+            assert np.array_equal(mine, theirs)
+
+
+def test_vector_axes_with_a_delay_or_a_cut_frame_are_made_and_checked_each():
+    move, _ = compile_(A.DELAY, delay=[0.5, 0.0])
+    assert [type(plan) for plan in move.plans] == [AxisPlan, AxisPlan]
+    move, notes = compile_(position=(6e5, 8e5), trajectory=(Trajectory(1.0, 1e4, 1e4),), rate=100.0)
+    assert all(plan.truncated and type(plan) is AxisPlan for plan in move.plans)
+    assert [kind for kind, _ in notes.events] == [E.FRAME_TIME_LIMIT] * 2
