@@ -403,7 +403,9 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
         profiles = _sync(profiles, starts, targets, attrs)
         limits = list(params.trajectory)
     elif len(starts) == 1:
-        profiles = [_scalar_profile(motion_type, starts[0], targets[0], finals[0], params.trajectory[0])]
+        one = starts[0]
+        profiles = [_profile_from(motion_type, one.position, one.velocity, one.acceleration, targets[0], finals[0],
+                                  params.trajectory[0])]
         limits = [params.trajectory[0]]
     else:
         profiles, limits, composite = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
@@ -422,7 +424,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
                 profile, start.axis, start.position, target, final, hold, outputs,  # (AxisPlan's fields)
                 None, 0.0, False, limits[i], start.velocity, start.acceleration, composite))
             continue
-        prof = _segments(profile)
+        prof = profile.segments() if isinstance(profile, ScaledProfile) else profile
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise PlanError(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
