@@ -206,8 +206,11 @@ class ScaledAxisPlan(AxisPlan):
         return plan
 
     def __post_init__(self) -> None:
-        # the same durations as the 1-D profile's, added in the same order (AxisPlan.__post_init__)
-        self.duration = end_time(self.scaled.line, self.origin_time)
+        if _segments_slot.__get__(self, AxisPlan) is None:
+            # the same durations as the 1-D profile's, added in the same order (AxisPlan.__post_init__)
+            self.duration = end_time(self.scaled.line, self.origin_time)
+        else:  # made with its segments (dataclasses.replace, a copy): as any AxisPlan
+            AxisPlan.__post_init__(self)
 
     @property
     def segments(self) -> list[Segment]:
@@ -224,7 +227,8 @@ class ScaledAxisPlan(AxisPlan):
     @property
     def segment_count(self) -> int:
         """As many as the 1-D profile's, without making them (the frame buffer counts them)."""
-        return len(self.scaled.line)
+        made = _segments_slot.__get__(self, AxisPlan)
+        return len(self.scaled.line) if made is None else len(made)
 
 
 @dataclass(slots=True)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 
@@ -243,6 +244,11 @@ def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving)
         assert plan.segments == eager.segments and len(plan.segments) == frames - 1
         for mine, theirs in zip(plan.evaluate(times), eager.evaluate(times), strict=True):
             assert np.array_equal(mine, theirs)
+    for plan in compile_(position=(3000.0, -4000.0), kind=kind, trajectory=trajectory, starts=starts)[0].plans:
+        # made again through AxisPlan's fields (a copy, dataclasses.replace): the same plan
+        for again in (copy.deepcopy(plan), dataclasses.replace(plan)):
+            assert (again.segments, again.duration, again.frame_count) == (plan.segments, plan.duration,
+                                                                            plan.frame_count)
 
 
 def test_vector_axes_with_a_delay_or_a_cut_frame_are_made_and_checked_each():
