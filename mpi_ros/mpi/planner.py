@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from operator import attrgetter, sub
+from operator import attrgetter, itemgetter, sub
 
 from . import cams
 from .events import MPIEventType
@@ -47,6 +47,7 @@ _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
 _VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
 _NO_EVENTS = MPIEventType.NONE
 _position_of, _velocity_of, _acceleration_of = (attrgetter(name) for name in ("position", "velocity", "acceleration"))
+_duration_of, _position_of_segment = itemgetter(0), itemgetter(1)  # (a Segment is a tuple)
 
 
 class PlanError(Exception):
@@ -115,16 +116,17 @@ def _on_target(end: float, start: AxisStart, target: float) -> bool:
     return math.isfinite(end) and abs(end - target) <= 1e-9 * max(1.0, abs(target), abs(start.position))
 
 
+def _end_position(segment: tuple[float, float, float, float, float]) -> float:
+    """Where a segment ends, as Segment.end_state calculates it, without its other values."""
+    t, p, v, a, j = segment
+    return p + t * (v + t * (a / 2.0 + t * j / 6.0))
+
+
 def _check_lands(segments: list[Segment], start: AxisStart, target: float) -> None:
     """The frames must end on the target: the executor snaps the command onto it when the
     trajectory completes, which must never be a jump (guards against overflow and any
     planning fault). Rounding grows with the positions and the distance travelled."""
-    if segments:
-        # where the last segment ends, as Segment.end_state calculates it, without the calls
-        t, p, v, a, j = segments[-1]
-        end = p + t * (v + t * (a / 2.0 + t * j / 6.0))
-    else:
-        end = start.position
+    end = _end_position(segments[-1]) if segments else start.position
     if _on_target(end, start, target):
         return  # on target without the travel, which can only widen the tolerance
     scale = max(1.0, abs(target), abs(start.position))
@@ -135,12 +137,16 @@ def _check_lands(segments: list[Segment], start: AxisStart, target: float) -> No
         raise ProfileError(f"axis {start.axis}: the profile cannot be calculated with these values")
 
 
-def _checked(segments: list[Segment], start: AxisStart, target: float, limit: float,
-             notes: PlanNotes) -> tuple[list[Segment], bool]:
+def _checked(segments: list[Segment], start: AxisStart, target: float, limit: float, notes: PlanNotes,
+             chained: bool) -> tuple[list[Segment], bool]:
     """An axis' plan after the landing, overflow and frame-limit checks: cut at the first frame
-    longer than ``limit`` seconds (16,384,000 samples), and whether it was. One pass over the
-    segments finds every segment finite and within the limit, the usual case."""
+    longer than ``limit`` seconds (16,384,000 samples), and whether it was. ``chained``: the
+    segments are reshape's, each starting where the one before ends, so that one that lands
+    is finite throughout (_finite_if_it_ends); otherwise one pass over them finds every segment
+    finite and within the limit, the usual case."""
     _check_lands(segments, start, target)
+    if chained and (not segments or max(map(_duration_of, segments)) <= limit):
+        return segments, False  # landed: finite (and reshape's pieces are positive)
     for d, p, v, a, j in segments:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
         if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
@@ -149,12 +155,27 @@ def _checked(segments: list[Segment], start: AxisStart, target: float, limit: fl
     return segments, False
 
 
-def _line_bound(line: list[Segment], limit: float) -> float | None:
+def _finite_if_it_ends(segments: list[Segment]) -> bool:
+    """Whether the end position of ``segments`` (reshape's: each starts at the position where
+    the one before ends, as Segment.end_state calculates it) is finite, which makes every value
+    of every segment finite: each enters that end position through +, -, * and division by a
+    constant, where an infinite or NaN operand gives an infinite or NaN result (a product too:
+    the pieces last more than 0 s). This is what _check_finite's pass would find."""
+    return math.isfinite(_end_position(segments[-1]))
+
+
+def _line_bound(line: list[Segment], limit: float, chained: bool) -> float | None:
     """The largest |position| in a vector's 1-D profile if all its values are finite and no
     frame exceeds ``limit`` (None otherwise, or for no profile). An axis' share of it, with
     a factor of at most 1 and a start ``offset``, is then finite and within the limit too when
     abs(offset) + this bound is finite: rounding to nearest is monotonic, so no product or sum
-    of the scaling exceeds it in magnitude."""
+    of the scaling exceeds it in magnitude. ``chained``: the profile is reshape's (_checked)."""
+    if not line:
+        return None
+    if chained:
+        if _finite_if_it_ends(line) and max(map(_duration_of, line)) <= limit:
+            return max(map(abs, map(_position_of_segment, line)))
+        return None
     bound = 0.0
     for d, p, v, a, j in line:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
@@ -162,7 +183,7 @@ def _line_bound(line: list[Segment], limit: float) -> float | None:
             return None
         if abs(p) > bound:
             bound = abs(p)
-    return bound if line else None
+    return bound
 
 
 def _passes_checks(scaled: ScaledProfile, bound: float | None, start: AxisStart, target: float) -> bool:
@@ -174,8 +195,8 @@ def _passes_checks(scaled: ScaledProfile, bound: float | None, start: AxisStart,
     if bound is None or not (abs(factor) <= 1.0 and math.isfinite(abs(offset) + bound)):
         return False
     t, p, v, a, j = line[-1]
-    p, v, a, j = offset + factor * p, factor * v, factor * a, factor * j  # (scaled_profile's operations)
-    return _on_target(p + t * (v + t * (a / 2.0 + t * j / 6.0)), start, target)
+    last = (t, offset + factor * p, factor * v, factor * a, factor * j)  # (scaled_profile's operations)
+    return _on_target(_end_position(last), start, target)
 
 
 def _cap_frames(segments: list[Segment], limit: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
@@ -415,7 +436,9 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
     first = profiles[0] if profiles else None
     lazy = not bits & (_DELAY | _NO_REVERSAL) and isinstance(first, ScaledProfile)
-    bound = _line_bound(first.line, limit) if isinstance(first, ScaledProfile) and lazy else None
+    # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
+    chained = motion_type is not _S_CURVE_JERK and not bits & (_SYNC | _DELAY) and not composite
+    bound = _line_bound(first.line, limit, chained) if isinstance(first, ScaledProfile) and lazy else None
     plans: list[AxisPlan] = []
     for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
@@ -424,13 +447,14 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
                 profile, start.axis, start.position, target, final, hold, outputs,  # (AxisPlan's fields)
                 None, 0.0, False, limits[i], start.velocity, start.acceleration, composite))
             continue
-        prof = profile.segments() if isinstance(profile, ScaledProfile) else profile
+        # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
+        prof, chain = (profile.segments(), False) if isinstance(profile, ScaledProfile) else (profile, chained)
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise PlanError(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
         if bits & _DELAY:
             prof = _wait(start.position, params.delay[i]) + prof
-        prof, truncated = _checked(prof, start, target, limit, notes)
+        prof, truncated = _checked(prof, start, target, limit, notes, chain)
         # (positional, as Move above: the fields in their order, a third cheaper than keywords)
         plans.append(AxisPlan(
             start.axis, prof, start.position,  # axis, segments, start_position

@@ -257,3 +257,13 @@ def test_vector_axes_with_a_delay_or_a_cut_frame_are_made_and_checked_each():
     move, notes = compile_(position=(6e5, 8e5), trajectory=(Trajectory(1.0, 1e4, 1e4),), rate=100.0)
     assert all(plan.truncated and type(plan) is AxisPlan for plan in move.plans)
     assert [kind for kind, _ in notes.events] == [E.FRAME_TIME_LIMIT] * 2
+
+
+def test_a_vector_axis_that_overflows_on_its_way_is_refused():
+    # The 1-D profile is finite and every axis lands, but axis 0 overshoots its target past the
+    # largest float on the way (MPI 000, MPIMotionMessagePROFILE_ERROR: "cannot be calculated")
+    params = MotionParams(trajectory=[Trajectory(2e154, 1.0, 1.0, 50.0)], position=[1.79e308, 0.0])
+    with pytest.raises(PlanError) as refused:
+        compile_move(0, T.S_CURVE, A.NONE, params, [AxisStart(0, 1.7e308, 1e154), AxisStart(1, 0.0, 0.0)], RATE)
+    assert refused.value.message is Message.MPIMotionMessagePROFILE_ERROR
+    assert refused.value.detail == "axis 0: the profile cannot be calculated with these values (overflow)"

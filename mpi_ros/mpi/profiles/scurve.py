@@ -36,7 +36,10 @@ def ramp_pieces(ramp: Ramp, fraction: float) -> list[tuple[float, float, float]]
 
 def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segment]:
     """Segments of a velocity plan starting at position ``p0`` with zero acceleration
-    at every ramp boundary (the standard S-curve starts each ramp from a = 0)."""
+    at every ramp boundary (the standard S-curve starts each ramp from a = 0). Each segment
+    lasts more than 0 s and starts at the position where the one before ends, as
+    Segment.end_state calculates it: the planner relies on it (a profile whose end position
+    is finite is finite throughout: planner._finite_if_it_ends)."""
     if not 0.0 <= jerk_percent <= 100.0:
         raise ProfileError("jerkPercent must be within 0..100")
     fraction = jerk_percent / 100.0
