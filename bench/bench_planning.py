@@ -15,7 +15,10 @@ side part times, interleaved problem by problem:
   where the velocity and acceleration limits are 1); the Ruckig and Trajectory objects are
   made once, as an online generator keeps them (and, for comparison, made for every call);
 * with ``--baseline REV``: compile_move of that commit (git archive, imported in the same
-  process under another package name), whose plans must be bit-identical to ours.
+  process under another package name), whose plans must be bit-identical to ours;
+* "+ first evaluation": compile_move and then every plan's SegmentTable (``plan.table``), which
+  the stepping builds when it first evaluates a plan: work a plan leaves for later (a vector
+  axis' segments, made when first asked for) is paid there, and a command's latency is both.
 
     python -P bench/bench_planning.py [--baseline ca83577] [--count 1000] [--rounds 3]
 """
@@ -222,6 +225,8 @@ class SideBySide:
     ruckig: list[float]
     ruckig_made: list[float]  # Ruckig(dofs) and Trajectory(dofs) made for each calculate()
     baseline: list[float]
+    ours_first: list[float]  # compile_move and every plan's table (the first evaluation)
+    baseline_first: list[float]
     verdicts: Counter
     ruckig_failures: int
     duration_rtol: float  # largest relative difference of the durations where the mapping is exact
@@ -263,6 +268,13 @@ def _timers(case: Case, requests: list, inputs: list, baseline: Planner | None, 
         compile_move(0, MPIMotionType.S_CURVE, MotionAttr.NONE, params, starts, SAMPLE_RATE)
         found.ours.append(clock() - t0)
 
+    def ours_first(i: int) -> None:
+        params, starts = requests[i]
+        t0 = clock()
+        for plan in compile_move(0, MPIMotionType.S_CURVE, MotionAttr.NONE, params, starts, SAMPLE_RATE)[0].plans:
+            plan.table  # noqa: B018  (built on first use)
+        found.ours_first.append(clock() - t0)
+
     def ruckig(i: int) -> None:
         inp = inputs[i]
         t0 = clock()
@@ -282,7 +294,15 @@ def _timers(case: Case, requests: list, inputs: list, baseline: Planner | None, 
         plan(0, s_curve, attrs, params, starts, SAMPLE_RATE)
         found.baseline.append(clock() - t0)
 
-    return [ours, ruckig, ruckig_made] + ([old] if baseline else [])
+    def old_first(i: int) -> None:
+        params, starts = old_requests[i]
+        plan, s_curve, attrs = baseline.compile_move, baseline.s_curve, baseline.attrs
+        t0 = clock()
+        for axis_plan in plan(0, s_curve, attrs, params, starts, SAMPLE_RATE)[0].plans:
+            axis_plan.table  # noqa: B018
+        found.baseline_first.append(clock() - t0)
+
+    return [ours, ruckig, ruckig_made, ours_first] + ([old, old_first] if baseline else [])
 
 
 def side_by_side(case: Case, count: int, rounds: int, baseline: Planner | None) -> SideBySide:
@@ -290,7 +310,7 @@ def side_by_side(case: Case, count: int, rounds: int, baseline: Planner | None) 
     todo = problems(case, count)
     requests = [ours.request(p) for p in todo]
     old_requests = [baseline.request(p) for p in todo] if baseline else []
-    found = SideBySide(case, [], [], [], [], Counter(), 0, 0.0, None)
+    found = SideBySide(case, [], [], [], [], [], [], Counter(), 0, 0.0, None)
     inputs = _ruckig_problems(case, ours, requests, found)
     if baseline:
         found.identical = all(_bits(ours.plan(new).plans) == _bits(baseline.plan(old).plans)
@@ -299,7 +319,7 @@ def side_by_side(case: Case, count: int, rounds: int, baseline: Planner | None) 
     for i in range(min(100, count)):  # warm up every path
         for timer in order:
             timer(i)
-    for times in (found.ours, found.ruckig, found.ruckig_made, found.baseline):
+    for times in (found.ours, found.ruckig, found.ruckig_made, found.baseline, found.ours_first, found.baseline_first):
         times.clear()
     gc.collect()
     for r in range(rounds):
@@ -313,30 +333,32 @@ def side_by_side(case: Case, count: int, rounds: int, baseline: Planner | None) 
 def ruckig_rows(count: int, rounds: int, revision: str | None) -> list[str]:
     head = ("| S_CURVE request | ruckig problem (cross-check) | ours median us | ours p99 us | ruckig median us "
             "| ruckig p99 us | ours / ruckig (medians) | ruckig incl. Ruckig(dofs), Trajectory(dofs): median us "
-            "| ours / that |")
-    rule = "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+            "| ours / that | ours + first evaluation: median us |")
+    rule = "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     if revision:
-        head += f" {revision} median us | {revision} p99 us | {revision} / ruckig | speed-up | plans identical |"
-        rule += " --- | --- | --- | --- | --- |"
+        head += (f" {revision} median us | {revision} p99 us | {revision} / ruckig | speed-up "
+                 f"| {revision} + first evaluation: median us | plans identical |")
+        rule += " --- | --- | --- | --- | --- | --- |"
     rows = [head, rule]
     with tempfile.TemporaryDirectory() as scratch:
         baseline = baseline_planner(revision, Path(scratch)) if revision else None
         for case in CASES:
             found = side_by_side(case, count, rounds, baseline)
             ours, theirs, made = _median_p99(found.ours), _median_p99(found.ruckig), _median_p99(found.ruckig_made)
+            first = _median_p99(found.ours_first)[0]
             kind = ", ".join(f"{n} {name}" for name, n in sorted(found.verdicts.items()))
             if not case.moving:
                 kind += f"; durations agree to {found.duration_rtol:.1e}"
             if found.ruckig_failures:
                 kind += f"; ruckig failed {found.ruckig_failures}x"
             row = (f"| {case.label} | {kind} | {ours[0]:.1f} | {ours[1]:.1f} | {theirs[0]:.2f} | {theirs[1]:.2f} "
-                   f"| {ours[0] / theirs[0]:.1f}x | {made[0]:.2f} | {ours[0] / made[0]:.1f}x |")
+                   f"| {ours[0] / theirs[0]:.1f}x | {made[0]:.2f} | {ours[0] / made[0]:.1f}x | {first:.1f} |")
             if baseline:
                 old = _median_p99(found.baseline)
                 row += (f" {old[0]:.1f} | {old[1]:.1f} | {old[0] / theirs[0]:.1f}x | {old[0] / ours[0]:.1f}x "
-                        f"| {'yes' if found.identical else 'NO'} |")
+                        f"| {_median_p99(found.baseline_first)[0]:.1f} | {'yes' if found.identical else 'NO'} |")
             elif revision:
-                row += " - | - | - | - | - |"
+                row += " - | - | - | - | - | - |"
             rows.append(row)
     return rows
 

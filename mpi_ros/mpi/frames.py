@@ -12,13 +12,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .events import MPIEventType
 from .params import Hold, Output, Trajectory
-from .profiles.segment import Segment, SegmentTable, end_time
+from .profiles.segment import ScaledProfile, Segment, SegmentTable, end_time
 from .types import MotionAttr, MPIMotionType
 
 if TYPE_CHECKING:
@@ -92,7 +92,11 @@ class AxisPlan:
         """Frames this plan loads: its segments, the final frame, and a hold frame."""
         if self.cam is not None:
             return self.cam.table.frames  # the whole table stays loaded (a repeat runs it again)
-        return len(self.segments) + 1 + (1 if self.hold is not None else 0)
+        return self.segment_count + 1 + (1 if self.hold is not None else 0)
+
+    @property
+    def segment_count(self) -> int:
+        return len(self.segments)
 
     def frames_left(self, rel: float) -> int:
         """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
@@ -170,6 +174,55 @@ class AxisPlan:
             return 0.0, [self.feedforward_at(rel, held)]
         slope = (values[i] - values[i - 1]) / (times[i] - times[i - 1])
         return float(times[i - 1]), [float(values[i - 1]), float(slope)]
+
+
+# The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
+_segments_slot = AxisPlan.__dict__["segments"]
+
+
+class ScaledAxisPlan(AxisPlan):
+    """An axis of a vector move whose segments are its share of the vector's 1-D profile
+    (``scaled``), made from it the first time they are asked for: by the stepping's table, a
+    cross-check or a plot, not while the command waits for its plan (a further axis of a
+    vector then costs little to plan). The segments, duration and frame count are those of an
+    AxisPlan made with ``scaled.segments()``, and so is every answer: the two are one plan.
+    Made by :meth:`of`."""
+
+    __slots__ = ("scaled",)
+    scaled: ScaledProfile
+
+    @classmethod
+    def of(cls, scaled: ScaledProfile, *fields: Any) -> ScaledAxisPlan:
+        """The plan with the AxisPlan ``fields`` in their order, the segments left out."""
+        plan = cls.__new__(cls)
+        plan.scaled = scaled
+        AxisPlan.__init__(plan, fields[0], None, *fields[1:])  # type: ignore[arg-type]  # (made when asked for)
+        return plan
+
+    def __post_init__(self) -> None:
+        if _segments_slot.__get__(self, AxisPlan) is None:
+            # the same durations as the 1-D profile's, added in the same order (AxisPlan.__post_init__)
+            self.duration = end_time(self.scaled.line, self.origin_time)
+        else:  # made with its segments (dataclasses.replace, a copy): as any AxisPlan
+            AxisPlan.__post_init__(self)
+
+    @property
+    def segments(self) -> list[Segment]:
+        made = _segments_slot.__get__(self, AxisPlan)
+        if made is None:
+            made = self.scaled.segments()
+            _segments_slot.__set__(self, made)
+        return made
+
+    @segments.setter
+    def segments(self, value: list[Segment] | None) -> None:
+        _segments_slot.__set__(self, value)
+
+    @property
+    def segment_count(self) -> int:
+        """As many as the 1-D profile's, without making them (the frame buffer counts them)."""
+        made = _segments_slot.__get__(self, AxisPlan)
+        return len(self.scaled.line) if made is None else len(made)
 
 
 @dataclass(slots=True)

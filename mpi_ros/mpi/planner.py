@@ -20,11 +20,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from operator import attrgetter
+from operator import attrgetter, itemgetter, sub
 
 from . import cams
 from .events import MPIEventType
-from .frames import AxisPlan, Move, Stream
+from .frames import AxisPlan, Move, ScaledAxisPlan, Stream
 from .messages import Message
 from .outcome import Refused
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, MotionParams, Trajectory
@@ -33,7 +33,7 @@ from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import point_to_point, reverses, velocity_move
 from .profiles.ramps import ProfileError, ramps_between
 from .profiles.scurve import reshape
-from .profiles.segment import Segment, chain, scaled_profile, segment_values
+from .profiles.segment import ScaledProfile, Segment, chain, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
 
 A = MotionAttr
@@ -42,7 +42,13 @@ A = MotionAttr
 _RELATIVE, _FINAL_VEL, _NO_REVERSAL, _DELAY, _OUTPUT, _ID, _ELEMENT_ID, _EVENT = map(
     int, (A.RELATIVE, A.FINAL_VEL, A.NO_REVERSAL, A.DELAY, A.OUTPUT, A.ID, A.ELEMENT_ID, A.EVENT))
 _SYNC, _HOLDS = int(A.SYNC_START | A.SYNC_END), int(HOLD_ATTRS)
-_duration_of = attrgetter("duration")
+# The motion types planning tells apart, looked up once: an enum member is a class attribute
+# lookup of ~0.1 us each time.
+_S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
+_VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
+_NO_EVENTS = MPIEventType.NONE
+_position_of, _velocity_of, _acceleration_of = (attrgetter(name) for name in ("position", "velocity", "acceleration"))
+_duration_of, _position_of_segment = itemgetter(0), itemgetter(1)  # (a Segment is a tuple)
 
 
 @dataclass(slots=True)
@@ -73,10 +79,10 @@ def _truncate_id(value: int, notes: PlanNotes) -> int:
     return truncated
 
 
-def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
+def _targets(params: MotionParams, bits: int, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
     """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
     targets = []
-    relative = int(attrs) & _RELATIVE
+    relative = bits & _RELATIVE
     for start, value in zip(starts, params.position, strict=True):
         if relative:
             distance = float(math.trunc(value))
@@ -93,33 +99,102 @@ def _targets(params: MotionParams, attrs: MotionAttr, starts: list[AxisStart], n
 
 def _check_finite(segments: list[Segment], axis: int) -> None:
     """A profile that overflowed (absurd distances or limits) cannot be calculated."""
-    for d, p, v, a, j in map(segment_values, segments):
+    for d, p, v, a, j in segments:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
         if not (d >= 0.0 and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
             raise ProfileError(f"axis {axis}: the profile cannot be calculated with these values (overflow)")
+
+
+def _on_target(end: float, start: AxisStart, target: float) -> bool:
+    """The plan's end is on the target within the rounding of the positions alone."""
+    return math.isfinite(end) and abs(end - target) <= 1e-9 * max(1.0, abs(target), abs(start.position))
+
+
+def _end_position(segment: tuple[float, float, float, float, float]) -> float:
+    """Where a segment ends, as Segment.end_state calculates it, without its other values."""
+    t, p, v, a, j = segment
+    return p + t * (v + t * (a / 2.0 + t * j / 6.0))
 
 
 def _check_lands(segments: list[Segment], start: AxisStart, target: float) -> None:
     """The frames must end on the target: the executor snaps the command onto it when the
     trajectory completes, which must never be a jump (guards against overflow and any
     planning fault). Rounding grows with the positions and the distance travelled."""
-    end = segments[-1].end_state()[0] if segments else start.position
-    scale = max(1.0, abs(target), abs(start.position))
-    if math.isfinite(end) and abs(end - target) <= 1e-9 * scale:
+    end = _end_position(segments[-1]) if segments else start.position
+    if _on_target(end, start, target):
         return  # on target without the travel, which can only widen the tolerance
+    scale = max(1.0, abs(target), abs(start.position))
     # each segment's end velocity as Segment.state_at computes it, without a call per segment
-    travel = sum([max(abs(v), abs(v + t * (a + t * j / 2.0))) * t for t, _, v, a, j in map(segment_values, segments)])
+    travel = sum([max(abs(v), abs(v + t * (a + t * j / 2.0))) * t for t, _, v, a, j in segments])
     scale = max(scale, travel)
     if not math.isfinite(end) or abs(end - target) > 1e-9 * scale:
         raise ProfileError(f"axis {start.axis}: the profile cannot be calculated with these values")
 
 
-def _cap_frames(segments: list[Segment], sample_rate: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
-    """Cut the plan at the first frame longer than 16,384,000 samples."""
-    _check_finite(segments, axis)
-    limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
-    if not segments or max(map(_duration_of, segments)) <= limit:  # (finite: checked) the usual case
-        return segments, False
+def _checked(segments: list[Segment], start: AxisStart, target: float, limit: float, notes: PlanNotes,
+             chained: bool) -> tuple[list[Segment], bool]:
+    """An axis' plan after the landing, overflow and frame-limit checks: cut at the first frame
+    longer than ``limit`` seconds (16,384,000 samples), and whether it was. ``chained``: the
+    segments are reshape's, each starting where the one before ends, so that one that lands
+    is finite throughout (_finite_if_it_ends); otherwise one pass over them finds every segment
+    finite and within the limit, the usual case."""
+    _check_lands(segments, start, target)
+    if chained and (not segments or max(map(_duration_of, segments)) <= limit):
+        return segments, False  # landed: finite (and reshape's pieces are positive)
+    for d, p, v, a, j in segments:
+        # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
+        if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
+            _check_finite(segments, start.axis)
+            return _cap_frames(segments, limit, start.axis, notes)
+    return segments, False
+
+
+def _finite_if_it_ends(segments: list[Segment]) -> bool:
+    """Whether the end position of ``segments`` (reshape's: each starts at the position where
+    the one before ends, as Segment.end_state calculates it) is finite, which makes every value
+    of every segment finite: each enters that end position through +, -, * and division by a
+    constant, where an infinite or NaN operand gives an infinite or NaN result (a product too:
+    the pieces last more than 0 s). This is what _check_finite's pass would find."""
+    return math.isfinite(_end_position(segments[-1]))
+
+
+def _line_bound(line: list[Segment], limit: float, chained: bool) -> float | None:
+    """The largest |position| in a vector's 1-D profile if all its values are finite and no
+    frame exceeds ``limit`` (None otherwise, or for no profile). An axis' share of it, with
+    a factor of at most 1 and a start ``offset``, is then finite and within the limit too when
+    abs(offset) + this bound is finite: rounding to nearest is monotonic, so no product or sum
+    of the scaling exceeds it in magnitude. ``chained``: the profile is reshape's (_checked)."""
+    if not line:
+        return None
+    if chained:
+        if _finite_if_it_ends(line) and max(map(_duration_of, line)) <= limit:
+            return max(map(abs, map(_position_of_segment, line)))
+        return None
+    bound = 0.0
+    for d, p, v, a, j in line:
+        # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
+        if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
+            return None
+        if abs(p) > bound:
+            bound = abs(p)
+    return bound
+
+
+def _passes_checks(scaled: ScaledProfile, bound: float | None, start: AxisStart, target: float) -> bool:
+    """True when the vector axis' share ``scaled`` of the checked 1-D profile (``bound``:
+    _line_bound) passes _checked as it is, without making its segments: finite, no frame
+    beyond the limit, and its last segment, scaled as scaled_profile scales it, ends on the
+    target (within the rounding of the positions: otherwise _checked decides)."""
+    line, factor, offset = scaled
+    if bound is None or not (abs(factor) <= 1.0 and math.isfinite(abs(offset) + bound)):
+        return False
+    t, p, v, a, j = line[-1]
+    last = (t, offset + factor * p, factor * v, factor * a, factor * j)  # (scaled_profile's operations)
+    return _on_target(_end_position(last), start, target)
+
+
+def _cap_frames(segments: list[Segment], limit: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
+    """Cut the (finite) plan at the first frame longer than ``limit`` seconds."""
     for i, seg in enumerate(segments):
         if seg.duration > limit:
             notes.events.append(
@@ -137,21 +212,32 @@ def _wait(position: float, duration: float) -> list[Segment]:
 
 
 def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float, v_final: float, traj: Trajectory):
-    if motion_type is MPIMotionType.S_CURVE_JERK:
+    return _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, v_final, traj)
+
+
+def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
+                  traj: Trajectory) -> list[Segment]:
+    """The 1-D profile of a point-to-point type from (p0, v0, a0); a0 is read by the jerk types only."""
+    if motion_type is _S_CURVE_JERK:
         return point_to_point_jerk(
-            start.position, start.velocity, start.acceleration, target, v_final, traj.velocity,
+            p0, v0, a0, target, v_final, traj.velocity,
             (traj.acceleration, traj.acceleration_jerk), (traj.deceleration, traj.deceleration_jerk))
-    jerk_percent = traj.jerk_percent if motion_type is MPIMotionType.S_CURVE else 0.0
-    return point_to_point(
-        start.position, start.velocity, target, v_final,
-        traj.velocity, traj.acceleration, traj.deceleration, jerk_percent,
-    )
+    jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
+    return point_to_point(p0, v0, target, v_final, traj.velocity, traj.acceleration, traj.deceleration, jerk_percent)
 
 
 def _scaled(traj: Trajectory, share: float) -> Trajectory:
     """An axis' share of the vector's limits (jerk percent is a ratio and stays)."""
     return Trajectory(traj.velocity * share, traj.acceleration * share, traj.deceleration * share,
                       traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
+
+
+# An axis' profile: its segments, or (a vector's axis) its share of the vector's 1-D profile
+Profile = list[Segment] | ScaledProfile
+
+
+def _segments(profile: Profile) -> list[Segment]:
+    return profile.segments() if isinstance(profile, ScaledProfile) else profile
 
 
 def _dot(a, b) -> float:
@@ -177,14 +263,15 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
     return along, True
 
 
-def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[list[Segment]], list[Trajectory], str]:
+def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[Profile], list[Trajectory], str]:
     """One profile along the straight line from the start to the targets, each axis'
     effective limits (the vector's scaled by the axis' share of the line), and why the
     profiles are not one profile per axis ("" when they are). Plain floats: a vector has at
     most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
-    p0 = [s.position for s in starts]
-    v0 = [s.velocity for s in starts]
-    delta = [t - p for t, p in zip(targets, p0, strict=True)]
+    # (maps rather than comprehensions: a comprehension is a call of its own)
+    p0 = list(map(_position_of, starts))
+    v0 = list(map(_velocity_of, starts))
+    delta = list(map(sub, targets, p0))  # (as many targets as starts: _targets makes them)
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
     if not (math.isfinite(length) and math.isfinite(speed)):
@@ -201,10 +288,10 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[l
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
-    accels = [s.acceleration for s in starts]
+    accels = list(map(_acceleration_of, starts))
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
-    line = _scalar_profile(motion_type, AxisStart(-1, 0.0, along, 0.0, accel), length, final_along, traj)
-    profiles = [scaled_profile(line, u, p) for u, p in zip(unit, p0, strict=True)]
+    line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
+    profiles: list[Profile] = [ScaledProfile(line, u, p) for u, p in zip(unit, p0, strict=True)]
     return profiles, [_scaled(traj, abs(u)) for u in unit], ""
 
 
@@ -222,7 +309,7 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     rest = [p + h * stopped_after for p, h in zip(p0, heading, strict=True)]
     go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest, strict=True)]
     go, limits, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
-    profiles = [scaled_profile(stop, h, p) + tail for h, p, tail in zip(heading, p0, go, strict=True)]
+    profiles = [scaled_profile(stop, h, p) + _segments(tail) for h, p, tail in zip(heading, p0, go, strict=True)]
     limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits, strict=True)]
     return profiles, limits, STOP_THEN_LINE
 
@@ -268,11 +355,12 @@ def compile_move(
     now) is planned by cams.py.
     """
     notes = PlanNotes()
-    moving = any(s.velocity != 0.0 for s in starts)
-    if int(attrs) & _DELAY and moving and any(d != 0.0 for d in params.delay):
-        raise Refused(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
-    if int(attrs) & _HOLDS and moving:
-        raise Refused(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
+    bits = int(attrs)
+    if bits & (_DELAY | _HOLDS) and any(s.velocity != 0.0 for s in starts):  # starts in motion
+        if bits & _DELAY and any(d != 0.0 for d in params.delay):
+            raise Refused(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
+        if bits & _HOLDS:
+            raise Refused(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
     stream = None
     try:
         if motion_type in CAM_TYPES:
@@ -280,20 +368,18 @@ def compile_move(
             plans = cams.cam_plans(motion_type, attrs, params, starts, cam_masters)
         elif motion_type in STREAMED_TYPES:
             plans, stream = _path_plans(motion_type, params, attrs, starts)
-        elif motion_type in (MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK):
+        elif motion_type in _VELOCITY_TYPES:
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
             plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
+    # (positional: a dataclass' __init__ matches keywords at a cost; the fields in their order)
     move = Move(
-        supervisor=supervisor,
-        type=motion_type,
-        attributes=attrs,
-        plans=plans,
-        id=_truncate_id(params.id, notes) if int(attrs) & _ID else 0,
-        element_id=int(params.element_id[0]) if int(attrs) & _ELEMENT_ID and params.element_id else 0,
-        event_mask=params.event_mask if int(attrs) & _EVENT else MPIEventType.NONE,
+        supervisor, motion_type, attrs, plans,
+        _truncate_id(params.id, notes) if bits & _ID else 0,  # id
+        int(params.element_id[0]) if bits & _ELEMENT_ID and params.element_id else 0,  # element_id
+        params.event_mask if bits & _EVENT else _NO_EVENTS,  # event_mask
         stream=stream,
     )
     return move, notes
@@ -313,8 +399,7 @@ def _path_plans(motion_type, params, attrs, starts) -> tuple[list[AxisPlan], Str
     return plans, Stream(open=not params.final, empty_count=params.empty_count, low_count=0, peaks=peaks)
 
 
-def _holds_and_outputs(params: MotionParams, attrs: MotionAttr, index: int):
-    bits = int(attrs)
+def _holds_and_outputs(params: MotionParams, bits: int, index: int):
     hold = params.hold[index] if bits & _HOLDS else None
     outputs = list(params.output) if bits & _OUTPUT and index == 0 else []
     return hold, outputs
@@ -322,7 +407,7 @@ def _holds_and_outputs(params: MotionParams, attrs: MotionAttr, index: int):
 
 def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
     bits = int(attrs)
-    targets = _targets(params, attrs, starts, notes)
+    targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
     if bits & _SYNC:
@@ -333,27 +418,45 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
         profiles = _sync(profiles, starts, targets, attrs)
         limits = list(params.trajectory)
     elif len(starts) == 1:
-        profiles = [_scalar_profile(motion_type, starts[0], targets[0], finals[0], params.trajectory[0])]
+        one = starts[0]
+        profiles = [_profile_from(motion_type, one.position, one.velocity, one.acceleration, targets[0], finals[0],
+                                  params.trajectory[0])]
         limits = [params.trajectory[0]]
     else:
         profiles, limits, composite = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
-    plans = []
-    for i, (start, target, final, prof) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
+    limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
+    # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
+    # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
+    # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
+    first = profiles[0] if profiles else None
+    lazy = not bits & (_DELAY | _NO_REVERSAL) and isinstance(first, ScaledProfile)
+    # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
+    chained = motion_type is not _S_CURVE_JERK and not bits & (_SYNC | _DELAY) and not composite
+    bound = _line_bound(first.line, limit, chained) if isinstance(first, ScaledProfile) and lazy else None
+    plans: list[AxisPlan] = []
+    for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
+        hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
+        if lazy and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
+            plans.append(ScaledAxisPlan.of(
+                profile, start.axis, start.position, target, final, hold, outputs,  # (AxisPlan's fields)
+                None, 0.0, False, limits[i], start.velocity, start.acceleration, composite))
+            continue
+        # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
+        prof, chain = (profile.segments(), False) if isinstance(profile, ScaledProfile) else (profile, chained)
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise Refused(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
         if bits & _DELAY:
             prof = _wait(start.position, params.delay[i]) + prof
-        _check_lands(prof, start, target)
-        prof, truncated = _cap_frames(prof, sample_rate, start.axis, notes)
-        hold, outputs = _holds_and_outputs(params, attrs, i)
+        prof, truncated = _checked(prof, start, target, limit, notes, chain)
+        # (positional, as Move above: the fields in their order, a third cheaper than keywords)
         plans.append(AxisPlan(
-            axis=start.axis, segments=prof, start_position=start.position,
-            target=prof[-1].end_state()[0] if truncated else target,  # truncated: where the cut plan ends
-            final_velocity=0.0 if truncated else final,
-            hold=hold, outputs=outputs, truncated=truncated,
-            limits=limits[i], start_velocity=start.velocity, start_acceleration=start.acceleration,
-            composite=composite,
+            start.axis, prof, start.position,  # axis, segments, start_position
+            prof[-1].end_state()[0] if truncated else target,  # target (truncated: where the cut plan ends)
+            0.0 if truncated else final,  # final_velocity
+            hold, outputs,
+            None, 0.0,  # velocity_target, ramp_end: not a VELOCITY move
+            truncated, limits[i], start.velocity, start.acceleration, composite,
         ))
     return plans
 
@@ -375,7 +478,7 @@ def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> l
         prof = _wait(start.position, delay) + prof
         _check_finite(prof, start.axis)
         end = prof[-1].end_state() if prof else (start.position, 0.0, 0.0)
-        hold, outputs = _holds_and_outputs(params, attrs, i)
+        hold, outputs = _holds_and_outputs(params, int(attrs), i)
         plans.append(AxisPlan(
             axis=start.axis, segments=prof, start_position=start.position, target=end[0],
             final_velocity=0.0, hold=hold, outputs=outputs, truncated=traj.velocity != 0.0,

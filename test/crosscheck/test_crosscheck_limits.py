@@ -54,7 +54,7 @@ def test_too_fast_is_caught():
 
 def test_position_jump_and_wrong_end_are_caught():
     segments = point_to_point(0.0, 0.0, 1000.0, 0.0, 500.0, 5000.0, 5000.0, 50.0)
-    segments[3:] = [replace(seg, p=seg.p + 1.0) for seg in segments[3:]]
+    segments[3:] = [seg._replace(p=seg.p + 1.0) for seg in segments[3:]]
     problems = _problems(_plan(segments))
     assert "jumps" in problems and "ends at" in problems
 

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 from mpi_ros.mpi import Hold, HoldType, MotionAttr, MotionParams, MPIMotionType, Output, OutputType, Trajectory
 from mpi_ros.mpi.events import MPIEventType
+from mpi_ros.mpi.frames import AxisPlan, ScaledAxisPlan
 from mpi_ros.mpi.messages import Message
 from mpi_ros.mpi.outcome import Refused
 from mpi_ros.mpi.planner import AxisStart, compile_move
@@ -218,3 +222,49 @@ def test_hold_and_outputs_go_to_the_plans():
     move, _ = compile_(A.HOLD | A.OUTPUT, hold=holds, output=[output])
     assert [p.hold.gate for p in move.plans] == [1, 2]
     assert move.plans[0].outputs == [output] and move.plans[1].outputs == []
+
+
+def _eager(plan: AxisPlan) -> AxisPlan:
+    """The same plan as a plain AxisPlan, its segments made now."""
+    return AxisPlan(**{f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.init})
+
+
+@pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
+@pytest.mark.parametrize("moving", [False, True])
+def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving):
+    trajectory = (Trajectory(1000.0, 10_000.0, 5_000.0, 40.0, 1e6, 2e6),)
+    speed = 100.0 if moving else 0.0  # along the line to the targets
+    starts = [AxisStart(0, 30.0, 0.6 * speed), AxisStart(1, -40.0, -0.8 * speed)]
+    move, _ = compile_(position=(3000.0, -4000.0), kind=kind, trajectory=trajectory, starts=starts)
+    times = np.linspace(-0.1, 8.0, 50)
+    for plan in move.plans:
+        assert isinstance(plan, ScaledAxisPlan)
+        frames = plan.frame_count  # counted from the line, before the segments are made
+        eager = _eager(plan)
+        assert (frames, plan.duration) == (eager.frame_count, eager.duration)
+        assert plan.segments == eager.segments and len(plan.segments) == frames - 1
+        for mine, theirs in zip(plan.evaluate(times), eager.evaluate(times), strict=True):
+            assert np.array_equal(mine, theirs)
+    for plan in compile_(position=(3000.0, -4000.0), kind=kind, trajectory=trajectory, starts=starts)[0].plans:
+        # made again through AxisPlan's fields (a copy, dataclasses.replace): the same plan
+        for again in (copy.deepcopy(plan), dataclasses.replace(plan)):
+            assert (again.segments, again.duration, again.frame_count) == (plan.segments, plan.duration,
+                                                                            plan.frame_count)
+
+
+def test_vector_axes_with_a_delay_or_a_cut_frame_are_made_and_checked_each():
+    move, _ = compile_(A.DELAY, delay=[0.5, 0.0])
+    assert [type(plan) for plan in move.plans] == [AxisPlan, AxisPlan]
+    move, notes = compile_(position=(6e5, 8e5), trajectory=(Trajectory(1.0, 1e4, 1e4),), rate=100.0)
+    assert all(plan.truncated and type(plan) is AxisPlan for plan in move.plans)
+    assert [kind for kind, _ in notes.events] == [E.FRAME_TIME_LIMIT] * 2
+
+
+def test_a_vector_axis_that_overflows_on_its_way_is_refused():
+    # The 1-D profile is finite and every axis lands, but axis 0 overshoots its target past the
+    # largest float on the way (MPI 000, MPIMotionMessagePROFILE_ERROR: "cannot be calculated")
+    params = MotionParams(trajectory=[Trajectory(2e154, 1.0, 1.0, 50.0)], position=[1.79e308, 0.0])
+    with pytest.raises(Refused) as refused:
+        compile_move(0, T.S_CURVE, A.NONE, params, [AxisStart(0, 1.7e308, 1e154), AxisStart(1, 0.0, 0.0)], RATE)
+    assert refused.value.message is Message.MPIMotionMessagePROFILE_ERROR
+    assert refused.value.detail == "axis 0: the profile cannot be calculated with these values (overflow)"

@@ -99,7 +99,7 @@ def test_a_point_to_point_target_past_the_wrap_moves_on_and_settles_there(ctl, m
     snap = ctl.axis_snapshot(0)
     assert snap.command_position == -HALF + 1000.0 and abs(snap.actual_position - (-HALF + 1000.0)) < 10.0
     assert snap.done and snap.settled and snap.in_fine_position and snap.at_target  # across the wrap
-    end = ms.move_ends[-1]
+    end = ctl.move_log.recent(ms.number)[-1]
     assert end.message.ok and end.command_position[0] == -HALF + 1000.0
 
 

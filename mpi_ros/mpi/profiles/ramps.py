@@ -14,15 +14,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from functools import partial
+from typing import NamedTuple
 
 
 class ProfileError(ValueError):
     """The profile cannot be calculated with the given constraints (PROFILE_ERROR)."""
 
 
-@dataclass(frozen=True, slots=True)
-class Ramp:
+class Ramp(NamedTuple):
+    """A tuple, made in one C call by :data:`_ramp` when planning (as :class:`Segment` is)."""
+
     duration: float
     v_start: float
     v_end: float
@@ -36,26 +38,8 @@ class Ramp:
         return 0.5 * (self.v_start + self.v_end) * self.duration
 
 
-def _ramp_maker() -> Callable[[float, float, float], Ramp]:
-    """``Ramp(duration, v_start, v_end)`` in half the time (its slots set directly, not
-    through object.__setattr__ as a frozen dataclass' __init__ does), for planning."""
-    new = object.__new__
-    # The slots' member descriptors (from the class' __dict__: the type checker takes Ramp.duration
-    # for a float, as the fields of a dataclass without slots would be).
-    slots = Ramp.__dict__
-    set_duration, set_v_start, set_v_end = slots["duration"].__set__, slots["v_start"].__set__, slots["v_end"].__set__
-
-    def ramp(duration: float, v_start: float, v_end: float) -> Ramp:
-        made = new(Ramp)
-        set_duration(made, duration)
-        set_v_start(made, v_start)
-        set_v_end(made, v_end)
-        return made
-
-    return ramp
-
-
-_ramp = _ramp_maker()
+# ``Ramp(duration, v_start, v_end)`` without the Python-level __new__ of a NamedTuple
+_ramp: Callable[[tuple[float, float, float]], Ramp] = partial(tuple.__new__, Ramp)
 
 
 def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> list[Ramp]:
@@ -65,7 +49,7 @@ def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> lis
     if v_from * v_to < 0.0:
         return ramps_between(v_from, 0.0, accel, decel) + ramps_between(0.0, v_to, accel, decel)
     rate = accel if abs(v_to) > abs(v_from) else decel  # the ramp does not cross zero
-    return [_ramp(abs(v_to - v_from) / rate, v_from, v_to)]
+    return [_ramp((abs(v_to - v_from) / rate, v_from, v_to))]
 
 
 def _ramp_time(v_from: float, v_to: float, accel: float, decel: float) -> float:
@@ -153,38 +137,33 @@ def plan_point_to_point(
         raise ProfileError("velocity, acceleration and deceleration must be positive")
     if abs(v_final) > vmax * (1.0 + 1e-12):
         raise ProfileError("final velocity exceeds the trajectory velocity")
-    found = []
-    for direction in (1.0, -1.0):
-        peak_cruise = _peak_in_direction(
-            direction * distance, direction * v_start, direction * v_final, vmax, accel, decel
-        )
-        if peak_cruise is not None:
-            found.append((direction * peak_cruise[0], peak_cruise[1]))
-    if not found:
-        raise ProfileError("no profile reaches the target")
-    peak, cruise = found[0]
-    # Both directions reach the target: the other only if it is faster. The times are
-    # needed for this comparison alone, so they are not calculated otherwise.
-    if len(found) == 2 and _total_time(*found[1], v_start, v_final, accel, decel) < _total_time(
-            peak, cruise, v_start, v_final, accel, decel) - 1e-15:
-        peak, cruise = found[1]
+    # The direction toward the target, then away from it (coordinates along each direction)
+    ahead = _peak_in_direction(distance, v_start, v_final, vmax, accel, decel)
+    behind = _peak_in_direction(-distance, -v_start, -v_final, vmax, accel, decel)
+    if ahead is None:
+        if behind is None:
+            raise ProfileError("no profile reaches the target")
+        peak, cruise = -behind[0], behind[1]
+    else:
+        peak, cruise = ahead
+        # Both directions reach the target: the other only if it is faster. The times are
+        # needed for this comparison alone, so they are not calculated otherwise.
+        if behind is not None and _total_time(-behind[0], behind[1], v_start, v_final, accel, decel) < _total_time(
+                peak, cruise, v_start, v_final, accel, decel) - 1e-15:
+            peak, cruise = -behind[0], behind[1]
     plan = ramps_between(v_start, peak, accel, decel)
+    # The cruise (if any) absorbs the last rounding error of the distance. (ramps_between makes
+    # no ramp of constant velocity: a cruise can only be this one.)
+    at = len(plan) if cruise > 0.0 and peak != 0.0 else -1
     if cruise > 0.0:
-        plan.append(_ramp(cruise, peak, peak))
+        plan.append(_ramp((cruise, peak, peak)))
     plan += ramps_between(peak, v_final, accel, decel)
-    return _absorb_rounding(plan, distance)
-
-
-def _absorb_rounding(plan: list[Ramp], distance: float) -> list[Ramp]:
-    """Let the cruise (if any) absorb the last rounding error of the distance."""
     # each ramp's distance as Ramp.distance calculates it, without a call per ramp
-    error = distance - sum([0.5 * (r.v_start + r.v_end) * r.duration for r in plan])
+    error = distance - sum([0.5 * (v0 + v1) * duration for duration, v0, v1 in plan])
     if not math.isfinite(error):
         raise ProfileError("the profile cannot be calculated with these values (overflow)")
-    for i, ramp in enumerate(plan):
-        if ramp.v_start == ramp.v_end and ramp.v_start != 0.0:  # a cruise (Ramp.is_cruise)
-            plan[i] = _ramp(max(0.0, ramp.duration + error / ramp.v_start), ramp.v_start, ramp.v_end)
-            break
+    if at >= 0:
+        plan[at] = _ramp((max(0.0, cruise + error / peak), peak, peak))
     return plan
 
 

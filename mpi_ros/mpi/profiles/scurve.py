@@ -14,12 +14,12 @@ import math
 from collections.abc import Sequence
 
 from .ramps import ProfileError, Ramp
-from .segment import Segment, segment_of
+from .segment import Segment, new_tuple
 
 
 def ramp_pieces(ramp: Ramp, fraction: float) -> list[tuple[float, float, float]]:
     """(duration, start acceleration, jerk) pieces of one ramp or cruise."""
-    duration, v_start, v_end = ramp.duration, ramp.v_start, ramp.v_end
+    duration, v_start, v_end = ramp
     dv = v_end - v_start
     jerk_time = 0.5 * fraction * duration
     # The S-curve's three pieces, unless this is a cruise, f = 0, the jerk phases are too short
@@ -36,7 +36,10 @@ def ramp_pieces(ramp: Ramp, fraction: float) -> list[tuple[float, float, float]]
 
 def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segment]:
     """Segments of a velocity plan starting at position ``p0`` with zero acceleration
-    at every ramp boundary (the standard S-curve starts each ramp from a = 0)."""
+    at every ramp boundary (the standard S-curve starts each ramp from a = 0). Each segment
+    lasts more than 0 s and starts at the position where the one before ends, as
+    Segment.end_state calculates it: the planner relies on it (a profile whose end position
+    is finite is finite throughout: planner._finite_if_it_ends)."""
     if not 0.0 <= jerk_percent <= 100.0:
         raise ProfileError("jerkPercent must be within 0..100")
     fraction = jerk_percent / 100.0
@@ -44,11 +47,11 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
     append = segments.append
     p = p0
     for ramp in plan:
-        v = ramp.v_start
+        v = ramp[1]  # (v_start)
         for t, a, j in ramp_pieces(ramp, fraction):
             if t <= 0.0:
                 continue
-            append(segment_of(t, p, v, a, j))
+            append(new_tuple(Segment, (t, p, v, a, j)))
             # Where the segment ends, as Segment.end_state computes it (the same operations in
             # the same order), without the method calls: the next piece starts there.
             p, v = p + t * (v + t * (a / 2.0 + t * j / 6.0)), v + t * (a + t * j / 2.0)

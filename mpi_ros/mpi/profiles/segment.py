@@ -8,18 +8,18 @@ seconds of profile time with jerk ``j``. A 1-D profile is a contiguous tuple of 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, fields
-from functools import reduce
+from functools import partial, reduce
 from itertools import chain as _chain_iterables
 from operator import add, attrgetter
+from typing import NamedTuple
 
 import numpy as np
 
 
-@dataclass(frozen=True, slots=True)
-class Segment:
-    """Planning builds many: :func:`segment_of` makes them faster than ``Segment(...)`` (keep
-    it in step if this class ever validates its fields)."""
+class Segment(NamedTuple):
+    """A tuple (immutable, compared and hashed by value): planning makes one per constant-jerk
+    piece of every axis, and a tuple is made in one C call (:data:`segment_from`), a fraction of
+    a frozen dataclass' __init__ (a modify is planned while its command waits for its sample)."""
 
     duration: float
     p: float
@@ -40,42 +40,34 @@ class Segment:
 
     def scaled(self, factor: float, offset: float) -> Segment:
         """The segment of an axis that moves ``factor`` times this 1-D profile."""
-        return segment_of(
-            self.duration, offset + factor * self.p, factor * self.v, factor * self.a, factor * self.j
-        )
+        return segment_from((self.duration, offset + factor * self.p, factor * self.v, factor * self.a,
+                             factor * self.j))
 
 
-def _segment_maker() -> Callable[[float, float, float, float, float], Segment]:
-    """``Segment(duration, p, v, a, j)`` in half the time: a frozen dataclass' __init__ sets
-    each field through object.__setattr__; this sets the slots directly. Planning makes a
-    segment per constant-jerk piece of every axis, and a modify is planned while its command
-    waits for its sample."""
-    new = object.__new__
-    set_duration, set_p, set_v, set_a, set_j = (getattr(Segment, f.name).__set__ for f in fields(Segment))
-
-    def segment_of(duration: float, p: float, v: float, a: float, j: float) -> Segment:
-        seg = new(Segment)
-        set_duration(seg, duration)
-        set_p(seg, p)
-        set_v(seg, v)
-        set_a(seg, a)
-        set_j(seg, j)
-        return seg
-
-    return segment_of
-
-
-segment_of = _segment_maker()
-# (duration, p, v, a, j) of a segment in one C call, for the loops over every segment
-segment_values: Callable[[Segment], tuple[float, float, float, float, float]] = attrgetter(
-    *(f.name for f in fields(Segment)))
+# ``Segment(*values)`` without the Python-level __new__ of a NamedTuple: one C call. The loops
+# that make a segment per constant-jerk piece call ``new_tuple(Segment, values)``, a little
+# faster still (no partial in between).
+new_tuple = tuple.__new__
+segment_from: Callable[[tuple[float, float, float, float, float]], Segment] = partial(new_tuple, Segment)
 
 
 def scaled_profile(segments: Iterable[Segment], factor: float, offset: float) -> list[Segment]:
     """``[seg.scaled(factor, offset) for seg in segments]``: the same operations, without a
     method call per segment (a vector move scales its profile for every axis)."""
-    return [segment_of(d, offset + factor * p, factor * v, factor * a, factor * j)
-            for d, p, v, a, j in map(segment_values, segments)]
+    return [new_tuple(Segment, (d, offset + factor * p, factor * v, factor * a, factor * j))
+            for d, p, v, a, j in segments]
+
+
+class ScaledProfile(NamedTuple):
+    """An axis of a vector move: ``factor`` times the vector's 1-D profile ``line``, plus
+    ``offset`` (the axis' start): :func:`scaled_profile` of them, made when asked for."""
+
+    line: list[Segment]
+    factor: float
+    offset: float
+
+    def segments(self) -> list[Segment]:
+        return scaled_profile(self.line, self.factor, self.offset)
 
 
 def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]]) -> list[Segment]:
@@ -89,7 +81,7 @@ def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]])
     for duration, jerk in moves:
         if duration <= 0.0:
             continue
-        seg = segment_of(duration, p, v, a, jerk)
+        seg = segment_from((duration, p, v, a, jerk))
         out.append(seg)
         p, v, a = seg.end_state()
     return out
@@ -120,7 +112,7 @@ class SegmentTable:
     def __init__(self, segments: Sequence[Segment], t0: float = 0.0):
         # One array of every segment's fields in a row (np.fromiter: five np.array calls on
         # lists cost several times more for a few segments), whose columns are the fields.
-        values = np.fromiter(_chain_iterables.from_iterable(map(segment_values, segments)), float, 5 * len(segments))
+        values = np.fromiter(_chain_iterables.from_iterable(segments), float, 5 * len(segments))
         d, self.p, self.v, self.a, self.j = values.reshape(-1, 5).T
         self.end = t0 + np.cumsum(d)
         self.start = self.end - d
