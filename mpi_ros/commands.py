@@ -139,7 +139,7 @@ def _config_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
     config = rq.motion_config(command.request.get("config", {}))
     message = ms.config_set(config)  # validates with MotionConfig.validate
-    if message is Message.MPIMotionMessageAXIS_COUNT:  # spec 000 MPIMotionMessageAXIS_COUNT
+    if message is Message.MPIMotionMessageAXIS_COUNT:  # MPI 000 MPIMotionMessageAXIS_COUNT
         return Reply.of(message, "the motion supervisor has no axes", state=ms.state)
     return Reply.of(message, _refusal_detail(message, config.validate()), state=ms.state)
 

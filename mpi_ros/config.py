@@ -160,7 +160,7 @@ class SuiteConfig:
         message, ms = ctl.create_motion(spec.number)
         _accepted(message, f"{where}.number")
         assert ms is not None  # (created: the message was OK)
-        # the axes first: mpiMotionConfigSet answers AXIS_COUNT without them (spec 000)
+        # the axes first: mpiMotionConfigSet answers AXIS_COUNT without them (MPI 000)
         _accepted(ms.axis_list_set(spec.axes), f"{where}.axes")
         _accepted(ms.config_set(spec.config), f"{where}.config", spec.config.validate())
         _accepted(ms.event_notify_set(spec.event_notify), f"{where}.event_notify")

@@ -52,7 +52,7 @@ class NoSuchSupervisor(LookupError):
     """The suite is there but has no supervisor with that number; the message lists those it has."""
 
 
-# -- MPIMessage: generic answers (spec 000, "Return Values") ------------------------------
+# -- MPIMessage: generic answers (MPI 000, "Return Values") ------------------------------
 class MPIMessageARG_INVALID(MpiError):
     """An argument of the call is invalid."""
     message_name = "MPIMessageARG_INVALID"
@@ -101,7 +101,7 @@ class MPIMessageFILE_OPEN_ERROR(MpiError):
     code = 0x0008
 
 
-# -- MPIAxisMessage (spec 002) ---------------------------------------------------------------
+# -- MPIAxisMessage (MPI 002) ---------------------------------------------------------------
 class MPIAxisMessageAXIS_INVALID(MpiError):
     """The axis does not exist."""
     message_name = "MPIAxisMessageAXIS_INVALID"
@@ -120,7 +120,7 @@ class MPIAxisMessageNOT_MAPPED_TO_MS(MpiError):
     code = 0x0302
 
 
-# -- MPIMotionMessage (spec 000, in the order of its enum listing) ------------------------------
+# -- MPIMotionMessage (MPI 000, in the order of its enum listing) ------------------------------
 class MPIMotionMessageMOTION_INVALID(MpiError):
     """The motion supervisor does not exist."""
     message_name = "MPIMotionMessageMOTION_INVALID"
@@ -241,7 +241,7 @@ class MPIMotionMessageFRAME_BUFFER_TOO_SMALL(MpiError):
     code = 0x0913
 
 
-# -- MEIMotionMessage (spec 000) -------------------------------------------------------------------
+# -- MEIMotionMessage (MPI 000) -------------------------------------------------------------------
 class MEIMotionMessageRESERVED0(MpiError):
     """Reserved by the spec."""
     message_name = "MEIMotionMessageRESERVED0"
@@ -272,7 +272,7 @@ class MEIMotionMessageBAD_PATH_DATA(MpiError):
     code = 0x0984
 
 
-# -- MEIListMessage (spec 000, mpiMotionAxis) -------------------------------------------------------
+# -- MEIListMessage (MPI 000, mpiMotionAxis) -------------------------------------------------------
 class MEIListMessageELEMENT_NOT_FOUND(MpiError):
     """The list element was not found."""
     message_name = "MEIListMessageELEMENT_NOT_FOUND"

@@ -85,7 +85,7 @@ def test_every_operation_applies(ctl):
 
 # ------------------------------------------------------------------ values the controller cannot hold ----
 # issue 9, "Configuration and errors", reproduced through the command layer the ROS services call.
-# Each is refused with MPIMessagePARAM_INVALID (spec 000, "Returns for mpiMotionStart and
+# Each is refused with MPIMessagePARAM_INVALID (MPI 000, "Returns for mpiMotionStart and
 # mpiMotionModify": "if the specified motion parameters are not valid"), the detail names the
 # field, nothing changes, and the clock keeps running a move to its end.
 def _goal_runs_to_idle(ctl) -> None:
@@ -98,7 +98,7 @@ def _goal_runs_to_idle(ctl) -> None:
 
 def test_axis_settling_time_1e308_is_refused_and_the_clock_runs(ctl):
     # issue 9: /mpi/axis0/config_set settling_time 1e308 crashed the clock on every step.
-    # spec 002 MPIAxisInPosition settlingTime: seconds, counted in samples.
+    # MPI 002 MPIAxisInPosition settlingTime: seconds, counted in samples.
     before = ctl.axes[0].in_position.copy()
     reply = apply(ctl, Command("axis_config_set", axis=0, request={"in_position": {"settling_time": 1e308}}))
     assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("settling_time:")
@@ -107,7 +107,7 @@ def test_axis_settling_time_1e308_is_refused_and_the_clock_runs(ctl):
 
 
 def test_a_fine_tolerance_the_encoder_cannot_resolve_is_refused_with_why(ctl):
-    # spec 002 status tables, NOTE 3: |target - actual| < positionFine; the default encoder reads
+    # MPI 002 status tables, NOTE 3: |target - actual| < positionFine; the default encoder reads
     # whole counts, so a reading can be 0.5 count from any target and 0.5 could never be met
     reply = apply(ctl, Command("axis_config_set", axis=1, request={"in_position": {"position_fine": 0.5}}))
     assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("position_fine:")
@@ -117,7 +117,7 @@ def test_a_fine_tolerance_the_encoder_cannot_resolve_is_refused_with_why(ctl):
 @pytest.mark.parametrize("feedrate", [1e308, 1e-300])
 def test_normal_feedrate_out_of_range_is_refused_and_goals_end(ctl, feedrate):
     # issue 9: normal_feedrate 1e308 gave NaN command positions and a goal that never ends,
-    # 1e-300 made the execute callback raise. spec 000 MPIMotionConfig normalFeedrate (1.0 = 100 %).
+    # 1e-300 made the execute callback raise. MPI 000 MPIMotionConfig normalFeedrate (1.0 = 100 %).
     config = {"decel_time_stop": 0.5, "decel_time_e_stop": 0.05, "normal_feedrate": feedrate}
     reply = apply(ctl, Command("config_set", 0, request={"config": config}))
     assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("normal_feedrate:")
@@ -126,7 +126,7 @@ def test_normal_feedrate_out_of_range_is_refused_and_goals_end(ctl, feedrate):
 
 
 def test_position_set_of_an_actual_1e308_is_refused(ctl):
-    # issue 9: accepted, then position_get read -inf while status showed 0. spec 000
+    # issue 9: accepted, then position_get read -inf while status showed 0. MPI 000
     # mpiMotionPositionSet / 002 mpiAxisActualPositionSet: positions a controller can hold.
     reply = apply(ctl, Command("position_set", 0, request={"actual": [1e308, 0.0], "command": [0.0, 0.0]}))
     assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("actual[0]:")
@@ -136,7 +136,7 @@ def test_position_set_of_an_actual_1e308_is_refused(ctl):
 
 @pytest.mark.parametrize("which", ["ACTUAL", "COMMAND", "ORIGIN"])
 def test_axis_position_set_past_what_a_controller_holds_is_refused(ctl, which):
-    # spec 002 mpiAxisActualPositionSet, mpiAxisCommandPositionSet, mpiAxisOriginSet
+    # MPI 002 mpiAxisActualPositionSet, mpiAxisCommandPositionSet, mpiAxisOriginSet
     reply = apply(ctl, Command("axis_position_set", axis=0, request={"which": which, "value": 1e308}))
     assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("value:")
     assert (ctl.axes[0].cmd_p, ctl.axes[0].act_p, ctl.axes[0].origin) == (0.0, 0.0, 0.0)
@@ -144,7 +144,7 @@ def test_axis_position_set_past_what_a_controller_holds_is_refused(ctl, which):
 
 def test_config_set_refuses_an_unknown_field(ctl):
     # a misspelt field would silently set its real field to 0 (mpiMotionConfigSet writes the
-    # whole MPIMotionConfig, spec 000): the request cannot be read, PARAM_INVALID, nothing changes
+    # whole MPIMotionConfig, MPI 000): the request cannot be read, PARAM_INVALID, nothing changes
     config = {"decel_time_stop": 0.2, "decel_time_e_stop": 0.02, "normal_feedrate": 1.0, "blend_limt": 0.5}
     reply = apply(ctl, Command("config_set", 0, request={"config": config}))
     assert reply.message is Message.MPIMessagePARAM_INVALID and "blend_limt" in reply.detail
@@ -152,16 +152,16 @@ def test_config_set_refuses_an_unknown_field(ctl):
 
 
 def test_params_set_checks_every_value_it_stores(ctl):
-    # spec 000 mpiMotionParamsSet stores the parameters for a later start (params None): a value
+    # MPI 000 mpiMotionParamsSet stores the parameters for a later start (params None): a value
     # no controller holds is refused now, not at that start
     reply = apply(ctl, Command("params_set", 0, request={"params": {**GOAL, "position": [1e300, 0.0]}}))
     assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("position[0]:")
 
 
 @pytest.mark.parametrize("empty_count,message", [
-    (-1, "MPIMessageOK"),  # spec 000 MPIMotionPoint: "-1 => disable"
-    (0, "MPIMessageOK"),  # spec 001 EMPTY_COUNT: "To disable ..., set the value to zero"
-    (2**40, "MPIMessagePARAM_INVALID"),  # spec 000 MPIMotionPoint: long emptyCount
+    (-1, "MPIMessageOK"),  # MPI 000 MPIMotionPoint: "-1 => disable"
+    (0, "MPIMessageOK"),  # MPI 001 EMPTY_COUNT: "To disable ..., set the value to zero"
+    (2**40, "MPIMessagePARAM_INVALID"),  # MPI 000 MPIMotionPoint: long emptyCount
 ])
 def test_goal_empty_count(ctl, empty_count, message):
     reply = apply(ctl, Command("motion_start", 0, request={**GOAL, "empty_count": empty_count}))
@@ -169,7 +169,7 @@ def test_goal_empty_count(ctl, empty_count, message):
 
 
 def test_config_set_with_no_axes_answers_axis_count(ctl):
-    # spec 000 MPIMotionMessageAXIS_COUNT: "returned from mpiMotionConfigSet(...) ... if there are
+    # MPI 000 MPIMotionMessageAXIS_COUNT: "returned from mpiMotionConfigSet(...) ... if there are
     # no axes associated with the motion object"
     assert apply(ctl, Command("axis_list_set", 1, request={"axis_numbers": [], "map": False})).accepted
     config = {"decel_time_stop": 0.2, "decel_time_e_stop": 0.02, "normal_feedrate": 1.0}
@@ -208,7 +208,7 @@ def _to_state(ctl, state: str) -> None:
     ("ERROR (ABORT)", True),
 ])
 def test_the_axis_service_and_position_set_follow_one_rule(state, settable):
-    # spec 002 "mpiAxisCommandPositionSet(...) Error Check" (MPIAxisMessageCOMMAND_NOT_SET); issue 9:
+    # MPI 002 "mpiAxisCommandPositionSet(...) Error Check" (MPIAxisMessageCOMMAND_NOT_SET); issue 9:
     # /mpi/axis<k>/position_set and /mpi/ms<n>/position_set disagreed in ERROR
     expected = Message.MPIMessageOK if settable else Message.MPIAxisMessageCOMMAND_NOT_SET
     answers = []
@@ -234,7 +234,7 @@ def test_the_axis_service_and_position_set_follow_one_rule(state, settable):
 
 
 def test_actual_position_set_while_moving_keeps_the_motion_on_its_path(ctl):
-    # spec 002 mpiAxisActualPositionSet ("Set actual position"): the encoder reads the new value
+    # MPI 002 mpiAxisActualPositionSet ("Set actual position"): the encoder reads the new value
     # from now on and the servo keeps following the command; the simulated motor does not jump
     assert apply(ctl, Command("motion_start", 0, request={**GOAL, "position": [100_000.0, 0.0]})).accepted
     ctl.step(1000)
@@ -325,7 +325,7 @@ def test_a_bug_is_an_internal_error_logged_with_its_traceback(ctl, monkeypatch, 
 
 def test_no_refusal_answers_the_internal_error_message():
     # the internal-error message is distinct: nothing in the controller answers NO_MEMORY itself
-    # (spec 000 lists it only for mpiMotionAxisAppend: "Not enough memory was available")
+    # (MPI 000 lists it only for mpiMotionAxisAppend: "Not enough memory was available")
     import pathlib
 
     controller = pathlib.Path(__file__).resolve().parent.parent / "mpi_ros" / "mpi"

@@ -93,7 +93,7 @@ def test_per_axis_overrides(tmp_path):
     ],
 )
 def test_values_the_controller_cannot_hold_name_the_key(data, where):
-    # the struct validators (spec 000 MPIMotionConfig/MEIMotionConfig, 002 MPIAxisInPosition, ...):
+    # the struct validators (MPI 000 MPIMotionConfig/MEIMotionConfig, 002 MPIAxisInPosition, ...):
     # the file is refused with the key named, never started with some other value
     with pytest.raises(config.ConfigError) as error:
         config.parse(data)
@@ -175,7 +175,7 @@ def test_yaml_service_and_controller_agree_on_motion_config(key, values):
     ("position_coarse", [0, 2**31 - 1, -1, 2**31]),
 ])
 def test_yaml_service_and_controller_agree_on_in_position(key, values):
-    # one AxisInPosition validator (spec 002 MPIAxisInPosition): YAML, /mpi/axis<k>/config_set
+    # one AxisInPosition validator (MPI 002 MPIAxisInPosition): YAML, /mpi/axis<k>/config_set
     for value in values:
         try:
             config.parse({"axes": {"defaults": {"in_position": {key: value}}}})

@@ -29,7 +29,7 @@ The models coincide (an *exact* mapping, compared tightly) for
   when A = D or when the velocity never changes sign (:func:`reverses`);
 * S_CURVE with jerkPercent > 0 from rest to rest with A = D (both ramps change the velocity
   by w at the same rate), short moves included;
-* VELOCITY: one ramp v0 -> v at A for any sign (spec 000 MPIMotionVelocity: deceleration is
+* VELOCITY: one ramp v0 -> v at A for any sign (MPI 000 MPIMotionVelocity: deceleration is
   ignored), with ``control_interface = Velocity``, ±A/(1-f/2) and J = 4A^2/(f(2-f)|v-v0|).
 
 Standard types start from zero acceleration: the ruckig problem starts from (p, v, 0), the

@@ -234,7 +234,7 @@ class Axis:
         return Message.MPIMessageOK
 
     def can_set_command(self, state: MPIState) -> bool:
-        """The one rule of mpiAxisCommandPositionSet (spec 002, "mpiAxisCommandPositionSet(...)
+        """The one rule of mpiAxisCommandPositionSet (MPI 002, "mpiAxisCommandPositionSet(...)
         Error Check"), for the axis service and mpiMotionPositionSet alike; ``state`` is the
         axis' state (its supervisor's). Refused while the controller computes a new command
         every sample: in a MOVING, STOPPING or STOPPED state (STOPPING_ERROR is a stopping

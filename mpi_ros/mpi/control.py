@@ -233,7 +233,7 @@ class Controller:
         return owner is not None and owner.own_state not in (MPIState.IDLE, MPIState.ERROR)
 
     def axis_command_position_set(self, number: int, position: float) -> Message:
-        """mpiAxisCommandPositionSet under the rule of spec 002 (Axis.can_set_command, which
+        """mpiAxisCommandPositionSet under the rule of MPI 002 (Axis.can_set_command, which
         mpiMotionPositionSet applies too): MPIAxisMessageCOMMAND_NOT_SET while it moves."""
         if not 0 <= number < len(self.axes):
             return Message.MPIAxisMessageAXIS_INVALID
@@ -431,7 +431,7 @@ class Controller:
             self._deliver(Event(sample, kind, supervisor, axis, move_id, element_id, detail))
 
     def _event_targets(self, supervisor: int, axis: int) -> list[MotionSupervisor]:
-        """spec 000 mpiMotionAxisAppend: supervisors sharing axes both get the events."""
+        """MPI 000 mpiMotionAxisAppend: supervisors sharing axes both get the events."""
         targets = []
         own = self.supervisor(supervisor)
         if own is not None:
@@ -545,7 +545,7 @@ class Controller:
                       sample=int(stretch.samples[i]))
 
     def _frame_time_limits(self, stop: int, stretch: Stretch) -> list[tuple[int, int, int, MPIEventType, str]]:
-        """spec 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
+        """MPI 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
         ends abruptly, reported when the axis gets there."""
         command = self.bank.command
         rows = self.bank.memo("truncated", lambda: np.flatnonzero(command.truncated))

@@ -31,7 +31,7 @@ class MPIEventType(IntFlag):
     FRAMES_EMPTY = 1 << 9
     HOLD_RELEASED = 1 << 10
     HOLD_TIMEOUT = 1 << 11
-    # Documented quirks of the firmware (spec 000 mpiMotionStart), reported when they bite.
+    # Documented quirks of the firmware (MPI 000 mpiMotionStart), reported when they bite.
     FRAME_TIME_LIMIT = 1 << 12
     RELATIVE_TRUNCATED = 1 << 13
     ID_TRUNCATED = 1 << 14

@@ -4,7 +4,7 @@ A move compiles, for each axis, into constant-jerk segments in profile time (mot
 DELAY and SYNC wait frames alike) plus one final frame that holds the end state; a
 HOLD adds one hold frame in front. Those frames occupy the axis' frame buffer
 (128 by default) from the moment the move is loaded until the axis has executed them.
-spec 000 mpiMotionStart: "Each axis has a 128 frame buffer (FIFO)".
+MPI 000 mpiMotionStart: "Each axis has a 128 frame buffer (FIFO)".
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""HOLD: a move waits on an axis until its trigger (spec 000 MEIMotionAttrHOLD).
+"""HOLD: a move waits on an axis until its trigger (MPI 000 MEIMotionAttrHOLD).
 
 Triggers: a closed gate opening, an I/O word matching a pattern under a mask, or an
 axis' actual/command position crossing a value (HOLD_LESS: <=, HOLD_GREATER: >=;

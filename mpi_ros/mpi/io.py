@@ -1,6 +1,6 @@
 """The simulated I/O image and the control gates.
 
-HOLD triggers read it (spec 000 MEIMotionAttrHoldSource: gate 0..31, an input word
+HOLD triggers read it (MPI 000 MEIMotionAttrHoldSource: gate 0..31, an input word
 ANDed with a mask compared to a pattern, a motor's general or dedicated I/O word) and
 OUTPUT writes it (MEIMotionAttrOutput: on/off masks of a motor's output word or of an
 I/O word). Words are 32-bit.

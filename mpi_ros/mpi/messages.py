@@ -24,7 +24,7 @@ _MEI_LIST = 0x1100
 class Message(IntEnum):
     """The answer of every controller call: OK or why nothing was done."""
 
-    # Generic messages (spec 000 "Return Values" of the methods).
+    # Generic messages (MPI 000 "Return Values" of the methods).
     MPIMessageOK = _MPI + 0
     MPIMessageARG_INVALID = _MPI + 1
     MPIMessagePARAM_INVALID = _MPI + 2
@@ -35,12 +35,12 @@ class Message(IntEnum):
     MPIMessageUNSUPPORTED = _MPI + 7
     MPIMessageFILE_OPEN_ERROR = _MPI + 8
 
-    # MPIAxisMessage (spec 002).
+    # MPIAxisMessage (MPI 002).
     MPIAxisMessageAXIS_INVALID = _AXIS + 0
     MPIAxisMessageCOMMAND_NOT_SET = _AXIS + 1
     MPIAxisMessageNOT_MAPPED_TO_MS = _AXIS + 2
 
-    # MPIMotionMessage (spec 000, in the order of its enum listing).
+    # MPIMotionMessage (MPI 000, in the order of its enum listing).
     MPIMotionMessageMOTION_INVALID = _MOTION + 0
     MPIMotionMessageAXIS_NOT_FOUND = _MOTION + 1
     MPIMotionMessageAXIS_COUNT = _MOTION + 2
@@ -62,14 +62,14 @@ class Message(IntEnum):
     MPIMotionMessageFRAMES_EMPTY = _MOTION + 18
     MPIMotionMessageFRAME_BUFFER_TOO_SMALL = _MOTION + 19
 
-    # MEIMotionMessage (spec 000).
+    # MEIMotionMessage (MPI 000).
     MEIMotionMessageRESERVED0 = _MEI_MOTION + 0
     MEIMotionMessageRESERVED1 = _MEI_MOTION + 1
     MEIMotionMessageRESERVED2 = _MEI_MOTION + 2
     MEIMotionMessageNO_AXES_MAPPED = _MEI_MOTION + 3
     MEIMotionMessageBAD_PATH_DATA = _MEI_MOTION + 4
 
-    # MEIListMessage (spec 000, mpiMotionAxis).
+    # MEIListMessage (MPI 000, mpiMotionAxis).
     MEIListMessageELEMENT_NOT_FOUND = _MEI_LIST + 0
 
     @property
@@ -89,7 +89,7 @@ class Message(IntEnum):
 OK = Message.MPIMessageOK
 
 # The message a refused start/modify/action answers for each supervisor state
-# (spec 000 MPIMotionMessageIDLE ... MPIMotionMessageERROR descriptions).
+# (MPI 000 MPIMotionMessageIDLE ... MPIMotionMessageERROR descriptions).
 STATE_MESSAGES = {
     "IDLE": Message.MPIMotionMessageIDLE,
     "MOVING": Message.MPIMotionMessageMOVING,

@@ -276,7 +276,7 @@ class MotionSupervisor:
         stop time while moving)."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
-        if not self._axis_list.listed:  # spec 000 MPIMotionMessageAXIS_COUNT: "from mpiMotionConfigSet ... no axes"
+        if not self._axis_list.listed:  # MPI 000 MPIMotionMessageAXIS_COUNT: "from mpiMotionConfigSet ... no axes"
             return Message.MPIMotionMessageAXIS_COUNT
         verdict = config.validate()  # the one MotionConfig validator (params.py): YAML and services too
         if not verdict.ok:
@@ -360,7 +360,7 @@ class MotionSupervisor:
         return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.notify_mask
 
     def event_notify_set(self, mask: MPIEventType) -> Message:
-        """mpiMotionEventNotifySet (also maps the axes, spec 002 NOT_MAPPED_TO_MS)."""
+        """mpiMotionEventNotifySet (also maps the axes, MPI 002 NOT_MAPPED_TO_MS)."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
         if self._state.own_state in (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR):

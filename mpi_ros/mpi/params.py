@@ -35,9 +35,9 @@ from .types import (
 )
 
 MAX_COORD_AXES = 8  # MEIXmpMAX_COORD_AXES
-MAX_GATES = 32  # gate numbers 0..31 (spec 000 MEIMotionAttrHoldSource)
-VELOCITY_FRAME_LIMIT_SAMPLES = 16_384_000  # spec 000 mpiMotionStart
-ID_BITS = 16  # spec 000 MPIMotionAttributes: "limited to 16-bit resolution"
+MAX_GATES = 32  # gate numbers 0..31 (MPI 000 MEIMotionAttrHoldSource)
+VELOCITY_FRAME_LIMIT_SAMPLES = 16_384_000  # MPI 000 mpiMotionStart
+ID_BITS = 16  # MPI 000 MPIMotionAttributes: "limited to 16-bit resolution"
 USER_LABEL_MAX = 16  # MEIObjectLabelCharMAX
 
 # -- ranges (docs/decisions.md "Validation and ranges") -------------------------------------
@@ -177,7 +177,7 @@ class Trajectory:
     def validate(self) -> Outcome:
         """Magnitudes a controller can hold. Which must be positive depends on the motion
         type and is checked with the move (validate.check_params): VELOCITY ignores the
-        deceleration, the jerk types the jerk percentage (spec 000, MPIMotionSCurve and
+        deceleration, the jerk types the jerk percentage (MPI 000, MPIMotionSCurve and
         MPIMotionVelocity: the trajectory parameters each type reads)."""
         return first_refusal((
             check_magnitude("velocity", self.velocity, MAX_VELOCITY),
@@ -286,8 +286,8 @@ class MotionParams:
 
     @property
     def empty_count_disabled(self) -> bool:
-        """spec 000 MPIMotionPoint: emptyCount (-1) disables the E_STOP on a starving buffer;
-        spec 001 MPIMotionPathAttrMask EMPTY_COUNT: "To disable path-based deceleration, set
+        """MPI 000 MPIMotionPoint: emptyCount (-1) disables the E_STOP on a starving buffer;
+        MPI 001 MPIMotionPathAttrMask EMPTY_COUNT: "To disable path-based deceleration, set
         the value to zero". Both do, and so does any value below: emptyCount <= 0 (no buffer
         holds fewer than 0 points, so the trigger could never fire anyway)."""
         return self.empty_count <= 0
@@ -295,7 +295,7 @@ class MotionParams:
     def validate(self, motion_type: MPIMotionType | None = None, attributes: MotionAttr | None = None) -> Outcome:
         """The values a move of ``motion_type`` with ``attributes`` uses (None: every value,
         as mpiMotionParamsSet stores them for any later start). Values a move ignores are
-        not read (spec 000 MPIMotionSCurve, position: VELOCITY "will ignore these values";
+        not read (MPI 000 MPIMotionSCurve, position: VELOCITY "will ignore these values";
         an attribute's array is read only with the attribute). Lengths are checked with
         the move."""
         every = motion_type is None
@@ -351,7 +351,7 @@ class DecelTime:
     e_stop: float = 0.05
 
     def validate(self) -> Outcome:
-        """Durations (spec 000 MPIMotionDecelTime, seconds); a stop takes some time."""
+        """Durations (MPI 000 MPIMotionDecelTime, seconds); a stop takes some time."""
         return first_refusal((check_duration("stop", self.stop, positive=True),
                               check_duration("e_stop", self.e_stop, positive=True)))
 
@@ -375,7 +375,7 @@ class MotionConfig:
         return copy.deepcopy(self)
 
     def validate(self) -> Outcome:
-        """spec 000 MPIMotionConfig/MEIMotionConfig. The decel times are named as the ROS
+        """MPI 000 MPIMotionConfig/MEIMotionConfig. The decel times are named as the ROS
         interface and the YAML name them (decel_time_stop); axis_numbers is read only."""
         return first_refusal((
             self.decel_time.validate().prefixed("decel_time_"),
@@ -416,7 +416,7 @@ class AxisInPosition:
         return copy.deepcopy(self)
 
     def validate(self) -> Outcome:
-        """spec 002 MPIAxisInPosition. The tolerances are compared with a strict "<" (the
+        """MPI 002 MPIAxisInPosition. The tolerances are compared with a strict "<" (the
         NOTEs under the status tables), so a zero tolerance could never be met."""
         return first_refusal((
             check_range("position_fine", self.position_fine, 0.0, MAX_POSITION, above_low=True),

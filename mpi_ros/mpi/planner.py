@@ -1,13 +1,13 @@
 """Compile a validated start/modify request into a Move: per-axis frames.
 
-Multi-axis rules (spec 000 MPIMotionAttrMask remarks, MPIMotionSCurve):
+Multi-axis rules (MPI 000 MPIMotionAttrMask remarks, MPIMotionSCurve):
 - without SYNC_START/SYNC_END the first trajectory is the vector's: the axes move on a
   straight line with one profile along it;
 - with SYNC_START/SYNC_END each axis uses its own trajectory; SYNC_END inserts wait
   frames before the shorter profiles so all end together, SYNC_START adds delay frames
   after them;
 - DELAY inserts a wait frame of delay[i] seconds before axis i's profile.
-Quirks kept from the firmware (spec 000 mpiMotionStart): a frame may not last more than
+Quirks kept from the firmware (MPI 000 mpiMotionStart): a frame may not last more than
 16,384,000 samples (the axis stops abruptly there), and the fraction of a RELATIVE
 distance is truncated. Both are reported through ``notes``.
 
@@ -349,8 +349,8 @@ def compile_move(
 
     Raises Refused with the spec's message when the profile cannot be made. A profile
     that starts while its axes move cannot wait first: a non-zero DELAY is
-    MPIMotionMessageILLEGAL_DELAY (spec 000, for a modify in motion) and a HOLD
-    MPIMotionMessageATTRIBUTE_INVALID (spec 000: HOLD is not permitted in modifies); either
+    MPIMotionMessageILLEGAL_DELAY (MPI 000, for a modify in motion) and a HOLD
+    MPIMotionMessageATTRIBUTE_INVALID (MPI 000: HOLD is not permitted in modifies); either
     would stop the axes dead. A cam (``cam_masters``: each slave's master and its position
     now) is planned by cams.py.
     """

@@ -1,4 +1,4 @@
-"""Axis status bits, generated exactly as the two tables at the end of spec 002 say.
+"""Axis status bits, generated exactly as the two tables at the end of MPI 002 say.
 
 settleOnStop (settleOnEstop) = FALSE (the default):
 
@@ -147,7 +147,7 @@ _FLAGS = ("stop", "abort", "settle_on", "moving", "velocity", "point_to_point", 
 
 @dataclass(slots=True)
 class StatusRows:
-    """Per axis, what its status bits depend on besides the trace (spec 002's two tables,
+    """Per axis, what its status bits depend on besides the trace (MPI 002's two tables,
     see the module docstring), as columns: rebuilt for an axis when its move, mode or
     tolerances change."""
 

@@ -19,7 +19,7 @@ class MPIState(IntEnum):
 
 
 # Which state wins when the states of a supervisor's axes differ: the supervisor
-# shows the most severe one (its status is derived from each axis' status, spec 000
+# shows the most severe one (its status is derived from each axis' status, MPI 000
 # mpiMotionAxisAppend).
 STATE_SEVERITY = {
     MPIState.INVALID: -1,
@@ -92,7 +92,7 @@ PATH_TYPES = frozenset(
     }
 )
 CAM_TYPES = frozenset({MPIMotionType.CAM_LINEAR, MPIMotionType.CAM_CUBIC})
-# spec 000 mpiMotionModify: "The types of motion whose parameters can be modified while
+# MPI 000 mpiMotionModify: "The types of motion whose parameters can be modified while
 # moving are TRAPEZOIDAL, S_CURVE, VELOCITY, PT and PVT." The jerk types replace the
 # trapezoidal/S-curve/velocity algorithm in firmware option 21, so they modify alike.
 MODIFIABLE_TYPES = frozenset(

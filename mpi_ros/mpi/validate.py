@@ -34,7 +34,7 @@ A = MotionAttr
 # MPI 000, ATTRIBUTE_INVALID lists for the point types, and the path attributes of MPI 001
 # (MPIMotionPathAttrMask, the attributes of path motion: docs/paths.md).
 _PATH_ALLOWED = A.APPEND | A.RELATIVE | A.ID | A.ELEMENT_ID | HOLD_ATTRS | A.OUTPUT | PATH_ATTRS
-# spec 000: which attributes each type may carry.
+# MPI 000: which attributes each type may carry.
 ALLOWED_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
     MPIMotionType.PT: _PATH_ALLOWED,
     MPIMotionType.PTF: _PATH_ALLOWED,
@@ -52,7 +52,7 @@ ALLOWED_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
     MPIMotionType.CAM_LINEAR: CAM_ATTRS | A.ID | A.EVENT,
     MPIMotionType.CAM_CUBIC: CAM_ATTRS | A.ID | A.EVENT,
 }
-# spec 000: "VELOCITY, VELOCITY_JERK Moves are not permitted to have the following".
+# MPI 000: "VELOCITY, VELOCITY_JERK Moves are not permitted to have the following".
 FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
     MPIMotionType.VELOCITY: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,
     MPIMotionType.VELOCITY_JERK: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,

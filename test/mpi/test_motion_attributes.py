@@ -127,7 +127,7 @@ def test_illegal_delay_on_modify_in_motion(ctl, ms, params, bring):
 
 
 def test_illegal_delay_while_the_axes_wait_out_a_delay(ctl, ms, params):
-    # spec 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in motion".
+    # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in motion".
     # In motion is the supervisor's state (MOVING), not the axes' velocity: during a start's
     # DELAY the axes stand still, yet the motion is under way.
     assert ms.start(T.TRAPEZOIDAL, A.DELAY, params((100.0, 0.0), delay=[0.5, 0.5])).ok

@@ -175,7 +175,7 @@ def test_params_set_keeps_a_copy(ms, params):
 
 
 def test_params_get_after_a_start_returns_the_start_s_parameters(ms, params):
-    # spec 000, mpiMotionParamsGet: the parameters are the ones set "by mpiMotionParamsSet(...) or
+    # MPI 000, mpiMotionParamsGet: the parameters are the ones set "by mpiMotionParamsSet(...) or
     # mpiMotionStart(...)": after a start with parameters of its own, a get returns those.
     assert ms.params_set(params((1.0, 2.0))).ok
     assert ms.start(T.TRAPEZOIDAL, params=params((300.0, -100.0))).ok
@@ -183,7 +183,7 @@ def test_params_get_after_a_start_returns_the_start_s_parameters(ms, params):
 
 
 def test_params_set_while_moving_changes_the_move_on_the_fly(ctl, ms, params, run_to):
-    # spec 000, mpiMotionParamsSet: while a motion runs the new parameters take effect "on-the-fly"
+    # MPI 000, mpiMotionParamsSet: while a motion runs the new parameters take effect "on-the-fly"
     # (docs/decisions.md: as a modify of the running move's type)
     assert ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0))).ok
     ctl.step(300)
@@ -194,7 +194,7 @@ def test_params_set_while_moving_changes_the_move_on_the_fly(ctl, ms, params, ru
 
 
 def test_params_set_while_moving_that_the_move_refuses_changes_nothing(ctl, ms, params):
-    # spec 000, mpiMotionParamsSet on the fly: refused as the modify would be, and then not stored
+    # MPI 000, mpiMotionParamsSet on the fly: refused as the modify would be, and then not stored
     assert ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0))).ok
     ctl.step(300)
     before = ms.params_get()[1]

@@ -136,7 +136,7 @@ def test_velocity_modify_changes_speed_and_direction(params):
 
 
 def test_a_velocity_modify_reaches_its_velocity_at_the_end_of_its_own_ramp(params):
-    # spec 000, MPIEventTypeMOTION_AT_VELOCITY and mpiMotionModify: the outcome a goal on a
+    # MPI 000, MPIEventTypeMOTION_AT_VELOCITY and mpiMotionModify: the outcome a goal on a
     # velocity move waits for is decided from the move the command made, at the sample its
     # axes reach the new velocity, never from the earlier velocity the modify replaced.
     ctl, ms = rig()

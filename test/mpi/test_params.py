@@ -2,7 +2,7 @@
 
 The YAML loader, the services and the controller all ask ``validate()``, so a value is
 accepted or refused alike whichever way it comes in (docs/decisions.md, "Validation and
-ranges"). Refusals answer the reference's message, MPIMessagePARAM_INVALID (spec 000,
+ranges"). Refusals answer the reference's message, MPIMessagePARAM_INVALID (MPI 000,
 "Returns for mpiMotionStart and mpiMotionModify": "if the specified motion parameters are
 not valid"), with the field named first in the detail.
 """
@@ -60,7 +60,7 @@ def test_only_finite_numbers_pass_a_range(value):
 
 
 def test_a_duration_fits_the_sample_counter_at_every_rate():
-    # The sample counter is a C long (spec 000: MPIMotionPoint and MPIMotionAttributes use
+    # The sample counter is a C long (MPI 000: MPIMotionPoint and MPIMotionAttributes use
     # long for counts); a duration that fits it at the highest rate fits it at every rate.
     assert MAX_DURATION * SAMPLE_RATE_MAX <= LONG_MAX
     assert check_duration("d", MAX_DURATION).ok and refused(check_duration("d", MAX_DURATION * 1.001), "d")
@@ -77,14 +77,14 @@ def test_positions_keep_sub_count_resolution():
 
 # ------------------------------------------------------------------ MPIMotionConfig ----
 def test_motion_config_defaults_are_valid():
-    # spec 000 MPIMotionConfig: normalFeedrate 1.0 (100 %), pauseFeedrate 0.0
+    # MPI 000 MPIMotionConfig: normalFeedrate 1.0 (100 %), pauseFeedrate 0.0
     assert MotionConfig().validate().ok
 
 
 @pytest.mark.parametrize("value", [1e308, 1e-300, 0.0, -1.0, *NOT_NUMBERS[:3]])
 def test_normal_feedrate_out_of_range_is_refused(value):
     # issue 9: normal_feedrate 1e308 gave NaN command positions, 1e-300 a division by zero.
-    # spec 000 MPIMotionConfig: normalFeedrate is a C float, 1.0 = 100 %.
+    # MPI 000 MPIMotionConfig: normalFeedrate is a C float, 1.0 = 100 %.
     assert refused(MotionConfig(normal_feedrate=value).validate(), "normal_feedrate")
 
 
@@ -94,7 +94,7 @@ def test_normal_feedrate_range_ends_are_accepted(value):
 
 
 def test_pause_feedrate_zero_or_within_the_normal_range():
-    # spec 000 MPIMotionConfig: pauseFeedrate "for the Stop action. The default value is 0.0"
+    # MPI 000 MPIMotionConfig: pauseFeedrate "for the Stop action. The default value is 0.0"
     assert MotionConfig(pause_feedrate=0.0).validate().ok
     assert MotionConfig(pause_feedrate=0.5).validate().ok
     for value in (1e-300, -0.1, 1e308, math.nan):
@@ -104,14 +104,14 @@ def test_pause_feedrate_zero_or_within_the_normal_range():
 @pytest.mark.parametrize("value,ok", [(-1.0, True), (0.0, True), (1.0, True), (5.0, False), (-1.01, False),
                                       (math.nan, False)])
 def test_blend_limit_is_a_cosine(value, ok):
-    # spec 000 MEIMotionConfig blendLimit: "If cosine (turn angle) is greater than the
+    # MPI 000 MEIMotionConfig blendLimit: "If cosine (turn angle) is greater than the
     # blendLimit ... 1.0 causes all moves to be blended. -1.0 allows no blending"
     verdict = MotionConfig(blend_limit=value).validate()
     assert verdict.ok if ok else refused(verdict, "blend_limit")
 
 
 def test_user_label_holds_16_characters():
-    # spec 000 MEIMotionConfig: userLabel[MEIObjectLabelCharMAX+1], "16 characters"
+    # MPI 000 MEIMotionConfig: userLabel[MEIObjectLabelCharMAX+1], "16 characters"
     assert MotionConfig(user_label="x" * 16).validate().ok
     assert refused(MotionConfig(user_label="x" * 17).validate(), "user_label")
 
@@ -119,7 +119,7 @@ def test_user_label_holds_16_characters():
 @pytest.mark.parametrize("field", ["stop", "e_stop"])
 @pytest.mark.parametrize("value", [0.0, -0.5, MAX_DURATION * 2, 1e308, math.nan])
 def test_decel_times_are_positive_durations(field, value):
-    # spec 000 mpiMotionAction: MPIMotionConfig.decelTime.stop / .eStop, "seconds"; a stop that
+    # MPI 000 mpiMotionAction: MPIMotionConfig.decelTime.stop / .eStop, "seconds"; a stop that
     # takes no time, or more samples than the counter holds, is not one a controller can run
     decel = DecelTime()
     setattr(decel, field, value)
@@ -146,7 +146,7 @@ def test_in_position_defaults_are_valid():
     ("settle_on_stop", 1),  # MPI_BOOL fields: true or false
 ])
 def test_in_position_out_of_range_is_refused(field, value):
-    # spec 002 MPIAxisInPosition: positionFine and velocity are C floats, positionCoarse a long,
+    # MPI 002 MPIAxisInPosition: positionFine and velocity are C floats, positionCoarse a long,
     # settlingTime seconds (which must fit the sample counter)
     in_position = AxisInPosition()
     setattr(in_position, field, value)
@@ -196,7 +196,7 @@ def test_plant_defaults_and_ends_are_valid():
     ("sample_rate", 1e9),
     ("axis_count", 0),
     ("supervisor_count", 0),
-    ("frame_buffer_size", 15),  # spec 000 mpiMotionStart: a frame buffer per axis (128 by default)
+    ("frame_buffer_size", 15),  # MPI 000 mpiMotionStart: a frame buffer per axis (128 by default)
     ("io_words", 0),
     ("motor_count", -2),
     ("firmware_option_21", 1),
@@ -208,13 +208,13 @@ def test_controller_config_out_of_range_is_refused(field, value):
 
 
 def test_controller_config_defaults_are_valid():
-    # spec 000 MPIMotionConfig sample code: "sample rate configured for 2000 (default)"
+    # MPI 000 MPIMotionConfig sample code: "sample rate configured for 2000 (default)"
     assert ControllerConfig().validate().ok
 
 
 # ------------------------------------------------------------------ MPIMotionParams ----
 def test_trajectory_magnitudes():
-    # spec 000 MPIMotionSCurve / MPIMotionVelocity: which trajectory values a type reads, and so
+    # MPI 000 MPIMotionSCurve / MPIMotionVelocity: which trajectory values a type reads, and so
     # which must be positive, depends on the type (checked with the move); here only what a
     # controller could hold
     assert Trajectory(1000.0, 1e4, 1e4, 50.0).validate().ok
@@ -232,7 +232,7 @@ def test_params_name_the_nested_field():
 
 
 def test_params_check_only_what_the_move_reads():
-    # spec 000 MPIMotionSCurve, position: "VELOCITY and VELOCITY_JERK do not require target
+    # MPI 000 MPIMotionSCurve, position: "VELOCITY and VELOCITY_JERK do not require target
     # positions and will ignore these values"; an attribute's array is read only with the
     # attribute (MPIMotionAttributes)
     params = MotionParams(trajectory=[Trajectory(100.0, 1e4, 0.0)], position=[1e300], delay=[-1.0])
@@ -252,13 +252,13 @@ def test_params_check_only_what_the_move_reads():
     (Output(type=OutputType.MOTOR, motor=2**40), "motor"),
 ])
 def test_hold_and_output_fields_are_c_longs(struct, field):
-    # spec 000 MEIMotionAttrHold / MEIMotionAttrOutput: long fields (32 bits, as the ROS
+    # MPI 000 MEIMotionAttrHold / MEIMotionAttrOutput: long fields (32 bits, as the ROS
     # interface's int32); the timeout must fit the sample counter
     assert refused(struct.validate(), field)
 
 
 def test_ids_are_c_longs():
-    # spec 000 MPIMotionAttributes: id and elementId are longs (the firmware keeps 16 bits)
+    # MPI 000 MPIMotionAttributes: id and elementId are longs (the firmware keeps 16 bits)
     assert MotionParams(id=LONG_MIN, element_id=[LONG_MAX]).validate().ok
     assert refused(MotionParams(id=2**31).validate(), "id")
     assert refused(MotionParams(element_id=[1, 2**40]).validate(), "element_id[1]")
@@ -276,7 +276,7 @@ def test_empty_count_at_or_below_zero_disables(empty_count, disabled):
 
 
 def test_empty_count_is_a_c_long():
-    # spec 000 MPIMotionPoint: long emptyCount
+    # MPI 000 MPIMotionPoint: long emptyCount
     assert refused(MotionParams(empty_count=2**31).validate(), "empty_count")
 
 
@@ -311,7 +311,7 @@ def _move_runs_to_idle(ctl: Controller, ms) -> None:
 @pytest.mark.parametrize("feedrate", [1e308, 1e-300, math.nan])
 def test_config_set_refuses_a_feedrate_it_cannot_run(feedrate):
     # issue 9: normal_feedrate 1e308 gave NaN command positions and a move that never ends;
-    # 1e-300 made the start divide by zero. spec 000 mpiMotionConfigSet answers a Message:
+    # 1e-300 made the start divide by zero. MPI 000 mpiMotionConfigSet answers a Message:
     # PARAM_INVALID, and nothing changes.
     ctl = Controller()
     ms = _mapped(ctl)
@@ -323,7 +323,7 @@ def test_config_set_refuses_a_feedrate_it_cannot_run(feedrate):
 
 def test_axis_config_set_refuses_a_settling_time_past_the_sample_counter():
     # issue 9: settling_time 1e308 via mpiAxisConfigSet killed the clock on every step after.
-    # spec 002 MPIAxisInPosition settlingTime "Duration in seconds"; it is counted in samples.
+    # MPI 002 MPIAxisInPosition settlingTime "Duration in seconds"; it is counted in samples.
     ctl = Controller()
     ms = _mapped(ctl)
     before = ctl.axes[0].in_position.copy()
@@ -339,7 +339,7 @@ def test_axis_config_set_refuses_a_settling_time_past_the_sample_counter():
 
 @pytest.mark.parametrize("setter", ["axis_command_position_set", "axis_actual_position_set", "axis_origin_set"])
 def test_axis_positions_past_what_a_controller_holds_are_refused(setter):
-    # issue 9: an actual position of 1e308 was accepted and read back as -inf. spec 002
+    # issue 9: an actual position of 1e308 was accepted and read back as -inf. MPI 002
     # mpiAxisActualPositionSet / CommandPositionSet / OriginSet take a position (a double);
     # PARAM_INVALID and nothing changes.
     ctl = Controller()
@@ -378,7 +378,7 @@ _HIGH = dict(
 def test_the_clock_runs_at_the_ends_of_every_range(ends, trajectory):
     # issue 9: "the clock thread can never die on a value it accepted". Every struct at the ends
     # of its range; moves at the ends of the trajectory ranges; every action. Each command is
-    # answered with a Message (a profile no controller can compute is PROFILE_ERROR, spec 000),
+    # answered with a Message (a profile no controller can compute is PROFILE_ERROR, MPI 000),
     # and every sample after it is finite.
     ctl = Controller(**ends)
     ms = _mapped(ctl)

@@ -612,7 +612,7 @@ def test_points_appended_without_element_ids_leave_the_later_ids_in_place():
 @pytest.mark.parametrize("batch", [1, 1000])
 def test_axis_events_carry_the_element_id_of_their_sample(batch):
     # MPI 000, MPIMotionAttributes, elementId: every event of the path carries the element it runs toward
-    # at the event's sample (IN_COARSE_POSITION, AT_TARGET, ... of spec 002 included), however the
+    # at the event's sample (IN_COARSE_POSITION, AT_TARGET, ... of MPI 002 included), however the
     # controller's samples are batched (docs/decisions.md, "Samples, commands and replay")
     ctl, ms = new_supervisor(notify=E.IN_COARSE_POSITION | E.AT_TARGET | E.DONE | E.MOTION_DONE)
     points = [[100.0, 50.0], [3000.0, 10.0], [3100.0, 30.0], [3200.0, 40.0]]

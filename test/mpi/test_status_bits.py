@@ -1,4 +1,4 @@
-"""Axis status bits (mpi_ros/mpi/status.py) exactly as the two tables at the end of spec 002
+"""Axis status bits (mpi_ros/mpi/status.py) exactly as the two tables at the end of MPI 002
 (MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events) with NOTE 1-3
 (MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events) say,
 settleOnStop/settleOnEstop (MPI 002, MPIAxisInPosition, settleOnStop, MPI 002, Configuration of

@@ -1,4 +1,4 @@
-"""Validation of start/modify (mpi_ros/mpi/validate.py): spec 000's return table
+"""Validation of start/modify (mpi_ros/mpi/validate.py): MPI 000's return table
 (MPI 000, Returns for mpiMotionStart and mpiMotionModify), the ATTRIBUTE_INVALID causes
 (MPI 000, MPIMotionMessageATTRIBUTE_INVALID) and the array lengths of docs/decisions.md
 ("The ROS contract: names, numbers, arrays").
@@ -333,7 +333,7 @@ def test_element_id_needs_values():
     (A.ID, p2p(id=2**40)),
 ])
 def test_values_no_controller_holds_are_param_invalid(attrs, params):
-    # spec 000 "Returns for mpiMotionStart and mpiMotionModify": MPIMessagePARAM_INVALID "if the
+    # MPI 000 "Returns for mpiMotionStart and mpiMotionModify": MPIMessagePARAM_INVALID "if the
     # specified motion parameters are not valid"; C longs and doubles (MPIMotionParams,
     # MPIMotionAttributes, MEIMotionAttrHold/Output), durations that fit the sample counter
     verdict = params_verdict(params, attrs=attrs)
@@ -348,7 +348,7 @@ def test_every_empty_count_is_accepted(empty_count):
 
 
 def test_empty_count_past_a_c_long_is_param_invalid():
-    # spec 000 MPIMotionPoint: long emptyCount
+    # MPI 000 MPIMotionPoint: long emptyCount
     assert params_verdict(p2p(empty_count=2**40)).message is M.MPIMessagePARAM_INVALID
 
 
@@ -363,7 +363,7 @@ def test_start_with_no_axes_answers_axis_count(ctl):
 
 
 def test_config_set_with_no_axes_answers_axis_count(ctl):
-    # spec 000 MPIMotionMessageAXIS_COUNT: "returned from mpiMotionConfigSet(...), mpiMotionStart(...),
+    # MPI 000 MPIMotionMessageAXIS_COUNT: "returned from mpiMotionConfigSet(...), mpiMotionStart(...),
     # or mpiMotionModify(...) if there are no axes associated with the motion object"
     _, ms = ctl.create_motion(0)
     before = ms.config.copy()

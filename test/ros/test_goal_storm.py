@@ -229,7 +229,7 @@ def test_e_stop_is_answered_as_fast_as_idle_with_hundreds_of_goals_in_flight(liv
               f"with {len(goals)} goals in flight: ms0 {e_stops[0][0] * 1e3:.2f} ms, ms1 {e_stops[1][0] * 1e3:.2f} ms; "
               f"action service median idle {statistics.median(probes_idle) * 1e3:.2f} ms, "
               f"loaded {statistics.median(probes_loaded) * 1e3:.2f} ms")
-        # spec 000, MPIMotionMessageERROR: the motion is in an error state due to an E_STOP action
+        # MPI 000, MPIMotionMessageERROR: the motion is in an error state due to an E_STOP action
         assert {(r.status, r.result.message) for r in results} == {
             (GoalStatus.STATUS_ABORTED, "MPIMotionMessageERROR")}
         # Generous bounds, against the idle figures of this run: the machine is shared and noisy
@@ -257,7 +257,7 @@ def test_more_goals_than_executor_threads_still_get_answers(suite, sender, probe
     assert all(h.accepted for h in sender.wait_answers(goals, timeout=WAIT))
     sender.wait_status(held, GoalStatus.STATUS_EXECUTING)  # its move is current, held at the gate
     sender.wait_status(queued, GoalStatus.STATUS_ACCEPTED)
-    # spec 000, meiControlGateSet: the held motion starts when the gate opens
+    # MPI 000, meiControlGateSet: the held motion starts when the gate opens
     assert service(probe, GateSet, "/mpi/gate_set", GateSet.Request(gate=3, closed=False)).message == "MPIMessageOK"
     drive(lambda: sum(i in sender.results for i in goals) >= 10)
     e_stop = _action(Timer(probe), 0, "E_STOP")[1]

@@ -1,7 +1,7 @@
 """S_CURVE_JERK and VELOCITY_JERK (firmware option 21): jerk-limited profiles that start
 from the full current state (position, velocity and acceleration).
 
-spec 000 MPIMotionTypeS_CURVE_JERK: "specified by acceleration, velocity,
+MPI 000 MPIMotionTypeS_CURVE_JERK: "specified by acceleration, velocity,
 deceleration, accelerationJerk, decelerationJerk, and final position". A change of
 speed that raises |v| uses the acceleration and accelerationJerk, one that lowers it
 the deceleration and decelerationJerk (jerk in counts/s^3).

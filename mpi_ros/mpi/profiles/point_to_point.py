@@ -2,7 +2,7 @@
 
 One function per motion type family; all return segments in profile time starting at
 the given position. Start/modify alike: the standard algorithm starts from the current
-position and velocity with zero acceleration (DESIGN.md).
+position and velocity with zero acceleration (docs/profiles.md, "Modify: from the current state").
 """
 
 from __future__ import annotations

@@ -2,12 +2,12 @@
 
 A plan is a list of :class:`Ramp` pieces, each a linear change of velocity (a cruise is
 a ramp whose start and end velocity are equal). The firmware builds the trapezoid
-first and S-curves reshape each ramp keeping its duration (DESIGN.md, "Facts about the
-libraries"), so the S-curve and trapezoid of the same limits share this plan.
+first and S-curves reshape each ramp keeping its duration (docs/profiles.md, "The trapezoid
+and the S-curve"), so the S-curve and trapezoid of the same limits share this plan.
 
 Rates: a ramp that raises |v| uses the acceleration, one that lowers |v| the
 deceleration; a ramp through zero is split at zero. VELOCITY moves use the
-acceleration for every ramp (spec 000 MPIMotionVelocity: "deceleration is ignored").
+acceleration for every ramp (MPI 000 MPIMotionVelocity: "deceleration is ignored").
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ With f = jerkPercent/100 and a ramp of duration Ta, the ramp becomes a jerk phas
 f*Ta/2, a constant-acceleration phase of (1-f)*Ta and a jerk phase of f*Ta/2, with peak
 acceleration dv / (Ta * (1 - f/2)). The ramp keeps its duration and distance (the
 velocity curve is symmetric about the ramp's midpoint), so an S-curve takes exactly as
-long as the trapezoid with the same limits (DESIGN.md, "Facts about the libraries").
+long as the trapezoid with the same limits (docs/profiles.md, "The trapezoid and the S-curve").
 f = 0 is the trapezoid itself.
 """
 

@@ -1,6 +1,6 @@
 """The one representation every profile compiles into: constant-jerk segments.
 
-spec 000 (Streaming Point Motion Type Calculations): "all motion is specified by
+MPI 000 (Streaming Point Motion Type Calculations): "all motion is specified by
 constant-jerk segments of motion". A segment starts at (p, v, a) and runs ``duration``
 seconds of profile time with jerk ``j``. A 1-D profile is a contiguous tuple of them.
 """
