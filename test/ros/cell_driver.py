@@ -80,6 +80,8 @@ def phase1(clients: dict[str, MotionClient]) -> dict:
     for ns, (statuses, events) in inboxes.items():
         done_sample = results[ns].end_sample
         clients[ns].status(WAIT, newer_than=done_sample)  # a status after the move's end arrived
+        # the result and the events are different topics: MOTION_DONE may arrive after the result
+        events.wait_for(lambda m: m.supervisor == 0 and m.type == "MOTION_DONE", WAIT)
         status_samples = [m.sample for m in statuses.since(0)]
         event_samples = [m.sample for m in events.since(0)]
         report[ns] = {"message": results[ns].message, "position": list(results[ns].command_position),
