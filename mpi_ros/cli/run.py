@@ -22,6 +22,7 @@ of run, `mpi-ros demo` for a narrated, recorded tour.
 from __future__ import annotations
 
 import argparse
+import ctypes
 import gc
 import os
 import sys
@@ -52,6 +53,28 @@ def discovery_range(flag: str | None, config_path: str | None, environ) -> tuple
     if environ.get(RANGE_VARIABLE):
         return environ[RANGE_VARIABLE], RANGE_VARIABLE
     return suite_config.load(config_path).ros.discovery.upper(), "ros.discovery"
+
+
+M_MMAP_THRESHOLD = -3  # glibc's mallopt parameter (malloc.h)
+MMAP_THRESHOLD = 128 * 1024  # bytes: glibc's default, kept fixed
+
+
+def release_large_buffers() -> bool:
+    """Have glibc give every buffer of 128 kB or more back to the system when it is freed.
+
+    glibc raises its mmap threshold to the size of the first large block freed (up to 32 MB);
+    from then on such blocks come from the heap of the thread that asks, and freed they stay
+    there. A refused request of 1,000,000 values (8 MB, serialized and deserialized on the
+    middleware's and the executor's threads) then left its buffers in several per-thread heaps:
+    the suite's RSS climbed by about 4 MB per such goal (bench/RESULTS.md, "Refused input and
+    memory"). A fixed threshold (setting it turns the adjustment off) returns them at once.
+    False where the C library is not glibc (nothing to do there)."""
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):  # not glibc: its allocator has no such threshold to pin
+        return False
+    return bool(mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD))
 
 
 def run(args) -> int:
@@ -107,6 +130,7 @@ def run(args) -> int:
     # 100,000-point stream (bench/RESULTS.md), a stall the 128-frame buffer (128 ms of 1 ms
     # points) cannot ride out: the clock then caught up in one batch and the path starved.
     gc.freeze()
+    release_large_buffers()
     suite.start(spin_in_thread=False)
     try:
         suite.spin()
