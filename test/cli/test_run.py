@@ -1,0 +1,42 @@
+"""`mpi-ros run`'s process set-up (mpi_ros/cli/run.py)."""
+
+from __future__ import annotations
+
+import platform
+import subprocess
+import sys
+
+import pytest
+
+# In a fresh process (an allocator no one has used for large blocks yet): is an 8 MB block
+# mapped on its own (returned to the system when freed), before and after one was freed?
+# glibc marks such a chunk IS_MMAPPED (bit 1 of the size word just before the pointer).
+_PROBE = """
+import ctypes, sys
+from mpi_ros.cli.run import release_large_buffers
+if sys.argv[1] == "pinned":
+    assert release_large_buffers()
+libc = ctypes.CDLL("libc.so.6")
+libc.malloc.restype = ctypes.c_void_p
+libc.free.argtypes = [ctypes.c_void_p]
+def mapped():
+    block = libc.malloc(8 << 20)
+    own = bool(ctypes.c_size_t.from_address(block - ctypes.sizeof(ctypes.c_size_t)).value & 2)
+    libc.free(block)
+    return own
+print(mapped(), mapped())
+"""
+
+
+def probe(mode: str) -> str:
+    done = subprocess.run([sys.executable, "-c", _PROBE, mode], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.strip()
+
+
+@pytest.mark.skipif(platform.libc_ver()[0] != "glibc", reason="glibc's allocator only: nothing to pin elsewhere")
+def test_large_buffers_go_back_to_the_system_once_the_threshold_is_pinned():
+    # glibc raises its mmap threshold when the first large block is freed: the next one comes
+    # from the heap and stays there (the refused-goal memory growth, docs/hostile-input.md)
+    assert probe("default") == "True False"
+    assert probe("pinned") == "True True"
