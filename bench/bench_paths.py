@@ -14,13 +14,18 @@ from __future__ import annotations
 
 import math
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState
-from mpi_ros.mpi.planner import AxisStart, compile_move
-from mpi_ros.mpi.types import MotionAttr
+# This source tree, not the copy scripts/setup.sh last installed into the venv (run with -P).
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState  # noqa: E402
+from mpi_ros.mpi.planner import AxisStart, compile_move  # noqa: E402
+from mpi_ros.mpi.types import MotionAttr  # noqa: E402
 
 POINTS = 1000
 KINDS = (MPIMotionType.PT, MPIMotionType.PVT, MPIMotionType.SPLINE, MPIMotionType.BESSEL, MPIMotionType.BSPLINE,

@@ -43,11 +43,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 
-from mpi_ros.crosscheck import check_plan
-from mpi_ros.crosscheck.result import RuckigLimits
-from mpi_ros.mpi.params import MotionParams, Trajectory
-from mpi_ros.mpi.planner import AxisStart, compile_move
-from mpi_ros.mpi.types import MotionAttr, MPIMotionType
+# This source tree, not the copy scripts/setup.sh last installed into the venv (run with -P).
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from mpi_ros.crosscheck import check_plan  # noqa: E402
+from mpi_ros.crosscheck.result import RuckigLimits  # noqa: E402
+from mpi_ros.mpi.params import MotionParams, Trajectory  # noqa: E402
+from mpi_ros.mpi.planner import AxisStart, compile_move  # noqa: E402
+from mpi_ros.mpi.types import MotionAttr, MPIMotionType  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 SAMPLE_RATE = 2000.0
