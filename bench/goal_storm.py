@@ -65,7 +65,7 @@ class _Storm:
         from rclpy.node import Node
 
         from mpi_ros.action import MotionModify, MotionStart
-        from mpi_ros.ros.supervisor_node import ACTION_QOS
+        from mpi_ros.client import ACTION_QOS
 
         self.types = {"start": MotionStart, "modify": MotionModify}
         self.node = Node("goal_storm_bench_sender", context=context)

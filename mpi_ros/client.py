@@ -745,10 +745,13 @@ class MotionClient(_Endpoint):
     def _send(self, action_client: ActionClient, msg: Any, feedback: Callable[[Any], None] | None) -> Goal:
         progress = threading.Event()
         holder: dict[str, Goal] = {}
+        early: list[Any] = []  # feedback that came before the goal's answer (the suite sends it from its next tick)
 
         def on_feedback(message: Any) -> None:
             if "goal" in holder:
                 holder["goal"].feedback = message.feedback
+            else:
+                early.append(message.feedback)
             progress.set()
             if feedback is not None:
                 feedback(message.feedback)
@@ -760,8 +763,10 @@ class MotionClient(_Endpoint):
         if not handle.accepted:
             raise NoResponse(f"{action_client._action_name} rejected the goal (the suite is shutting down)")
         result = self._on_executor(handle.get_result_async)
-        holder["goal"] = Goal(self, handle, result, progress, action_client)
-        return holder["goal"]
+        goal = holder["goal"] = Goal(self, handle, result, progress, action_client)
+        if goal.feedback is None and early:
+            goal.feedback = early[-1]
+        return goal
 
     def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float | None = None,
              jerk_percent: float = 0.0, motion_type: MotionType | str = MotionType.S_CURVE,

@@ -5,31 +5,24 @@ command ends the goal ABORTED with the spec's message). Services live in their o
 reentrant callback group, apart from the goals, so E_STOP is served while goals run.
 
 A goal holds no executor thread while its move runs (with more goals than threads nothing
-else would be served, E_STOP included). Deferred execution: the goal callback applies the
-goal's command (so the client's goal response comes after it took effect), the
-handle_accepted callback files the goal in a GoalBook, and the runner reviews the book
-after every step batch and command, under its lock. A goal whose move has become current
-is marked EXECUTING; a goal whose move has ended is handed back to rclpy, whose execute
-callback (scheduled then) sets the terminal state and returns the result at once.
-Feedback for every running goal comes from one periodic hook at the feedback rate.
-Goal and cancel requests are handled in the order they arrived (_GoalServer).
-With ``lost_client_timeout`` > 0 a watchdog STOPs the motion of a goal whose client has
-left the graph (watchdog.py, docs/cell.md).
+else would be served, E_STOP included), and runs no callback: GoalServer (goal_server.py)
+takes every goal request waiting, the node applies their commands together (so a client's
+goal response comes after its command took effect) and files the goals in a GoalBook; the
+runner reviews the book after every step batch and command, under its lock. A goal whose
+move has become current is marked EXECUTING; a goal whose move has ended is finished with
+its result, after the lock. Feedback for every running goal comes from one periodic hook at
+the feedback rate. With ``lost_client_timeout`` > 0 a watchdog STOPs the motion of a goal
+whose client has left the graph (watchdog.py, docs/cell.md).
 """
 
 from __future__ import annotations
 
 import threading
 import traceback
-from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
-from typing import Any
 
 from action_msgs.msg import GoalStatus
-from rclpy.action import ActionServer, CancelResponse, GoalResponse
-from rclpy.action.server import GoalEvent, RCLError, ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -66,6 +59,7 @@ from ..mpi.outcome import MoveEnd, Outcome
 from ..mpi.snapshot import MotionFeedback
 from ..runner import ControllerRunner, Output
 from . import convert, snapshots, wire
+from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
 from .goal_tracker import GoalBook, TrackedGoal
 from .watchdog import LostClientWatchdog
 
@@ -74,8 +68,6 @@ FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feed
 # The action's services default to a history of 10: an E_STOP that ends more goals than
 # that at once would drop results. Deep enough for every goal a frame buffer can queue.
 ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-ACTION_QOS = dict(goal_service_qos_profile=ACTION_SERVICE_QOS, result_service_qos_profile=ACTION_SERVICE_QOS,
-                  cancel_service_qos_profile=ACTION_SERVICE_QOS)
 TRIGGER_ACTIONS = {"stop": "STOP", "e_stop": "E_STOP", "abort": "ABORT", "reset": "RESET", "resume": "RESUME"}
 # A goal whose cancel was accepted is still in one of these until rclpy has moved it to
 # CANCELING (right after our cancel callback returns); only then may it end CANCELED.
@@ -86,86 +78,8 @@ _NOT_YET_CANCELING = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING)
 class _RosGoal:
     """What finishing a goal needs from ROS (the payload of its TrackedGoal)."""
 
-    handle: ServerGoalHandle
+    server: GoalServer
     action_type: type
-    server: ActionServer
-    executing: bool = False  # we moved it to EXECUTING (changed under the node's _transitions)
-
-
-class _GoalServer(ActionServer):
-    """An ActionServer that handles goal and cancel requests in the order it took them.
-
-    rclpy takes one request per executor round and handles each in a task of its own, so
-    with a reentrant group two goals sent back to back could be applied out of order (an
-    APPEND before the start it follows, an older modify last) and a cancel could be handled
-    before its goal is filed. Here the requests join a queue as they are taken (takes of
-    one waitable never overlap), and whichever task holds the queue's lock handles all of
-    them, oldest first; the others return at once, so no executor thread waits here. The
-    callbacks are synchronous: nothing awaits while the lock is held.
-    """
-
-    def __init__(self, *args: Any, after_cancel: Callable[[], None], **kwargs: Any) -> None:
-        self._taken: deque[dict] = deque()
-        self._in_order = threading.Lock()
-        self._after_cancel = after_cancel
-        self.goal_id: bytes | None = None  # the goal request being handled (for the goal callback)
-        # goal id -> its command's (reply, sample), or the error
-        self.applied: dict[bytes, tuple[Reply, int] | Exception] = {}
-        super().__init__(*args, **kwargs)
-
-    def kept(self) -> int:
-        """Goals rclpy keeps: the unfinished ones and the ended ones until result_timeout."""
-        return len(self._goal_handles)
-
-    def unfiled(self) -> int:
-        """Goal and cancel requests taken and not yet handled, and goals applied and not yet filed."""
-        return len(self._taken) + len(self.applied)
-
-    def take_data(self):
-        data = super().take_data()
-        requests = {key: data.pop(key) for key in ("goal", "cancel") if key in data}
-        if requests:
-            self._taken.append(requests)
-        return data
-
-    async def execute(self, taken_data):
-        # Try again after releasing: a request taken while another task held the lock
-        # (and so returned at once) is handled by the holder.
-        while self._taken and self._in_order.acquire(blocking=False):
-            try:
-                while self._taken:
-                    await self._serve(self._taken.popleft())
-            finally:
-                self._in_order.release()
-        if taken_data:
-            await super().execute(taken_data)  # result requests, expired goals
-
-    async def _serve(self, requests: dict) -> None:
-        goal = requests.get("goal")
-        self.goal_id = bytes(goal[1].goal_id.uuid) if goal is not None else None
-        try:
-            await super().execute(requests)
-            if "cancel" in requests:
-                self._after_cancel()  # the goals whose cancel was accepted are CANCELING now
-        except Exception:  # noqa: BLE001 - one bad request must neither strand the queue nor stop the executor
-            self._node.get_logger().error(f"a goal or cancel request failed:\n{traceback.format_exc()}")
-        finally:
-            if self.goal_id is not None and self.applied.pop(self.goal_id, None) is not None:
-                # rclpy did not hand the accepted goal over (its response could not be sent)
-                self._node.get_logger().warning("a goal's command was applied, but the goal did not reach "
-                                                "its client (gone?): its move runs without a goal")
-            self.goal_id = None
-
-
-def _never_executed(_handle) -> None:
-    """The action servers' registered execute callback. Goals are finished with a callback
-    of their own (``SupervisorNode._close``), so rclpy never calls this one; if it ever did,
-    the goal would fail loudly (rclpy logs the error and aborts it) instead of hanging."""
-    raise RuntimeError("a goal was executed without going through the goal book")
-
-
-def _reraise(exc: BaseException, _handle) -> None:
-    raise exc
 
 
 class SupervisorNode(Node):
@@ -180,10 +94,8 @@ class SupervisorNode(Node):
         self._service_group = ReentrantCallbackGroup()
         self._book = GoalBook(number)
         self._snapshots = snapshots.shared(runner)
-        # Orders our own goal-state changes against an accepted cancel (see _mark_executing).
-        self._transitions = threading.Lock()
         self._closing = threading.Condition()
-        self._unfinished = 0  # goals handed to rclpy whose execute callback has not run yet
+        self._unfinished = 0  # goals ended whose result has not been handed to their server yet
         actions = ((MotionStart, "motion_start", MOTION_START), (MotionModify, "motion_modify", MOTION_MODIFY))
         # each action's feedback topic: its clients subscribe there (the watchdog looks for them)
         self._feedback_topics = {action_type: f"{self.get_fully_qualified_name()}/{name}/_action/feedback"
@@ -219,19 +131,18 @@ class SupervisorNode(Node):
 
     def held(self) -> dict[str, int]:
         """What this node holds of its goals (for /diagnostics: none of it may grow without
-        bound): goals tracked until they end, goals rclpy keeps until their result expires,
-        requests not yet filed. Runner lock held."""
+        bound): goals tracked until they end, goals kept until their result expires,
+        requests taken and not yet handled. Runner lock held."""
         return {"goals_tracked": len(self._book), "goals_kept": sum(s.kept() for s in self._servers.values()),
                 "requests_unfiled": sum(s.unfiled() for s in self._servers.values())}
 
-    def _action_server(self, action_type, name: str, operation: str) -> _GoalServer:
-        return _GoalServer(self, action_type, f"~/{name}", _never_executed,
-                           goal_callback=lambda goal: self._on_goal(goal, action_type, operation),
-                           handle_accepted_callback=lambda handle: self._accept(handle, action_type),
-                           cancel_callback=self._on_cancel,
-                           after_cancel=lambda: self.runner.update(self._review),
-                           callback_group=self._goal_group, result_timeout=self.settings.result_timeout,
-                           **ACTION_QOS)
+    def _action_server(self, action_type, name: str, operation: str) -> GoalServer:
+        callbacks = Callbacks(accepting=lambda: not self._shutting_down,
+                              apply=partial(self._on_goals, action_type, operation), cancel=self._on_cancel,
+                              cancelled=lambda: self.runner.update(self._review))
+        return GoalServer(self, action_type, f"~/{name}", callbacks, callback_group=self._goal_group,
+                          service_qos=ACTION_SERVICE_QOS, feedback_qos=FEEDBACK_QOS,
+                          result_timeout=self.settings.result_timeout)
 
     def _service(self, srv_type, name, callback):
         """A service of this supervisor: /<ns>/ms<n>/<name>."""
@@ -239,7 +150,7 @@ class SupervisorNode(Node):
 
     def shutdown(self, timeout: float = 2.0) -> None:
         """Reject new goals and end the pending ones with MPIMotionMessageSTOPPED ("the suite
-        is shutting down"); waits (up to ``timeout`` s, while ROS runs) until rclpy has them."""
+        is shutting down"); waits (up to ``timeout`` s, while ROS runs) until their results are out."""
         self._shutting_down = True
         self.runner.update(self._end_all)
         if self.context.ok():
@@ -263,63 +174,59 @@ class SupervisorNode(Node):
         return lambda: convert.publish(self, self._pub_status, msg)
 
     # -- goals: acceptance and cancel (executor threads) -------------------------------
-    def _on_goal(self, goal_msg, action_type, operation: str) -> GoalResponse:
-        """goal_callback: apply the goal's command now, before rclpy answers the client, so
-        that a client that sends a modify on receiving its start's answer finds the move.
-        Every goal is accepted (but while shutting down); a refused command ends it ABORTED."""
-        if self._shutting_down:
-            return GoalResponse.REJECT
-        server = self._servers[action_type]
-        goal_id = server.goal_id
-        assert goal_id is not None  # set while the server handles the goal request that calls this
-        try:
-            command = Command(operation, self.number, request=convert.to_dict(goal_msg))
-            convert.release(goal_msg)  # read once; rclpy would keep it until the result expires
-            server.applied[goal_id] = self.runner.submit(command)
-        except Exception as exc:  # noqa: BLE001 - not swallowed: the goal is aborted with it (_accept)
-            server.applied[goal_id] = exc
-        return GoalResponse.ACCEPT
+    def _on_goals(self, action_type, operation: str, goals: list[tuple[bytes, object]]) -> None:
+        """A batch of accepted goals: their commands applied now, together, in order, and the
+        goals filed in the book under the same hold of the lock (GoalServer answers their
+        clients after this: a client that sends a modify on receiving its start's answer
+        finds the move). A refused command ends its goal ABORTED; a command that raised (an
+        internal error) ends it ABORTED with the error in its detail, and the error is logged."""
+        commands: dict[bytes, Command | Exception] = {}
+        for key, message in goals:
+            try:
+                commands[key] = Command(operation, self.number, request=convert.to_dict(message))
+            except Exception as exc:  # noqa: BLE001 - not swallowed: the goal is aborted with it (_tracked)
+                commands[key] = exc
+        valid = [(key, command) for key, command in commands.items() if isinstance(command, Command)]
+        payload = _RosGoal(self._servers[action_type], action_type)
 
-    def _accept(self, handle: ServerGoalHandle, action_type) -> None:
-        """handle_accepted_callback: file the goal (its command has been applied) and review
-        the book at once. Returns at once. Goal and cancel requests are handled in order
-        (_GoalServer), so a cancel of this goal comes after this."""
-        server = self._servers[action_type]
-        key = bytes(handle.goal_id.uuid)
-        applied = server.applied.pop(key, None)
-        if not isinstance(applied, tuple):  # the command raised: rclpy logs it and aborts the goal
-            handle.execute(partial(_reraise, applied or RuntimeError("the goal's command was not applied")))
-            return
-        reply, sample = applied
-        goal = TrackedGoal(key, _RosGoal(handle, action_type, server), sample=sample)
+        def file(ctl: Controller, answers: list) -> None:
+            answered = dict(zip((key for key, _ in valid), answers, strict=True))
+            for key, command in commands.items():
+                goal = self._tracked(key, payload, answered.get(key, command), ctl)
+                if self._shutting_down and goal.end is None:
+                    goal.end = self._shutdown_end(ctl)  # accepted just before shutdown began
+                self._book.add(goal)
+
+        self.runner.submit_all([command for _, command in valid], then=file)
+        if self.watchdog is not None:
+            for key, _ in goals:
+                self.watchdog.watch(key, self._feedback_topics[action_type])
+
+    def _tracked(self, key: bytes, payload: _RosGoal, answer, ctl: Controller) -> TrackedGoal:
+        """The goal to follow, from its command's answer: its move, or its end."""
+        if isinstance(answer, Exception):
+            self.get_logger().error("a goal's command failed (an internal error, not the request's):\n"
+                                    + "".join(traceback.format_exception(answer)))
+            outcome = Outcome(Message.MPIMotionMessageERROR, f"internal error: {type(answer).__name__}: {answer}")
+            return TrackedGoal(key, payload, end=MoveEnd(0, outcome, ctl.sample))
+        reply, sample = answer
+        goal = TrackedGoal(key, payload, sample=sample)
         if reply.accepted and reply.serial:
             goal.serial = reply.serial
         else:  # refused, or answered without a move to follow (NO_WAIT): the reply is the result
             goal.end = MoveEnd(0, reply.outcome, sample)
-        self.runner.update(partial(self._file, goal))
-        if self.watchdog is not None:
-            self.watchdog.watch(key, self._feedback_topics[action_type])
+        return goal
 
-    def _file(self, goal: TrackedGoal, ctl: Controller) -> Output | None:
-        """Runner lock held: file the goal and review the book. What its move did since its
-        command is in the controller's move log, so the review decides it as if it had been
-        filed with the command; a refused command ends it here."""
-        if self._shutting_down and goal.end is None:
-            goal.end = self._shutdown_end(ctl)  # accepted just before shutdown began
-        self._book.add(goal)
-        return self._review(ctl)
-
-    def _on_cancel(self, handle: ServerGoalHandle) -> CancelResponse:
+    def _on_cancel(self, key: bytes) -> bool:
         """Cancel = STOP: the axes decelerate over decelTime.stop and the goal ends CANCELED
         once stopped. A goal whose end is already known cannot be cancelled any more."""
         with self.runner.lock:
-            goal = self._book.get(bytes(handle.goal_id.uuid))
+            goal = self._book.get(key)
             if goal is None or goal.end is not None or goal.cancel:
-                return CancelResponse.REJECT
-            with self._transitions:
-                goal.cancel = True
+                return False
+            goal.cancel = True
         self._stop()
-        return CancelResponse.ACCEPT
+        return True
 
     def _stop(self) -> None:
         self.runner.submit(Command(ACTION, self.number, request={"action": "STOP"}))
@@ -351,13 +258,20 @@ class SupervisorNode(Node):
                 self._mark_executing(goal)
             if close is not None:
                 close()
+            self._publish_statuses()
 
         return output
 
+    def _publish_statuses(self) -> None:
+        """Each action's goal statuses, once for all the changes of a review."""
+        for server in self._servers.values():
+            server.publish_status()
+
     @staticmethod
     def _may_end(goal: TrackedGoal) -> bool:
-        # A cancelled goal ends CANCELED, which rclpy allows only from CANCELING.
-        return not goal.cancel or goal.payload.handle.status not in _NOT_YET_CANCELING
+        # A cancelled goal ends CANCELED, which rcl_action allows only from CANCELING: its
+        # server moves it there right after the cancel callback accepted.
+        return not goal.cancel or goal.payload.server.status(goal.key) not in _NOT_YET_CANCELING
 
     def _end_all(self, ctl: Controller) -> Output | None:
         goals = self._book.end_all(self._shutdown_end(ctl))
@@ -376,6 +290,7 @@ class SupervisorNode(Node):
         def close() -> None:
             for goal in goals:
                 self._close(goal, facts)
+            self._publish_statuses()
 
         return close
 
@@ -408,56 +323,29 @@ class SupervisorNode(Node):
         return partial(_publish_feedback, review, sends)
 
     # -- goals: state changes (after the lock) ----------------------------------------
-    def _mark_executing(self, goal: TrackedGoal) -> None:
-        """The goal's move is now the supervisor's current one: status EXECUTING.
-
-        rclpy has no public call for a deferred goal that starts executing (rclcpp has
-        ServerGoalHandle::set_executing): ServerGoalHandle.execute() also schedules the
-        execute callback, which would end the goal at once. ServerGoalHandle._update_state
-        is what execute() itself uses, unchanged since rclpy's first ActionServer; it keeps
-        the status honest for clients (ACCEPTED while an appended move waits its turn,
-        EXECUTING while it runs).
-        """
-        with self._transitions:
-            if goal.cancel or goal.payload.executing:
-                return  # cancelled while waiting: rclpy moves it from ACCEPTED to CANCELING
-            goal.payload.handle._update_state(GoalEvent.EXECUTE)
-            goal.payload.executing = True
+    @staticmethod
+    def _mark_executing(goal: TrackedGoal) -> None:
+        """The goal's move is now the supervisor's current one: EXECUTING (the status stays
+        honest for clients: ACCEPTED while an appended move waits its turn). A goal whose
+        cancel was accepted meanwhile stays CANCELING."""
+        goal.payload.server.start(goal.key)
 
     def _close(self, goal: TrackedGoal, facts: MotionFeedback | None) -> None:
-        """Hand an ended goal back to rclpy: its execute callback, scheduled now on the
-        executor, sets the terminal state and returns the result without waiting."""
-        ros = goal.payload
-        assert goal.end is not None  # an ended goal
-        finish = partial(self._finish, goal, _result(ros.action_type, goal.end, goal.sample, facts))
-        with self._transitions:
-            if ros.executing:
-                ros.server.notify_execute(ros.handle, finish)
-                return
-            try:
-                ros.handle.execute(finish)  # ACCEPTED -> EXECUTING (not if CANCELING), then `finish`
-            except RCLError:
-                # A cancel moved it to CANCELING between rclpy's check and its EXECUTE (only
-                # at shutdown, which does not wait for the cancel): just schedule `finish`.
-                if not ros.handle.is_cancel_requested:
-                    raise
-                ros.server.notify_execute(ros.handle, finish)
-
-    def _finish(self, goal: TrackedGoal, result, handle: ServerGoalHandle):
-        """The goal's execute callback (executor thread): terminal state and result."""
+        """An ended goal: its terminal state and its result, to the clients that asked."""
+        end = goal.end
+        assert end is not None  # an ended goal
+        if end.succeeded:
+            event = SUCCEED  # done (or at velocity) before a cancel's STOP took effect
+        elif goal.serial is not None and goal.cancel:
+            event = CANCELED
+        else:
+            event = ABORT  # refused, stopped, E_STOP/ABORT, dropped, shut down
         try:
-            assert goal.end is not None  # an ended goal
-            if goal.end.succeeded:
-                handle.succeed()  # done (or at velocity) before a cancel's STOP took effect
-            elif goal.serial is not None and handle.is_cancel_requested:
-                handle.canceled()
-            else:
-                handle.abort()  # refused, stopped, E_STOP/ABORT, dropped, shut down
+            goal.payload.server.finish(goal.key, event, _result(goal.payload.action_type, end, goal.sample, facts))
         finally:
             with self._closing:
                 self._unfinished -= 1
                 self._closing.notify_all()
-        return result
 
     # -- services ---------------------------------------------------------------------
     def _submit(self, operation: str, request: dict) -> Reply:

@@ -18,10 +18,13 @@ def _step(text: str, number: int) -> str:
 
 def test_demo_tours_records_and_plots(tmp_path):
     out = tmp_path / "tour"
-    proc = mpi_ros("demo", "--output", str(out), "--time-scale", "4", "--namespace", "/demo", timeout=180)
+    # Twice real time: at 4x the suite (4 axes, status and recording at 4x their rates) fell
+    # 20 s of controller time behind on a 2-core machine where ruckig itself ran at half the
+    # speed of another day's, and the tour then overran the timeout.
+    proc = mpi_ros("demo", "--output", str(out), "--time-scale", "2", "--namespace", "/demo", timeout=180)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     text = proc.stdout
-    assert re.match(r"suite up under /demo on ROS_DOMAIN_ID \d+ \(process \d+, log .*suite.log\), time scale 4, "
+    assert re.match(r"suite up under /demo on ROS_DOMAIN_ID \d+ \(process \d+, log .*suite.log\), time scale 2, "
                     r"recording to .*bag\n", text)
     assert re.findall(r"^(\d+)\. ", text, re.MULTILINE) == [str(n) for n in range(1, 10)]
 

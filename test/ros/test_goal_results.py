@@ -38,11 +38,11 @@ def test_an_ended_goal_is_kept_for_result_timeout_then_released(suite, client, d
     ended = time.monotonic()
     assert _late_result(client, goal) == GoalStatus.STATUS_SUCCEEDED  # kept: a late client gets it
 
-    # rclpy expires goals on its executor; wait (bounded) until the goal is gone
+    # the action server expires goals on its executor; wait (bounded) until the goal is gone
     gone = threading.Event()
     deadline = ended + RESULT_TIMEOUT + WAIT
     while not gone.is_set() and time.monotonic() < deadline:
-        if all(not s._goal_handles for s in server.values()):
+        if all(s.kept() == 0 for s in server.values()):
             gone.set()
         else:
             gone.wait(0.05)
