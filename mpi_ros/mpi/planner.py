@@ -312,8 +312,9 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     accels = list(map(_acceleration_of, starts))
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
-    # (ScaledProfile(line, u, p) without the Python-level __new__ of a NamedTuple, as segments are made)
-    profiles: list[Profile] = [new_tuple(ScaledProfile, (line, u, p)) for u, p in zip(unit, p0, strict=True)]
+    # (ScaledProfile(line, u, p) without the Python-level __new__ of a NamedTuple, as segments are
+    # made; zip without strict=, whose keyword doubles its cost: unit and p0 are made alike above)
+    profiles: list[Profile] = [new_tuple(ScaledProfile, (line, u, p)) for u, p in zip(unit, p0)]  # noqa: B905
     return profiles, [_scaled(traj, abs(u)) for u in unit], ""
 
 
@@ -458,7 +459,9 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     # (the duration of every ScaledAxisPlan: the 1-D profile's, calculated once)
     line_duration = end_time(first.line) if isinstance(first, ScaledProfile) and bound is not None else 0.0
     plans: list[AxisPlan] = []
-    for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
+    # (zip without strict=, whose keyword doubles its cost: one target, final velocity and profile
+    # per start, made so above from a request check_params has found one value per axis in)
+    for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles)):  # noqa: B905
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
         if lazy and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
             plans.append(ScaledAxisPlan.of(
