@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from operator import attrgetter, sub
+from itertools import repeat
+from operator import attrgetter, sub, truediv
 
 from . import cams
 from .events import MPIEventType
@@ -298,7 +299,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     if not (math.isfinite(length) and math.isfinite(speed)):
         raise ProfileError("the move's length cannot be calculated (overflow)")
     if length > 0.0:
-        unit = [d / length for d in delta]
+        unit = list(map(truediv, delta, repeat(length)))  # d / length for each d
     elif speed > 0.0:
         unit = [v / speed for v in v0]
     else:
@@ -315,7 +316,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     # (ScaledProfile(line, u, p) without the Python-level __new__ of a NamedTuple, as segments are
     # made; zip without strict=, whose keyword doubles its cost: unit and p0 are made alike above)
     profiles: list[Profile] = [new_tuple(ScaledProfile, (line, u, p)) for u, p in zip(unit, p0)]  # noqa: B905
-    return profiles, [_scaled(traj, abs(u)) for u in unit], ""
+    return profiles, list(map(_scaled, repeat(traj), map(abs, unit))), ""
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
