@@ -47,7 +47,9 @@ def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> lis
     if v_from == v_to:
         return []
     if v_from * v_to < 0.0:
-        return ramps_between(v_from, 0.0, accel, decel) + ramps_between(0.0, v_to, accel, decel)
+        # to rest (lowering |v|: the deceleration), then from it (the acceleration): the ramps
+        # ramps_between(v_from, 0.0) and ramps_between(0.0, v_to) make, without their calls
+        return [_ramp((abs(v_from) / decel, v_from, 0.0)), _ramp((abs(v_to) / accel, 0.0, v_to))]
     rate = accel if abs(v_to) > abs(v_from) else decel  # the ramp does not cross zero
     return [_ramp((abs(v_to - v_from) / rate, v_from, v_to))]
 
