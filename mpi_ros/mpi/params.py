@@ -103,6 +103,8 @@ def first_refusal(verdicts: Iterable[Outcome]) -> Outcome:
 
 def _finite_number(value: object) -> TypeGuard[float]:
     """A finite real number (bool excluded): int, float, numpy's, ..."""
+    if type(value) is float:  # nearly every value checked (no ABC check for it)
+        return math.isfinite(value)
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         return False
     try:
@@ -125,6 +127,8 @@ def check_frame_buffer_size(name: str, value: object) -> Outcome:
 
 
 def check_integer(name: str, value: object, low: int, high: int) -> Outcome:
+    if type(value) is int and low <= value <= high:  # nearly every value checked (no ABC check for it)
+        return VALID
     if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= int(value) <= high:
         return VALID
     return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {shown(value)}")
@@ -300,8 +304,10 @@ class MotionParams:
         the move."""
         every = motion_type is None
 
+        bits = None if attributes is None else attributes.value  # (int masks: a Flag's & costs a new member)
+
         def uses(attr: MotionAttr) -> bool:
-            return attributes is None or bool(attributes & attr)
+            return bits is None or bool(bits & attr.value)
 
         checks: list[Iterable[Outcome]] = [
             _each("position", self.position if every or motion_type not in VELOCITY_TYPES else (), check_position),
