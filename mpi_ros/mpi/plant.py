@@ -130,7 +130,8 @@ class Plant:
         out = [0.0] * len(u)
         deriv = u
         for g in gains[: len(u)]:
-            out[: len(deriv)] = [o + g * c for o, c in zip(out, deriv)]  # out[i] += g c
+            # out[i] += g c; deriv shortens by one each time (the rest of out stays)
+            out[: len(deriv)] = [o + g * c for o, c in zip(out, deriv, strict=False)]
             deriv = poly_der(deriv)
         return out
 
