@@ -13,6 +13,7 @@ way it comes in, and a value the controller accepted can never break its clock.
 from __future__ import annotations
 
 import copy
+import itertools
 import math
 import numbers
 import reprlib
@@ -334,7 +335,7 @@ class MotionParams:
             checks.append(_each_struct("output", self.output))
         if every or motion_type not in POINT_TO_POINT_TYPES | VELOCITY_TYPES:
             checks += self._path_checks()
-        return first_refusal(v for group in checks for v in group)
+        return first_refusal(itertools.chain.from_iterable(checks))
 
     def _path_checks(self) -> list[Iterable[Outcome]]:
         """Path, cam and frame data (read only by those types)."""
