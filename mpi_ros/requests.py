@@ -18,8 +18,9 @@ stays small and is refused again, with the same message, when it is replayed.
 
 from __future__ import annotations
 
+import functools
 import numbers as _numbers
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -122,10 +123,11 @@ def request_size(data: Any, where: str = "request") -> RequestSize:
     stack = [(where, data)]
     while stack:
         here, value = stack.pop()
-        if isinstance(value, str):
+        kind = type(value)  # exact types first: the ABC check below costs more than the rest
+        if kind is str or (kind is not list and kind is not dict and isinstance(value, str)):
             text += len(value)
             longest_text = _longer(longest_text, here, len(value))
-        elif isinstance(value, (list, tuple)):
+        elif kind is list or (kind is not dict and isinstance(value, (list, tuple))):
             values += len(value)
             longest_array = _longer(longest_array, here, len(value))
             if len(value) <= MAX_REQUEST_VALUES:
@@ -175,7 +177,7 @@ def mapping(data: Any, what: str) -> Mapping[str, Any]:
     """A mapping (None: an empty one)."""
     if data is None:
         return {}
-    if not isinstance(data, Mapping):
+    if type(data) is not dict and not isinstance(data, Mapping):  # (a dict: no ABC check)
         raise _unreadable(what, "a mapping", data)
     return data
 
@@ -193,6 +195,8 @@ def number(value: Any, what: str) -> float:
     """A number as a float (its range is the validators' business: nan passes here). A
     string that spells a number reads as one, as in the YAML loader (PyYAML reads 1e9,
     without an exponent sign, as a string)."""
+    if type(value) is float:  # what nearly every request holds
+        return value
     if isinstance(value, bool) or not isinstance(value, (_numbers.Real, str)):
         raise _unreadable(what, "a number", value)
     try:
@@ -203,6 +207,8 @@ def number(value: Any, what: str) -> float:
 
 def integer(value: Any, what: str) -> int:
     """An integer (an integral float such as 3.0 reads as 3; its range is the validators')."""
+    if type(value) is int:  # what nearly every request holds (bool is not int's type)
+        return value
     if isinstance(value, bool) or not isinstance(value, _numbers.Real):
         raise _unreadable(what, "an integer", value)
     if isinstance(value, _numbers.Integral):
@@ -268,17 +274,26 @@ def _struct(cls, data: Any, what: str, enum_fields: dict | None = None):
     """Dataclass ``cls`` from a mapping of its fields (each read as its default's type)."""
     enum_fields = enum_fields or {}
     kwargs = {}
-    defaults = cls()
-    known = {f.name for f in fields(cls)}
+    readers = _readers(cls)
     for key, value in mapping(data, what).items():
-        if key not in known:
+        if key not in readers:
             raise Refused(Message.MPIMessagePARAM_INVALID, f"{what}: unknown field {shown(key)}")
         if key in enum_fields:
             enum, message = enum_fields[key]
             kwargs[key] = enum.NONE if value in ("", None) else enum_by_name(enum, value, f"{what} type", message)
             continue
-        kwargs[key] = _READERS[type(getattr(defaults, key))](value, f"{what}.{key}")
+        read = readers[key]
+        assert read is not None  # (only an enum's field has none: read above)
+        kwargs[key] = read(value, f"{what}.{key}")
     return cls(**kwargs)
+
+
+@functools.cache
+def _readers(cls) -> dict[str, Callable[[Any, str], Any] | None]:
+    """The reader of each field of dataclass ``cls``, by its default's type (None for an
+    enum's: read by name); made once per class, not per request."""
+    defaults = cls()
+    return {f.name: _READERS.get(type(getattr(defaults, f.name))) for f in fields(cls)}
 
 
 def _structs(cls, values: Any, what: str, enum_fields: dict | None = None) -> list:

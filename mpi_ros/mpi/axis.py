@@ -383,13 +383,18 @@ class Axis:
         return p, dp * f, ddp * f * f + dp * df, rel
 
     def _piece_key(self, clock: ProfileClock | None):
-        if self.plan is None or clock is None:
-            return (self.mode, None, self.rest, self._held_feedforward)
+        """What the command pieces derive from, as values that hash without Python calls
+        (the mode's name; the clock's fields, which are what its equality compares): the
+        key is hashed at every piece looked up."""
+        plan = self.plan
+        if plan is None or clock is None:
+            return (self.mode.value, None, self.rest, self._held_feedforward)
         # The cache keeps the plan while entries keyed by its id exist: a plan freed meanwhile
         # could hand its id to a new one (a path extended at the same tau_start and clock) and
         # the new one would read the old one's pieces.
-        self._cache.setdefault(("plan", id(self.plan)), self.plan)
-        return (self.mode, id(self.plan), self.tau_start, clock, self._held_feedforward)
+        self._cache.setdefault(("plan", id(plan)), plan)
+        return (self.mode.value, id(plan), self.tau_start, (clock.t0, clock.tau0, clock.f0, clock.f1, clock.t_end),
+                self._held_feedforward)
 
     def _boundary_times(self, key, clock: ProfileClock | None) -> list[float]:
         """All times at which the command polynomial changes (sorted)."""
@@ -397,9 +402,10 @@ class Axis:
         if cached is not None:
             return cached
         times: list[float] = []
-        if self.plan is not None and clock is not None:
+        plan, tau_start = self.plan, self.tau_start
+        if plan is not None and clock is not None:
             times.append(clock.t_end)
-            times += [clock.time_of_tau(self.tau_start + float(b), clock.t0) for b in self.plan.boundaries()]
+            times += [clock.time_of_tau(tau_start + b, clock.t0) for b in plan.boundaries().tolist()]
             times = sorted(set(x for x in times if math.isfinite(x)))
         self._cache[("times", key)] = times
         return times
@@ -409,16 +415,18 @@ class Axis:
         cached = self._cache.get(("piece", key, ts))
         if cached is not None:
             return cached
-        if self.plan is None or clock is None:
-            poly, dac = [self.rest], [self._held_feedforward]
+        plan, held = self.plan, self._held_feedforward
+        if plan is None or clock is None:
+            poly, dac = [self.rest], [held]
         else:
+            tau_start = self.tau_start
             mid = ts + 0.5 * (te - ts) if math.isfinite(te) else ts + 1.0
-            rel = clock.tau_at(mid) - self.tau_start
-            seg_start, seg_poly = self.plan.segment_poly(rel)
+            rel = clock.tau_at(mid) - tau_start
+            seg_start, seg_poly = plan.segment_poly(rel)
             q0, q1, q2 = clock.local_quadratic(ts)
-            poly = compose(seg_poly, (q0 - self.tau_start - seg_start, q1, q2))
-            ff_start, ff_poly = self.plan.feedforward_poly(rel, self._held_feedforward)
-            dac = compose(ff_poly, (q0 - self.tau_start - ff_start, q1, q2))
+            poly = compose(seg_poly, (q0 - tau_start - seg_start, q1, q2))
+            ff_start, ff_poly = plan.feedforward_poly(rel, held)
+            dac = compose(ff_poly, (q0 - tau_start - ff_start, q1, q2))
         forced = self.plant.prepare(poly, dac)
         if len(self._cache) > 256:
             self._cache.clear()

@@ -144,10 +144,8 @@ class PlantRows:
     def _set_steady(self, row: int, y: list[float], dy: list[float]) -> None:
         """The steady response's coefficients; rows are evaluated in groups of the same
         length, exactly as plant.poly_eval evaluates one."""
-        self.steady_y[row] = 0.0
-        self.steady_dy[row] = 0.0
-        self.steady_y[row, :len(y)] = y
-        self.steady_dy[row, :len(dy)] = dy
+        self.steady_y[row] = y + [0.0] * (_MAX_TERMS - len(y))  # zero-padded: one write per row
+        self.steady_dy[row] = dy + [0.0] * (_MAX_TERMS - len(dy))
         self.terms[row] = len(y)
 
     def _set_transient(self, row: int, transient: Transient | None, table: int) -> None:
@@ -266,8 +264,15 @@ class AxisBank:
         """Rebuild the stale rows (``refresh_row(number)`` does an axis), and those of the
         axes whose anchor moved (``reanchor_row(number)``)."""
         stale, moved = np.flatnonzero(self.stale), np.flatnonzero(self.moved & ~self.stale)
-        if len(stale) or len(moved):
+        if len(stale):
             self._memo.clear()
+        elif len(moved):
+            # A moved anchor changes only the axes' kinds and plant rows: what derives from
+            # the command rows (their clocks, the truncated plans) stands, and is not redone
+            # at every piece an axis starts (each sample, stepped a sample at a time).
+            for kind in Kind:
+                self._memo.pop(kind, None)
+        if len(stale) or len(moved):
             for row in stale.tolist():
                 refresh_row(row)
             for row in moved.tolist():

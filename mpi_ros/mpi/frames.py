@@ -192,19 +192,21 @@ class ScaledAxisPlan(AxisPlan):
     scaled: ScaledProfile
 
     @classmethod
-    def of(cls, scaled: ScaledProfile, *fields: Any) -> ScaledAxisPlan:
-        """The plan with the AxisPlan ``fields`` in their order, the segments left out."""
+    def of(cls, scaled: ScaledProfile, duration: float, *fields: Any) -> ScaledAxisPlan:
+        """The plan with the AxisPlan ``fields`` in their order (origin_time left at 0), the
+        segments left out. ``duration``: ``end_time(scaled.line)``, the same durations added in
+        the same order as AxisPlan.__post_init__ adds the segments' (the vector's axes share it:
+        calculated once)."""
         plan = cls.__new__(cls)
         plan.scaled = scaled
+        plan.duration = duration
         AxisPlan.__init__(plan, fields[0], None, *fields[1:])  # type: ignore[arg-type]  # (made when asked for)
         return plan
 
     def __post_init__(self) -> None:
-        if _segments_slot.__get__(self, AxisPlan) is None:
-            # the same durations as the 1-D profile's, added in the same order (AxisPlan.__post_init__)
-            self.duration = end_time(self.scaled.line, self.origin_time)
-        else:  # made with its segments (dataclasses.replace, a copy): as any AxisPlan
-            AxisPlan.__post_init__(self)
+        if _segments_slot.__get__(self, AxisPlan) is not None:
+            AxisPlan.__post_init__(self)  # made with its segments (dataclasses.replace, a copy): as any AxisPlan
+        # (made by of(): the duration is given)
 
     @property
     def segments(self) -> list[Segment]:

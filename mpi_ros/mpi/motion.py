@@ -432,11 +432,11 @@ class MotionSupervisor:
             # nothing to follow: the call did not wait for the move
             return self._command_no_wait(motion_type, attrs, params, modify), 0
         outcome = self._command(motion_type, attrs, params, modify)
-        if outcome.ok and attrs & (MotionAttr.NO_HANDSHAKE | MotionAttr.NO_WAIT):
+        if outcome.ok and (MotionAttr.NO_HANDSHAKE in attrs or MotionAttr.NO_WAIT in attrs):
             self._state.unacknowledged = self._host.sample  # status reads IDLE until the next sample
         current = self._moves.current
         serial = current.serial if current is not None else 0
-        if outcome.message in (OK, Message.MPIMotionMessageAUTO_START) and attrs & MotionAttr.APPEND:
+        if outcome.message in (OK, Message.MPIMotionMessageAUTO_START) and MotionAttr.APPEND in attrs:
             if self._moves.queue:
                 serial = self._moves.queue[-1].serial
             elif current is not None and current.stream is not None and current.stream.chunks:

@@ -246,7 +246,7 @@ class Moves:
         self.holds.clear()
         if previous is not None:
             move.serial = previous.serial
-            if not MotionAttr.ID & move.attributes:
+            if MotionAttr.ID not in move.attributes:
                 move.id = previous.id
             if previous.stream is not None:  # points appended to the path are replaced too
                 for serial, _ in previous.stream.chunks:

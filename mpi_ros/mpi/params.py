@@ -13,6 +13,7 @@ way it comes in, and a value the controller accepted can never break its clock.
 from __future__ import annotations
 
 import copy
+import itertools
 import math
 import numbers
 import reprlib
@@ -103,6 +104,8 @@ def first_refusal(verdicts: Iterable[Outcome]) -> Outcome:
 
 def _finite_number(value: object) -> TypeGuard[float]:
     """A finite real number (bool excluded): int, float, numpy's, ..."""
+    if type(value) is float:  # nearly every value checked (no ABC check for it)
+        return math.isfinite(value)
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         return False
     try:
@@ -125,6 +128,8 @@ def check_frame_buffer_size(name: str, value: object) -> Outcome:
 
 
 def check_integer(name: str, value: object, low: int, high: int) -> Outcome:
+    if type(value) is int and low <= value <= high:  # nearly every value checked (no ABC check for it)
+        return VALID
     if isinstance(value, numbers.Integral) and not isinstance(value, bool) and low <= int(value) <= high:
         return VALID
     return refuse(f"{name}: must be an integer >= {low} and <= {high}, got {shown(value)}")
@@ -300,8 +305,10 @@ class MotionParams:
         the move."""
         every = motion_type is None
 
+        bits = None if attributes is None else attributes.value  # (int masks: a Flag's & costs a new member)
+
         def uses(attr: MotionAttr) -> bool:
-            return attributes is None or bool(attributes & attr)
+            return bits is None or bool(bits & attr.value)
 
         checks: list[Iterable[Outcome]] = [
             _each("position", self.position if every or motion_type not in VELOCITY_TYPES else (), check_position),
@@ -328,7 +335,7 @@ class MotionParams:
             checks.append(_each_struct("output", self.output))
         if every or motion_type not in POINT_TO_POINT_TYPES | VELOCITY_TYPES:
             checks += self._path_checks()
-        return first_refusal(v for group in checks for v in group)
+        return first_refusal(itertools.chain.from_iterable(checks))
 
     def _path_checks(self) -> list[Iterable[Outcome]]:
         """Path, cam and frame data (read only by those types)."""

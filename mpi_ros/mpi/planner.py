@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from operator import attrgetter, itemgetter, sub
+from itertools import repeat
+from operator import attrgetter, sub, truediv
 
 from . import cams
 from .events import MPIEventType
@@ -30,10 +31,10 @@ from .outcome import Refused
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, MotionParams, Trajectory
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
-from .profiles.point_to_point import point_to_point, reverses, velocity_move
-from .profiles.ramps import ProfileError, ramps_between
+from .profiles.point_to_point import reverses, velocity_move
+from .profiles.ramps import ProfileError, plan_point_to_point, ramps_between
 from .profiles.scurve import reshape
-from .profiles.segment import ScaledProfile, Segment, chain, scaled_profile
+from .profiles.segment import ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
 
 A = MotionAttr
@@ -48,7 +49,6 @@ _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
 _VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
 _NO_EVENTS = MPIEventType.NONE
 _position_of, _velocity_of, _acceleration_of = (attrgetter(name) for name in ("position", "velocity", "acceleration"))
-_duration_of, _position_of_segment = itemgetter(0), itemgetter(1)  # (a Segment is a tuple)
 
 
 @dataclass(slots=True)
@@ -107,7 +107,17 @@ def _check_finite(segments: list[Segment], axis: int) -> None:
 
 def _on_target(end: float, start: AxisStart, target: float) -> bool:
     """The plan's end is on the target within the rounding of the positions alone."""
-    return math.isfinite(end) and abs(end - target) <= 1e-9 * max(1.0, abs(target), abs(start.position))
+    if not math.isfinite(end):
+        return False
+    # max(1.0, |target|, |start|) by comparisons, as max makes them: a call of max costs ten
+    scale = 1.0
+    size = abs(target)
+    if size > scale:
+        scale = size
+    size = abs(start.position)
+    if size > scale:
+        scale = size
+    return abs(end - target) <= 1e-9 * scale
 
 
 def _end_position(segment: tuple[float, float, float, float, float]) -> float:
@@ -116,13 +126,12 @@ def _end_position(segment: tuple[float, float, float, float, float]) -> float:
     return p + t * (v + t * (a / 2.0 + t * j / 6.0))
 
 
-def _check_lands(segments: list[Segment], start: AxisStart, target: float) -> None:
+def _check_lands(segments: list[Segment], start: AxisStart, target: float, end: float) -> None:
     """The frames must end on the target: the executor snaps the command onto it when the
     trajectory completes, which must never be a jump (guards against overflow and any
-    planning fault). Rounding grows with the positions and the distance travelled."""
-    end = _end_position(segments[-1]) if segments else start.position
-    if _on_target(end, start, target):
-        return  # on target without the travel, which can only widen the tolerance
+    planning fault). Rounding grows with the positions and the distance travelled. ``end``:
+    where they end, not on the target within the rounding of the positions alone (_on_target,
+    which _checked asks first: the travel can only widen the tolerance)."""
     scale = max(1.0, abs(target), abs(start.position))
     # each segment's end velocity as Segment.state_at computes it, without a call per segment
     travel = sum([max(abs(v), abs(v + t * (a + t * j / 2.0))) * t for t, _, v, a, j in segments])
@@ -138,9 +147,15 @@ def _checked(segments: list[Segment], start: AxisStart, target: float, limit: fl
     segments are reshape's, each starting where the one before ends, so that one that lands
     is finite throughout (_finite_if_it_ends); otherwise one pass over them finds every segment
     finite and within the limit, the usual case."""
-    _check_lands(segments, start, target)
-    if chained and (not segments or max(map(_duration_of, segments)) <= limit):
-        return segments, False  # landed: finite (and reshape's pieces are positive)
+    end = _end_position(segments[-1]) if segments else start.position
+    if not _on_target(end, start, target):
+        _check_lands(segments, start, target, end)
+    if chained:
+        for segment in segments:
+            if segment[0] > limit:  # (its duration: a loop with an index costs half of max(map(...)))
+                break
+        else:
+            return segments, False  # landed: finite (and reshape's pieces are positive)
     for d, p, v, a, j in segments:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
         if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
@@ -166,11 +181,16 @@ def _line_bound(line: list[Segment], limit: float, chained: bool) -> float | Non
     of the scaling exceeds it in magnitude. ``chained``: the profile is reshape's (_checked)."""
     if not line:
         return None
-    if chained:
-        if _finite_if_it_ends(line) and max(map(_duration_of, line)) <= limit:
-            return max(map(abs, map(_position_of_segment, line)))
-        return None
     bound = 0.0
+    if chained:
+        if not _finite_if_it_ends(line):
+            return None
+        for segment in line:  # (a loop with indexes costs half of max(map(...)) twice)
+            if segment[0] > limit:  # (its duration)
+                return None
+            if abs(segment[1]) > bound:  # (its position)
+                bound = abs(segment[1])
+        return bound
     for d, p, v, a, j in line:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
         if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
@@ -223,7 +243,9 @@ def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, t
             p0, v0, a0, target, v_final, traj.velocity,
             (traj.acceleration, traj.acceleration_jerk), (traj.deceleration, traj.deceleration_jerk))
     jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
-    return point_to_point(p0, v0, target, v_final, traj.velocity, traj.acceleration, traj.deceleration, jerk_percent)
+    # point_to_point's two steps, without its call (a modify is planned while its command waits)
+    plan = plan_point_to_point(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
+    return reshape(plan, p0, jerk_percent)
 
 
 def _scaled(traj: Trajectory, share: float) -> Trajectory:
@@ -277,7 +299,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     if not (math.isfinite(length) and math.isfinite(speed)):
         raise ProfileError("the move's length cannot be calculated (overflow)")
     if length > 0.0:
-        unit = [d / length for d in delta]
+        unit = list(map(truediv, delta, repeat(length)))  # d / length for each d
     elif speed > 0.0:
         unit = [v / speed for v in v0]
     else:
@@ -291,8 +313,10 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     accels = list(map(_acceleration_of, starts))
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
-    profiles: list[Profile] = [ScaledProfile(line, u, p) for u, p in zip(unit, p0, strict=True)]
-    return profiles, [_scaled(traj, abs(u)) for u in unit], ""
+    # (ScaledProfile(line, u, p) without the Python-level __new__ of a NamedTuple, as segments are
+    # made; zip without strict=, whose keyword doubles its cost: unit and p0 are made alike above)
+    profiles: list[Profile] = [new_tuple(ScaledProfile, (line, u, p)) for u, p in zip(unit, p0)]  # noqa: B905
+    return profiles, list(map(_scaled, repeat(traj), map(abs, unit))), ""
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
@@ -380,7 +404,7 @@ def compile_move(
         _truncate_id(params.id, notes) if bits & _ID else 0,  # id
         int(params.element_id[0]) if bits & _ELEMENT_ID and params.element_id else 0,  # element_id
         params.event_mask if bits & _EVENT else _NO_EVENTS,  # event_mask
-        stream=stream,
+        0, stream,  # serial (the supervisor's to give), stream
     )
     return move, notes
 
@@ -433,12 +457,16 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
     chained = motion_type is not _S_CURVE_JERK and not bits & (_SYNC | _DELAY) and not composite
     bound = _line_bound(first.line, limit, chained) if isinstance(first, ScaledProfile) and lazy else None
+    # (the duration of every ScaledAxisPlan: the 1-D profile's, calculated once)
+    line_duration = end_time(first.line) if isinstance(first, ScaledProfile) and bound is not None else 0.0
     plans: list[AxisPlan] = []
-    for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles, strict=True)):
+    # (zip without strict=, whose keyword doubles its cost: one target, final velocity and profile
+    # per start, made so above from a request check_params has found one value per axis in)
+    for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles)):  # noqa: B905
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
         if lazy and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
             plans.append(ScaledAxisPlan.of(
-                profile, start.axis, start.position, target, final, hold, outputs,  # (AxisPlan's fields)
+                profile, line_duration, start.axis, start.position, target, final, hold, outputs,  # (AxisPlan's fields)
                 None, 0.0, False, limits[i], start.velocity, start.acceleration, composite))
             continue
         # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)

@@ -84,16 +84,20 @@ class Plant:
         self._c = 2.0 * z * w  # damping term
         self._sigma = -z * w
         self._kind, self._q = self._modes(z, w)
+        # Lists of floats, not arrays: the particular solution is a few scalar products per
+        # piece, and numpy's scalars multiply many times slower (to the same bits).
         self._gains = self._taylor(
             num=(w * w, 2.0 * z * w * config.velocity_feedforward, config.acceleration_feedforward),
             den=(w * w, 2.0 * z * w, 1.0),
-        )
+        ).tolist()
         # A DAC feedforward d drives the motor directly: y'' + c y' + w^2 y = ... + K d, whose
         # steady response to a polynomial d has the gains of K / (w^2 + c s + s^2).
-        self._dac_gains = self._taylor(num=(config.dac_acceleration,), den=(w * w, 2.0 * z * w, 1.0))
+        self._dac_gains = self._taylor(num=(config.dac_acceleration,), den=(w * w, 2.0 * z * w, 1.0)).tolist()
         self._resolution = config.encoder_resolution
         self._coast = config.coast_time_constant
         self._steps: dict = {}  # sample_step, per rate
+        self._tables: dict[float, _FreeTable] = {}  # table, per rate
+        self._transients: dict = {}  # transient: (id(state), id(forced), rate) -> (state, forced, transient)
         # M^2 = kappa I (Cayley-Hamilton: A's eigenvalues are sigma +- i q, sigma +- q, or sigma twice)
         self._kappa = {"under": -self._q * self._q, "over": self._q * self._q}.get(self._kind, 0.0)
 
@@ -122,12 +126,12 @@ class Plant:
         return self._particular(u, self._gains)
 
     @staticmethod
-    def _particular(u: list[float], gains: np.ndarray) -> list[float]:
+    def _particular(u: list[float], gains: list[float]) -> list[float]:
         out = [0.0] * len(u)
-        deriv = list(u)
+        deriv = u
         for g in gains[: len(u)]:
-            for i, c in enumerate(deriv):
-                out[i] += g * c
+            # out[i] += g c; deriv shortens by one each time (the rest of out stays)
+            out[: len(deriv)] = [o + g * c for o, c in zip(out, deriv, strict=False)]
             deriv = poly_der(deriv)
         return out
 
@@ -152,10 +156,13 @@ class Plant:
 
     def table(self, rate: float) -> _FreeTable:
         """The free response of this loop at whole samples of ``rate`` (shared by identical loops)."""
-        key = (self.config.bandwidth_hz, self.config.damping, self._coast, rate)
-        table = _TABLES.get(key)
+        table = self._tables.get(rate)  # (every transient asks)
         if table is None:
-            table = _TABLES[key] = _FreeTable.build(self, rate)
+            key = (self.config.bandwidth_hz, self.config.damping, self._coast, rate)
+            table = _TABLES.get(key)
+            if table is None:
+                table = _TABLES[key] = _FreeTable.build(self, rate)
+            self._tables[rate] = table
         return table
 
     def prepare(self, u: list[float], dac: list[float] | None = None) -> Forced:
@@ -170,7 +177,20 @@ class Plant:
         """The decaying part of the response of a piece anchored at ``state``, reduced to
         what every whole sample needs (None: below the quiet level from the anchor on).
         The one place the anchor's free state is computed, for one axis and for rows of
-        axes alike, so both give the same bits."""
+        axes alike, so both give the same bits. The last few are kept: a piece that starts
+        inside a stretch is made into rows there (stretch._following_pieces) and again once
+        the axis is anchored at its start, with the same anchor and steady response."""
+        key = (id(state), id(forced), rate)
+        known = self._transients.get(key)
+        if known is not None and known[0] is state and known[1] is forced:
+            return known[2]
+        transient = self._transient(state, forced, rate)
+        if len(self._transients) >= 64:
+            self._transients.clear()
+        self._transients[key] = (state, forced, transient)  # (kept: their ids stay theirs)
+        return transient
+
+    def _transient(self, state: PlantState, forced: Forced, rate: float) -> Transient | None:
         e0 = state.y - forced.y[0]
         e1 = state.dy - forced.dy[0]
         size = abs(e0) + abs(e1) / (-self._sigma)
@@ -412,14 +432,13 @@ class _FreeTable:
 
 def _windows(table: np.ndarray, starts: np.ndarray, n: int, out: np.ndarray | None = None) -> np.ndarray:
     """Rows table[s : s + n] for each start s (copies of contiguous runs), into ``out`` if
-    given. Long rows are copied one by one: np.take would first copy the whole (virtual)
-    window view."""
-    if out is None or n < 256:
-        windows = sliding_window_view(table, n)[starts]
-        if out is None:
-            return windows
-        out[...] = windows
-        return out
+    given. Short rows are gathered by index (s + 0 .. n-1), which costs less to set up than
+    a window view (a stretch of a few samples pays little else); long rows are copied one by
+    one (np.take on a window view would first copy the whole virtual view)."""
+    if n < 256:
+        return np.take(table, starts[:, None] + np.arange(n), out=out)
+    if out is None:
+        return sliding_window_view(table, n)[starts]
     for row, start in enumerate(starts.tolist()):
         out[row] = table[start:start + n]
     return out
@@ -447,8 +466,8 @@ def poly_eval(c: list[float], s: np.ndarray) -> np.ndarray:
 def _poly_mul(a: list[float], b: list[float]) -> list[float]:
     out = [0.0] * (len(a) + len(b) - 1)
     for i, x in enumerate(a):
-        for j, y in enumerate(b):
-            out[i + j] += x * y
+        for k, y in enumerate(b, i):  # k = i + j
+            out[k] += x * y
     return out
 
 
@@ -460,6 +479,8 @@ def _poly_add(a: list[float], b: list[float]) -> list[float]:
 
 def compose(segment_poly: list[float], quadratic: tuple[float, float, float]) -> list[float]:
     """segment_poly(q0 + q1 s + q2 s^2) as coefficients in s (low first)."""
+    if len(segment_poly) == 1:  # a constant (no feedforward: [held]) stays itself
+        return [segment_poly[0]]
     q = list(quadratic) if quadratic[2] != 0.0 else list(quadratic[:2])
     out = [segment_poly[-1]]
     for c in reversed(segment_poly[:-1]):

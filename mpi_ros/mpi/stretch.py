@@ -341,8 +341,8 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
     act_p, act_v = _servo(rows_of, bank.tables, np.arange(len(pieces)), out, direct=False, following=True)
     shape = (len(pieces), len(t))
     act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
-    for i, (row, start, end) in enumerate(pieces):
-        first, last = np.searchsorted(t, (start, end), side="left").tolist()
+    spans = np.searchsorted(t, [(start, end) for _, start, end in pieces], side="left").tolist()
+    for i, ((row, _, _), (first, last)) in enumerate(zip(pieces, spans, strict=True)):
         out.act_p[row, first:last] = act_p[i, first:last]
         out.act_v[row, first:last] = act_v[i, first:last]
 

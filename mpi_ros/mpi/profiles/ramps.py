@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from functools import partial
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 
 class ProfileError(ValueError):
@@ -47,7 +47,9 @@ def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> lis
     if v_from == v_to:
         return []
     if v_from * v_to < 0.0:
-        return ramps_between(v_from, 0.0, accel, decel) + ramps_between(0.0, v_to, accel, decel)
+        # to rest (lowering |v|: the deceleration), then from it (the acceleration): the ramps
+        # ramps_between(v_from, 0.0) and ramps_between(0.0, v_to) make, without their calls
+        return [_ramp((abs(v_from) / decel, v_from, 0.0)), _ramp((abs(v_to) / accel, 0.0, v_to))]
     rate = accel if abs(v_to) > abs(v_from) else decel  # the ramp does not cross zero
     return [_ramp((abs(v_to - v_from) / rate, v_from, v_to))]
 
@@ -88,34 +90,42 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
     piecewise alpha*w^2 + beta with breakpoints at u0 and uf; the fastest profile uses
     the largest w with F(w) <= x and cruises at w for the rest.
     """
-    tolerance = 1e-12 * max(1.0, abs(x))
-    if u0 == 0.0 and uf == 0.0 and x + tolerance < 0.0 and 1.0 / (2.0 * accel) + 1.0 / (2.0 * decel) < math.inf:
+    # (conditionals where max and min would do: a call of either costs ten comparisons, and a
+    # modify is planned while its command waits; each is what max or min answers, NaN included)
+    size = abs(x)
+    reach = x + 1e-12 * (size if size > 1.0 else 1.0)  # F(w) may exceed x by this much (rounding)
+    if u0 == 0.0 and uf == 0.0 and reach < 0.0 and 1.0 / (2.0 * accel) + 1.0 / (2.0 * decel) < math.inf:
         # From rest to rest, away from the target: F(w) = alpha*w^2 with a finite alpha is 0 at
         # w = 0 and grows, so the scan below would find every breakpoint overshooting.
         return None
     if 0.0 < u0 < vmax or 0.0 < uf < vmax:
-        points = [0.0, *sorted({u for u in (u0, uf) if 0.0 < u < vmax}), vmax]  # the breakpoints, ascending
+        # the breakpoints, ascending: 0, u0 and uf where inside (0, vmax) (a velocity outside
+        # stands in as 0, once: a set), vmax
+        points = sorted({0.0, u0 if 0.0 < u0 < vmax else 0.0, uf if 0.0 < uf < vmax else 0.0, vmax})
     else:
         points = [0.0, vmax]
-    top = len(points) - 1
-    piece = -1
-    # Scan the breakpoints from the top: the first one that does not overshoot bounds w.
-    for i in range(top, -1, -1):
-        # F at a breakpoint is that of the piece above it (below it at vmax): the top two
-        # breakpoints share a piece, whose coefficients are calculated once
-        k = min(i, top - 1)
-        if k != piece:
-            piece = k
-            alpha, beta = _coefficients(u0, uf, 0.5 * (points[k] + points[k + 1]), accel, decel)
-        lo = points[i]
+    # Scan the pieces [points[k], points[k + 1]] from the top: the first breakpoint that does not
+    # overshoot bounds w. F at vmax is the top piece's, at any other breakpoint the piece above's.
+    top = len(points) - 2
+    for k in range(top, -1, -1):
+        alpha, beta = _coefficients(u0, uf, 0.5 * (points[k] + points[k + 1]), accel, decel)
+        if k == top:
+            f_top = alpha * vmax * vmax + beta
+            if not f_top > reach:  # even the top speed leaves distance: cruise at vmax
+                cruise = (x - f_top) / vmax if vmax > 0.0 else 0.0
+                return vmax, cruise if cruise > 0.0 else 0.0
+        lo = points[k]
         f_lo = alpha * lo * lo + beta
-        if f_lo > x + tolerance:
+        if f_lo > reach:
             continue
-        if i == top:  # even the top speed leaves distance: cruise at vmax
-            cruise = (x - f_lo) / vmax if vmax > 0.0 else 0.0
-            return vmax, max(0.0, cruise)
-        w = math.sqrt(max(0.0, (x - beta) / alpha)) if alpha > 0.0 else lo
-        return min(max(w, lo), points[i + 1]), 0.0
+        if alpha > 0.0:
+            square = (x - beta) / alpha
+            w = math.sqrt(square if square > 0.0 else 0.0)
+        else:
+            w = lo
+        w = lo if lo > w else w
+        hi = points[k + 1]
+        return hi if hi < w else w, 0.0
     return None
 
 
@@ -151,19 +161,26 @@ def plan_point_to_point(
         if behind is not None and _total_time(-behind[0], behind[1], v_start, v_final, accel, decel) < _total_time(
                 peak, cruise, v_start, v_final, accel, decel) - 1e-15:
             peak, cruise = -behind[0], behind[1]
-    plan = ramps_between(v_start, peak, accel, decel)
+    plan: list[Any] = ramps_between(v_start, peak, accel, decel)  # (Ramps, and the cruise a while)
     # The cruise (if any) absorbs the last rounding error of the distance. (ramps_between makes
-    # no ramp of constant velocity: a cruise can only be this one.)
-    at = len(plan) if cruise > 0.0 and peak != 0.0 else -1
+    # no ramp of constant velocity: a cruise can only be this one.) Until then it is a plain
+    # tuple: a Ramp is made once, with its final duration.
+    at = len(plan)
     if cruise > 0.0:
-        plan.append(_ramp((cruise, peak, peak)))
+        plan.append((cruise, peak, peak))
     plan += ramps_between(peak, v_final, accel, decel)
-    # each ramp's distance as Ramp.distance calculates it, without a call per ramp
-    error = distance - sum([0.5 * (v0 + v1) * duration for duration, v0, v1 in plan])
+    # each ramp's distance as Ramp.distance calculates it, without a call per ramp, added in order
+    travelled = 0.0
+    for duration, v0, v1 in plan:
+        travelled += 0.5 * (v0 + v1) * duration
+    error = distance - travelled
     if not math.isfinite(error):
         raise ProfileError("the profile cannot be calculated with these values (overflow)")
-    if at >= 0:
-        plan[at] = _ramp((max(0.0, cruise + error / peak), peak, peak))
+    if cruise > 0.0:
+        if peak != 0.0:
+            cruise += error / peak  # (not below 0: a conditional rather than max, as above)
+            cruise = cruise if cruise > 0.0 else 0.0
+        plan[at] = _ramp((cruise, peak, peak))
     return plan
 
 

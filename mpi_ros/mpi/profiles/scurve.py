@@ -17,23 +17,6 @@ from .ramps import ProfileError, Ramp
 from .segment import Segment, new_tuple
 
 
-def ramp_pieces(ramp: Ramp, fraction: float) -> list[tuple[float, float, float]]:
-    """(duration, start acceleration, jerk) pieces of one ramp or cruise."""
-    duration, v_start, v_end = ramp
-    dv = v_end - v_start
-    jerk_time = 0.5 * fraction * duration
-    # The S-curve's three pieces, unless this is a cruise, f = 0, the jerk phases are too short
-    # to represent (tiny jerkPercent, or a ramp of ~1e-324 s), or the jerk overflows (jerkPercent
-    # ~1e-308: the positions would be NaN). Then the trapezoid's ramp.
-    if not (v_start == v_end or jerk_time <= 0.0):
-        flat_time = (1.0 - fraction) * duration
-        peak = dv / (duration * (1.0 - 0.5 * fraction))
-        jerk = peak / jerk_time
-        if math.isfinite(jerk):
-            return [(jerk_time, 0.0, jerk), (flat_time, peak, 0.0), (jerk_time, peak, -jerk)]
-    return [(duration, dv / duration if duration > 0.0 else 0.0, 0.0)]
-
-
 def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segment]:
     """Segments of a velocity plan starting at position ``p0`` with zero acceleration
     at every ramp boundary (the standard S-curve starts each ramp from a = 0). Each segment
@@ -46,9 +29,22 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
     segments: list[Segment] = []
     append = segments.append
     p = p0
-    for ramp in plan:
-        v = ramp[1]  # (v_start)
-        for t, a, j in ramp_pieces(ramp, fraction):
+    # (each ramp's pieces in this loop, not a function of their own: a call per ramp costs as
+    # much as a segment's arithmetic, and a modify is planned while its command waits)
+    for duration, v, v_end in plan:
+        dv = v_end - v
+        jerk_time = 0.5 * fraction * duration
+        # The S-curve's three pieces (duration, start acceleration, jerk), unless this is a
+        # cruise, f = 0, the jerk phases are too short to represent (tiny jerkPercent, or a ramp
+        # of ~1e-324 s), or the jerk overflows (jerkPercent ~1e-308: the positions would be NaN).
+        # Then the trapezoid's ramp.
+        pieces = None
+        if not (v == v_end or jerk_time <= 0.0):
+            peak = dv / (duration * (1.0 - 0.5 * fraction))
+            jerk = peak / jerk_time
+            if math.isfinite(jerk):
+                pieces = ((jerk_time, 0.0, jerk), ((1.0 - fraction) * duration, peak, 0.0), (jerk_time, peak, -jerk))
+        for t, a, j in pieces or ((duration, dv / duration if duration > 0.0 else 0.0, 0.0),):
             if t <= 0.0:
                 continue
             append(new_tuple(Segment, (t, p, v, a, j)))

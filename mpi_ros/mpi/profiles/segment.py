@@ -8,9 +8,8 @@ seconds of profile time with jerk ``j``. A 1-D profile is a contiguous tuple of 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from functools import partial, reduce
+from functools import partial
 from itertools import chain as _chain_iterables
-from operator import add, attrgetter
 from typing import NamedTuple
 
 import numpy as np
@@ -91,13 +90,15 @@ def total_duration(segments: Sequence[Segment]) -> float:
     return float(sum(s.duration for s in segments))
 
 
-_duration_of = attrgetter("duration")
-
-
 def end_time(segments: Sequence[Segment], t0: float = 0.0) -> float:
     """``SegmentTable(segments, t0).end[-1]`` without the arrays: the same additions in the
     same order as the table's cumulative sum (``segments`` must not be empty)."""
-    return t0 + reduce(add, map(_duration_of, segments))
+    # A loop: reduce(add, map(attrgetter)) would make two calls per segment (every plan's
+    # duration is calculated here). -0.0 + d is d for every d, as the sum's first term is.
+    total = -0.0
+    for segment in segments:
+        total += segment.duration
+    return t0 + total
 
 
 def end_state(segments: Sequence[Segment], start: tuple[float, float, float]) -> tuple[float, float, float]:

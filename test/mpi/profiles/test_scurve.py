@@ -9,14 +9,14 @@ import pytest
 
 from mpi_ros.mpi.profiles.point_to_point import point_to_point
 from mpi_ros.mpi.profiles.ramps import ProfileError, Ramp, plan_point_to_point
-from mpi_ros.mpi.profiles.scurve import ramp_pieces, reshape
+from mpi_ros.mpi.profiles.scurve import reshape
 
 
 def test_jerk_phases_and_peak():
     # docs/profiles.md, "The trapezoid and the S-curve": jerk phases of f*Ta/2, constant acceleration
     # for (1-f)*Ta, peak acceleration A/(1 - f/2)
     ramp = Ramp(0.1, 0.0, 1000.0)  # A = 10000
-    (t1, a1, j1), (t2, a2, j2), (t3, a3, j3) = ramp_pieces(ramp, 0.5)
+    (t1, _, _, a1, j1), (t2, _, _, a2, j2), (t3, _, _, a3, j3) = reshape([ramp], 0.0, 50.0)
     assert (t1, t2, t3) == pytest.approx((0.025, 0.05, 0.025))
     assert a2 == pytest.approx(10_000.0 / 0.75) and j2 == 0.0
     assert j1 == pytest.approx(-j3) and a1 == 0.0
@@ -106,6 +106,5 @@ def test_tiny_jerk_percent_stays_finite(percent):
 def test_ramp_too_short_to_reshape(ramp, percent):
     # docs/quality.md, "Robust" (no input can crash): a ramp whose duration underflows (a VELOCITY move to
     # 5e-324 counts/s) is kept as the trapezoid's ramp instead of dividing by zero
-    for duration, acceleration, jerk in ramp_pieces(ramp, percent / 100.0):
-        assert math.isfinite(duration) and math.isfinite(acceleration) and math.isfinite(jerk)
-    assert all(math.isfinite(x) for s in reshape([ramp], 0.0, percent) for x in s.end_state())
+    for segment in reshape([ramp], 0.0, percent):
+        assert all(math.isfinite(x) for x in (*segment, *segment.end_state()))

@@ -1,0 +1,155 @@
+"""The core's CPU per MotionModify: applying it, and the stepping it adds.
+
+Issue 14's soak target: 8 motion supervisors, each sent 100 modifies a second (800/s),
+with the suite in real time. Here the ROS-free core alone: 8 one-axis supervisors in
+S_CURVE moves, each modified every ``--every`` samples (20: 100/s at 2 kHz) toward the
+other end of its stroke (AUTO_START), the controller stepped in batches of each size in
+``--batches`` (20 is what the clock thread steps every 10 ms). Per modify:
+
+- apply: CPU in commands.apply (parsing, checks, planning, loading the move);
+- stepping extra: CPU stepping the run minus CPU stepping the same samples without any
+  modify (the moves then run to their end and settle), per modify.
+
+The machine is shared, so every case runs in a fresh process, alternating between this tree
+and the package at ``--baseline`` (git archive), best of ``--rounds`` per figure. Both trees
+must give the same bits: each run digests every axis' values after every step (outside the
+timed calls) and the table says whether the digests agree.
+
+    python -P bench/bench_modify.py [--baseline b39be10] [--rounds 3] [--batches 1 2 5 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_controller import REPO, baseline_tree  # noqa: E402 - after the path it is found on
+
+if TYPE_CHECKING:
+    from mpi_ros.mpi import Controller
+
+SUPERVISORS = 8
+TRAJECTORY = [{"velocity": 5000.0, "acceleration": 100000.0, "deceleration": 100000.0, "jerk_percent": 50.0}]
+
+
+# -- the measuring process ------------------------------------------------------------------
+def _controller() -> Controller:
+    from mpi_ros.commands import MOTION_START, Command, apply
+    from mpi_ros.mpi import Controller, ControllerConfig, MPIAction
+
+    ctl = Controller(ControllerConfig(axis_count=SUPERVISORS, supervisor_count=SUPERVISORS))
+    for n in range(SUPERVISORS):
+        _, ms = ctl.create_motion(n)
+        ms.axis_list_set([n])
+        ms.action(MPIAction.MAP)
+        apply(ctl, Command(MOTION_START, n, request={"type": "S_CURVE", "position": [2000.0],
+                                                      "trajectory": TRAJECTORY}))
+    ctl.step(100)
+    return ctl
+
+
+def measure(batch: int, every: int, samples: int, modify: bool) -> dict:
+    """CPU seconds stepping and applying over ``samples`` samples, the modifies applied, and a
+    digest of every axis' values after every step."""
+    from mpi_ros.commands import MOTION_MODIFY, Command, apply
+
+    ctl = _controller()
+    digest = hashlib.sha256()
+    stepping = applying = 0.0
+    mods = flips = 0
+    end, due = ctl.sample + samples, ctl.sample + every
+    while ctl.sample < end:
+        t0 = time.process_time()
+        ctl.step(min(end, ctl.sample + batch) - ctl.sample)
+        stepping += time.process_time() - t0
+        digest.update(ctl.bank.values.tobytes())
+        if modify and ctl.sample >= due:
+            due += every
+            flips += 1
+            request = {"type": "S_CURVE", "position": [2000.0 if flips % 2 else -2000.0],
+                       "attributes": ["AUTO_START"], "trajectory": TRAJECTORY}
+            t0 = time.process_time()
+            for n in range(SUPERVISORS):
+                apply(ctl, Command(MOTION_MODIFY, n, request=request))
+            applying += time.process_time() - t0
+            mods += SUPERVISORS
+    return {"stepping": stepping, "applying": applying, "mods": mods, "digest": digest.hexdigest()}
+
+
+def _measure_in(source: Path, case: list) -> dict:
+    """``measure(*case)`` in a fresh process running the package in ``source``."""
+    code = ("import sys, json; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[1]); "
+            "sys.path.insert(0, sys.argv[2]); import bench_modify as b; "
+            "print(json.dumps(b.measure(*json.loads(sys.argv[3]))))")
+    done = subprocess.run([sys.executable, "-P", "-c", code, str(source), str(REPO / "bench"), json.dumps(case)],
+                          check=True, capture_output=True, text=True)
+    return json.loads(done.stdout)
+
+
+# -- the table ------------------------------------------------------------------------------
+def per_modify(source: Path, batch: int, every: int, samples: int, rounds: int) -> dict:
+    """Microseconds per modify (apply, stepping extra, sum; the least of ``rounds`` runs
+    each) and the digest of the modified run."""
+    with_mods = [_measure_in(source, [batch, every, samples, True]) for _ in range(rounds)]
+    without = [_measure_in(source, [batch, every, samples, False]) for _ in range(rounds)]
+    mods = with_mods[0]["mods"]
+    apply_us = min(run["applying"] for run in with_mods) / mods * 1e6
+    extra_us = (min(run["stepping"] for run in with_mods) - min(run["stepping"] for run in without)) / mods * 1e6
+    digests = {run["digest"] for run in with_mods}
+    assert len(digests) == 1, "one tree gave different values from run to run"
+    return {"apply": apply_us, "extra": extra_us, "total": apply_us + extra_us, "mods": mods,
+            "digest": digests.pop()}
+
+
+def main(baseline: str, rounds: int, batches: list[int], every: int, seconds: float) -> list[str]:
+    samples = int(seconds * 2000)
+    rows = [f"| batch | modifies | apply us | stepping extra us | per modify us | {baseline}: apply us | "
+            f"{baseline}: stepping extra us | {baseline}: per modify us | CPU per modify, this / {baseline} | "
+            "same values |",
+            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    with tempfile.TemporaryDirectory() as scratch:
+        old = baseline_tree(baseline, Path(scratch))
+        for batch in batches:
+            new_runs, old_runs = [], []
+            for _ in range(rounds):  # alternate, so both see the same load
+                new_runs.append(per_modify(REPO, batch, every, samples, 1))
+                if old is not None:
+                    old_runs.append(per_modify(old, batch, every, samples, 1))
+            new = _least(new_runs)
+            row = f"| {batch} | {new['mods']} | {new['apply']:.0f} | {new['extra']:.0f} | {new['total']:.0f} |"
+            if old_runs:
+                before = _least(old_runs)
+                same = "yes" if before["digest"] == new["digest"] else "**NO**"
+                row += (f" {before['apply']:.0f} | {before['extra']:.0f} | {before['total']:.0f} | "
+                        f"{new['total'] / before['total']:.2f} | {same} |")
+            else:
+                row += " - | - | - | - | - |"
+            rows.append(row)
+    return rows
+
+
+def _least(runs: list[dict]) -> dict:
+    """The least apply and stepping extra over ``runs`` (the noise of a shared machine only adds)."""
+    least = {key: min(run[key] for run in runs) for key in ("apply", "extra")}
+    digests = {run["digest"] for run in runs}
+    assert len(digests) == 1, "one tree gave different values from run to run"
+    return {**least, "total": least["apply"] + least["extra"], "mods": runs[0]["mods"], "digest": digests.pop()}
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--baseline", default="b39be10", help="commit to measure side by side")
+    parser.add_argument("--rounds", type=int, default=3, help="runs of each case on each tree (least kept)")
+    parser.add_argument("--batches", type=int, nargs="+", default=[1, 2, 5, 20], help="samples stepped at a time")
+    parser.add_argument("--every", type=int, default=20, help="samples between modifies of each supervisor")
+    parser.add_argument("--seconds", type=float, default=3.0, help="simulated seconds per run")
+    options = parser.parse_args()
+    print("\n".join(main(options.baseline, options.rounds, options.batches, options.every, options.seconds)))
