@@ -70,6 +70,7 @@ EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 _SUPERVISOR_NODE = re.compile(r"ms(\d+)")
 _POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
 RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting for its result
+RESULT_REASK = 2.0  # s without an answer after asking again (the server came back) before asking once more
 # Every node of a process is announced together (one DDS participant per context), but give
 # a late announcement a moment before saying a supervisor is not there.
 _GRACE = 0.5
@@ -624,13 +625,19 @@ class Goal:
         reappears on the graph after having left it."""
         deadline = time.monotonic() + timeout
         lost = False
+        asked_at: float | None = None
         while not self._finished.wait(max(0.0, min(RESULT_RECHECK, deadline - time.monotonic()))):
-            if time.monotonic() >= deadline or self._action_client is None:
+            now = time.monotonic()
+            if now >= deadline or self._action_client is None:
                 return
             if not self._action_client.server_is_ready():
                 lost = True
-            elif lost:
+            elif lost or (asked_at is not None and now - asked_at >= RESULT_REASK):
+                # Right after a link comes back the suite may answer before its middleware
+                # has matched this client's reader again, and that answer is dropped: ask
+                # again until one arrives.
                 lost = False
+                asked_at = now
                 self._ask_again()
 
     def _ask_again(self) -> None:
