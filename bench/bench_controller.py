@@ -93,10 +93,10 @@ def measure(axes: int, supervisors: int, motion: str, batch: int, samples: int) 
     return {"wall": axes * samples / wall, "cpu": axes * samples / cpu, "real_time": samples / ctl.rate / wall}
 
 
-def _measure_in(source: Path, case: tuple) -> dict[str, float]:
-    """``measure(*case)`` in a fresh process running the controller in ``source``."""
+def measure_in(source: Path, case: tuple | list, bench: str = "bench_controller") -> dict:
+    """``<bench>.measure(*case)`` in a fresh process running the package in ``source``."""
     code = ("import sys, json; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[1]); "
-            "sys.path.insert(0, sys.argv[2]); import bench_controller as b; "
+            f"sys.path.insert(0, sys.argv[2]); import {bench} as b; "
             "print(json.dumps(b.measure(*json.loads(sys.argv[3]))))")
     done = subprocess.run([sys.executable, "-P", "-c", code, str(source), str(REPO / "bench"), json.dumps(case)],
                           check=True, capture_output=True, text=True)
@@ -118,7 +118,7 @@ def baseline_tree(revision: str, into: Path) -> Path | None:
 
 
 def _best(source: Path, case: tuple, rounds: int) -> dict[str, float]:
-    runs = [_measure_in(source, case) for _ in range(rounds)]
+    runs = [measure_in(source, case) for _ in range(rounds)]
     return {key: max(run[key] for run in runs) for key in runs[0]}
 
 
@@ -131,9 +131,9 @@ def main(baseline: str = "dd12ae1", rounds: int = 3) -> list[str]:
         for case in CASES:
             new_runs, old_runs = [], []
             for _ in range(rounds):  # alternate, so both see the same load
-                new_runs.append(_measure_in(REPO, case))
+                new_runs.append(measure_in(REPO, case))
                 if old is not None:
-                    old_runs.append(_measure_in(old, case))
+                    old_runs.append(measure_in(old, case))
             new = {key: max(run[key] for run in new_runs) for key in new_runs[0]}
             axes, supervisors, motion, batch, _ = case
             row = f"| {axes} | {supervisors} | {motion} | {batch} | {new['wall']:,.0f} | {new['cpu']:,.0f} | " \

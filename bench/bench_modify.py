@@ -22,8 +22,6 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import json
-import subprocess
 import sys
 import tempfile
 import time
@@ -31,7 +29,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_controller import REPO, baseline_tree  # noqa: E402 - after the path it is found on
+from bench_controller import REPO, baseline_tree, measure_in  # noqa: E402 - after the path it is found on
 
 if TYPE_CHECKING:
     from mpi_ros.mpi import Controller
@@ -84,22 +82,12 @@ def measure(batch: int, every: int, samples: int, modify: bool) -> dict:
     return {"stepping": stepping, "applying": applying, "mods": mods, "digest": digest.hexdigest()}
 
 
-def _measure_in(source: Path, case: list) -> dict:
-    """``measure(*case)`` in a fresh process running the package in ``source``."""
-    code = ("import sys, json; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[1]); "
-            "sys.path.insert(0, sys.argv[2]); import bench_modify as b; "
-            "print(json.dumps(b.measure(*json.loads(sys.argv[3]))))")
-    done = subprocess.run([sys.executable, "-P", "-c", code, str(source), str(REPO / "bench"), json.dumps(case)],
-                          check=True, capture_output=True, text=True)
-    return json.loads(done.stdout)
-
-
 # -- the table ------------------------------------------------------------------------------
 def per_modify(source: Path, batch: int, every: int, samples: int, rounds: int) -> dict:
     """Microseconds per modify (apply, stepping extra, sum; the least of ``rounds`` runs
     each) and the digest of the modified run."""
-    with_mods = [_measure_in(source, [batch, every, samples, True]) for _ in range(rounds)]
-    without = [_measure_in(source, [batch, every, samples, False]) for _ in range(rounds)]
+    with_mods = [measure_in(source, [batch, every, samples, True], "bench_modify") for _ in range(rounds)]
+    without = [measure_in(source, [batch, every, samples, False], "bench_modify") for _ in range(rounds)]
     mods = with_mods[0]["mods"]
     apply_us = min(run["applying"] for run in with_mods) / mods * 1e6
     extra_us = (min(run["stepping"] for run in with_mods) - min(run["stepping"] for run in without)) / mods * 1e6

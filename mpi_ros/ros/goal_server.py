@@ -40,7 +40,7 @@ from rclpy.waitable import NumberOfEntities, Waitable
 GoalEvent = _rclpy.GoalEvent
 # the events that end a goal, by how it ended
 SUCCEED, ABORT, CANCELED = GoalEvent.SUCCEED, GoalEvent.ABORT, GoalEvent.CANCELED
-_ACTIVE = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING, GoalStatus.STATUS_CANCELING)
+_CANCELABLE = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING)  # rcl_action's CANCEL_GOAL starts there
 
 
 @dataclass(eq=False, slots=True)
@@ -308,7 +308,7 @@ class GoalServer(Waitable):
     def _to_canceling(self, key: bytes) -> bool:
         with self._lock:
             goal = self._goals.get(key)
-            if goal is None or goal.handle.get_status() not in _ACTIVE[:2]:
+            if goal is None or goal.handle.get_status() not in _CANCELABLE:
                 return False  # ended meanwhile
             goal.handle.update_goal_state(GoalEvent.CANCEL_GOAL)
             self._status_changed = True
