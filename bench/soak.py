@@ -37,6 +37,7 @@ import uuid
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -107,101 +108,144 @@ def rss_mb(pid: int) -> float:
 
 
 # -- the load (its own process) -------------------------------------------------------------------
+class Load:
+    """The clients of the load, served by one thread without an executor.
+
+    rclpy's executor costs a round per response (its wait set rebuilt in Python from the
+    node's 40 clients), and every goal has two responses (its answer, its result): the load
+    would take CPU that the suite, on the same two cores, needs. Here one thread waits on the
+    clients' handles itself, takes every response ready, sends each accepted goal's result
+    request at once, and sends the next round of modifies when it is due. The goal messages
+    are made once per target (each request only gets a fresh goal id)."""
+
+    def __init__(self, node, rclpy_impl):
+        from mpi_ros.action import MotionModify, MotionStart
+        from mpi_ros.ros.supervisor_node import ACTION_SERVICE_QOS
+        from mpi_ros.srv import MotionAction
+
+        self._rclpy = rclpy_impl
+        self._context = node.context
+        self.counts: Counter = Counter()
+        self.clients: dict[tuple[int, str], Any] = {}
+        self._pending: dict[tuple[int, int], tuple] = {}  # (client id, sequence) -> what to do with the answer
+        actions = {"start": (MotionStart, "motion_start"), "modify": (MotionModify, "motion_modify")}
+        for n in range(SUPERVISORS):
+            base = f"/mpi/ms{n}"
+            for kind, (action, name) in actions.items():
+                self.clients[n, kind] = node.create_client(action.Impl.SendGoalService,
+                                                           f"{base}/{name}/_action/send_goal",
+                                                           qos_profile=ACTION_SERVICE_QOS)
+                self.clients[n, f"{kind}_result"] = node.create_client(action.Impl.GetResultService,
+                                                                       f"{base}/{name}/_action/get_result",
+                                                                       qos_profile=ACTION_SERVICE_QOS)
+            self.clients[n, "action"] = node.create_client(MotionAction, f"{base}/action")
+        self._by_pointer = {client.handle.pointer: client for client in self.clients.values()}
+        self._wait_set = None
+
+    def wait_for_services(self) -> None:
+        for client in self.clients.values():
+            client.wait_for_service(timeout_sec=WAIT)
+
+    def send_goal(self, n: int, kind: str, request) -> None:
+        """``request``: a SendGoal request whose goal is set; it gets a new goal id here."""
+        request.goal_id.uuid = list(uuid.uuid4().bytes)
+        self._send(self.clients[n, kind], request, ("answer", n, kind, bytes(request.goal_id.uuid)))
+        self.counts["sent"] += 1
+
+    def send_action(self, n: int, action: str) -> None:
+        client = self.clients[n, "action"]
+        self._send(client, client.srv_type.Request(action=action), ("action",))
+
+    def _send(self, client, request, then: tuple) -> None:
+        with client.handle:
+            sequence = client.handle.send_request(request)
+        self._pending[id(client), sequence] = (client, then)
+
+    def serve(self, timeout: float) -> None:
+        """Wait up to ``timeout`` s for responses; handle every one ready."""
+        if self._wait_set is None:
+            with self._context.handle:
+                self._wait_set = self._rclpy.WaitSet(0, 0, 0, len(self.clients), 0, 0, self._context.handle)
+        wait_set = self._wait_set
+        wait_set.clear_entities()
+        for client in self.clients.values():
+            wait_set.add_client(client.handle)
+        wait_set.wait(max(0, int(timeout * 1e9)))
+        for pointer in wait_set.get_ready_entities("client"):
+            client = self._by_pointer[pointer]
+            while True:
+                with client.handle:
+                    header, response = client.handle.take_response(client.srv_type.Response)
+                if header is None:
+                    break
+                found = self._pending.pop((id(client), header.request_id.sequence_number), None)
+                if found is not None:
+                    self._on_response(found[1], response)
+
+    def _on_response(self, then: tuple, response) -> None:
+        if then[0] == "answer":
+            _, n, kind, goal_id = then
+            if not response.accepted:
+                self.counts["rejected"] += 1
+                return
+            self.counts["accepted"] += 1
+            client = self.clients[n, f"{kind}_result"]
+            request = client.srv_type.Request()
+            request.goal_id.uuid = list(goal_id)
+            self._send(client, request, ("result",))
+        elif then[0] == "result":
+            self.counts["results"] += 1
+            self.counts[f"result {response.result.message or f'(none: goal status {response.status})'}"] += 1
+
+    def settled(self) -> bool:
+        return self.counts["results"] + self.counts["rejected"] >= self.counts["sent"]
+
+
 def load(domain: str, rate: float, seconds: float, out: str, ready) -> None:
     """Modify goals at ``rate`` per supervisor for ``seconds``, through the action protocol's
     services; then E_STOP each supervisor and wait for every result; writes counts to ``out``."""
     os.environ["ROS_DOMAIN_ID"] = domain
     import rclpy
-    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.impl.implementation_singleton import rclpy_implementation
     from rclpy.node import Node
-    from unique_identifier_msgs.msg import UUID
 
     from mpi_ros.action import MotionModify, MotionStart
-    from mpi_ros.ros.supervisor_node import ACTION_SERVICE_QOS
-    from mpi_ros.srv import MotionAction
+    from mpi_ros.client import fill
 
     rclpy.init()
     node = Node("soak_load")
-    counts: Counter = Counter()
-    lock = threading.Lock()
-    services = {}
-    for n in range(SUPERVISORS):
-        base = f"/mpi/ms{n}"
-        services[n] = {
-            "start": node.create_client(MotionStart.Impl.SendGoalService, f"{base}/motion_start/_action/send_goal",
-                                        qos_profile=ACTION_SERVICE_QOS),
-            "start_result": node.create_client(MotionStart.Impl.GetResultService,
-                                               f"{base}/motion_start/_action/get_result",
-                                               qos_profile=ACTION_SERVICE_QOS),
-            "modify": node.create_client(MotionModify.Impl.SendGoalService, f"{base}/motion_modify/_action/send_goal",
-                                         qos_profile=ACTION_SERVICE_QOS),
-            "modify_result": node.create_client(MotionModify.Impl.GetResultService,
-                                                f"{base}/motion_modify/_action/get_result",
-                                                qos_profile=ACTION_SERVICE_QOS),
-            "action": node.create_client(MotionAction, f"{base}/action"),
-        }
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    spinning = threading.Thread(target=executor.spin, daemon=True)
-    spinning.start()
-    for client in (c for s in services.values() for c in s.values()):
-        client.wait_for_service(timeout_sec=WAIT)
+    clients = Load(node, rclpy_implementation)
+    clients.wait_for_services()
     # Each retarget is a move of 4000 counts taking about a second, so every modify finds the
     # supervisor MOVING (modifies come 10 ms to 1 s apart) and the axes never come to rest.
     trajectory = [{"velocity": 5_000.0, "acceleration": 100_000.0, "deceleration": 100_000.0, "jerk_percent": 50.0}]
-
-    def count(key: str) -> None:
-        with lock:
-            counts[key] += 1
-
-    def on_result(future) -> None:
-        count("results")
-        response = future.result()
-        count(f"result {response.result.message or f'(none: goal status {response.status})'}")
-
-    def send(n: int, kind: str, goal) -> None:
-        request = services[n][kind].srv_type.Request(goal_id=UUID(uuid=list(uuid.uuid4().bytes)), goal=goal)
-        count("sent")
-
-        def on_answer(future) -> None:
-            if not future.result().accepted:
-                count("rejected")
-                return
-            count("accepted")
-            result_request = services[n][f"{kind}_result"].srv_type.Request(goal_id=request.goal_id)
-            services[n][f"{kind}_result"].call_async(result_request).add_done_callback(on_result)
-
-        services[n][kind].call_async(request).add_done_callback(on_answer)
-
-    from mpi_ros.client import fill
-
+    start = MotionStart.Impl.SendGoalService.Request(
+        goal=fill(MotionStart.Goal(), {"type": "S_CURVE", "position": [2000.0], "trajectory": trajectory}))
+    modifies = [MotionModify.Impl.SendGoalService.Request(goal=fill(MotionModify.Goal(), {
+        "type": "S_CURVE", "position": [target], "attributes": ["AUTO_START"], "trajectory": trajectory}))
+        for target in (-2000.0, 2000.0)]  # a modify late enough to find the axis at rest starts
     for n in range(SUPERVISORS):
-        send(n, "start", fill(MotionStart.Goal(), {"type": "S_CURVE", "position": [2000.0],
-                                                   "trajectory": trajectory}))
+        clients.send_goal(n, "start", start)
     ready.set()
     tick = 0
     period = 1.0 / rate
     began = time.monotonic()
-    pause = threading.Event()
     while time.monotonic() - began < seconds:
-        target = 2000.0 if tick % 2 else -2000.0
-        for n in range(SUPERVISORS):
-            send(n, "modify", fill(MotionModify.Goal(), {"type": "S_CURVE", "position": [target], "attributes": [
-                "AUTO_START"], "trajectory": trajectory}))  # a modify late enough to find the axis at rest starts
-        tick += 1
-        pause.wait(max(0.0, began + tick * period - time.monotonic()))  # pacing the load, not a test wait
+        due = began + tick * period
+        if time.monotonic() >= due:
+            for n in range(SUPERVISORS):
+                clients.send_goal(n, "modify", modifies[tick % 2])
+            tick += 1
+            continue
+        clients.serve(due - time.monotonic())  # pacing the load: waits for responses until the next round
+    sending = time.monotonic() - began
     for n in range(SUPERVISORS):
-        services[n]["action"].call_async(MotionAction.Request(action="E_STOP"))
+        clients.send_action(n, "E_STOP")
     deadline = time.monotonic() + 120.0
-    while time.monotonic() < deadline:
-        with lock:
-            if counts["results"] + counts["rejected"] >= counts["sent"]:
-                break
-        pause.wait(0.1)
-    with lock:
-        Path(out).write_text(json.dumps({**counts, "ticks": tick, "seconds": time.monotonic() - began}))
-    executor.shutdown(timeout_sec=2.0)
-    spinning.join(timeout=5.0)
+    while time.monotonic() < deadline and not clients.settled():
+        clients.serve(0.1)
+    Path(out).write_text(json.dumps({**clients.counts, "ticks": tick, "sending": sending,
+                                     "load_cpu": time.process_time()}))
     node.destroy_node()
     rclpy.try_shutdown()
 
@@ -321,8 +365,9 @@ def report(rows: list[Minute], totals: dict, args) -> str:
         lines.append(f"| {row.minute} | {row.rss_mb:.0f} | {row.cpu:.0%} | {row.statuses:,} | {row.gaps} | "
                      f"{d.get('samples_behind', '?')} | {tracked} / {kept} / {unfiled} | "
                      f"{d.get('outputs_queued', '?')} |")
-    lines += ["", f"Goals: {sent:,} sent ({totals.get('ticks', 0) * SUPERVISORS / max(totals.get('seconds', 1), 1):.0f}"
-              f"/s offered), {totals.get('accepted', 0):,} accepted, {totals.get('rejected', 0):,} rejected, "
+    lines += ["", f"Goals: {sent:,} sent ({totals.get('ticks', 0) * SUPERVISORS / max(totals.get('sending', 1), 1):.0f}"
+              f"/s offered while sending; the load process used {totals.get('load_cpu', 0):.0f} s of CPU), "
+              f"{totals.get('accepted', 0):,} accepted, {totals.get('rejected', 0):,} rejected, "
               f"{totals.get('results', 0):,} results; "
               + ", ".join(f"{k[7:]} {v:,}" for k, v in sorted(totals.items()) if k.startswith("result ")) + ".",
               f"Statuses: {totals['statuses']:,} received, {totals['gaps']} gaps ({totals['missing']} status points "

@@ -66,6 +66,9 @@ _MARKER_KEYS = frozenset((OMITTED_VALUES, OMITTED_TEXT))
 _COMPACT_ELEMENTS = 32  # a compacted record keeps arrays up to this long ...
 _COMPACT_TEXT = 256  # ... and strings up to this long
 _LEAVES = (int, float, bool, type(None))
+# Empty, these add nothing to a size: a goal's dict holds a dozen empty arrays, not walked.
+# (Exact types only: the truth of anything else, a numpy array say, is not asked.)
+_EMPTIABLE = frozenset((list, dict, str))
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,7 +144,8 @@ def request_size(data: Any, where: str = "request") -> RequestSize:
                 longest_text = _longer(longest_text, here, marker[1])
             else:
                 prefix = "" if here == "request" else f"{here}."
-                stack.extend((f"{prefix}{key}", item) for key, item in value.items() if not isinstance(item, _LEAVES))
+                stack.extend((f"{prefix}{key}", item) for key, item in value.items()
+                             if not isinstance(item, _LEAVES) and (item or type(item) not in _EMPTIABLE))
     return RequestSize(values, text, longest_array, longest_text)
 
 

@@ -16,7 +16,8 @@ import array
 import math
 import time
 import weakref
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
+from functools import cache
 from typing import Any
 
 import numpy as np
@@ -34,17 +35,38 @@ from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 def to_dict(msg) -> dict[str, Any]:
     """A ROS message as a dict of plain Python values (nested messages as dicts); also a
     message read from a bag by the definition the bag stores (its fields are its slots)."""
-    return {name: _plain(getattr(msg, name)) for name in _fields(msg)}
+    readers = _readers(type(msg))
+    if readers is None:
+        return {name: _plain(getattr(msg, name)) for name in _fields(msg)}
+    return {name: getattr(msg, name) if read is None else read(getattr(msg, name)) for name, read in readers}
 
 
-def release(msg) -> None:
-    """Reset ``msg`` to its defaults in place, once it has been read (:func:`to_dict`).
+@cache
+def _readers(cls) -> tuple[tuple[str, Callable[[Any], Any] | None], ...] | None:
+    """For a generated message class: each field with how its value becomes plain (None: it
+    is plain already), decided once from the field's declared type; a goal has some thirty
+    fields and arrives hundreds of times a second. None for other classes (read by value)."""
+    slot_types = getattr(cls, "SLOT_TYPES", None)
+    if slot_types is None or not hasattr(cls, "get_fields_and_field_types"):
+        return None
+    return tuple((name, _reader(slot_type))
+                 for name, slot_type in zip(cls.get_fields_and_field_types(), slot_types, strict=True))
 
-    rclpy's ActionServer keeps the goal message in the goal's ServerGoalHandle until the
-    goal's result expires (result_timeout, 900 s by default); the suite reads a goal once,
-    so keeping its arrays would hold up to megabytes per goal for a quarter of an hour
-    (8 MB for a refused goal of 1,000,000 positions; docs/hostile-input.md)."""
-    msg.__init__()
+
+def _reader(slot_type) -> Callable[[Any], Any] | None:
+    from rosidl_parser import definition
+
+    if isinstance(slot_type, definition.NamespacedType):
+        return to_dict
+    if isinstance(slot_type, definition.AbstractNestedType):
+        if isinstance(slot_type.value_type, definition.NamespacedType):
+            return _dicts
+        return _plain  # numbers (array.array, numpy) or strings: plain lists
+    return None
+
+
+def _dicts(messages) -> list[dict[str, Any]]:
+    return [to_dict(m) for m in messages]
 
 
 def _fields(msg) -> list[str]:
@@ -59,7 +81,7 @@ def _plain(value):
     if isinstance(value, (list, tuple)):
         return [_plain(v) for v in value]
     if isinstance(value, (array.array, np.ndarray)):
-        return [v.item() if hasattr(v, "item") else v for v in value]
+        return value.tolist()  # Python numbers
     return value
 
 

@@ -16,10 +16,12 @@ difference) and does per batch what rclpy does per goal:
   request for a finished goal is answered at once, for a running one when it finishes;
 - the status array is published once per batch of changes, not once per change.
 
-Requests are handled in the order they were taken: takes of one waitable never overlap, and
-whichever execute task holds ``_in_order`` handles everything taken so far (the others
-return at once, so no executor thread waits here). Within one take, goal requests come
-before cancel requests (a cancel names goals its client has seen accepted).
+The suite's GoalLoop (goal_loop.py) waits on every server's handle in one thread, takes what
+is ready (``take_data``) and hands ``serve`` to a pool. Requests are handled in the order they
+were taken: takes never overlap, and whichever ``serve`` holds ``_in_order`` handles
+everything taken so far (the others return at once, so no pool thread waits here). Within
+one take, goal requests come before cancel requests (a cancel names goals its client has
+seen accepted).
 """
 
 from __future__ import annotations
@@ -35,7 +37,6 @@ from action_msgs.msg import GoalInfo, GoalStatus
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.qos import QoSProfile, qos_profile_action_status_default
 from rclpy.type_support import check_for_type_support
-from rclpy.waitable import NumberOfEntities, Waitable
 
 GoalEvent = _rclpy.GoalEvent
 # the events that end a goal, by how it ended
@@ -71,13 +72,12 @@ class Callbacks:
     cancelled: Callable[[], None]
 
 
-class GoalServer(Waitable):
+class GoalServer:
     """One action (``<node>/<name>``) of one node. The goals' outcome comes from the node:
     ``start(id)`` when its move runs, ``finish(id, event, result)`` when it has ended."""
 
-    def __init__(self, node, action_type, name: str, callbacks: Callbacks, *, callback_group,
+    def __init__(self, node, action_type, name: str, callbacks: Callbacks, *,
                  service_qos: QoSProfile, feedback_qos: QoSProfile, result_timeout: float):
-        super().__init__(callback_group)
         self._node = node
         self._type = action_type
         self._callbacks = callbacks
@@ -94,8 +94,6 @@ class GoalServer(Waitable):
         self._taken: deque[dict[str, list]] = deque()
         self._in_order = threading.Lock()
         self._status_changed = False
-        callback_group.add_entity(self)
-        node.add_waitable(self)
 
     # -- what the node reads ----------------------------------------------------------
     def kept(self) -> int:
@@ -156,17 +154,18 @@ class GoalServer(Waitable):
                 goal.handle.destroy_when_not_in_use()
             self._goals.clear()
             self._handle.destroy_when_not_in_use()
-        self._node.remove_waitable(self)
 
-    # -- the Waitable API (the executor) --------------------------------------------------
+    # -- what the goal loop calls (its thread; ``serve`` on its pool) ------------------------
     def __enter__(self):
         return self._handle.__enter__()
 
     def __exit__(self, t, v, tb):
         self._handle.__exit__(t, v, tb)
 
-    def get_num_entities(self) -> NumberOfEntities:
-        return NumberOfEntities(*self._handle.get_num_entities())
+    def entity_counts(self) -> tuple[int, ...]:
+        """What the handle puts in a wait set: subscriptions, guard conditions, timers,
+        clients, services."""
+        return tuple(self._handle.get_num_entities())
 
     def add_to_wait_set(self, wait_set) -> None:
         with self._lock:
@@ -178,7 +177,7 @@ class GoalServer(Waitable):
         return any(self._ready)
 
     def take_data(self) -> dict[str, list]:
-        """Everything waiting of each kind the wait set found ready (queued for ``execute``)."""
+        """Everything waiting of each kind the wait set found ready (queued for ``serve``)."""
         goal, cancel, result, expired = self._ready
         impl = self._type.Impl
         taken: dict[str, list] = {}
@@ -203,7 +202,8 @@ class GoalServer(Waitable):
                 return requests
             requests.append((header, request))
 
-    async def execute(self, _taken) -> None:
+    def serve(self) -> None:
+        """Handle everything taken so far, unless another thread is doing so."""
         # Try again after releasing: a batch taken while another task held the lock (and so
         # returned at once) is handled by the holder.
         while self._taken and self._in_order.acquire(blocking=False):

@@ -6,7 +6,8 @@ a suite of 8 supervisors, against 0.6 ms for the 36 of one supervisor node). A g
 rounds (its request, its result request, the task that finishes it), so with one executor for
 the whole suite the goal path was bound by those rounds: about 35 goals a second, with status,
 stepping and E_STOP waiting behind them. With an executor per node a request wakes only its own
-node's executor, whose round costs what that node has.
+node's executor, whose round costs what that node has. The goal servers are not on the
+executors at all: one GoalLoop waits for all of them (goal_loop.py).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from ..config import SuiteConfig
 from ..runner import ControllerRunner
 from . import convert
 from .controller_node import ControllerNode
+from .goal_loop import GoalLoop
 from .supervisor_node import SupervisorNode
 
 
@@ -44,8 +46,10 @@ class Suite:
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)
         self.runner = ControllerRunner(self.controller, time_scale)
         self.controller_node = ControllerNode(self.runner, config.ros, context=context)
+        self.goal_loop = GoalLoop(self.controller_node.context, config.ros.executor_threads)
         self.supervisor_nodes = [
-            SupervisorNode(self.runner, spec.number, config.ros, spec.lost_client_timeout, context=context)
+            SupervisorNode(self.runner, spec.number, config.ros, self.goal_loop, spec.lost_client_timeout,
+                           context=context)
             for spec in config.supervisors
         ]
         self.configuration = self.controller_node.publish_configuration(config)
@@ -89,6 +93,7 @@ class Suite:
     def start(self, spin_in_thread: bool = True) -> None:
         """Start the controller clock and (optionally) spin the executor in a thread."""
         self.runner.start()
+        self.goal_loop.start()
         if spin_in_thread:
             self._spin_thread = threading.Thread(target=self.spin, name="mpi-ros-executor", daemon=True)
             self._spin_thread.start()
@@ -109,6 +114,7 @@ class Suite:
         for node in self.supervisor_nodes:
             node.shutdown()
         self.runner.stop()
+        self.goal_loop.stop()
         for executor in self.executors:
             executor.shutdown(timeout_sec=5.0)
         if self._spin_thread is not None:

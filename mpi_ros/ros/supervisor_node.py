@@ -6,7 +6,8 @@ reentrant callback group, apart from the goals, so E_STOP is served while goals 
 
 A goal holds no executor thread while its move runs (with more goals than threads nothing
 else would be served, E_STOP included), and runs no callback: GoalServer (goal_server.py)
-takes every goal request waiting, the node applies their commands together (so a client's
+takes every goal request waiting (the suite's GoalLoop waits for them in a thread of its
+own, outside the node's executor: goal_loop.py), the node applies their commands together (so a client's
 goal response comes after its command took effect) and files the goals in a GoalBook; the
 runner reviews the book after every step batch and command, under its lock. A goal whose
 move has become current is marked EXECUTING; a goal whose move has ended is finished with
@@ -59,11 +60,16 @@ from ..mpi.outcome import MoveEnd, Outcome
 from ..mpi.snapshot import MotionFeedback
 from ..runner import ControllerRunner, Output
 from . import convert, snapshots, wire
+from .goal_loop import GoalLoop
 from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
 from .goal_tracker import GoalBook, TrackedGoal
 from .watchdog import LostClientWatchdog
 
-STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+# The status writers keep 100 samples for their readers: a suite catching up after a stall
+# publishes many status points of a topic at once, and a reliable writer keeping only 10
+# dropped the oldest of a burst before a reader had them (gaps in the soak). Depth is not part
+# of QoS matching, so readers keep whatever history they ask for.
+STATUS_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feedback publisher
 # The action's services default to a history of 10: an E_STOP that ends more goals than
 # that at once would drop results. Deep enough for every goal a frame buffer can queue.
@@ -83,14 +89,13 @@ class _RosGoal:
 
 
 class SupervisorNode(Node):
-    def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings,
+    def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings, goal_loop: GoalLoop,
                  lost_client_timeout: float = 0.0, **kwargs):
         super().__init__(f"ms{number}", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.number = number
         self.settings = settings
         self._shutting_down = False
-        self._goal_group = ReentrantCallbackGroup()
         self._service_group = ReentrantCallbackGroup()
         self._book = GoalBook(number)
         self._snapshots = snapshots.shared(runner)
@@ -102,6 +107,8 @@ class SupervisorNode(Node):
                                  for action_type, name, _ in actions}
         self._servers = {action_type: self._action_server(action_type, name, operation)
                          for action_type, name, operation in actions}
+        for server in self._servers.values():
+            goal_loop.add(server)
         # Feedback goes out pre-serialized on the actions' own feedback topics (see _collect_feedback).
         self._feedback_pubs = {action_type: self.create_publisher(action_type.Impl.FeedbackMessage,
                                                                   f"~/{name}/_action/feedback", FEEDBACK_QOS)
@@ -140,9 +147,8 @@ class SupervisorNode(Node):
         callbacks = Callbacks(accepting=lambda: not self._shutting_down,
                               apply=partial(self._on_goals, action_type, operation), cancel=self._on_cancel,
                               cancelled=lambda: self.runner.update(self._review))
-        return GoalServer(self, action_type, f"~/{name}", callbacks, callback_group=self._goal_group,
-                          service_qos=ACTION_SERVICE_QOS, feedback_qos=FEEDBACK_QOS,
-                          result_timeout=self.settings.result_timeout)
+        return GoalServer(self, action_type, f"~/{name}", callbacks, service_qos=ACTION_SERVICE_QOS,
+                          feedback_qos=FEEDBACK_QOS, result_timeout=self.settings.result_timeout)
 
     def _service(self, srv_type, name, callback):
         """A service of this supervisor: /<ns>/ms<n>/<name>."""
@@ -158,7 +164,8 @@ class SupervisorNode(Node):
                 self._closing.wait_for(lambda: self._unfinished == 0, timeout)
 
     def destroy_node(self):
-        """The action servers go first (after the executor has stopped: see Suite.shutdown)."""
+        """The action servers go first (after the executor and the goal loop have stopped: see
+        Suite.shutdown)."""
         for server in self._servers.values():
             server.destroy()
         return super().destroy_node()

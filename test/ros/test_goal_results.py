@@ -38,7 +38,7 @@ def test_an_ended_goal_is_kept_for_result_timeout_then_released(suite, client, d
     ended = time.monotonic()
     assert _late_result(client, goal) == GoalStatus.STATUS_SUCCEEDED  # kept: a late client gets it
 
-    # the action server expires goals on its executor; wait (bounded) until the goal is gone
+    # the goal loop expires goals when the server's timer says; wait (bounded) until the goal is gone
     gone = threading.Event()
     deadline = ended + RESULT_TIMEOUT + WAIT
     while not gone.is_set() and time.monotonic() < deadline:

@@ -1,0 +1,101 @@
+"""One thread that waits for the requests of every goal server of the suite.
+
+Why not the nodes' executors: rclpy's executor rebuilds its wait set in Python from every
+entity of its node on every round (about 0.6 ms for a supervisor node's 36 entities), and a
+goal costs at least two rounds (its request, its result request) plus the task that serves
+it. Under a stream of modifies those rounds took more of the suite's CPU than applying the
+commands did (bench/RESULTS.md, "The goal path without the executors"). This loop's wait set
+holds only the goal servers' handles (three services and a timer each) and a guard
+condition: made once, refilled each round with a few C calls. What a round takes is served
+on a pool of threads (a goal's command waits there for its sample, never in this thread),
+each server's batches in the order they were taken (GoalServer.serve).
+
+The loop must be stopped (``stop``) before the nodes holding its servers are destroyed.
+"""
+
+from __future__ import annotations
+
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import ExitStack
+
+from rclpy.context import Context
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+
+from .goal_server import GoalServer
+
+# The longest a round waits. A request that arrives while its reader is being re-matched
+# (a link that was cut comes back) can leave no wake-up behind; a new round finds it anyway,
+# since each wait first looks at what every handle already holds (seen: a client's re-asked
+# result request answered only when something else woke the loop).
+ROUND_NS = 100_000_000
+
+
+class GoalLoop:
+    """``add`` every server, then ``start``; ``stop`` before the servers are destroyed."""
+
+    def __init__(self, context: Context, threads: int):
+        if context.handle is None:
+            raise RuntimeError("the goal loop needs an initialized context")
+        self._handle = context.handle
+        self._context = context
+        self._servers: list[GoalServer] = []
+        with self._handle:
+            self._wake = _rclpy.GuardCondition(self._handle)
+        self._pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="mpi-ros-goals")
+        self._stopping = False
+        self._thread: threading.Thread | None = None
+
+    def add(self, server: GoalServer) -> None:
+        if self._thread is not None:
+            raise RuntimeError("goal servers are added before the goal loop starts")
+        self._servers.append(server)
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._run, name="mpi-ros-goal-loop", daemon=True)
+        self._thread.start()
+
+    def stop(self, timeout: float = 5.0) -> None:
+        """Stop taking requests and finish serving what was taken."""
+        self._stopping = True
+        self._wake.trigger_guard_condition()
+        if self._thread is not None:
+            self._thread.join(timeout)
+        self._pool.shutdown(wait=True)
+        self._wake.destroy_when_not_in_use()
+
+    def _run(self) -> None:
+        try:
+            with ExitStack() as held:  # no server's C handle is destroyed while it is waited on
+                for server in self._servers:
+                    held.enter_context(server)
+                held.enter_context(self._handle)
+                wait_set = self._wait_set()
+                while not self._stopping:
+                    self._round(wait_set)
+        except _rclpy.RCLError:
+            # The context shut down (Ctrl-C) before the loop was stopped: nothing can be
+            # waited on any more. Anything else is a real error.
+            if self._context.ok():
+                raise
+
+    def _wait_set(self):
+        counts = [0] * 5  # subscriptions, guard conditions, timers, clients, services
+        for server in self._servers:
+            for kind, count in enumerate(server.entity_counts()):
+                counts[kind] += count
+        subscriptions, guards, timers, clients, services = counts
+        return _rclpy.WaitSet(subscriptions, guards + 1, timers, clients, services, 0, self._handle)
+
+    def _round(self, wait_set) -> None:
+        wait_set.clear_entities()
+        wait_set.add_guard_condition(self._wake)
+        for server in self._servers:
+            server.add_to_wait_set(wait_set)
+        wait_set.wait(ROUND_NS)
+        if self._stopping:
+            return
+        for server in self._servers:
+            if server.is_ready(wait_set):
+                server.take_data()
+                self._pool.submit(server.serve)
