@@ -17,7 +17,6 @@ import math
 import time
 import weakref
 from collections.abc import Callable, Iterable, Mapping
-from functools import cache
 from typing import Any
 
 import numpy as np
@@ -41,8 +40,20 @@ def to_dict(msg) -> dict[str, Any]:
     return {name: getattr(msg, name) if read is None else read(getattr(msg, name)) for name, read in readers}
 
 
-@cache
-def _readers(cls) -> tuple[tuple[str, Callable[[Any], Any] | None], ...] | None:
+Readers = tuple[tuple[str, Callable[[Any], Any] | None], ...]
+_READERS: dict[type, Readers] = {}  # generated classes only: a bag's message classes come and go
+
+
+def _readers(cls: type) -> Readers | None:
+    readers = _READERS.get(cls)
+    if readers is None:
+        readers = _plan(cls)
+        if readers is not None:
+            _READERS[cls] = readers
+    return readers
+
+
+def _plan(cls: type) -> Readers | None:
     """For a generated message class: each field with how its value becomes plain (None: it
     is plain already), decided once from the field's declared type; a goal has some thirty
     fields and arrives hundreds of times a second. None for other classes (read by value)."""
