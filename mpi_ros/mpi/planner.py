@@ -42,7 +42,8 @@ A = MotionAttr
 # 1 us each, a dozen per move), an int's & does not.
 _RELATIVE, _FINAL_VEL, _NO_REVERSAL, _DELAY, _OUTPUT, _ID, _ELEMENT_ID, _EVENT = map(
     int, (A.RELATIVE, A.FINAL_VEL, A.NO_REVERSAL, A.DELAY, A.OUTPUT, A.ID, A.ELEMENT_ID, A.EVENT))
-_SYNC, _HOLDS = int(A.SYNC_START | A.SYNC_END), int(HOLD_ATTRS)
+_SYNC_START, _SYNC_END, _HOLDS = int(A.SYNC_START), int(A.SYNC_END), int(HOLD_ATTRS)
+_SYNC = _SYNC_START | _SYNC_END
 # The motion types planning tells apart, looked up once: an enum member is a class attribute
 # lookup of ~0.1 us each time.
 _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
@@ -81,19 +82,17 @@ def _truncate_id(value: int, notes: PlanNotes) -> int:
 
 def _targets(params: MotionParams, bits: int, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
     """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
+    if not bits & _RELATIVE:  # (the usual case, in one comprehension)
+        return [value + start.origin for start, value in zip(starts, params.position, strict=True)]
     targets = []
-    relative = bits & _RELATIVE
     for start, value in zip(starts, params.position, strict=True):
-        if relative:
-            distance = float(math.trunc(value))
-            if distance != value:
-                notes.events.append(
-                    (MPIEventType.RELATIVE_TRUNCATED,
-                     f"axis {start.axis}: relative distance {value!r} truncated to {distance:g}")
-                )
-            targets.append(start.position + distance)
-        else:
-            targets.append(value + start.origin)
+        distance = float(math.trunc(value))
+        if distance != value:
+            notes.events.append(
+                (MPIEventType.RELATIVE_TRUNCATED,
+                 f"axis {start.axis}: relative distance {value!r} truncated to {distance:g}")
+            )
+        targets.append(start.position + distance)
     return targets
 
 
@@ -346,15 +345,15 @@ def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) ->
     return reshape(ramps_between(speed, 0.0, traj.acceleration, traj.deceleration), 0.0, jerk_percent)
 
 
-def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], attrs: MotionAttr):
+def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], bits: int):
     durations = [sum(s.duration for s in prof) for prof in profiles]
     longest = max(durations, default=0.0)
     out = []
     for prof, start, target, duration in zip(profiles, starts, targets, durations, strict=True):
         pad = longest - duration
-        if A.SYNC_END in attrs and start.velocity == 0.0:
+        if bits & _SYNC_END and start.velocity == 0.0:
             prof = _wait(start.position, pad) + prof
-        elif A.SYNC_START in attrs:
+        elif bits & _SYNC_START:
             prof = prof + _wait(target, pad)
         out.append(prof)
     return out
@@ -395,7 +394,7 @@ def compile_move(
         elif motion_type in _VELOCITY_TYPES:
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
-            plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
+            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
     # (positional: a dataclass' __init__ matches keywords at a cost; the fields in their order)
@@ -429,8 +428,9 @@ def _holds_and_outputs(params: MotionParams, bits: int, index: int):
     return hold, outputs
 
 
-def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
-    bits = int(attrs)
+def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits: int, starts: list[AxisStart],
+                          sample_rate: float, notes: PlanNotes) -> list[AxisPlan]:
+    """``bits``: the move's attributes as an int (compile_move's)."""
     targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
@@ -439,7 +439,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
             _scalar_profile(motion_type, start, target, final, traj)
             for start, target, final, traj in zip(starts, targets, finals, params.trajectory, strict=True)
         ]
-        profiles = _sync(profiles, starts, targets, attrs)
+        profiles = _sync(profiles, starts, targets, bits)
         limits = list(params.trajectory)
     elif len(starts) == 1:
         one = starts[0]
@@ -452,22 +452,25 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
     # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
-    first = profiles[0] if profiles else None
-    lazy = not bits & (_DELAY | _NO_REVERSAL) and isinstance(first, ScaledProfile)
     # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
     chained = motion_type is not _S_CURVE_JERK and not bits & (_SYNC | _DELAY) and not composite
-    bound = _line_bound(first.line, limit, chained) if isinstance(first, ScaledProfile) and lazy else None
-    # (the duration of every ScaledAxisPlan: the 1-D profile's, calculated once)
-    line_duration = end_time(first.line) if isinstance(first, ScaledProfile) and bound is not None else 0.0
+    # ``bound`` (_line_bound) is not None only for a vector's shares (every profile a
+    # ScaledProfile) whose 1-D profile passed its checks; line_duration is then every
+    # ScaledAxisPlan's duration, the 1-D profile's, calculated once.
+    first = profiles[0] if profiles else None
+    bound, line_duration = None, 0.0
+    if isinstance(first, ScaledProfile) and not bits & (_DELAY | _NO_REVERSAL):
+        bound = _line_bound(first.line, limit, chained)
+        if bound is not None:
+            line_duration = end_time(first.line)
     plans: list[AxisPlan] = []
     # (zip without strict=, whose keyword doubles its cost: one target, final velocity and profile
     # per start, made so above from a request check_params has found one value per axis in)
     for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles)):  # noqa: B905
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
-        if lazy and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
-            plans.append(ScaledAxisPlan.of(
-                profile, line_duration, start.axis, start.position, target, final, hold, outputs,  # (AxisPlan's fields)
-                None, 0.0, False, limits[i], start.velocity, start.acceleration, composite))
+        if bound is not None and _passes_checks(profile, bound, start, target):
+            plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final, hold,
+                                           outputs, limits[i], start.velocity, start.acceleration, composite))
             continue
         # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
         prof, chain = (profile.segments(), False) if isinstance(profile, ScaledProfile) else (profile, chained)
