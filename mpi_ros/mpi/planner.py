@@ -20,8 +20,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from itertools import repeat
-from operator import attrgetter, sub, truediv
 
 from . import cams
 from .events import MPIEventType
@@ -49,7 +47,6 @@ _SYNC = _SYNC_START | _SYNC_END
 _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
 _VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
 _NO_EVENTS = MPIEventType.NONE
-_position_of, _velocity_of, _acceleration_of = (attrgetter(name) for name in ("position", "velocity", "acceleration"))
 
 
 @dataclass(slots=True)
@@ -82,10 +79,17 @@ def _truncate_id(value: int, notes: PlanNotes) -> int:
 
 def _targets(params: MotionParams, bits: int, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
     """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
-    if not bits & _RELATIVE:  # (the usual case, in one comprehension)
-        return [value + start.origin for start, value in zip(starts, params.position, strict=True)]
-    targets = []
-    for start, value in zip(starts, params.position, strict=True):
+    positions = params.position
+    # (check_params has found one position per axis; this is its guard here, as zip's strict=
+    # was, which costs eight times as much)
+    if len(positions) != len(starts):
+        raise ValueError(f"{len(positions)} positions for {len(starts)} axes")
+    targets: list[float] = []
+    if not bits & _RELATIVE:  # (the usual case; a loop of appends costs half of a comprehension for a few axes)
+        for start, value in zip(starts, positions):  # noqa: B905  (lengths checked above)
+            targets.append(value + start.origin)
+        return targets
+    for start, value in zip(starts, positions):  # noqa: B905
         distance = float(math.trunc(value))
         if distance != value:
             notes.events.append(
@@ -253,6 +257,19 @@ def _scaled(traj: Trajectory, share: float) -> Trajectory:
                       traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
 
 
+def _shares(traj: Trajectory, unit: list[float]) -> list[Trajectory]:
+    """Each axis' share of the vector's limits, ``_scaled(traj, abs(u))`` for each component u of
+    the line's unit vector (the trajectory's fields read once, not once per axis)."""
+    velocity, acceleration, deceleration = traj.velocity, traj.acceleration, traj.deceleration
+    jerk_percent, accel_jerk, decel_jerk = traj.jerk_percent, traj.acceleration_jerk, traj.deceleration_jerk
+    limits = []
+    for u in unit:
+        share = abs(u)
+        limits.append(Trajectory(velocity * share, acceleration * share, deceleration * share, jerk_percent,
+                                 accel_jerk * share, decel_jerk * share))
+    return limits
+
+
 # An axis' profile: its segments, or (a vector's axis) its share of the vector's 1-D profile
 Profile = list[Segment] | ScaledProfile
 
@@ -278,7 +295,9 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
         return 0.0, True
     along = _dot(vector, unit)
     tolerance = 1e-9 * (1.0 + scale)
-    for x, u in zip(vector, unit, strict=True):
+    # (zip without strict=, which costs more than this loop: the vector and the unit have one
+    # component per axis, made so by the callers)
+    for x, u in zip(vector, unit):  # noqa: B905
         if not abs(x - along * u) <= tolerance + 1e-9 * abs(x):
             return along, False
     return along, True
@@ -289,16 +308,26 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     effective limits (the vector's scaled by the axis' share of the line), and why the
     profiles are not one profile per axis ("" when they are). Plain floats: a vector has at
     most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
-    # (maps rather than comprehensions: a comprehension is a call of its own)
-    p0 = list(map(_position_of, starts))
-    v0 = list(map(_velocity_of, starts))
-    delta = list(map(sub, targets, p0))  # (as many targets as starts: _targets makes them)
+    # (loops of appends: for a few axes they cost half of list(map(...)) or a comprehension, each
+    # of which makes an object of its own)
+    p0: list[float] = []
+    v0: list[float] = []
+    accels: list[float] = []
+    for start in starts:
+        p0.append(start.position)
+        v0.append(start.velocity)
+        accels.append(start.acceleration)
+    delta: list[float] = []
+    for target, p in zip(targets, p0):  # noqa: B905  (as many targets as starts: _targets makes them)
+        delta.append(target - p)
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
     if not (math.isfinite(length) and math.isfinite(speed)):
         raise ProfileError("the move's length cannot be calculated (overflow)")
     if length > 0.0:
-        unit = list(map(truediv, delta, repeat(length)))  # d / length for each d
+        unit: list[float] = []
+        for d in delta:
+            unit.append(d / length)
     elif speed > 0.0:
         unit = [v / speed for v in v0]
     else:
@@ -309,13 +338,14 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
-    accels = list(map(_acceleration_of, starts))
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
-    # (ScaledProfile(line, u, p) without the Python-level __new__ of a NamedTuple, as segments are
-    # made; zip without strict=, whose keyword doubles its cost: unit and p0 are made alike above)
-    profiles: list[Profile] = [new_tuple(ScaledProfile, (line, u, p)) for u, p in zip(unit, p0)]  # noqa: B905
-    return profiles, list(map(_scaled, repeat(traj), map(abs, unit))), ""
+    profiles: list[Profile] = []
+    # (zip without strict=, whose keyword doubles its cost: unit and p0 are made alike above)
+    for u, p in zip(unit, p0):  # noqa: B905
+        # (ScaledProfile(line, u, p) without the Python-level __new__ of a NamedTuple, as segments are made)
+        profiles.append(new_tuple(ScaledProfile, (line, u, p)))
+    return profiles, _shares(traj, unit), ""
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
