@@ -494,11 +494,13 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         if bound is not None:
             line_duration = end_time(first.line)
     plans: list[AxisPlan] = []
-    # (zip without strict=, whose keyword doubles its cost: one target, final velocity and profile
-    # per start, made so above from a request check_params has found one value per axis in)
-    for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles)):  # noqa: B905
+    # (indexes rather than a zip of the four lists, which costs twice as much: one target, final
+    # velocity and profile per start, made so above from a request check_params has found one
+    # value per axis in)
+    for i, start in enumerate(starts):
+        target, final, profile = targets[i], finals[i], profiles[i]
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
-        if bound is not None and _passes_checks(profile, bound, start, target):
+        if bound is not None and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
             plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final, hold,
                                            outputs, limits[i], start.velocity, start.acceleration, composite))
             continue
