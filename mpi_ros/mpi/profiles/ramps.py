@@ -97,10 +97,15 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
         # From rest to rest, away from the target: F(w) = alpha*w^2 with a finite alpha is 0 at
         # w = 0 and grows, so the scan below would find every breakpoint overshooting.
         return None
-    if 0.0 < u0 < vmax or 0.0 < uf < vmax:
-        # the breakpoints, ascending: 0, u0 and uf where inside (0, vmax) (a velocity outside
-        # stands in as 0, once: a set), vmax
-        points = sorted({0.0, u0 if 0.0 < u0 < vmax else 0.0, uf if 0.0 < uf < vmax else 0.0, vmax})
+    # the breakpoints, ascending: 0, u0 and uf where inside (0, vmax) (once if equal), vmax (by
+    # comparisons: a set of them, sorted, costs twice as much)
+    inner_u0, inner_uf = 0.0 < u0 < vmax, 0.0 < uf < vmax
+    if inner_u0 and inner_uf:
+        points = [0.0, u0, uf, vmax] if u0 < uf else [0.0, uf, u0, vmax] if uf < u0 else [0.0, u0, vmax]
+    elif inner_u0:
+        points = [0.0, u0, vmax]
+    elif inner_uf:
+        points = [0.0, uf, vmax]
     else:
         points = [0.0, vmax]
     # Scan the pieces [points[k], points[k + 1]] from the top: the first breakpoint that does not
