@@ -42,6 +42,11 @@ _RELATIVE, _FINAL_VEL, _NO_REVERSAL, _DELAY, _OUTPUT, _ID, _ELEMENT_ID, _EVENT =
     int, (A.RELATIVE, A.FINAL_VEL, A.NO_REVERSAL, A.DELAY, A.OUTPUT, A.ID, A.ELEMENT_ID, A.EVENT))
 _SYNC_START, _SYNC_END, _HOLDS = int(A.SYNC_START), int(A.SYNC_END), int(HOLD_ATTRS)
 _SYNC = _SYNC_START | _SYNC_END
+# Unions the planning tests, made once (each | of two globals would cost as much as the test)
+_IN_MOTION_REFUSED = _DELAY | _HOLDS  # a move that starts in motion may not wait first
+_PADDED = _SYNC | _DELAY  # profiles with wait frames: not reshape's chain of pieces
+_AXIS_BY_AXIS = _DELAY | _NO_REVERSAL  # a vector's axes made and checked one by one
+_HOLD_OR_OUTPUT = _HOLDS | _OUTPUT
 # The motion types planning tells apart, looked up once: an enum member is a class attribute
 # lookup of ~0.1 us each time.
 _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
@@ -409,7 +414,7 @@ def compile_move(
     """
     notes = PlanNotes()
     bits = int(attrs)
-    if bits & (_DELAY | _HOLDS) and any(s.velocity != 0.0 for s in starts):  # starts in motion
+    if bits & _IN_MOTION_REFUSED and any(s.velocity != 0.0 for s in starts):  # starts in motion
         if bits & _DELAY and any(d != 0.0 for d in params.delay):
             raise Refused(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
         if bits & _HOLDS:
@@ -483,13 +488,13 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
     # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
-    chained = motion_type is not _S_CURVE_JERK and not bits & (_SYNC | _DELAY) and not composite
+    chained = motion_type is not _S_CURVE_JERK and not bits & _PADDED and not composite
     # ``bound`` (_line_bound) is not None only for a vector's shares (every profile a
     # ScaledProfile) whose 1-D profile passed its checks; line_duration is then every
     # ScaledAxisPlan's duration, the 1-D profile's, calculated once.
     first = profiles[0] if profiles else None
     bound, line_duration = None, 0.0
-    if isinstance(first, ScaledProfile) and not bits & (_DELAY | _NO_REVERSAL):
+    if isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS:
         bound = _line_bound(first.line, limit, chained)
         if bound is not None:
             line_duration = end_time(first.line)
@@ -499,7 +504,7 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     # value per axis in)
     for i, start in enumerate(starts):
         target, final, profile = targets[i], finals[i], profiles[i]
-        hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
+        hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
         if bound is not None and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
             plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final, hold,
                                            outputs, limits[i], start.velocity, start.acceleration, composite))
