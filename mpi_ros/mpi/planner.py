@@ -505,12 +505,15 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     for i, start in enumerate(starts):
         target, final, profile = targets[i], finals[i], profiles[i]
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
-        if bound is not None and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
-            plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final, hold,
-                                           outputs, limits[i], start.velocity, start.acceleration, composite))
-            continue
-        # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
-        prof, chain = (profile.segments(), False) if isinstance(profile, ScaledProfile) else (profile, chained)
+        if isinstance(profile, ScaledProfile):
+            if bound is not None and _passes_checks(profile, bound, start, target):
+                plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final,
+                                               hold, outputs, limits[i], start.velocity, start.acceleration, composite))
+                continue
+            # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
+            prof, chain = profile.segments(), False
+        else:
+            prof, chain = profile, chained
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise Refused(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
