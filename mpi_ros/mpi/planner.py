@@ -90,7 +90,7 @@ def _targets(params: MotionParams, bits: int, starts: list[AxisStart], notes: Pl
     if len(positions) != len(starts):
         raise ValueError(f"{len(positions)} positions for {len(starts)} axes")
     targets: list[float] = []
-    # (loops of appends over the starts, with the positions by index: for a few axes a third
+    # (loops of appends over the starts, with the positions by index: for one or two axes a fifth
     # cheaper than a zip of the two, half of a comprehension)
     if not bits & _RELATIVE:  # (the usual case)
         for i, start in enumerate(starts):
@@ -316,8 +316,8 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     effective limits (the vector's scaled by the axis' share of the line), and why the
     profiles are not one profile per axis ("" when they are). Plain floats: a vector has at
     most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
-    # (loops of appends, lists alike by index: for a few axes they cost half of list(map(...)), a
-    # comprehension or a zip, each of which makes an object of its own)
+    # (loops of appends, lists alike by index: for one or two axes they cost about half of
+    # list(map(...)) or a comprehension and less than a zip, each of which makes an object of its own)
     p0: list[float] = []
     v0: list[float] = []
     accels: list[float] = []
@@ -500,7 +500,7 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         if bound is not None:
             line_duration = end_time(first.line)
     plans: list[AxisPlan] = []
-    # (indexes rather than a zip of the four lists, which costs twice as much: one target, final
+    # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
     # velocity and profile per start, made so above from a request check_params has found one
     # value per axis in)
     for i, start in enumerate(starts):

@@ -37,7 +37,7 @@ class Ramp(NamedTuple):
 
 
 # ``_new(Ramp, (duration, v_start, v_end))``: ``Ramp(duration, v_start, v_end)`` without the
-# Python-level __new__ of a NamedTuple (nor a partial in between, which costs a third more)
+# Python-level __new__ of a NamedTuple (nor a partial in between, which costs a quarter more)
 _new = tuple.__new__
 
 
@@ -98,7 +98,7 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
         # w = 0 and grows, so the scan below would find every breakpoint overshooting.
         return None
     # the breakpoints, ascending: 0, u0 and uf where inside (0, vmax) (once if equal), vmax (by
-    # comparisons: a set of them, sorted, costs twice as much)
+    # comparisons: a set of them sorted into a list makes two objects more)
     inner_u0, inner_uf = 0.0 < u0 < vmax, 0.0 < uf < vmax
     if inner_u0 and inner_uf:
         points = [0.0, u0, uf, vmax] if u0 < uf else [0.0, uf, u0, vmax] if uf < u0 else [0.0, u0, vmax]
