@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -178,6 +178,7 @@ class AxisPlan:
 
 # The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
 _segments_slot = AxisPlan.__dict__["segments"]
+_init_plan = AxisPlan.__init__  # (ScaledAxisPlan.of: a global, not an attribute of the class looked up per plan)
 
 
 class ScaledAxisPlan(AxisPlan):
@@ -192,15 +193,19 @@ class ScaledAxisPlan(AxisPlan):
     scaled: ScaledProfile
 
     @classmethod
-    def of(cls, scaled: ScaledProfile, duration: float, *fields: Any) -> ScaledAxisPlan:
-        """The plan with the AxisPlan ``fields`` in their order (origin_time left at 0), the
-        segments left out. ``duration``: ``end_time(scaled.line)``, the same durations added in
-        the same order as AxisPlan.__post_init__ adds the segments' (the vector's axes share it:
-        calculated once)."""
+    def of(cls, scaled: ScaledProfile, duration: float, axis: int, start_position: float, target: float,
+           final_velocity: float, hold: Hold | None, outputs: list[Output], limits: Trajectory | None,
+           start_velocity: float, start_acceleration: float, composite: str) -> ScaledAxisPlan:
+        """The plan of a vector's axis: AxisPlan's fields of a point-to-point plan (not a
+        VELOCITY move, not truncated, origin_time 0), the segments left out. ``duration``:
+        ``end_time(scaled.line)``, the same durations added in the same order as
+        AxisPlan.__post_init__ adds the segments' (the vector's axes share it: calculated once).
+        (Named parameters, not ``*fields``: packing and unpacking them cost a third of the plan.)"""
         plan = cls.__new__(cls)
         plan.scaled = scaled
         plan.duration = duration
-        AxisPlan.__init__(plan, fields[0], None, *fields[1:])  # type: ignore[arg-type]  # (made when asked for)
+        _init_plan(plan, axis, None, start_position, target, final_velocity, hold, outputs,  # type: ignore[arg-type]
+                   None, 0.0, False, limits, start_velocity, start_acceleration, composite)  # (segments when asked for)
         return plan
 
     def __post_init__(self) -> None:

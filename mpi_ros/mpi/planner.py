@@ -20,8 +20,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from itertools import repeat
-from operator import attrgetter, sub, truediv
 
 from . import cams
 from .events import MPIEventType
@@ -42,13 +40,18 @@ A = MotionAttr
 # 1 us each, a dozen per move), an int's & does not.
 _RELATIVE, _FINAL_VEL, _NO_REVERSAL, _DELAY, _OUTPUT, _ID, _ELEMENT_ID, _EVENT = map(
     int, (A.RELATIVE, A.FINAL_VEL, A.NO_REVERSAL, A.DELAY, A.OUTPUT, A.ID, A.ELEMENT_ID, A.EVENT))
-_SYNC, _HOLDS = int(A.SYNC_START | A.SYNC_END), int(HOLD_ATTRS)
+_SYNC_START, _SYNC_END, _HOLDS = int(A.SYNC_START), int(A.SYNC_END), int(HOLD_ATTRS)
+_SYNC = _SYNC_START | _SYNC_END
+# Unions the planning tests, made once (each | of two globals would cost as much as the test)
+_IN_MOTION_REFUSED = _DELAY | _HOLDS  # a move that starts in motion may not wait first
+_PADDED = _SYNC | _DELAY  # profiles with wait frames: not reshape's chain of pieces
+_AXIS_BY_AXIS = _DELAY | _NO_REVERSAL  # a vector's axes made and checked one by one
+_HOLD_OR_OUTPUT = _HOLDS | _OUTPUT
 # The motion types planning tells apart, looked up once: an enum member is a class attribute
 # lookup of ~0.1 us each time.
 _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
 _VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
 _NO_EVENTS = MPIEventType.NONE
-_position_of, _velocity_of, _acceleration_of = (attrgetter(name) for name in ("position", "velocity", "acceleration"))
 
 
 @dataclass(slots=True)
@@ -81,19 +84,27 @@ def _truncate_id(value: int, notes: PlanNotes) -> int:
 
 def _targets(params: MotionParams, bits: int, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
     """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
-    targets = []
-    relative = bits & _RELATIVE
-    for start, value in zip(starts, params.position, strict=True):
-        if relative:
-            distance = float(math.trunc(value))
-            if distance != value:
-                notes.events.append(
-                    (MPIEventType.RELATIVE_TRUNCATED,
-                     f"axis {start.axis}: relative distance {value!r} truncated to {distance:g}")
-                )
-            targets.append(start.position + distance)
-        else:
-            targets.append(value + start.origin)
+    positions = params.position
+    # (check_params has found one position per axis; this is its guard here, as zip's strict=
+    # was, which costs eight times as much)
+    if len(positions) != len(starts):
+        raise ValueError(f"{len(positions)} positions for {len(starts)} axes")
+    targets: list[float] = []
+    # (loops of appends over the starts, with the positions by index: for one or two axes a fifth
+    # cheaper than a zip of the two, half of a comprehension)
+    if not bits & _RELATIVE:  # (the usual case)
+        for i, start in enumerate(starts):
+            targets.append(positions[i] + start.origin)
+        return targets
+    for i, start in enumerate(starts):
+        value = positions[i]
+        distance = float(math.trunc(value))
+        if distance != value:
+            notes.events.append(
+                (MPIEventType.RELATIVE_TRUNCATED,
+                 f"axis {start.axis}: relative distance {value!r} truncated to {distance:g}")
+            )
+        targets.append(start.position + distance)
     return targets
 
 
@@ -254,6 +265,19 @@ def _scaled(traj: Trajectory, share: float) -> Trajectory:
                       traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
 
 
+def _shares(traj: Trajectory, unit: list[float]) -> list[Trajectory]:
+    """Each axis' share of the vector's limits, ``_scaled(traj, abs(u))`` for each component u of
+    the line's unit vector (the trajectory's fields read once, not once per axis)."""
+    velocity, acceleration, deceleration = traj.velocity, traj.acceleration, traj.deceleration
+    jerk_percent, accel_jerk, decel_jerk = traj.jerk_percent, traj.acceleration_jerk, traj.deceleration_jerk
+    limits = []
+    for u in unit:
+        share = abs(u)
+        limits.append(Trajectory(velocity * share, acceleration * share, deceleration * share, jerk_percent,
+                                 accel_jerk * share, decel_jerk * share))
+    return limits
+
+
 # An axis' profile: its segments, or (a vector's axis) its share of the vector's 1-D profile
 Profile = list[Segment] | ScaledProfile
 
@@ -279,7 +303,9 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
         return 0.0, True
     along = _dot(vector, unit)
     tolerance = 1e-9 * (1.0 + scale)
-    for x, u in zip(vector, unit, strict=True):
+    # (zip without strict=, which costs more than this loop: the vector and the unit have one
+    # component per axis, made so by the callers)
+    for x, u in zip(vector, unit):  # noqa: B905
         if not abs(x - along * u) <= tolerance + 1e-9 * abs(x):
             return along, False
     return along, True
@@ -290,16 +316,25 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     effective limits (the vector's scaled by the axis' share of the line), and why the
     profiles are not one profile per axis ("" when they are). Plain floats: a vector has at
     most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
-    # (maps rather than comprehensions: a comprehension is a call of its own)
-    p0 = list(map(_position_of, starts))
-    v0 = list(map(_velocity_of, starts))
-    delta = list(map(sub, targets, p0))  # (as many targets as starts: _targets makes them)
+    # (loops of appends, lists alike by index: for one or two axes they cost about half of
+    # list(map(...)) or a comprehension and less than a zip, each of which makes an object of its own)
+    p0: list[float] = []
+    v0: list[float] = []
+    accels: list[float] = []
+    delta: list[float] = []
+    for i, start in enumerate(starts):
+        p0.append(start.position)
+        v0.append(start.velocity)
+        accels.append(start.acceleration)
+        delta.append(targets[i] - start.position)  # (as many targets as starts: _targets makes them)
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
     if not (math.isfinite(length) and math.isfinite(speed)):
         raise ProfileError("the move's length cannot be calculated (overflow)")
     if length > 0.0:
-        unit = list(map(truediv, delta, repeat(length)))  # d / length for each d
+        unit: list[float] = []
+        for d in delta:
+            unit.append(d / length)
     elif speed > 0.0:
         unit = [v / speed for v in v0]
     else:
@@ -310,13 +345,13 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
-    accels = list(map(_acceleration_of, starts))
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
-    # (ScaledProfile(line, u, p) without the Python-level __new__ of a NamedTuple, as segments are
-    # made; zip without strict=, whose keyword doubles its cost: unit and p0 are made alike above)
-    profiles: list[Profile] = [new_tuple(ScaledProfile, (line, u, p)) for u, p in zip(unit, p0)]  # noqa: B905
-    return profiles, list(map(_scaled, repeat(traj), map(abs, unit))), ""
+    profiles: list[Profile] = []
+    for i, u in enumerate(unit):  # (unit and p0 are made alike above)
+        # (ScaledProfile(line, u, p0[i]) without the Python-level __new__ of a NamedTuple, as segments are made)
+        profiles.append(new_tuple(ScaledProfile, (line, u, p0[i])))
+    return profiles, _shares(traj, unit), ""
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
@@ -346,15 +381,15 @@ def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) ->
     return reshape(ramps_between(speed, 0.0, traj.acceleration, traj.deceleration), 0.0, jerk_percent)
 
 
-def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], attrs: MotionAttr):
+def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], bits: int):
     durations = [sum(s.duration for s in prof) for prof in profiles]
     longest = max(durations, default=0.0)
     out = []
     for prof, start, target, duration in zip(profiles, starts, targets, durations, strict=True):
         pad = longest - duration
-        if A.SYNC_END in attrs and start.velocity == 0.0:
+        if bits & _SYNC_END and start.velocity == 0.0:
             prof = _wait(start.position, pad) + prof
-        elif A.SYNC_START in attrs:
+        elif bits & _SYNC_START:
             prof = prof + _wait(target, pad)
         out.append(prof)
     return out
@@ -380,7 +415,7 @@ def compile_move(
     """
     notes = PlanNotes()
     bits = int(attrs)
-    if bits & (_DELAY | _HOLDS) and any(s.velocity != 0.0 for s in starts):  # starts in motion
+    if bits & _IN_MOTION_REFUSED and any(s.velocity != 0.0 for s in starts):  # starts in motion
         if bits & _DELAY and any(d != 0.0 for d in params.delay):
             raise Refused(Message.MPIMotionMessageILLEGAL_DELAY, "a move that starts in motion cannot be delayed")
         if bits & _HOLDS:
@@ -395,7 +430,7 @@ def compile_move(
         elif motion_type in _VELOCITY_TYPES:
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
-            plans = _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes)
+            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
     # (positional: a dataclass' __init__ matches keywords at a cost; the fields in their order)
@@ -429,8 +464,9 @@ def _holds_and_outputs(params: MotionParams, bits: int, index: int):
     return hold, outputs
 
 
-def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
-    bits = int(attrs)
+def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits: int, starts: list[AxisStart],
+                          sample_rate: float, notes: PlanNotes) -> list[AxisPlan]:
+    """``bits``: the move's attributes as an int (compile_move's)."""
     targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
@@ -439,7 +475,7 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
             _scalar_profile(motion_type, start, target, final, traj)
             for start, target, final, traj in zip(starts, targets, finals, params.trajectory, strict=True)
         ]
-        profiles = _sync(profiles, starts, targets, attrs)
+        profiles = _sync(profiles, starts, targets, bits)
         limits = list(params.trajectory)
     elif len(starts) == 1:
         one = starts[0]
@@ -452,25 +488,33 @@ def _point_to_point_plans(motion_type, params, attrs, starts, sample_rate, notes
     # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
     # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
-    first = profiles[0] if profiles else None
-    lazy = not bits & (_DELAY | _NO_REVERSAL) and isinstance(first, ScaledProfile)
     # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
-    chained = motion_type is not _S_CURVE_JERK and not bits & (_SYNC | _DELAY) and not composite
-    bound = _line_bound(first.line, limit, chained) if isinstance(first, ScaledProfile) and lazy else None
-    # (the duration of every ScaledAxisPlan: the 1-D profile's, calculated once)
-    line_duration = end_time(first.line) if isinstance(first, ScaledProfile) and bound is not None else 0.0
+    chained = motion_type is not _S_CURVE_JERK and not bits & _PADDED and not composite
+    # ``bound`` (_line_bound) is not None only for a vector's shares (every profile a
+    # ScaledProfile) whose 1-D profile passed its checks; line_duration is then every
+    # ScaledAxisPlan's duration, the 1-D profile's, calculated once.
+    first = profiles[0] if profiles else None
+    bound, line_duration = None, 0.0
+    if isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS:
+        bound = _line_bound(first.line, limit, chained)
+        if bound is not None:
+            line_duration = end_time(first.line)
     plans: list[AxisPlan] = []
-    # (zip without strict=, whose keyword doubles its cost: one target, final velocity and profile
-    # per start, made so above from a request check_params has found one value per axis in)
-    for i, (start, target, final, profile) in enumerate(zip(starts, targets, finals, profiles)):  # noqa: B905
-        hold, outputs = _holds_and_outputs(params, bits, i) if bits & (_HOLDS | _OUTPUT) else (None, [])
-        if lazy and isinstance(profile, ScaledProfile) and _passes_checks(profile, bound, start, target):
-            plans.append(ScaledAxisPlan.of(
-                profile, line_duration, start.axis, start.position, target, final, hold, outputs,  # (AxisPlan's fields)
-                None, 0.0, False, limits[i], start.velocity, start.acceleration, composite))
-            continue
-        # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
-        prof, chain = (profile.segments(), False) if isinstance(profile, ScaledProfile) else (profile, chained)
+    # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
+    # velocity and profile per start, made so above from a request check_params has found one
+    # value per axis in)
+    for i, start in enumerate(starts):
+        target, final, profile = targets[i], finals[i], profiles[i]
+        hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
+        if isinstance(profile, ScaledProfile):
+            if bound is not None and _passes_checks(profile, bound, start, target):
+                plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final,
+                                               hold, outputs, limits[i], start.velocity, start.acceleration, composite))
+                continue
+            # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
+            prof, chain = profile.segments(), False
+        else:
+            prof, chain = profile, chained
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise Refused(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")

@@ -26,28 +26,34 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
     if not 0.0 <= jerk_percent <= 100.0:
         raise ProfileError("jerkPercent must be within 0..100")
     fraction = jerk_percent / 100.0
+    # The fractions of a ramp each piece takes, the same for every ramp: computed once, as the
+    # same operations give the same values (0.5 * fraction * duration is (0.5 * fraction) * duration)
+    half = 0.5 * fraction  # each jerk phase
+    flat = 1.0 - fraction  # the constant-acceleration phase
+    kept = 1.0 - half  # peak acceleration = dv / (duration * kept)
     segments: list[Segment] = []
     append = segments.append
+    make, segment, isfinite = new_tuple, Segment, math.isfinite  # (locals: a global lookup per segment)
     p = p0
     # (each ramp's pieces in this loop, not a function of their own: a call per ramp costs as
     # much as a segment's arithmetic, and a modify is planned while its command waits)
     for duration, v, v_end in plan:
         dv = v_end - v
-        jerk_time = 0.5 * fraction * duration
+        jerk_time = half * duration
         # The S-curve's three pieces (duration, start acceleration, jerk), unless this is a
         # cruise, f = 0, the jerk phases are too short to represent (tiny jerkPercent, or a ramp
         # of ~1e-324 s), or the jerk overflows (jerkPercent ~1e-308: the positions would be NaN).
         # Then the trapezoid's ramp.
         pieces = None
         if not (v == v_end or jerk_time <= 0.0):
-            peak = dv / (duration * (1.0 - 0.5 * fraction))
+            peak = dv / (duration * kept)
             jerk = peak / jerk_time
-            if math.isfinite(jerk):
-                pieces = ((jerk_time, 0.0, jerk), ((1.0 - fraction) * duration, peak, 0.0), (jerk_time, peak, -jerk))
+            if isfinite(jerk):
+                pieces = ((jerk_time, 0.0, jerk), (flat * duration, peak, 0.0), (jerk_time, peak, -jerk))
         for t, a, j in pieces or ((duration, dv / duration if duration > 0.0 else 0.0, 0.0),):
             if t <= 0.0:
                 continue
-            append(new_tuple(Segment, (t, p, v, a, j)))
+            append(make(segment, (t, p, v, a, j)))
             # Where the segment ends, as Segment.end_state computes it (the same operations in
             # the same order), without the method calls: the next piece starts there.
             p, v = p + t * (v + t * (a / 2.0 + t * j / 6.0)), v + t * (a + t * j / 2.0)
