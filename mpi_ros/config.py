@@ -89,7 +89,7 @@ class RosSettings:
     diagnostics_rate: float = 1.0
     clock_rate: float = 100.0
     crosscheck: bool = False
-    executor_threads: int = 8  # threads of each node's executor (every node has its own: ros/suite.py)
+    executor_threads: int = 8  # threads of each node's executor and of the goal loop's pool (ros/suite.py)
     clock: bool = True  # publish /clock; in a cell of several suites exactly one should (docs/cell.md)
     discovery: str = "localhost"  # see DISCOVERY_RANGES
     # s an ended goal's result stays available to a client that asks for it late (rclpy's
