@@ -238,6 +238,8 @@ def text(value: Any, what: str) -> str:
 
 
 def numbers(values: Any, what: str) -> list[float]:
+    if values is None:  # most of a request's arrays are absent
+        return []
     values = sequence(values, what)
     if all(type(v) is float for v in values):  # what the ROS edge gives: read as is, no name per element
         return values
@@ -245,6 +247,8 @@ def numbers(values: Any, what: str) -> list[float]:
 
 
 def integers(values: Any, what: str) -> list[int]:
+    if values is None:
+        return []
     values = sequence(values, what)
     if all(type(v) is int for v in values):
         return values

@@ -12,7 +12,7 @@ at tau(t). The feedrate ramps linearly, so tau(t) is piecewise quadratic:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -24,16 +24,16 @@ class ProfileClock:
     f0: float = 1.0
     f1: float = 1.0  # feedrate from t_end on (stored, so a finished ramp is exact)
     t_end: float = 0.0
+    # Derived once: every command piece and boundary time of every axis asks for them.
+    rate: float = field(init=False, repr=False, compare=False)  # the feedrate's slope in the ramp
+    tau_end: float = field(init=False, repr=False, compare=False)  # profile time at t_end
+
+    def __post_init__(self) -> None:
+        span = self.t_end - self.t0
+        object.__setattr__(self, "rate", (self.f1 - self.f0) / span if span > 0.0 else 0.0)
+        object.__setattr__(self, "tau_end", self.tau0 + 0.5 * (self.f0 + self.f1) * (self.t_end - self.t0))
 
     # -- scalar queries -------------------------------------------------------------
-    @property
-    def rate(self) -> float:
-        span = self.t_end - self.t0
-        return (self.f1 - self.f0) / span if span > 0.0 else 0.0
-
-    @property
-    def tau_end(self) -> float:
-        return self.tau0 + 0.5 * (self.f0 + self.f1) * (self.t_end - self.t0)
 
     def ramping(self, t: float) -> bool:
         return t < self.t_end

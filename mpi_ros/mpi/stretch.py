@@ -335,9 +335,7 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
             followers.append((anchor, end, forced, axis.plant, axis.rate))
             pieces.append((row, start, end))
             out.anchors[row].append(anchor)
-    rows_of = PlantRows.empty(len(followers))
-    for i, piece in enumerate(followers):
-        rows_of.set_piece(i, *piece, bank.table_index)
+    rows_of = PlantRows.of_pieces(followers, bank.table_index)
     act_p, act_v = _servo(rows_of, bank.tables, np.arange(len(pieces)), out, direct=False, following=True)
     shape = (len(pieces), len(t))
     act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
