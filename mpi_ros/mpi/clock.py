@@ -78,22 +78,33 @@ class ProfileClock:
 
     def time_of_tau(self, tau: float, t_from: float) -> float:
         """Earliest time >= t_from at which profile time reaches ``tau`` (inf if never)."""
-        if self.tau_at(t_from) >= tau:
-            return t_from
-        if t_from < self.t_end and self.tau_end >= tau:
-            # tau0 + f0 x + rate/2 x^2 = tau with x = t - t0, on the increasing branch.
-            c = self.tau0 - tau
-            rate = self.rate
-            if rate == 0.0:
-                x = -c / self.f0
+        return self.times_of_tau([tau], t_from)[0]
+
+    def times_of_tau(self, taus: list[float], t_from: float) -> list[float]:
+        """:meth:`time_of_tau` of each of ``taus`` (a plan's boundaries: what is common to
+        them is worked out once)."""
+        tau_from = self.tau_at(t_from)
+        t0, tau0, f0, f1, rate = self.t0, self.tau0, self.f0, self.f1, self.rate
+        t_end, tau_end = self.t_end, self.tau_end
+        times = []
+        for tau in taus:
+            if tau_from >= tau:
+                times.append(t_from)
+            elif t_from < t_end and tau_end >= tau:
+                # tau0 + f0 x + rate/2 x^2 = tau with x = t - t0, on the increasing branch.
+                c = tau0 - tau
+                if rate == 0.0:
+                    x = -c / f0
+                else:
+                    root = math.sqrt(max(0.0, f0 * f0 - 2.0 * rate * c))
+                    denominator = f0 + root
+                    x = (-2.0 * c) / denominator if denominator > 0.0 else (root - f0) / rate
+                times.append(max(t_from, t0 + x))
+            elif f1 <= 0.0:
+                times.append(math.inf)
             else:
-                root = math.sqrt(max(0.0, self.f0 * self.f0 - 2.0 * rate * c))
-                denominator = self.f0 + root
-                x = (-2.0 * c) / denominator if denominator > 0.0 else (root - self.f0) / rate
-            return max(t_from, self.t0 + x)
-        if self.f1 <= 0.0:
-            return math.inf
-        return max(t_from, self.t_end + (tau - self.tau_end) / self.f1)
+                times.append(max(t_from, t_end + (tau - tau_end) / f1))
+        return times
 
     def local_quadratic(self, t: float) -> tuple[float, float, float]:
         """tau(t + s) = q0 + q1 s + q2 s^2 for s within the current clock piece."""
