@@ -184,7 +184,9 @@ def trim_leading_zeros(coefficients: list[float]) -> list[float]:
     """Coefficients (low first) that give what Horner's scheme (plant.poly_eval) gives for
     ``coefficients`` at every s > 0, to the bit: a leading -0.0 passes the next coefficient
     on unchanged (-0 s + c is c), a leading +0.0 passes it on as c + 0.0 (only a -0.0
-    changes: to +0.0)."""
+    changes: to +0.0). The list itself when it has nothing to trim (not to be changed)."""
+    if len(coefficients) <= 1 or coefficients[-1] != 0.0:  # (nearly every piece's)
+        return coefficients
     out = list(coefficients)
     while len(out) > 1 and out[-1] == 0.0:
         leading = out.pop()
