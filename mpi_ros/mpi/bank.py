@@ -281,6 +281,7 @@ class AxisBank:
         self.clocks = ClockRows.empty(supervisor_count)
         self.tables: list[_FreeTable] = []
         self._memo: dict = {}
+        self._clock_memo: dict = {}  # derived from the clocks alone: kept while no clock changes
 
     def refresh(self, refresh_row: Callable[[int], None], reanchor_row: Callable[[int], None]) -> None:
         """Rebuild the stale rows (``refresh_row(number)`` does an axis), and those of the
@@ -311,6 +312,16 @@ class AxisBank:
             value = self._memo[key] = compute()
         return value
 
+    def clock_memo(self, key: Hashable, compute: Callable[[], T]) -> T:
+        """:meth:`memo` for a value derived from the clocks (ClockRows) and ``key`` alone:
+        kept across changes of the rows (a modify's new plan), until a clock changes."""
+        value = self._clock_memo.get(key)
+        if value is None:
+            if len(self._clock_memo) >= 64:  # (keys of rows no longer planned)
+                self._clock_memo.clear()
+            value = self._clock_memo[key] = compute()
+        return value
+
     def table_index(self, table: _FreeTable) -> int:
         """A small number for a free-response table (axes with identical loops share one)."""
         for i, known in enumerate(self.tables):
@@ -324,6 +335,7 @@ class AxisBank:
         self.clocks.set(number, clock)
         self.stale |= self.owner == number
         self._memo.clear()
+        self._clock_memo.clear()
 
     def reset_counters(self, row: int) -> None:
         self.runs[:, row] = 0
