@@ -209,34 +209,16 @@ def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
 
 def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
               single: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`_segment` for the rows that stay in one segment; :func:`_crossing` for those that
-    move on to another inside the stretch."""
+    """:func:`_segment` for the rows that stay in one segment; the plan's own evaluation
+    (AxisPlan.evaluate, one row at a time) for those that move on to another inside the stretch."""
     shape = rel.shape
     p, dp, ddp = np.empty(shape), np.empty(shape), np.empty(shape)
     if single.any():
         p[single], dp[single], ddp[single] = _segment(bank.command, rows[single], rel[single], lo[single],
                                                       hi[single], None)
-    crossing = ~single
-    p[crossing], dp[crossing], ddp[crossing] = _crossing(bank, rows[crossing], rel[crossing])
+    for i in np.flatnonzero(~single).tolist():
+        p[i], dp[i], ddp[i] = bank.plans[int(rows[i])].evaluate(rel[i])
     return p, dp, ddp
-
-
-def _crossing(bank: AxisBank, rows: np.ndarray, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """AxisPlan.evaluate of rows that pass from segment to segment: the segment of each sample
-    found row by row (SegmentTable.index on the row's plan), its coefficients gathered, and
-    all evaluated at once as SegmentTable.evaluate sums them (:func:`_cubic`), the end state
-    from the plan's end on (:func:`_completed`)."""
-    cmd = bank.command
-    inside = np.minimum(rel, cmd.duration[rows, None])
-    coefficients = np.empty((5, *rel.shape))
-    for i, row in enumerate(rows.tolist()):
-        table = bank.plans[row].table
-        index = table.index(inside[i])
-        for column, values in zip(coefficients, (table.start, table.p, table.v, table.a, table.j), strict=True):
-            np.take(values, index, out=column[i])
-    start, p, v, a, j = coefficients
-    pos, vel, acc = _cubic(start, p, v, a, j, inside, None)
-    return _completed(cmd, rows, rel, pos, vel, acc)
 
 
 def _clocks_of(bank: AxisBank, numbers: np.ndarray) -> tuple[np.ndarray, ClockColumns]:
@@ -283,21 +265,13 @@ def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray
         for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
             pos[group], vel[group], acc[group] = evaluate(cmd, rows[group], inside[group], None)
     if (hi >= duration).any():
-        return _completed(cmd, rows, rel, pos, vel, acc)
-    return pos, vel, acc
-
-
-def _completed(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, pos: np.ndarray, vel: np.ndarray,
-               acc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """From the plan's end on, the end state (AxisPlan.evaluate): on target at the final
-    velocity, no acceleration."""
-    duration = cmd.duration[rows, None]
-    complete = rel >= duration
-    target, final = cmd.target[rows, None], cmd.final_velocity[rows, None]
-    extra = np.maximum(rel - duration, 0.0)
-    pos = np.where(complete, target + final * extra, pos)
-    vel = np.where(complete, final, vel)
-    acc = np.where(complete, 0.0, acc)
+        duration = duration[:, None]
+        complete = rel >= duration
+        target, final = cmd.target[rows, None], cmd.final_velocity[rows, None]
+        extra = np.maximum(rel - duration, 0.0)
+        pos = np.where(complete, target + final * extra, pos)
+        vel = np.where(complete, final, vel)
+        acc = np.where(complete, 0.0, acc)
     return pos, vel, acc
 
 
@@ -320,14 +294,8 @@ def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
 
 def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
                    into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """SegmentTable.evaluate's sums, operation for operation (x + y and x y commute)."""
     start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
-    return _cubic(start, p, v, a, j, inside, into)
-
-
-def _cubic(start: np.ndarray, p: np.ndarray, v: np.ndarray, a: np.ndarray, j: np.ndarray, inside: np.ndarray,
-           into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """SegmentTable.evaluate's sums, operation for operation (x + y and x y commute), for
-    segment coefficients given as columns (one segment per row) or per sample."""
     dt = inside - start
     jerk = dt * j
     pos = np.divide(jerk, 6.0, out=into)
