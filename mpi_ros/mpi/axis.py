@@ -406,8 +406,8 @@ class Axis:
     def _command_of(self, clock: ProfileClock | None) -> _Command:
         """The command pieces of the plan (or rest) the axis follows now through ``clock``,
         found by what they derive from (as a flat tuple of values that hash without Python
-        calls: the clock's fields, which are what its equality compares). Looked up once per
-        question, not per piece."""
+        calls: the clock's fields, which are what its equality compares; not the mode, which
+        they do not depend on). Looked up once per question, not per piece."""
         plan = self.plan
         if plan is None or clock is None:
             key: tuple = (None, self.rest, self._held_feedforward)

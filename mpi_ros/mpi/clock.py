@@ -34,7 +34,6 @@ class ProfileClock:
         object.__setattr__(self, "tau_end", self.tau0 + 0.5 * (self.f0 + self.f1) * (self.t_end - self.t0))
 
     # -- scalar queries -------------------------------------------------------------
-
     def ramping(self, t: float) -> bool:
         return t < self.t_end
 
