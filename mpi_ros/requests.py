@@ -242,6 +242,8 @@ def text(value: Any, what: str) -> str:
 
 
 def numbers(values: Any, what: str) -> list[float]:
+    if values is None:  # most of a request's arrays are absent
+        return []
     values = sequence(values, what)
     if all(type(v) is float for v in values):  # what the ROS edge gives: read as is, no name per element
         return values
@@ -249,6 +251,8 @@ def numbers(values: Any, what: str) -> list[float]:
 
 
 def integers(values: Any, what: str) -> list[int]:
+    if values is None:
+        return []
     values = sequence(values, what)
     if all(type(v) is int for v in values):
         return values
@@ -322,34 +326,41 @@ _HOLD_TYPED = {"type": (HoldType, Message.MPIMessagePARAM_INVALID)}
 _OUTPUT_TYPED = {"type": (OutputType, Message.MPIMessagePARAM_INVALID)}
 
 
+# Each field of MotionParams a request may hold, with its reader, in the order they are read.
+_PARAM_READERS: dict[str, Callable[[Any, str], Any]] = {
+    "trajectory": lambda values, what: _structs(Trajectory, values, what),
+    "position": numbers,
+    "point_velocity": numbers,
+    "time": numbers,
+    "feedforward": numbers,
+    "final": boolean,
+    "retain": boolean,
+    "empty_count": integer,
+    "delay": numbers,
+    "id": integer,
+    "element_id": integers,
+    "final_velocity": numbers,
+    "hold": lambda values, what: _structs(Hold, values, what, _HOLD_TYPED),
+    "output": lambda values, what: _structs(Output, values, what, _OUTPUT_TYPED),
+    "event_mask": event_mask,
+    "master_start": integer,
+    "repeat_from": integer,
+    "master_distance": numbers,
+    "slave_position": numbers,
+    "gear_ratio": numbers,
+    "frames": lambda values, what: _structs(UserFrame, values, what),
+    "behavior": integer,
+    "low_count": integer,
+    "expected_axes": integer,
+}
+
+
 def motion_params(data: Any) -> MotionParams:
+    """The fields a request holds, read in _PARAM_READERS' order (a request with several bad
+    fields is refused for the first); the others keep MotionParams' defaults, which are what
+    reading their absence gives (a request holds a few of the two dozen: each is read once)."""
     data = mapping(data, "params")
-    return MotionParams(
-        trajectory=_structs(Trajectory, data.get("trajectory"), "trajectory"),
-        position=numbers(data.get("position"), "position"),
-        point_velocity=numbers(data.get("point_velocity"), "point_velocity"),
-        time=numbers(data.get("time"), "time"),
-        feedforward=numbers(data.get("feedforward"), "feedforward"),
-        final=boolean(data.get("final", True), "final"),
-        retain=boolean(data.get("retain", False), "retain"),
-        empty_count=integer(data.get("empty_count", 5), "empty_count"),
-        delay=numbers(data.get("delay"), "delay"),
-        id=integer(data.get("id", 0), "id"),
-        element_id=integers(data.get("element_id"), "element_id"),
-        final_velocity=numbers(data.get("final_velocity"), "final_velocity"),
-        hold=_structs(Hold, data.get("hold"), "hold", _HOLD_TYPED),
-        output=_structs(Output, data.get("output"), "output", _OUTPUT_TYPED),
-        event_mask=event_mask(data.get("event_mask"), "event_mask"),
-        master_start=integer(data.get("master_start", 0), "master_start"),
-        repeat_from=integer(data.get("repeat_from", 0), "repeat_from"),
-        master_distance=numbers(data.get("master_distance"), "master_distance"),
-        slave_position=numbers(data.get("slave_position"), "slave_position"),
-        gear_ratio=numbers(data.get("gear_ratio"), "gear_ratio"),
-        frames=_structs(UserFrame, data.get("frames"), "frames"),
-        behavior=integer(data.get("behavior", 0), "behavior"),
-        low_count=integer(data.get("low_count", 0), "low_count"),
-        expected_axes=integer(data.get("expected_axes", 0), "expected_axes"),
-    )
+    return MotionParams(**{name: read(data[name], name) for name, read in _PARAM_READERS.items() if name in data})
 
 
 def params_to_dict(params: MotionParams) -> dict[str, Any]:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
+import operator
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Generic, Self, TypeVar, overload
@@ -56,6 +57,22 @@ class AxisTrace:
         return len(self.samples)
 
 
+@dataclass(slots=True)
+class _Command:
+    """The command pieces of one plan read from one start through one clock with one held
+    feedforward (or of one rest): their boundary times (made when first asked for) and each
+    piece's steady response, by its start time."""
+
+    plan: AxisPlan | None  # kept while this lives: its id is in the key, and a plan freed
+    # meanwhile could hand its id to a new one (a path extended at the same start and clock)
+    times: list[float] | None = None
+    forced: dict[float, Forced] = field(default_factory=dict)
+
+
+_COMMANDS_KEPT = 64  # commands whose pieces an axis keeps (a modify makes a new one)
+_PIECES_KEPT = 256  # steady responses kept per command (a long path has a piece per segment)
+
+
 class CommandMode(Enum):
     SERVO = "SERVO"  # command drives the loop
     FOLLOW_ACTUAL = "FOLLOW_ACTUAL"  # settleOnEstopCmdEqAct: command = previous actual
@@ -71,6 +88,10 @@ class _Derived(Generic[V]):
 
     def __set_name__(self, owner: type, name: str) -> None:
         self.slot = "_" + name
+        # At run time the attribute is a property with this __set__ and a getter in C: a
+        # descriptor's Python __get__ costs a frame per read, and the stepping reads these
+        # attributes tens of times per command piece. (__get__ below is what type checkers see.)
+        setattr(owner, name, property(operator.attrgetter(self.slot), self.__set__))
 
     @overload
     def __get__(self, axis: None, owner: type | None = None) -> Self: ...
@@ -151,7 +172,7 @@ class Axis:
         self.element_id = 0
         self._held_feedforward = 0.0  # PTF/PVTF feedforward kept from move to move
         self.state = PlantState(0.0, 0.0, 0.0)
-        self._cache: dict = {}
+        self._cache: dict[tuple, _Command] = {}  # (_command_of)
         self._sampled: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # a cam slave's last trace
         self.status_mode = StatusMode.POINT_TO_POINT
         self.target = 0.0
@@ -382,37 +403,40 @@ class Axis:
         f, df = clock.feedrates(t)
         return p, dp * f, ddp * f * f + dp * df, rel
 
-    def _piece_key(self, clock: ProfileClock | None):
-        """What the command pieces derive from, as values that hash without Python calls
-        (the mode's name; the clock's fields, which are what its equality compares): the
-        key is hashed at every piece looked up."""
+    def _command_of(self, clock: ProfileClock | None) -> _Command:
+        """The command pieces of the plan (or rest) the axis follows now through ``clock``,
+        found by what they derive from (as a flat tuple of values that hash without Python
+        calls: the clock's fields, which are what its equality compares; not the mode, which
+        they do not depend on). Looked up once per question, not per piece."""
         plan = self.plan
         if plan is None or clock is None:
-            return (self.mode.value, None, self.rest, self._held_feedforward)
-        # The cache keeps the plan while entries keyed by its id exist: a plan freed meanwhile
-        # could hand its id to a new one (a path extended at the same tau_start and clock) and
-        # the new one would read the old one's pieces.
-        self._cache.setdefault(("plan", id(plan)), plan)
-        return (self.mode.value, id(plan), self.tau_start, (clock.t0, clock.tau0, clock.f0, clock.f1, clock.t_end),
-                self._held_feedforward)
+            key: tuple = (None, self.rest, self._held_feedforward)
+        else:
+            key = (id(plan), self.tau_start, clock.t0, clock.tau0, clock.f0, clock.f1, clock.t_end,
+                   self._held_feedforward)
+        command = self._cache.get(key)
+        if command is None:
+            if len(self._cache) >= _COMMANDS_KEPT:
+                self._cache.clear()
+            command = self._cache[key] = _Command(plan)
+        return command
 
-    def _boundary_times(self, key, clock: ProfileClock | None) -> list[float]:
+    def _boundary_times(self, command: _Command, clock: ProfileClock | None) -> list[float]:
         """All times at which the command polynomial changes (sorted)."""
-        cached = self._cache.get(("times", key))
-        if cached is not None:
-            return cached
+        if command.times is not None:
+            return command.times
         times: list[float] = []
         plan, tau_start = self.plan, self.tau_start
         if plan is not None and clock is not None:
             times.append(clock.t_end)
-            times += [clock.time_of_tau(tau_start + b, clock.t0) for b in plan.boundaries().tolist()]
-            times = sorted(set(x for x in times if math.isfinite(x)))
-        self._cache[("times", key)] = times
+            times += clock.times_of_tau([tau_start + b for b in plan.boundaries().tolist()], clock.t0)
+            times = sorted({x for x in times if -math.inf < x < math.inf})  # (the finite ones)
+        command.times = times
         return times
 
-    def _forced(self, key, ts: float, te: float, clock: ProfileClock | None) -> Forced:
+    def _forced(self, command: _Command, ts: float, te: float, clock: ProfileClock | None) -> Forced:
         """Steady response of the loop for the command piece [ts, te)."""
-        cached = self._cache.get(("piece", key, ts))
+        cached = command.forced.get(ts)
         if cached is not None:
             return cached
         plan, held = self.plan, self._held_feedforward
@@ -428,17 +452,17 @@ class Axis:
             ff_start, ff_poly = plan.feedforward_poly(rel, held)
             dac = compose(ff_poly, (q0 - tau_start - ff_start, q1, q2))
         forced = self.plant.prepare(poly, dac)
-        if len(self._cache) > 256:
-            self._cache.clear()
-        self._cache[("piece", key, ts)] = forced
+        if len(command.forced) >= _PIECES_KEPT:
+            command.forced.clear()
+        command.forced[ts] = forced
         return forced
 
     def _pieces(self, t_from: float, t_to: float, clock: ProfileClock | None):
         """[(start, end, steady response)] of the command pieces covering [t_from, t_to]."""
         if self.mode is CommandMode.COAST:
             return [(t_from, math.inf, None)]
-        key = self._piece_key(clock)
-        times = self._boundary_times(key, clock)
+        command = self._command_of(clock)
+        times = self._boundary_times(command, clock)
         i = bisect.bisect_right(times, t_from)
         cuts = [t_from]
         while i < len(times) and cuts[-1] <= t_to:
@@ -446,7 +470,7 @@ class Axis:
             i += 1
         if cuts[-1] <= t_to:
             cuts.append(math.inf)
-        return [(a, b, self._forced(key, a, b, clock)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
+        return [(a, b, self._forced(command, a, b, clock)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
 
     def steady(self, clock: ProfileClock | None) -> bool:
         """At rest with the loop settled: every coming sample is the same."""
@@ -596,11 +620,11 @@ class Axis:
 
     def _write_piece(self, clock: ProfileClock | None) -> None:
         """The command piece that starts at the anchor (what :meth:`_pieces` gives first)."""
-        key = self._piece_key(clock)
-        times = self._boundary_times(key, clock)
+        command = self._command_of(clock)
+        times = self._boundary_times(command, clock)
         i = bisect.bisect_right(times, self.state.t)
         end = times[i] if i < len(times) else math.inf
-        forced = self._forced(key, self.state.t, end, clock)
+        forced = self._forced(command, self.state.t, end, clock)
         bank, row = self._bank, self.number
         bank.plant.set_piece(row, self.state, end, forced, self.plant, self.rate, bank.table_index)
         at_rest = self.plan is None and not self.holding

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 
 from .clock import ProfileClock
-from .plant import _MAX_DEGREE, Forced, Plant, PlantState, Transient, _FreeTable
+from .plant import _MAX_DEGREE, Forced, Plant, PlantState, _FreeTable
 from .status import BITS, StatusRows
 
 if TYPE_CHECKING:
@@ -130,41 +130,63 @@ class PlantRows:
         rows.steady_dy = np.zeros((count, _MAX_TERMS))
         return rows
 
+    @classmethod
+    def of_pieces(cls, pieces: list[tuple[PlantState, float, Forced, Plant, float]],
+                  table_index: Callable[[_FreeTable], int]) -> PlantRows:
+        """One row per piece (anchor, end, steady response, plant, rate; see :meth:`set_piece`),
+        each column made from a list at once: setting a row's dozen numpy elements one by one
+        costs more than computing them."""
+        rows = [_piece_row(*piece, table_index) for piece in pieces]
+        count = len(rows)
+        columns = list(zip(*rows, strict=True)) if rows else [()] * (2 + len(_PIECE_COLUMNS))
+        scalars = {name: np.array(column, dtype=np.int64 if name in _INT_COLUMNS else float)
+                   for name, column in zip(_PIECE_COLUMNS, columns[2:], strict=True)}
+        return cls(steady_y=np.array(columns[0], dtype=float).reshape(count, _MAX_TERMS),
+                   steady_dy=np.array(columns[1], dtype=float).reshape(count, _MAX_TERMS),
+                   snap_after=np.full(count, math.inf), **scalars)
+
     def set_piece(self, row: int, anchor: PlantState, end: float, forced: Forced, plant: Plant, rate: float,
                   table_index: Callable[[_FreeTable], int]) -> None:
         """Row ``row``: the servo ``plant`` from ``anchor`` through a command piece ending at
         ``end`` with steady response ``forced`` (``table_index(table)`` numbers free-response
         tables)."""
-        self.anchor_t[row], self.piece_end[row] = anchor.t, end
-        self._set_steady(row, trim_leading_zeros(forced.y), trim_leading_zeros(forced.dy))
-        transient = plant.transient(anchor, forced, rate)
-        self._set_transient(row, transient, table_index(transient.table) if transient else 0)
-        self.resolution[row] = plant.config.encoder_resolution
+        steady_y, steady_dy, *scalars = _piece_row(anchor, end, forced, plant, rate, table_index)
+        self.steady_y[row] = steady_y
+        self.steady_dy[row] = steady_dy
+        for name, value in zip(_PIECE_COLUMNS, scalars, strict=True):
+            getattr(self, name)[row] = value
 
-    def _set_steady(self, row: int, y: list[float], dy: list[float]) -> None:
-        """The steady response's coefficients; rows are evaluated in groups of the same
-        length, exactly as plant.poly_eval evaluates one."""
-        self.steady_y[row] = y + [0.0] * (_MAX_TERMS - len(y))  # zero-padded: one write per row
-        self.steady_dy[row] = dy + [0.0] * (_MAX_TERMS - len(dy))
-        self.terms[row] = len(y)
 
-    def _set_transient(self, row: int, transient: Transient | None, table: int) -> None:
-        if transient is None:
-            self.k0[row], self.v0[row], self.v1[row], self.m0[row], self.m1[row] = 0, 0.0, 0.0, 0.0, 0.0
-            self.decayed_after[row] = -math.inf
-            return
-        self.k0[row] = transient.k0
-        self.v0[row], self.v1[row], self.m0[row], self.m1[row] = transient.v0, transient.v1, transient.m0, transient.m1
-        self.decayed_after[row] = transient.decayed_after
-        self.vanishing[row] = transient.k0 + transient.table.vanishing_count()
-        self.table[row] = table
+# The columns of a piece's row besides its steady response (_piece_row gives them in this order).
+_PIECE_COLUMNS = ("anchor_t", "piece_end", "terms", "k0", "v0", "v1", "m0", "m1", "decayed_after", "vanishing",
+                  "table", "resolution")
+_INT_COLUMNS = ("terms", "k0", "table")
+
+
+def _piece_row(anchor: PlantState, end: float, forced: Forced, plant: Plant, rate: float,
+               table_index: Callable[[_FreeTable], int]) -> tuple:
+    """A piece's row of PlantRows: the steady response's coefficients (zero-padded: rows are
+    evaluated in groups of the same length, exactly as plant.poly_eval evaluates one), then
+    the values of _PIECE_COLUMNS; without a transient, k0 and the transient's parts 0,
+    decayed_after -inf (none), vanishing inf and table 0 (unread)."""
+    y, dy = trim_leading_zeros(forced.y), trim_leading_zeros(forced.dy)
+    padded_y, padded_dy = y + [0.0] * (_MAX_TERMS - len(y)), dy + [0.0] * (_MAX_TERMS - len(dy))
+    resolution = plant.config.encoder_resolution
+    transient = plant.transient(anchor, forced, rate)
+    if transient is None:
+        return padded_y, padded_dy, anchor.t, end, len(y), 0, 0.0, 0.0, 0.0, 0.0, -math.inf, math.inf, 0, resolution
+    return (padded_y, padded_dy, anchor.t, end, len(y), transient.k0, transient.v0, transient.v1, transient.m0,
+            transient.m1, transient.decayed_after, transient.k0 + transient.table.vanishing_count(),
+            table_index(transient.table), resolution)
 
 
 def trim_leading_zeros(coefficients: list[float]) -> list[float]:
     """Coefficients (low first) that give what Horner's scheme (plant.poly_eval) gives for
     ``coefficients`` at every s > 0, to the bit: a leading -0.0 passes the next coefficient
     on unchanged (-0 s + c is c), a leading +0.0 passes it on as c + 0.0 (only a -0.0
-    changes: to +0.0)."""
+    changes: to +0.0). The list itself when it has nothing to trim (not to be changed)."""
+    if len(coefficients) <= 1 or coefficients[-1] != 0.0:  # (nearly every piece's)
+        return coefficients
     out = list(coefficients)
     while len(out) > 1 and out[-1] == 0.0:
         leading = out.pop()
@@ -259,6 +281,7 @@ class AxisBank:
         self.clocks = ClockRows.empty(supervisor_count)
         self.tables: list[_FreeTable] = []
         self._memo: dict = {}
+        self._clock_memo: dict = {}  # derived from the clocks alone: kept while no clock changes
 
     def refresh(self, refresh_row: Callable[[int], None], reanchor_row: Callable[[int], None]) -> None:
         """Rebuild the stale rows (``refresh_row(number)`` does an axis), and those of the
@@ -289,6 +312,16 @@ class AxisBank:
             value = self._memo[key] = compute()
         return value
 
+    def clock_memo(self, key: Hashable, compute: Callable[[], T]) -> T:
+        """:meth:`memo` for a value derived from the clocks (ClockRows) and ``key`` alone:
+        kept across changes of the rows (a modify's new plan), until a clock changes."""
+        value = self._clock_memo.get(key)
+        if value is None:
+            if len(self._clock_memo) >= 64:  # (keys of rows no longer planned)
+                self._clock_memo.clear()
+            value = self._clock_memo[key] = compute()
+        return value
+
     def table_index(self, table: _FreeTable) -> int:
         """A small number for a free-response table (axes with identical loops share one)."""
         for i, known in enumerate(self.tables):
@@ -302,6 +335,7 @@ class AxisBank:
         self.clocks.set(number, clock)
         self.stale |= self.owner == number
         self._memo.clear()
+        self._clock_memo.clear()
 
     def reset_counters(self, row: int) -> None:
         self.runs[:, row] = 0

@@ -12,7 +12,7 @@ at tau(t). The feedrate ramps linearly, so tau(t) is piecewise quadratic:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -24,17 +24,16 @@ class ProfileClock:
     f0: float = 1.0
     f1: float = 1.0  # feedrate from t_end on (stored, so a finished ramp is exact)
     t_end: float = 0.0
+    # Derived once: every command piece and boundary time of every axis asks for them.
+    rate: float = field(init=False, repr=False, compare=False)  # the feedrate's slope in the ramp
+    tau_end: float = field(init=False, repr=False, compare=False)  # profile time at t_end
+
+    def __post_init__(self) -> None:
+        span = self.t_end - self.t0
+        object.__setattr__(self, "rate", (self.f1 - self.f0) / span if span > 0.0 else 0.0)
+        object.__setattr__(self, "tau_end", self.tau0 + 0.5 * (self.f0 + self.f1) * (self.t_end - self.t0))
 
     # -- scalar queries -------------------------------------------------------------
-    @property
-    def rate(self) -> float:
-        span = self.t_end - self.t0
-        return (self.f1 - self.f0) / span if span > 0.0 else 0.0
-
-    @property
-    def tau_end(self) -> float:
-        return self.tau0 + 0.5 * (self.f0 + self.f1) * (self.t_end - self.t0)
-
     def ramping(self, t: float) -> bool:
         return t < self.t_end
 
@@ -78,22 +77,33 @@ class ProfileClock:
 
     def time_of_tau(self, tau: float, t_from: float) -> float:
         """Earliest time >= t_from at which profile time reaches ``tau`` (inf if never)."""
-        if self.tau_at(t_from) >= tau:
-            return t_from
-        if t_from < self.t_end and self.tau_end >= tau:
-            # tau0 + f0 x + rate/2 x^2 = tau with x = t - t0, on the increasing branch.
-            c = self.tau0 - tau
-            rate = self.rate
-            if rate == 0.0:
-                x = -c / self.f0
+        return self.times_of_tau([tau], t_from)[0]
+
+    def times_of_tau(self, taus: list[float], t_from: float) -> list[float]:
+        """:meth:`time_of_tau` of each of ``taus`` (a plan's boundaries: what is common to
+        them is worked out once)."""
+        tau_from = self.tau_at(t_from)
+        t0, tau0, f0, f1, rate = self.t0, self.tau0, self.f0, self.f1, self.rate
+        t_end, tau_end = self.t_end, self.tau_end
+        times = []
+        for tau in taus:
+            if tau_from >= tau:
+                times.append(t_from)
+            elif t_from < t_end and tau_end >= tau:
+                # tau0 + f0 x + rate/2 x^2 = tau with x = t - t0, on the increasing branch.
+                c = tau0 - tau
+                if rate == 0.0:
+                    x = -c / f0
+                else:
+                    root = math.sqrt(max(0.0, f0 * f0 - 2.0 * rate * c))
+                    denominator = f0 + root
+                    x = (-2.0 * c) / denominator if denominator > 0.0 else (root - f0) / rate
+                times.append(max(t_from, t0 + x))
+            elif f1 <= 0.0:
+                times.append(math.inf)
             else:
-                root = math.sqrt(max(0.0, self.f0 * self.f0 - 2.0 * rate * c))
-                denominator = self.f0 + root
-                x = (-2.0 * c) / denominator if denominator > 0.0 else (root - self.f0) / rate
-            return max(t_from, self.t0 + x)
-        if self.f1 <= 0.0:
-            return math.inf
-        return max(t_from, self.t_end + (tau - self.tau_end) / self.f1)
+                times.append(max(t_from, t_end + (tau - tau_end) / f1))
+        return times
 
     def local_quadratic(self, t: float) -> tuple[float, float, float]:
         """tau(t + s) = q0 + q1 s + q2 s^2 for s within the current clock piece."""

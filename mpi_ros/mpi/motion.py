@@ -51,6 +51,9 @@ from .types import (
 
 OK = Message.MPIMessageOK
 # Attributes that belong to a start, not to the on-the-fly modify of mpiMotionParamsSet.
+# Bits read on every start and modify, as plain ints (an IntFlag's ``in`` is a Python call).
+_APPEND, _AUTO_START, _DELAY = int(MotionAttr.APPEND), int(MotionAttr.AUTO_START), int(MotionAttr.DELAY)
+_NO_WAIT, _NO_HANDSHAKE = int(MotionAttr.NO_WAIT), int(MotionAttr.NO_HANDSHAKE)
 _START_ONLY = (MotionAttr.APPEND | MotionAttr.AUTO_START | MotionAttr.DELAY | MotionAttr.HOLD
                | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER)
 # meiMotionActionFunction: called with (motion, motion type, action name) on every
@@ -428,15 +431,16 @@ class MotionSupervisor:
     def command(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
                 modify: bool) -> tuple[Outcome, int]:
         """Start or modify; returns the outcome and the serial of the move it made or changed."""
-        if MotionAttr.NO_WAIT in attrs:
+        bits = int(attrs)
+        if bits & _NO_WAIT:
             # nothing to follow: the call did not wait for the move
             return self._command_no_wait(motion_type, attrs, params, modify), 0
         outcome = self._command(motion_type, attrs, params, modify)
-        if outcome.ok and (MotionAttr.NO_HANDSHAKE in attrs or MotionAttr.NO_WAIT in attrs):
+        if outcome.ok and bits & (_NO_HANDSHAKE | _NO_WAIT):
             self._state.unacknowledged = self._host.sample  # status reads IDLE until the next sample
         current = self._moves.current
         serial = current.serial if current is not None else 0
-        if outcome.message in (OK, Message.MPIMotionMessageAUTO_START) and MotionAttr.APPEND in attrs:
+        if outcome.message in (OK, Message.MPIMotionMessageAUTO_START) and bits & _APPEND:
             if self._moves.queue:
                 serial = self._moves.queue[-1].serial
             elif current is not None and current.stream is not None and current.stream.chunks:
@@ -451,8 +455,9 @@ class MotionSupervisor:
             params = self.stored_params
         if not self._axis_list.listed:
             return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes")
+        bits = int(attrs)
         verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21,
-                                      append=MotionAttr.APPEND in attrs)
+                                      append=bool(bits & _APPEND))
         if not verdict.ok:
             return verdict
         state = self._moves.state_for(self._axis_list.listed)
@@ -465,11 +470,11 @@ class MotionSupervisor:
             axis, other, other_state = held[0]
             return Outcome(STATE_MESSAGES[state.name], (f"axis {axis} is in the {other_state.name} motion of "
                                                         f"supervisor {other}: command it there, or RESET it"))
-        append = MotionAttr.APPEND in attrs
+        append = bool(bits & _APPEND)
         auto_start = False
         if modify:
             if state is MPIState.IDLE:
-                if MotionAttr.AUTO_START not in attrs:
+                if not bits & _AUTO_START:
                     return Outcome(Message.MPIMotionMessageIDLE, "no motion in progress to modify")
                 auto_start = True
             elif state is not MPIState.MOVING:
@@ -485,7 +490,7 @@ class MotionSupervisor:
             return verdict
         if open_path is not None:
             return self._append_points(open_path, motion_type, attrs, params)
-        if modify and not auto_start and MotionAttr.DELAY in attrs and any(d != 0.0 for d in params.delay):
+        if modify and not auto_start and bits & _DELAY and any(d != 0.0 for d in params.delay):
             # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
             return Outcome(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")

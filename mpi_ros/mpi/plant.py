@@ -127,12 +127,16 @@ class Plant:
 
     @staticmethod
     def _particular(u: list[float], gains: list[float]) -> list[float]:
-        out = [0.0] * len(u)
+        """sum_m g_m u^(m): out[i] = 0.0 + g_0 u[i] + g_1 u'[i] + ..., summed in that order
+        (the 0.0 first: a -0.0 product comes out +0.0), each derivative as poly_der makes it.
+        Written out in place, since it runs for every command piece."""
+        out = [0.0 + gains[0] * c for c in u]
         deriv = u
-        for g in gains[: len(u)]:
-            # out[i] += g c; deriv shortens by one each time (the rest of out stays)
-            out[: len(deriv)] = [o + g * c for o, c in zip(out, deriv, strict=False)]
-            deriv = poly_der(deriv)
+        for m in range(1, min(len(u), len(gains))):
+            deriv = [i * c for i, c in enumerate(deriv) if i]  # poly_der (never empty here)
+            g = gains[m]
+            for i, c in enumerate(deriv):
+                out[i] += g * c
         return out
 
     def _free(self, s: float) -> tuple[float, float]:
@@ -481,9 +485,21 @@ def compose(segment_poly: list[float], quadratic: tuple[float, float, float]) ->
     """segment_poly(q0 + q1 s + q2 s^2) as coefficients in s (low first)."""
     if len(segment_poly) == 1:  # a constant (no feedforward: [held]) stays itself
         return [segment_poly[0]]
+    if len(segment_poly) == 4 and quadratic[2] == 0.0:
+        return _cubic_of_linear(segment_poly, quadratic[0], quadratic[1])
     q = list(quadratic) if quadratic[2] != 0.0 else list(quadratic[:2])
     out = [segment_poly[-1]]
     for c in reversed(segment_poly[:-1]):
         out = _poly_mul(out, q)
         out[0] += c
     return out
+
+
+def _cubic_of_linear(cubic: list[float], q0: float, q1: float) -> list[float]:
+    """:func:`compose` of a cubic with q0 + q1 s (a segment while the feedrate does not ramp:
+    nearly every command piece), its loop written out: each product of _poly_mul summed in
+    its order (coefficient k: 0.0 + out[k-1] q1 + out[k] q0), then the next coefficient added."""
+    c0, c1, c2, c3 = cubic
+    a0, a1 = 0.0 + c3 * q0 + c2, 0.0 + c3 * q1
+    b0, b1, b2 = 0.0 + a0 * q0 + c1, 0.0 + a0 * q1 + a1 * q0, 0.0 + a1 * q1
+    return [0.0 + b0 * q0 + c0, 0.0 + b0 * q1 + b1 * q0, 0.0 + b1 * q1 + b2 * q0, 0.0 + b2 * q1]

@@ -16,6 +16,7 @@ The arrays live in a :class:`Scratch` and are reused by the next stretch.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -182,7 +183,8 @@ def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
 def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
     """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate)."""
     cmd = bank.command
-    which, clocks = bank.memo(("clocks", rows.tobytes()), lambda: _clocks_of(bank, rows))
+    numbers = cmd.clock[rows]  # (the clocks the rows run on: the key, as a modify keeps them)
+    which, clocks = bank.clock_memo(numbers.tobytes(), lambda: _clocks_of(bank, numbers))
     tau, f, df = clocks.evaluate(out.t, out.scratch)
     rel = np.take(tau, which, axis=0, out=out.target("rel", rows))
     rel -= cmd.tau_start[rows, None]
@@ -219,10 +221,10 @@ def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
     return p, dp, ddp
 
 
-def _clocks_of(bank: AxisBank, rows: np.ndarray) -> tuple[np.ndarray, ClockColumns]:
-    """Each row's index among the clocks its rows run on, and those clocks."""
-    numbers, which = np.unique(bank.command.clock[rows], return_inverse=True)
-    return which, bank.clocks.columns(numbers)
+def _clocks_of(bank: AxisBank, numbers: np.ndarray) -> tuple[np.ndarray, ClockColumns]:
+    """Each row's index among the clocks (``numbers``: each row's) its rows run on, and those clocks."""
+    distinct, which = np.unique(numbers, return_inverse=True)
+    return which, bank.clocks.columns(distinct)
 
 
 def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -234,7 +236,10 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     for i in np.flatnonzero(~keep).tolist():
         row = int(rows[i])
         plan = bank.plans[row]
-        first, last = plan.table.index(np.array([lo[i], hi[i]])).tolist()
+        table = plan.table
+        # SegmentTable.index of the two times (bisect_right is its searchsorted on two values,
+        # without numpy's cost per call)
+        first, last = (min(bisect.bisect_right(table.end, x), table.count - 1) for x in (lo[i], hi[i]))
         if first == last:
             cmd.set_segment(row, plan, first)
             keep[i] = True
@@ -335,9 +340,7 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
             followers.append((anchor, end, forced, axis.plant, axis.rate))
             pieces.append((row, start, end))
             out.anchors[row].append(anchor)
-    rows_of = PlantRows.empty(len(followers))
-    for i, piece in enumerate(followers):
-        rows_of.set_piece(i, *piece, bank.table_index)
+    rows_of = PlantRows.of_pieces(followers, bank.table_index)
     act_p, act_v = _servo(rows_of, bank.tables, np.arange(len(pieces)), out, direct=False, following=True)
     shape = (len(pieces), len(t))
     act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
