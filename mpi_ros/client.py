@@ -71,6 +71,8 @@ _SUPERVISOR_NODE = re.compile(r"ms(\d+)")
 _POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
 RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting for its result
 RESULT_REASK = 2.0  # s without an answer after asking again (the server came back) before asking once more
+# The goal states after which the server has a result to give.
+_ENDED = frozenset({GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_CANCELED, GoalStatus.STATUS_ABORTED})
 # Every node of a process is announced together (one DDS participant per context), but give
 # a late announcement a moment before saying a supervisor is not there.
 _GRACE = 0.5
@@ -573,7 +575,8 @@ class Goal:
     Its result survives a lost link: while waiting, the goal watches its action server on
     the graph; when the server has left it (a link down past the DDS lease) and comes back,
     the goal asks for its result again (the suite keeps results of ended goals), because an
-    answer sent while the link was down is lost (docs/cell.md, "A cut link")."""
+    answer sent while the link was down is lost (docs/cell.md, "A cut link"). It asks again
+    too when the goal's status says it ended and no result has come within RESULT_REASK."""
 
     def __init__(self, client: MotionClient, handle: Any, result_future: Any, progress: threading.Event,
                  action_client: ActionClient | None = None):
@@ -626,16 +629,22 @@ class Goal:
         deadline = time.monotonic() + timeout
         lost = False
         asked_at: float | None = None
+        ended_at: float | None = None  # when the goal's status was first seen terminal
         while not self._finished.wait(max(0.0, min(RESULT_RECHECK, deadline - time.monotonic()))):
             now = time.monotonic()
             if now >= deadline or self._action_client is None:
                 return
+            if ended_at is None and self.handle.status in _ENDED:
+                ended_at = now
+            quiet_since = asked_at if asked_at is not None else ended_at
             if not self._action_client.server_is_ready():
                 lost = True
-            elif lost or (asked_at is not None and now - asked_at >= RESULT_REASK):
+            elif lost or (quiet_since is not None and now - quiet_since >= RESULT_REASK):
                 # Right after a link comes back the suite may answer before its middleware
                 # has matched this client's reader again, and that answer is dropped: ask
-                # again until one arrives.
+                # again until one arrives. The same when the goal's status says it ended
+                # and no result follows: a link cut too briefly for the graph to lose the
+                # server can drop the answer without the server ever seeming gone.
                 lost = False
                 asked_at = now
                 self._ask_again()

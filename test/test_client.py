@@ -7,14 +7,19 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import threading
+from concurrent.futures import Future
 from types import SimpleNamespace
 
 import pytest
+from action_msgs.msg import GoalStatus
 
 from mpi_ros import errors
+from mpi_ros.action import MotionStart
 from mpi_ros.client import (
     Action,
     EventType,
+    Goal,
     MotionResult,
     MotionType,
     Outcome,
@@ -144,7 +149,6 @@ def test_client_and_errors_import_nothing_of_the_simulated_controller():
 # The controller's side is in test/ros/test_paths_ros.py; here the goals the client sends and
 # the cues it follows: this supervisor's FRAMES_LOW on /mpi/events, and a MotionStatus of the
 # running path with few frames left. Goals are recorded and ended by the test.
-import threading  # noqa: E402 - these tests were added at the end of the module
 
 
 def test_interleave_and_path_goal_build_the_goals_flat_lists():
@@ -354,3 +358,24 @@ def test_path_sends_one_goal_and_raises_as_move_does(recorder):
     future.set_result(_ros_result("MEIMotionMessageBAD_PATH_DATA", "a path value is infinite or NaN", 5, 5, 6))
     with pytest.raises(errors.MEIMotionMessageBAD_PATH_DATA):
         running.wait()
+
+
+def test_a_goal_whose_status_ended_without_a_result_asks_for_it_again():
+    # The answer to the first result request was lost (a link cut too briefly for the graph
+    # to lose the server): the status says SUCCEEDED, so the goal asks again.
+    response = MotionStart.Impl.GetResultService.Response(
+        status=GoalStatus.STATUS_SUCCEEDED, result=MotionStart.Result(message="MPIMessageOK"))
+    asked: list[Future] = []
+
+    def get_result_async() -> Future:
+        answer: Future = Future()
+        answer.set_result(response)
+        asked.append(answer)
+        return answer
+
+    handle = SimpleNamespace(status=GoalStatus.STATUS_SUCCEEDED, get_result_async=get_result_async)
+    client = SimpleNamespace(timeout=10.0, _on_executor=lambda call: call())
+    server = SimpleNamespace(server_is_ready=lambda: True)
+    goal = Goal(client, handle, Future(), threading.Event(), server)  # type: ignore[arg-type]
+    result = goal.wait(10.0)
+    assert result.message == "MPIMessageOK" and goal.asked_again == 1 and len(asked) == 1

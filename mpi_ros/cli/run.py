@@ -59,6 +59,9 @@ M_MMAP_THRESHOLD = -3  # glibc's mallopt parameter (malloc.h)
 MMAP_THRESHOLD = 128 * 1024  # bytes: glibc's default, kept fixed
 
 
+GC_THRESHOLDS = (20_000, 20, 10)  # the collector's generations (Python's defaults: 700, 10, 10)
+
+
 def release_large_buffers() -> bool:
     """Have glibc give every buffer of 128 kB or more back to the system when it is freed.
 
@@ -130,6 +133,14 @@ def run(args) -> int:
     # 100,000-point stream (bench/RESULTS.md), a stall the 128-frame buffer (128 ms of 1 ms
     # points) cannot ride out: the clock then caught up in one batch and the path starved.
     gc.freeze()
+    # The young generation collected every 20,000 objects allocated and not freed rather than
+    # every 700: the suite's garbage is nearly all freed by reference counting, while its
+    # long-lived objects (goals kept for result_timeout, requests waiting) made each young
+    # collection promote more and each full one walk them all. At 800 modify goals a second
+    # the collector held the interpreter 12.6 s in a minute (23 full collections of ~350 ms,
+    # each a stall of the clock); so set, 4.1 s (3 full collections). bench/RESULTS.md, "The
+    # collector and the goal queue".
+    gc.set_threshold(*GC_THRESHOLDS)
     release_large_buffers()
     suite.start(spin_in_thread=False)
     try:

@@ -8,7 +8,7 @@ commands did (bench/RESULTS.md, "The goal path without the executors"). This loo
 holds only the goal servers' handles (three services and a timer each) and a guard
 condition: made once, refilled each round with a few C calls. What a round takes is served
 on a pool of threads (a goal's command waits there for its sample, never in this thread),
-each server's batches in the order they were taken (GoalServer.serve).
+each server's batches in the order they were taken, by one task at a time (GoalServer.serve).
 
 The loop must be stopped (``stop``) before the nodes holding its servers are destroyed.
 """
@@ -96,6 +96,5 @@ class GoalLoop:
         if self._stopping:
             return
         for server in self._servers:
-            if server.is_ready(wait_set):
-                server.take_data()
+            if server.is_ready(wait_set) and server.take_data():
                 self._pool.submit(server.serve)
