@@ -65,11 +65,13 @@ from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
 from .goal_tracker import GoalBook, TrackedGoal
 from .watchdog import LostClientWatchdog
 
-# The status writers keep 100 samples for their readers: a suite catching up after a stall
-# publishes many status points of a topic at once, and a reliable writer keeping only 10
-# dropped the oldest of a burst before a reader had them (gaps in the soak). Depth is not part
-# of QoS matching, so readers keep whatever history they ask for.
-STATUS_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+# The status writers keep 1000 samples for their readers: a suite catching up after a stall
+# publishes many status points of a topic at once, and a reliable writer keeping fewer drops
+# the oldest of a burst before a reader has them (gaps in the soak: with 10, and with 100 in a
+# 10-minute soak that fell 2.4 s behind, 235 points of each topic at once). 1000 rides out 10 s
+# at 100 Hz, 1 s at 1 kHz. Depth is not part of QoS matching, so readers keep whatever history
+# they ask for.
+STATUS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feedback publisher
 # The action's services default to a history of 10: an E_STOP that ends more goals than
 # that at once would drop results. Deep enough for every goal a frame buffer can queue.
