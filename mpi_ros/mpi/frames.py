@@ -13,7 +13,7 @@ import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Self
 
 import numpy as np
 
@@ -75,6 +75,46 @@ class AxisPlan:
         if not self.segments:
             self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
         self.duration = end_time(self.segments, self.origin_time) if self.cam is None else self.cam.duration
+
+    @classmethod
+    def with_duration(cls, segments: list[Segment] | None, duration: float, axis: int, start_position: float,
+                      target: float, final_velocity: float, hold: Hold | None, outputs: list[Output], truncated: bool,
+                      limits: Trajectory | None, start_velocity: float, start_acceleration: float,
+                      composite: str) -> Self:
+        """A point-to-point plan (not a VELOCITY move, a path or a cam: origin_time 0) whose
+        ``duration``, ``end_time(segments)``, its planner has calculated already (with the
+        segments: scurve.reshaped), as ``cls(...)`` makes it. Its slots are filled here rather than
+        by the dataclass' __init__ and __post_init__, which would add the segments up again, a
+        pass of their own, behind two calls (a modify is planned while its command waits).
+        ``segments`` None: a ScaledAxisPlan's, made when first asked for."""
+        if segments is not None and not segments:  # (as __post_init__: a plan holds at least its end)
+            segments = [Segment(0.0, target, final_velocity, 0.0, 0.0)]
+            duration = end_time(segments)
+        plan = _new_object(cls)
+        _segments_slot.__set__(plan, segments)  # (past ScaledAxisPlan's property)
+        plan.duration = duration
+        plan.axis = axis
+        plan.start_position = start_position
+        plan.target = target
+        plan.final_velocity = final_velocity
+        plan.hold = hold
+        plan.outputs = outputs
+        plan.truncated = truncated
+        plan.limits = limits
+        plan.start_velocity = start_velocity
+        plan.start_acceleration = start_acceleration
+        plan.composite = composite
+        # the other fields' defaults (test_planner checks that every field is as cls(...) makes it)
+        plan.velocity_target = None
+        plan.ramp_end = 0.0
+        plan.origin_time = 0.0
+        plan.point_times = None
+        plan.element_ids = ()
+        plan.timed_outputs = []
+        plan.feedforward = None
+        plan.cam = None
+        plan._table = None
+        return plan
 
     @property
     def table(self) -> SegmentTable:
@@ -182,7 +222,8 @@ class AxisPlan:
 
 # The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
 _segments_slot = AxisPlan.__dict__["segments"]
-_init_plan = AxisPlan.__init__  # (ScaledAxisPlan.of: a global, not an attribute of the class looked up per plan)
+_new_object = object.__new__
+_with_duration = AxisPlan.with_duration.__func__  # type: ignore[attr-defined]  # (ScaledAxisPlan.of's, for its class)
 
 
 class ScaledAxisPlan(AxisPlan):
@@ -200,16 +241,12 @@ class ScaledAxisPlan(AxisPlan):
     def of(cls, scaled: ScaledProfile, duration: float, axis: int, start_position: float, target: float,
            final_velocity: float, hold: Hold | None, outputs: list[Output], limits: Trajectory | None,
            start_velocity: float, start_acceleration: float, composite: str) -> ScaledAxisPlan:
-        """The plan of a vector's axis: AxisPlan's fields of a point-to-point plan (not a
-        VELOCITY move, not truncated, origin_time 0), the segments left out. ``duration``:
-        ``end_time(scaled.line)``, the same durations added in the same order as
-        AxisPlan.__post_init__ adds the segments' (the vector's axes share it: calculated once).
-        (Named parameters, not ``*fields``: packing and unpacking them cost a third of the plan.)"""
-        plan = cls.__new__(cls)
+        """The plan of a vector's axis: AxisPlan.with_duration's, not truncated, the segments left out.
+        ``duration``: ``end_time(scaled.line)``, the same durations added in the same order as
+        ``end_time(scaled.segments())`` adds the segments' (the vector's axes share it: calculated once)."""
+        plan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold, outputs, False,
+                        limits, start_velocity, start_acceleration, composite)
         plan.scaled = scaled
-        plan.duration = duration
-        _init_plan(plan, axis, None, start_position, target, final_velocity, hold, outputs,  # type: ignore[arg-type]
-                   None, 0.0, False, limits, start_velocity, start_acceleration, composite)  # (segments when asked for)
         return plan
 
     def __post_init__(self) -> None:

@@ -26,12 +26,12 @@ from .events import MPIEventType
 from .frames import AxisPlan, Move, ScaledAxisPlan, Stream
 from .messages import Message
 from .outcome import Refused
-from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, MotionParams, Trajectory
+from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, Hold, MotionParams, Output, Trajectory
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import reverses, velocity_move
 from .profiles.ramps import ProfileError, plan_point_to_point, ramps_between
-from .profiles.scurve import reshape
+from .profiles.scurve import reshape, reshaped
 from .profiles.segment import ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
 
@@ -47,6 +47,9 @@ _IN_MOTION_REFUSED = _DELAY | _HOLDS  # a move that starts in motion may not wai
 _PADDED = _SYNC | _DELAY  # profiles with wait frames: not reshape's chain of pieces
 _AXIS_BY_AXIS = _DELAY | _NO_REVERSAL  # a vector's axes made and checked one by one
 _HOLD_OR_OUTPUT = _HOLDS | _OUTPUT
+# The attributes that change a point-to-point axis' plan: without them one axis is planned by
+# _lone_axis_plan, the general path's lists and tests left out
+_GENERAL = _RELATIVE | _FINAL_VEL | _SYNC | _DELAY | _NO_REVERSAL | _HOLD_OR_OUTPUT
 # The motion types planning tells apart, looked up once: an enum member is a class attribute
 # lookup of ~0.1 us each time.
 _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
@@ -152,21 +155,17 @@ def _check_lands(segments: list[Segment], start: AxisStart, target: float, end: 
 
 
 def _checked(segments: list[Segment], start: AxisStart, target: float, limit: float, notes: PlanNotes,
-             chained: bool) -> tuple[list[Segment], bool]:
+             end: float, duration: float | None) -> tuple[list[Segment], bool]:
     """An axis' plan after the landing, overflow and frame-limit checks: cut at the first frame
-    longer than ``limit`` seconds (16,384,000 samples), and whether it was. ``chained``: the
-    segments are reshape's, each starting where the one before ends, so that one that lands
-    is finite throughout (_finite_if_it_ends); otherwise one pass over them finds every segment
-    finite and within the limit, the usual case."""
-    end = _end_position(segments[-1]) if segments else start.position
+    longer than ``limit`` seconds (16,384,000 samples), and whether it was. ``end``: where the
+    segments end (_end_position of the last; the start without any). ``duration``: their
+    end_time when they are reshape's (each starting where the one before ends, so that one that
+    lands is finite throughout: _finite_if_it_ends), None otherwise: then one pass over them
+    finds every segment finite and within the limit, the usual case."""
     if not _on_target(end, start, target):
         _check_lands(segments, start, target, end)
-    if chained:
-        for segment in segments:
-            if segment[0] > limit:  # (its duration: a loop with an index costs half of max(map(...)))
-                break
-        else:
-            return segments, False  # landed: finite (and reshape's pieces are positive)
+    if duration is not None and _within(segments, duration, limit):
+        return segments, False  # landed: finite (and reshape's pieces are positive)
     for d, p, v, a, j in segments:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
         if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
@@ -175,34 +174,41 @@ def _checked(segments: list[Segment], start: AxisStart, target: float, limit: fl
     return segments, False
 
 
-def _finite_if_it_ends(segments: list[Segment]) -> bool:
-    """Whether the end position of ``segments`` (reshape's: each starts at the position where
-    the one before ends, as Segment.end_state calculates it) is finite, which makes every value
+def _within(segments: list[Segment], duration: float, limit: float) -> bool:
+    """No segment of a 1-D profile (reshape's: finite if it lands, no duration below 0) lasts
+    longer than ``limit``; ``duration``: theirs. Durations of at least 0 add up to at least each
+    of them, in floating point too (rounding is monotonic), so one comparison answers the usual
+    case; a profile that lasts longer than the limit is asked segment by segment."""
+    return duration <= limit or not any(segment[0] > limit for segment in segments)  # (segment[0]: its duration)
+
+
+def _finite_if_it_ends(end: float) -> bool:
+    """Whether ``end``, the end position of reshape's segments (each starts at the position where
+    the one before ends, as Segment.end_state calculates it), is finite, which makes every value
     of every segment finite: each enters that end position through +, -, * and division by a
     constant, where an infinite or NaN operand gives an infinite or NaN result (a product too:
     the pieces last more than 0 s). This is what _check_finite's pass would find."""
-    return math.isfinite(_end_position(segments[-1]))
+    return math.isfinite(end)
 
 
-def _line_bound(line: list[Segment], limit: float, chained: bool) -> float | None:
+def _line_bound(line: Line, limit: float, chained: bool) -> float | None:
     """The largest |position| in a vector's 1-D profile if all its values are finite and no
     frame exceeds ``limit`` (None otherwise, or for no profile). An axis' share of it, with
     a factor of at most 1 and a start ``offset``, is then finite and within the limit too when
     abs(offset) + this bound is finite: rounding to nearest is monotonic, so no product or sum
     of the scaling exceeds it in magnitude. ``chained``: the profile is reshape's (_checked)."""
-    if not line:
+    segments, end, duration = line
+    if not segments:
         return None
     bound = 0.0
     if chained:
-        if not _finite_if_it_ends(line):
+        if not (_finite_if_it_ends(end) and _within(segments, duration, limit)):
             return None
-        for segment in line:  # (a loop with indexes costs half of max(map(...)) twice)
-            if segment[0] > limit:  # (its duration)
-                return None
+        for segment in segments:  # (a loop with indexes costs half of max(map(...)))
             if abs(segment[1]) > bound:  # (its position)
                 bound = abs(segment[1])
         return bound
-    for d, p, v, a, j in line:
+    for d, p, v, a, j in segments:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
         if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
             return None
@@ -243,20 +249,27 @@ def _wait(position: float, duration: float) -> list[Segment]:
 
 
 def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float, v_final: float, traj: Trajectory):
-    return _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, v_final, traj)
+    return _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, v_final, traj)[0]
+
+
+# A 1-D profile: its segments, where they end (the position Segment.end_state gives at the end
+# of the last; the start without any) and its duration (end_time of the segments). The planner
+# checks and times every profile: reshape calculates both as it makes the segments.
+Line = tuple[list[Segment], float, float]
 
 
 def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
-                  traj: Trajectory) -> list[Segment]:
+                  traj: Trajectory) -> Line:
     """The 1-D profile of a point-to-point type from (p0, v0, a0); a0 is read by the jerk types only."""
     if motion_type is _S_CURVE_JERK:
-        return point_to_point_jerk(
+        segments = point_to_point_jerk(
             p0, v0, a0, target, v_final, traj.velocity,
             (traj.acceleration, traj.acceleration_jerk), (traj.deceleration, traj.deceleration_jerk))
+        return segments, _end_position(segments[-1]) if segments else p0, end_time(segments)
     jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
     # point_to_point's two steps, without its call (a modify is planned while its command waits)
     plan = plan_point_to_point(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
-    return reshape(plan, p0, jerk_percent)
+    return reshaped(plan, p0, jerk_percent)
 
 
 def _scaled(traj: Trajectory, share: float) -> Trajectory:
@@ -311,11 +324,13 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
     return along, True
 
 
-def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[Profile], list[Trajectory], str]:
+def _vector_profiles(motion_type, starts, targets, finals,
+                     traj) -> tuple[list[Profile], list[Trajectory], str, Line | None]:
     """One profile along the straight line from the start to the targets, each axis'
-    effective limits (the vector's scaled by the axis' share of the line), and why the
-    profiles are not one profile per axis ("" when they are). Plain floats: a vector has at
-    most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
+    effective limits (the vector's scaled by the axis' share of the line), why the
+    profiles are not one profile per axis ("" when they are) and the 1-D profile every axis has
+    a share of (None when they have not: no move, or not one line). Plain floats: a vector has
+    at most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
     # (loops of appends, lists alike by index: for one or two axes they cost about half of
     # list(map(...)) or a comprehension and less than a zip, each of which makes an object of its own)
     p0: list[float] = []
@@ -338,7 +353,7 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     elif speed > 0.0:
         unit = [v / speed for v in v0]
     else:
-        return [[] for _ in starts], [traj for _ in starts], ""
+        return [[] for _ in starts], [traj for _ in starts], "", None
     along, parallel = _along(v0, unit, speed)
     final_along, final_parallel = _along(finals, unit, math.hypot(*finals))
     if not final_parallel:
@@ -347,11 +362,12 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
+    segments = line[0]
     profiles: list[Profile] = []
     for i, u in enumerate(unit):  # (unit and p0 are made alike above)
-        # (ScaledProfile(line, u, p0[i]) without the Python-level __new__ of a NamedTuple, as segments are made)
-        profiles.append(new_tuple(ScaledProfile, (line, u, p0[i])))
-    return profiles, _shares(traj, unit), ""
+        # (ScaledProfile(segments, u, p0[i]) without the Python-level __new__ of a NamedTuple, as segments are made)
+        profiles.append(new_tuple(ScaledProfile, (segments, u, p0[i])))
+    return profiles, _shares(traj, unit), "", line
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
@@ -367,10 +383,10 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     stopped_after = stop[-1].end_state()[0] if stop else 0.0
     rest = [p + h * stopped_after for p, h in zip(p0, heading, strict=True)]
     go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest, strict=True)]
-    go, limits, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
+    go, limits, _, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
     profiles = [scaled_profile(stop, h, p) + _segments(tail) for h, p, tail in zip(heading, p0, go, strict=True)]
     limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits, strict=True)]
-    return profiles, limits, STOP_THEN_LINE
+    return profiles, limits, STOP_THEN_LINE, None
 
 
 def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) -> list[Segment]:
@@ -467,9 +483,12 @@ def _holds_and_outputs(params: MotionParams, bits: int, index: int):
 def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits: int, starts: list[AxisStart],
                           sample_rate: float, notes: PlanNotes) -> list[AxisPlan]:
     """``bits``: the move's attributes as an int (compile_move's)."""
+    if len(starts) == 1 and not bits & _GENERAL:  # (the usual start or modify of an axis)
+        return [_lone_axis_plan(motion_type, params, starts[0], sample_rate, notes)]
     targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
+    line: Line | None = None  # the 1-D profile of one axis, or of a vector's axes (_vector_profiles)
     if bits & _SYNC:
         profiles = [
             _scalar_profile(motion_type, start, target, final, traj)
@@ -479,11 +498,13 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         limits = list(params.trajectory)
     elif len(starts) == 1:
         one = starts[0]
-        profiles = [_profile_from(motion_type, one.position, one.velocity, one.acceleration, targets[0], finals[0],
-                                  params.trajectory[0])]
+        line = _profile_from(motion_type, one.position, one.velocity, one.acceleration, targets[0], finals[0],
+                             params.trajectory[0])
+        profiles = [line[0]]
         limits = [params.trajectory[0]]
     else:
-        profiles, limits, composite = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
+        profiles, limits, composite, line = _vector_profiles(motion_type, starts, targets, finals,
+                                                             params.trajectory[0])
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
     # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
@@ -491,14 +512,12 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
     chained = motion_type is not _S_CURVE_JERK and not bits & _PADDED and not composite
     # ``bound`` (_line_bound) is not None only for a vector's shares (every profile a
-    # ScaledProfile) whose 1-D profile passed its checks; line_duration is then every
-    # ScaledAxisPlan's duration, the 1-D profile's, calculated once.
+    # ScaledProfile) whose 1-D profile passed its checks; every ScaledAxisPlan's duration is then
+    # the 1-D profile's.
     first = profiles[0] if profiles else None
-    bound, line_duration = None, 0.0
-    if isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS:
-        bound = _line_bound(first.line, limit, chained)
-        if bound is not None:
-            line_duration = end_time(first.line)
+    bound = None
+    if line is not None and isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS:
+        bound = _line_bound(line, limit, chained)
     plans: list[AxisPlan] = []
     # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
     # velocity and profile per start, made so above from a request check_params has found one
@@ -508,29 +527,57 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
         if isinstance(profile, ScaledProfile):
             if bound is not None and _passes_checks(profile, bound, start, target):
-                plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final,
-                                               hold, outputs, limits[i], start.velocity, start.acceleration, composite))
+                plans.append(ScaledAxisPlan.of(profile, line[2], start.axis, start.position,  # type: ignore[index]
+                                               target, final, hold, outputs, limits[i], start.velocity,
+                                               start.acceleration, composite))
                 continue
             # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
-            prof, chain = profile.segments(), False
+            prof, own = profile.segments(), None
         else:
-            prof, chain = profile, chained
+            prof, own = profile, line  # (a lone axis' profile is its line; the other plain profiles have none)
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise Refused(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
         if bits & _DELAY:
-            prof = _wait(start.position, params.delay[i]) + prof
-        prof, truncated = _checked(prof, start, target, limit, notes, chain)
-        # (positional, as Move above: the fields in their order, a third cheaper than keywords)
-        plans.append(AxisPlan(
-            start.axis, prof, start.position,  # axis, segments, start_position
-            prof[-1].end_state()[0] if truncated else target,  # target (truncated: where the cut plan ends)
-            0.0 if truncated else final,  # final_velocity
-            hold, outputs,
-            None, 0.0,  # velocity_target, ramp_end: not a VELOCITY move
-            truncated, limits[i], start.velocity, start.acceleration, composite,
-        ))
+            prof, own = _wait(start.position, params.delay[i]) + prof, None
+        plans.append(_checked_plan(prof, own, chained, start, target, final, limit, notes, hold, outputs, limits[i],
+                                   composite))
     return plans
+
+
+def _lone_axis_plan(motion_type: MPIMotionType, params: MotionParams, start: AxisStart, sample_rate: float,
+                    notes: PlanNotes) -> AxisPlan:
+    """The plan of one axis whose attributes change nothing in it (none of _GENERAL's), as
+    _point_to_point_plans makes it: the same target, profile and checks, without the lists and
+    tests that further axes and those attributes need."""
+    positions, traj = params.position, params.trajectory[0]
+    if len(positions) != 1:  # (_targets' guard)
+        raise ValueError(f"{len(positions)} positions for 1 axes")
+    target = positions[0] + start.origin  # (_targets' target: not RELATIVE)
+    line = _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, 0.0, traj)
+    # (chained: reshape's profile unless a jerk type's; one axis is neither padded nor composite)
+    return _checked_plan(line[0], line, motion_type is not _S_CURVE_JERK, start, target, 0.0,
+                         VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate, notes, None, [], traj, "")
+
+
+def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: AxisStart, target: float,
+                  final: float, limit: float, notes: PlanNotes, hold: Hold | None, outputs: list[Output],
+                  limits: Trajectory, composite: str) -> AxisPlan:
+    """An axis' plan of the segments ``prof`` after _checked. ``own``: the Line they are (where
+    they end and their duration, calculated with them), or None; ``chained``: they are
+    reshape's (_point_to_point_plans)."""
+    if own is None:
+        end, duration = (_end_position(prof[-1]) if prof else start.position), None
+    else:
+        end, duration = own[1], own[2]
+    prof, truncated = _checked(prof, start, target, limit, notes, end, duration if chained else None)
+    if truncated:
+        # where the cut plan ends, at rest
+        return AxisPlan.with_duration(prof, end_time(prof), start.axis, start.position, prof[-1].end_state()[0],
+                                      0.0, hold, outputs, True, limits, start.velocity, start.acceleration, composite)
+    return AxisPlan.with_duration(prof, end_time(prof) if duration is None else duration, start.axis,
+                                  start.position, target, final, hold, outputs, False, limits, start.velocity,
+                                  start.acceleration, composite)
 
 
 def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:

@@ -229,6 +229,25 @@ def _eager(plan: AxisPlan) -> AxisPlan:
     return AxisPlan(**{f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.init})
 
 
+def _fields(plan: AxisPlan) -> dict:
+    return {f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan)}
+
+
+@pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
+@pytest.mark.parametrize("axes", [1, 2])
+@pytest.mark.parametrize("cut", [False, True])
+def test_a_plan_made_with_its_duration_is_the_dataclass_plan(kind, axes, cut):
+    # AxisPlan.with_duration fills the slots itself: every field as AxisPlan(...) makes it
+    trajectory = (Trajectory(1.0 if cut else 1000.0, 1e4, 1e4 if cut else 5e3, 40.0, 1e6, 2e6),)
+    position = (6e5, 8e5)[:axes] if cut else (3000.0, -4000.0)[:axes]
+    move, _ = compile_(position=position, kind=kind, trajectory=trajectory, rate=100.0 if cut else RATE)
+    for plan in move.plans:
+        assert plan.truncated == cut
+        assert _fields(plan) == _fields(_eager(plan))
+    empty = AxisPlan.with_duration([], 0.0, 3, 5.0, 5.0, 0.0, None, [], False, None, 0.0, 0.0, "")
+    assert _fields(empty) == _fields(AxisPlan(3, [], 5.0, 5.0))
+
+
 @pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
 @pytest.mark.parametrize("moving", [False, True])
 def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving):

@@ -23,6 +23,15 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
     lasts more than 0 s and starts at the position where the one before ends, as
     Segment.end_state calculates it: the planner relies on it (a profile whose end position
     is finite is finite throughout: planner._finite_if_it_ends)."""
+    return reshaped(plan, p0, jerk_percent)[0]
+
+
+def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> tuple[list[Segment], float, float]:
+    """:func:`reshape`'s segments, where they end and how long they last: the position
+    Segment.end_state gives at the end of the last one (``p0`` without segments) and
+    ``end_time(segments)``, the same additions in the same order (0.0 without segments).
+    The planner needs both of every profile; here they are a by-product of the loop that makes
+    the segments (it calculates each segment's end to start the next), not a pass of their own."""
     if not 0.0 <= jerk_percent <= 100.0:
         raise ProfileError("jerkPercent must be within 0..100")
     fraction = jerk_percent / 100.0
@@ -35,6 +44,7 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
     append = segments.append
     make, segment, isfinite = new_tuple, Segment, math.isfinite  # (locals: a global lookup per segment)
     p = p0
+    total = -0.0  # end_time's sum: -0.0 + d is d for every d, as its first term is
     # (each ramp's pieces in this loop, not a function of their own: a call per ramp costs as
     # much as a segment's arithmetic, and a modify is planned while its command waits)
     for duration, v, v_end in plan:
@@ -57,4 +67,5 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
             # Where the segment ends, as Segment.end_state computes it (the same operations in
             # the same order), without the method calls: the next piece starts there.
             p, v = p + t * (v + t * (a / 2.0 + t * j / 6.0)), v + t * (a + t * j / 2.0)
-    return segments
+            total += t
+    return segments, p, 0.0 + total  # (end_time's t0 + total, with t0 = 0.0)
