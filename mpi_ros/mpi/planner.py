@@ -19,6 +19,7 @@ moves on a straight line to the new targets (docs/decisions.md).
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 
 from . import cams
@@ -54,6 +55,9 @@ _GENERAL = _RELATIVE | _FINAL_VEL | _SYNC | _DELAY | _NO_REVERSAL | _HOLD_OR_OUT
 # lookup of ~0.1 us each time.
 _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
 _VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
+# The types not planned as point-to-point moves: one test for the point-to-point types (the
+# starts and modifies a command waits for), a set lookup each for the others
+_NOT_POINT_TO_POINT = CAM_TYPES | STREAMED_TYPES | _VELOCITY_TYPES
 _NO_EVENTS = MPIEventType.NONE
 
 
@@ -191,39 +195,47 @@ def _finite_if_it_ends(end: float) -> bool:
     return math.isfinite(end)
 
 
-def _line_bound(line: Line, limit: float, chained: bool) -> float | None:
-    """The largest |position| in a vector's 1-D profile if all its values are finite and no
-    frame exceeds ``limit`` (None otherwise, or for no profile). An axis' share of it, with
-    a factor of at most 1 and a start ``offset``, is then finite and within the limit too when
-    abs(offset) + this bound is finite: rounding to nearest is monotonic, so no product or sum
-    of the scaling exceeds it in magnitude. ``chained``: the profile is reshape's (_checked)."""
+def _line_passes(line: Line, limit: float, chained: bool) -> bool:
+    """Whether a vector's 1-D profile is not empty, all its values are finite and no frame exceeds
+    ``limit``. An axis' share of it, with a factor of at most 1 and a start ``offset``, is then
+    finite and within the limit too when abs(offset) + its largest |position| is finite
+    (_no_overflow): rounding to nearest is monotonic, so no product or sum of the scaling
+    exceeds that in magnitude. ``chained``: the profile is reshape's (_checked)."""
     segments, end, duration = line
     if not segments:
-        return None
-    bound = 0.0
+        return False
     if chained:
-        if not (_finite_if_it_ends(end) and _within(segments, duration, limit)):
-            return None
-        for segment in segments:  # (a loop with indexes costs half of max(map(...)))
-            if abs(segment[1]) > bound:  # (its position)
-                bound = abs(segment[1])
-        return bound
-    for d, p, v, a, j in segments:
-        # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
-        if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
-            return None
-        if abs(p) > bound:
-            bound = abs(p)
-    return bound
+        return _finite_if_it_ends(end) and _within(segments, duration, limit)
+    # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
+    return all(0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0
+               for d, p, v, a, j in segments)
 
 
-def _passes_checks(scaled: ScaledProfile, bound: float | None, start: AxisStart, target: float) -> bool:
-    """True when the vector axis' share ``scaled`` of the checked 1-D profile (``bound``:
-    _line_bound) passes _checked as it is, without making its segments: finite, no frame
+# Half a unit in the last place of the largest float: a finite x plus any |y| below it rounds to
+# at most the largest float, finite (a tie rounds to even, up: hence below)
+_HALF_ULP_OF_MAX = math.ulp(sys.float_info.max) / 2.0
+
+
+def _no_overflow(offset: float, segments: list[Segment]) -> bool:
+    """abs(offset) + the largest |position| of ``segments`` (finite: _line_passes) is finite. For
+    any offset below _HALF_ULP_OF_MAX it is, whatever that position (every offset a controller
+    holds), so the positions are looked at for a larger one only."""
+    if abs(offset) < _HALF_ULP_OF_MAX:
+        return True
+    bound = 0.0
+    for segment in segments:
+        if abs(segment[1]) > bound:  # (its position)
+            bound = abs(segment[1])
+    return math.isfinite(abs(offset) + bound)
+
+
+def _passes_checks(scaled: ScaledProfile, start: AxisStart, target: float) -> bool:
+    """True when the vector axis' share ``scaled`` of a 1-D profile that passed its checks
+    (_line_passes) passes _checked as it is, without making its segments: finite, no frame
     beyond the limit, and its last segment, scaled as scaled_profile scales it, ends on the
     target (within the rounding of the positions: otherwise _checked decides)."""
     line, factor, offset = scaled
-    if bound is None or not (abs(factor) <= 1.0 and math.isfinite(abs(offset) + bound)):
+    if not (abs(factor) <= 1.0 and _no_overflow(offset, line)):
         return False
     t, p, v, a, j = line[-1]
     last = (t, offset + factor * p, factor * v, factor * a, factor * j)  # (scaled_profile's operations)
@@ -429,7 +441,7 @@ def compile_move(
     would stop the axes dead. A cam (``cam_masters``: each slave's master and its position
     now) is planned by cams.py.
     """
-    notes = PlanNotes()
+    notes = PlanNotes([])  # (its list given: the dataclass' default factory is a call more)
     bits = int(attrs)
     if bits & _IN_MOTION_REFUSED and any(s.velocity != 0.0 for s in starts):  # starts in motion
         if bits & _DELAY and any(d != 0.0 for d in params.delay):
@@ -438,15 +450,15 @@ def compile_move(
             raise Refused(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
     stream = None
     try:
-        if motion_type in CAM_TYPES:
+        if motion_type not in _NOT_POINT_TO_POINT:
+            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
+        elif motion_type in CAM_TYPES:
             assert cam_masters is not None  # (the supervisor reads each slave's master)
             plans = cams.cam_plans(motion_type, attrs, params, starts, cam_masters)
         elif motion_type in STREAMED_TYPES:
             plans, stream = _path_plans(motion_type, params, attrs, starts)
-        elif motion_type in _VELOCITY_TYPES:
-            plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
-            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
+            plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
     # (positional: a dataclass' __init__ matches keywords at a cost; the fields in their order)
@@ -511,13 +523,11 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
     # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
     chained = motion_type is not _S_CURVE_JERK and not bits & _PADDED and not composite
-    # ``bound`` (_line_bound) is not None only for a vector's shares (every profile a
-    # ScaledProfile) whose 1-D profile passed its checks; every ScaledAxisPlan's duration is then
-    # the 1-D profile's.
+    # ``shared`` only for a vector's shares (every profile a ScaledProfile) whose 1-D profile
+    # passed its checks; every ScaledAxisPlan's duration is then the 1-D profile's.
     first = profiles[0] if profiles else None
-    bound = None
-    if line is not None and isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS:
-        bound = _line_bound(line, limit, chained)
+    shared = (line is not None and isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS
+              and _line_passes(line, limit, chained))
     plans: list[AxisPlan] = []
     # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
     # velocity and profile per start, made so above from a request check_params has found one
@@ -526,7 +536,7 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         target, final, profile = targets[i], finals[i], profiles[i]
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
         if isinstance(profile, ScaledProfile):
-            if bound is not None and _passes_checks(profile, bound, start, target):
+            if shared and _passes_checks(profile, start, target):
                 plans.append(ScaledAxisPlan.of(profile, line[2], start.axis, start.position,  # type: ignore[index]
                                                target, final, hold, outputs, limits[i], start.velocity,
                                                start.acceleration, composite))
