@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Literal, overload
 
 from . import cams
 from .events import MPIEventType
@@ -33,7 +35,7 @@ from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import reverses, velocity_move
 from .profiles.ramps import ProfileError, plan_point_to_point, ramps_between
 from .profiles.scurve import reshape, reshaped
-from .profiles.segment import ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
+from .profiles.segment import Row, ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
 
 A = MotionAttr
@@ -178,7 +180,7 @@ def _checked(segments: list[Segment], start: AxisStart, target: float, limit: fl
     return segments, False
 
 
-def _within(segments: list[Segment], duration: float, limit: float) -> bool:
+def _within(segments: Sequence[Row], duration: float, limit: float) -> bool:
     """No segment of a 1-D profile (reshape's: finite if it lands, no duration below 0) lasts
     longer than ``limit``; ``duration``: theirs. Durations of at least 0 add up to at least each
     of them, in floating point too (rounding is monotonic), so one comparison answers the usual
@@ -195,7 +197,7 @@ def _finite_if_it_ends(end: float) -> bool:
     return math.isfinite(end)
 
 
-def _line_passes(line: Line, limit: float, chained: bool) -> bool:
+def _line_passes(line: RowLine, limit: float, chained: bool) -> bool:
     """Whether a vector's 1-D profile is not empty, all its values are finite and no frame exceeds
     ``limit``. An axis' share of it, with a factor of at most 1 and a start ``offset``, is then
     finite and within the limit too when abs(offset) + its largest |position| is finite
@@ -216,7 +218,7 @@ def _line_passes(line: Line, limit: float, chained: bool) -> bool:
 _HALF_ULP_OF_MAX = math.ulp(sys.float_info.max) / 2.0
 
 
-def _no_overflow(offset: float, segments: list[Segment]) -> bool:
+def _no_overflow(offset: float, segments: Sequence[Row]) -> bool:
     """abs(offset) + the largest |position| of ``segments`` (finite: _line_passes) is finite. For
     any offset below _HALF_ULP_OF_MAX it is, whatever that position (every offset a controller
     holds), so the positions are looked at for a larger one only."""
@@ -266,13 +268,26 @@ def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float,
 
 # A 1-D profile: its segments, where they end (the position Segment.end_state gives at the end
 # of the last; the start without any) and its duration (end_time of the segments). The planner
-# checks and times every profile: reshape calculates both as it makes the segments.
+# checks and times every profile: reshape calculates both as it makes the segments. A vector's
+# line is made of Rows (its axes' Segments are made from it), an axis' own profile of Segments.
 Line = tuple[list[Segment], float, float]
+RowLine = tuple[list[Row], float, float]
+
+
+@overload
+def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
+                  traj: Trajectory, rows: Literal[False] = False) -> Line: ...
+
+
+@overload
+def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
+                  traj: Trajectory, rows: Literal[True]) -> RowLine: ...
 
 
 def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
-                  traj: Trajectory) -> Line:
-    """The 1-D profile of a point-to-point type from (p0, v0, a0); a0 is read by the jerk types only."""
+                  traj: Trajectory, rows: bool = False) -> Line | RowLine:
+    """The 1-D profile of a point-to-point type from (p0, v0, a0); a0 is read by the jerk types
+    only. ``rows``: reshape's segments as Rows (scurve.reshaped; a jerk type's are Segments)."""
     if motion_type is _S_CURVE_JERK:
         segments = point_to_point_jerk(
             p0, v0, a0, target, v_final, traj.velocity,
@@ -281,7 +296,7 @@ def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, t
     jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
     # point_to_point's two steps, without its call (a modify is planned while its command waits)
     plan = plan_point_to_point(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
-    return reshaped(plan, p0, jerk_percent)
+    return reshaped(plan, p0, jerk_percent, True) if rows else reshaped(plan, p0, jerk_percent)
 
 
 def _scaled(traj: Trajectory, share: float) -> Trajectory:
@@ -337,7 +352,7 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
 
 
 def _vector_profiles(motion_type, starts, targets, finals,
-                     traj) -> tuple[list[Profile], list[Trajectory], str, Line | None]:
+                     traj) -> tuple[list[Profile], list[Trajectory], str, RowLine | None]:
     """One profile along the straight line from the start to the targets, each axis'
     effective limits (the vector's scaled by the axis' share of the line), why the
     profiles are not one profile per axis ("" when they are) and the 1-D profile every axis has
@@ -373,7 +388,7 @@ def _vector_profiles(motion_type, starts, targets, finals,
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
     accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
-    line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
+    line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj, True)
     segments = line[0]
     profiles: list[Profile] = []
     for i, u in enumerate(unit):  # (unit and p0 are made alike above)
@@ -500,7 +515,8 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
-    line: Line | None = None  # the 1-D profile of one axis, or of a vector's axes (_vector_profiles)
+    line: Line | None = None  # the 1-D profile of one axis
+    vector: RowLine | None = None  # or the one of a vector's axes (_vector_profiles)
     if bits & _SYNC:
         profiles = [
             _scalar_profile(motion_type, start, target, final, traj)
@@ -515,8 +531,8 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         profiles = [line[0]]
         limits = [params.trajectory[0]]
     else:
-        profiles, limits, composite, line = _vector_profiles(motion_type, starts, targets, finals,
-                                                             params.trajectory[0])
+        profiles, limits, composite, vector = _vector_profiles(motion_type, starts, targets, finals,
+                                                               params.trajectory[0])
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
     # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
@@ -526,8 +542,8 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     # ``shared`` only for a vector's shares (every profile a ScaledProfile) whose 1-D profile
     # passed its checks; every ScaledAxisPlan's duration is then the 1-D profile's.
     first = profiles[0] if profiles else None
-    shared = (line is not None and isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS
-              and _line_passes(line, limit, chained))
+    shared = (vector is not None and isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS
+              and _line_passes(vector, limit, chained))
     plans: list[AxisPlan] = []
     # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
     # velocity and profile per start, made so above from a request check_params has found one
@@ -537,7 +553,7 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
         if isinstance(profile, ScaledProfile):
             if shared and _passes_checks(profile, start, target):
-                plans.append(ScaledAxisPlan.of(profile, line[2], start.axis, start.position,  # type: ignore[index]
+                plans.append(ScaledAxisPlan.of(profile, vector[2], start.axis, start.position,  # type: ignore[index]
                                                target, final, hold, outputs, limits[i], start.velocity,
                                                start.acceleration, composite))
                 continue
