@@ -100,7 +100,7 @@ class AxisPlan:
         plan.hold = hold
         plan.outputs = outputs
         plan.truncated = truncated
-        plan.limits = limits
+        _limits_slot.__set__(plan, limits)  # (past ScaledAxisPlan's property)
         plan.start_velocity = start_velocity
         plan.start_acceleration = start_acceleration
         plan.composite = composite
@@ -222,31 +222,36 @@ class AxisPlan:
 
 # The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
 _segments_slot = AxisPlan.__dict__["segments"]
+_limits_slot = AxisPlan.__dict__["limits"]  # (and its limits, likewise)
 _new_object = object.__new__
 _with_duration = AxisPlan.with_duration.__func__  # type: ignore[attr-defined]  # (ScaledAxisPlan.of's, for its class)
 
 
 class ScaledAxisPlan(AxisPlan):
     """An axis of a vector move whose segments are its share of the vector's 1-D profile
-    (``scaled``), made from it the first time they are asked for: by the stepping's table, a
-    cross-check or a plot, not while the command waits for its plan (a further axis of a
-    vector then costs little to plan). The segments, duration and frame count are those of an
-    AxisPlan made with ``scaled.segments()``, and so is every answer: the two are one plan.
-    Made by :meth:`of`."""
+    (``scaled``), and its limits its share of the vector's (``vector_limits``), each made the
+    first time it is asked for: by the stepping's table, a cross-check or a plot, not while the
+    command waits for its plan (a further axis of a vector then costs little to plan). The
+    segments, limits, duration and frame count are those of an AxisPlan made with
+    ``scaled.segments()`` and ``vector_limits.share(abs(scaled.factor))``, and so is every
+    answer: the two are one plan. Made by :meth:`of`."""
 
-    __slots__ = ("scaled",)
+    __slots__ = ("scaled", "vector_limits")
     scaled: ScaledProfile
+    vector_limits: Trajectory
 
     @classmethod
     def of(cls, scaled: ScaledProfile, duration: float, axis: int, start_position: float, target: float,
-           final_velocity: float, hold: Hold | None, outputs: list[Output], limits: Trajectory | None,
+           final_velocity: float, hold: Hold | None, outputs: list[Output], vector_limits: Trajectory,
            start_velocity: float, start_acceleration: float, composite: str) -> ScaledAxisPlan:
-        """The plan of a vector's axis: AxisPlan.with_duration's, not truncated, the segments left out.
-        ``duration``: ``end_time(scaled.line)``, the same durations added in the same order as
-        ``end_time(scaled.segments())`` adds the segments' (the vector's axes share it: calculated once)."""
-        plan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold, outputs, False,
-                        limits, start_velocity, start_acceleration, composite)
+        """The plan of a vector's axis: AxisPlan.with_duration's, not truncated, the segments and
+        limits left out. ``duration``: ``end_time(scaled.line)``, the same durations added in the
+        same order as ``end_time(scaled.segments())`` adds the segments' (the vector's axes share
+        it: calculated once)."""
+        plan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold, outputs,
+                              False, None, start_velocity, start_acceleration, composite)
         plan.scaled = scaled
+        plan.vector_limits = vector_limits
         return plan
 
     def __post_init__(self) -> None:
@@ -265,6 +270,18 @@ class ScaledAxisPlan(AxisPlan):
     @segments.setter
     def segments(self, value: list[Segment] | None) -> None:
         _segments_slot.__set__(self, value)
+
+    @property
+    def limits(self) -> Trajectory | None:
+        made = _limits_slot.__get__(self, AxisPlan)
+        if made is None:
+            made = self.vector_limits.share(abs(self.scaled.factor))
+            _limits_slot.__set__(self, made)
+        return made
+
+    @limits.setter
+    def limits(self, value: Trajectory | None) -> None:
+        _limits_slot.__set__(self, value)
 
     @property
     def segment_count(self) -> int:

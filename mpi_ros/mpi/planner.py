@@ -299,23 +299,13 @@ def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, t
     return reshaped(plan, p0, jerk_percent, True) if rows else reshaped(plan, p0, jerk_percent)
 
 
-def _scaled(traj: Trajectory, share: float) -> Trajectory:
-    """An axis' share of the vector's limits (jerk percent is a ratio and stays)."""
-    return Trajectory(traj.velocity * share, traj.acceleration * share, traj.deceleration * share,
-                      traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
-
-
-def _shares(traj: Trajectory, unit: list[float]) -> list[Trajectory]:
-    """Each axis' share of the vector's limits, ``_scaled(traj, abs(u))`` for each component u of
-    the line's unit vector (the trajectory's fields read once, not once per axis)."""
-    velocity, acceleration, deceleration = traj.velocity, traj.acceleration, traj.deceleration
-    jerk_percent, accel_jerk, decel_jerk = traj.jerk_percent, traj.acceleration_jerk, traj.deceleration_jerk
-    limits = []
-    for u in unit:
-        share = abs(u)
-        limits.append(Trajectory(velocity * share, acceleration * share, deceleration * share, jerk_percent,
-                                 accel_jerk * share, decel_jerk * share))
-    return limits
+def _limits_of(profile: Profile, limits: list[Trajectory] | None, i: int, traj: Trajectory) -> Trajectory:
+    """Axis i's limits: ``limits[i]``, or where a vector's shares are not made (None: every
+    profile a ScaledProfile), its share of the vector's ``traj``, by its factor (_vector_profiles)."""
+    if limits is not None:
+        return limits[i]
+    assert isinstance(profile, ScaledProfile)
+    return traj.share(abs(profile.factor))
 
 
 # An axis' profile: its segments, or (a vector's axis) its share of the vector's 1-D profile
@@ -352,12 +342,14 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
 
 
 def _vector_profiles(motion_type, starts, targets, finals,
-                     traj) -> tuple[list[Profile], list[Trajectory], str, RowLine | None]:
+                     traj) -> tuple[list[Profile], list[Trajectory] | None, str, RowLine | None]:
     """One profile along the straight line from the start to the targets, each axis'
-    effective limits (the vector's scaled by the axis' share of the line), why the
-    profiles are not one profile per axis ("" when they are) and the 1-D profile every axis has
-    a share of (None when they have not: no move, or not one line). Plain floats: a vector has
-    at most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
+    effective limits (the vector's scaled by the axis' share of the line: None when every
+    profile is a ScaledProfile, whose factor is that share, the limits then made when asked for,
+    _limits_of), why the profiles are not one profile per axis ("" when they are) and the 1-D
+    profile every axis has a share of (None when they have not: no move, or not one line).
+    Plain floats: a vector has at most MEIXmpMAX_COORD_AXES components, too few for numpy to
+    pay off."""
     # (loops of appends, lists alike by index: for one or two axes they cost about half of
     # list(map(...)) or a comprehension and less than a zip, each of which makes an object of its own)
     p0: list[float] = []
@@ -394,7 +386,7 @@ def _vector_profiles(motion_type, starts, targets, finals,
     for i, u in enumerate(unit):  # (unit and p0 are made alike above)
         # (ScaledProfile(segments, u, p0[i]) without the Python-level __new__ of a NamedTuple, as segments are made)
         profiles.append(new_tuple(ScaledProfile, (segments, u, p0[i])))
-    return profiles, _shares(traj, unit), "", line
+    return profiles, None, "", line
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
@@ -410,9 +402,10 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     stopped_after = stop[-1].end_state()[0] if stop else 0.0
     rest = [p + h * stopped_after for p, h in zip(p0, heading, strict=True)]
     go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest, strict=True)]
-    go, limits, _, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
+    go, go_limits, _, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
     profiles = [scaled_profile(stop, h, p) + _segments(tail) for h, p, tail in zip(heading, p0, go, strict=True)]
-    limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits, strict=True)]
+    limits = [traj.share(max(abs(h), _limits_of(tail, go_limits, i, traj).velocity / traj.velocity))
+              for i, (h, tail) in enumerate(zip(heading, go, strict=True))]
     return profiles, limits, STOP_THEN_LINE, None
 
 
@@ -517,6 +510,7 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     composite = ""
     line: Line | None = None  # the 1-D profile of one axis
     vector: RowLine | None = None  # or the one of a vector's axes (_vector_profiles)
+    limits: list[Trajectory] | None  # (None: a vector's shares, _limits_of)
     if bits & _SYNC:
         profiles = [
             _scalar_profile(motion_type, start, target, final, traj)
@@ -554,7 +548,7 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         if isinstance(profile, ScaledProfile):
             if shared and _passes_checks(profile, start, target):
                 plans.append(ScaledAxisPlan.of(profile, vector[2], start.axis, start.position,  # type: ignore[index]
-                                               target, final, hold, outputs, limits[i], start.velocity,
+                                               target, final, hold, outputs, params.trajectory[0], start.velocity,
                                                start.acceleration, composite))
                 continue
             # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
@@ -566,8 +560,8 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
         if bits & _DELAY:
             prof, own = _wait(start.position, params.delay[i]) + prof, None
-        plans.append(_checked_plan(prof, own, chained, start, target, final, limit, notes, hold, outputs, limits[i],
-                                   composite))
+        plans.append(_checked_plan(prof, own, chained, start, target, final, limit, notes, hold, outputs,
+                                   _limits_of(profile, limits, i, params.trajectory[0]), composite))
     return plans
 
 

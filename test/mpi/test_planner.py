@@ -269,6 +269,7 @@ def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving)
         for again in (copy.deepcopy(plan), dataclasses.replace(plan)):
             assert (again.segments, again.duration, again.frame_count) == (plan.segments, plan.duration,
                                                                             plan.frame_count)
+            assert again.limits == plan.limits == trajectory[0].share(abs(plan.scaled.factor))
 
 
 def test_vector_axes_with_a_delay_or_a_cut_frame_are_made_and_checked_each():
