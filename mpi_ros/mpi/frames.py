@@ -19,7 +19,7 @@ import numpy as np
 
 from .events import MPIEventType
 from .params import Hold, Output, Trajectory
-from .profiles.segment import ScaledProfile, Segment, SegmentTable, end_time
+from .profiles.segment import Row, ScaledProfile, Segment, SegmentTable, end_time, segment_from
 from .types import MotionAttr, MPIMotionType
 
 if TYPE_CHECKING:
@@ -77,16 +77,16 @@ class AxisPlan:
         self.duration = end_time(self.segments, self.origin_time) if self.cam is None else self.cam.duration
 
     @classmethod
-    def with_duration(cls, segments: list[Segment] | None, duration: float, axis: int, start_position: float,
-                      target: float, final_velocity: float, hold: Hold | None, outputs: list[Output], truncated: bool,
-                      limits: Trajectory | None, start_velocity: float, start_acceleration: float,
-                      composite: str) -> Self:
+    def with_duration(cls, segments: list[Segment] | list[Row] | None, duration: float, axis: int,
+                      start_position: float, target: float, final_velocity: float, hold: Hold | None,
+                      outputs: list[Output], truncated: bool, limits: Trajectory | None, start_velocity: float,
+                      start_acceleration: float, composite: str) -> Self:
         """A point-to-point plan (not a VELOCITY move, a path or a cam: origin_time 0) whose
         ``duration``, ``end_time(segments)``, its planner has calculated already (with the
         segments: scurve.reshaped), as ``cls(...)`` makes it. Its slots are filled here rather than
         by the dataclass' __init__ and __post_init__, which would add the segments up again, a
         pass of their own, behind two calls (a modify is planned while its command waits).
-        ``segments`` None: a ScaledAxisPlan's, made when first asked for."""
+        ``segments`` None: a ScaledAxisPlan's, made when first asked for; Rows: a RowAxisPlan's."""
         if segments is not None and not segments:  # (as __post_init__: a plan holds at least its end)
             segments = [Segment(0.0, target, final_velocity, 0.0, 0.0)]
             duration = end_time(segments)
@@ -121,8 +121,13 @@ class AxisPlan:
         """The segments as arrays. Built on first use, not with the plan: numpy on a handful of
         segments costs more than planning them, and a modify is planned while its command waits."""
         if self._table is None:
-            self._table = SegmentTable(self.segments, self.origin_time)
+            self._table = SegmentTable(self._rows(), self.origin_time)
         return self._table
+
+    def _rows(self) -> Sequence[Row]:
+        """The segments' values, as the stepping reads them (by index): the segments themselves,
+        or a RowAxisPlan's Rows before its Segments are made."""
+        return self.segments
 
     @property
     def is_velocity(self) -> bool:
@@ -199,8 +204,8 @@ class AxisPlan:
         # bisect_right is searchsorted(side="right") (a nan rel too goes past the end); on a
         # handful of ends it costs a fraction of numpy's call, and it runs for every piece.
         i = min(bisect.bisect_right(table.end, rel), table.count - 1)
-        seg = self.segments[i]
-        return float(table.start[i]), [seg.p, seg.v, seg.a / 2.0, seg.j / 6.0]
+        _, p, v, a, j = self._rows()[i]
+        return float(table.start[i]), [p, v, a / 2.0, j / 6.0]
 
     def boundaries(self) -> np.ndarray:
         """Relative profile times at which the command polynomial (or the feedforward) changes."""
@@ -288,6 +293,36 @@ class ScaledAxisPlan(AxisPlan):
         """As many as the 1-D profile's, without making them (the frame buffer counts them)."""
         made = _segments_slot.__get__(self, AxisPlan)
         return len(self.scaled.line) if made is None else len(made)
+
+
+class RowAxisPlan(AxisPlan):
+    """A plan whose segments may be kept as Rows (plain tuples: scurve.reshaped(rows=True), an
+    axis' own profile), which the stepping reads as they are (its table, segment_poly); the
+    Segments are made from them the first time they are asked for (a cross-check, a plot, a
+    copy). A Segment, a tuple subclass, takes three times as long to make as a tuple, and a
+    modify is planned while its command waits. Its segments, and every answer, are those of
+    the AxisPlan with the same values: the two are one plan. Made by ``with_duration``."""
+
+    __slots__ = ()
+
+    def _rows(self) -> Sequence[Row]:
+        return _segments_slot.__get__(self, AxisPlan)
+
+    @property
+    def segments(self) -> list[Segment]:
+        made = _segments_slot.__get__(self, AxisPlan)
+        if type(made[0]) is not Segment:  # (never empty: with_duration and __post_init__ see to it)
+            made = list(map(segment_from, made))
+            _segments_slot.__set__(self, made)
+        return made
+
+    @segments.setter
+    def segments(self, value: list[Segment]) -> None:
+        _segments_slot.__set__(self, value)
+
+    @property
+    def segment_count(self) -> int:
+        return len(_segments_slot.__get__(self, AxisPlan))
 
 
 @dataclass(slots=True)

@@ -26,7 +26,7 @@ from typing import Literal, overload
 
 from . import cams
 from .events import MPIEventType
-from .frames import AxisPlan, Move, ScaledAxisPlan, Stream
+from .frames import AxisPlan, Move, RowAxisPlan, ScaledAxisPlan, Stream
 from .messages import Message
 from .outcome import Refused
 from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, Hold, MotionParams, Output, Trajectory
@@ -245,16 +245,16 @@ def _passes_checks(scaled: ScaledProfile, start: AxisStart, target: float) -> bo
 
 
 def _cap_frames(segments: list[Segment], limit: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
-    """Cut the (finite) plan at the first frame longer than ``limit`` seconds."""
-    for i, seg in enumerate(segments):
-        if seg.duration > limit:
+    """Cut the (finite) plan at the first frame longer than ``limit`` seconds. (Its segments by
+    index: Segments or Rows, a lone axis': _lone_axis_plan.)"""
+    for i, (duration, p, v, a, j) in enumerate(segments):
+        if duration > limit:
             notes.events.append(
                 (MPIEventType.FRAME_TIME_LIMIT,
-                 f"axis {axis}: a frame of {seg.duration:.1f} s exceeds {VELOCITY_FRAME_LIMIT_SAMPLES} samples;"
+                 f"axis {axis}: a frame of {duration:.1f} s exceeds {VELOCITY_FRAME_LIMIT_SAMPLES} samples;"
                  " the axis will stop abruptly after it")
             )
-            cut = Segment(limit, seg.p, seg.v, seg.a, seg.j)
-            return segments[:i] + [cut], True
+            return segments[:i] + [Segment(limit, p, v, a, j)], True
     return segments, False
 
 
@@ -574,18 +574,19 @@ def _lone_axis_plan(motion_type: MPIMotionType, params: MotionParams, start: Axi
     if len(positions) != 1:  # (_targets' guard)
         raise ValueError(f"{len(positions)} positions for 1 axes")
     target = positions[0] + start.origin  # (_targets' target: not RELATIVE)
-    line = _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, 0.0, traj)
+    # (its segments as Rows, the Segments made when first asked for: RowAxisPlan)
+    line = _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, 0.0, traj, True)
     # (chained: reshape's profile unless a jerk type's; one axis is neither padded nor composite)
-    return _checked_plan(line[0], line, motion_type is not _S_CURVE_JERK, start, target, 0.0,
-                         VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate, notes, None, [], traj, "")
+    return _checked_plan(line[0], line, motion_type is not _S_CURVE_JERK, start, target, 0.0,  # type: ignore[arg-type]
+                         VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate, notes, None, [], traj, "", RowAxisPlan)
 
 
 def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: AxisStart, target: float,
                   final: float, limit: float, notes: PlanNotes, hold: Hold | None, outputs: list[Output],
-                  limits: Trajectory, composite: str) -> AxisPlan:
+                  limits: Trajectory, composite: str, kind: type[AxisPlan] = AxisPlan) -> AxisPlan:
     """An axis' plan of the segments ``prof`` after _checked. ``own``: the Line they are (where
     they end and their duration, calculated with them), or None; ``chained``: they are
-    reshape's (_point_to_point_plans)."""
+    reshape's (_point_to_point_plans); ``kind``: the plan's class (RowAxisPlan for Rows)."""
     if own is None:
         end, duration = (_end_position(prof[-1]) if prof else start.position), None
     else:
@@ -593,11 +594,11 @@ def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: A
     prof, truncated = _checked(prof, start, target, limit, notes, end, duration if chained else None)
     if truncated:
         # where the cut plan ends, at rest
-        return AxisPlan.with_duration(prof, end_time(prof), start.axis, start.position, prof[-1].end_state()[0],
-                                      0.0, hold, outputs, True, limits, start.velocity, start.acceleration, composite)
-    return AxisPlan.with_duration(prof, end_time(prof) if duration is None else duration, start.axis,
-                                  start.position, target, final, hold, outputs, False, limits, start.velocity,
-                                  start.acceleration, composite)
+        return kind.with_duration(prof, end_time(prof), start.axis, start.position, prof[-1].end_state()[0],
+                                  0.0, hold, outputs, True, limits, start.velocity, start.acceleration, composite)
+    return kind.with_duration(prof, end_time(prof) if duration is None else duration, start.axis,
+                              start.position, target, final, hold, outputs, False, limits, start.velocity,
+                              start.acceleration, composite)
 
 
 def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:

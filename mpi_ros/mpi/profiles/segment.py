@@ -117,7 +117,7 @@ class SegmentTable:
 
     __slots__ = ("start", "end", "p", "v", "a", "j", "count")
 
-    def __init__(self, segments: Sequence[Segment], t0: float = 0.0):
+    def __init__(self, segments: Sequence[Row], t0: float = 0.0):
         # One array of every segment's fields in a row (np.fromiter: five np.array calls on
         # lists cost several times more for a few segments), whose columns are the fields.
         values = np.fromiter(_chain_iterables.from_iterable(segments), float, 5 * len(segments))
