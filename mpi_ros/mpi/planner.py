@@ -341,6 +341,12 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
     return along, True
 
 
+def _accel_along(starts: list[AxisStart], unit: list[float]) -> float:
+    """The component of the axes' acceleration along ``unit``: the jerk types plan from it."""
+    accels = [start.acceleration for start in starts]
+    return _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
+
+
 def _vector_profiles(motion_type, starts, targets, finals,
                      traj) -> tuple[list[Profile], list[Trajectory] | None, str, RowLine | None]:
     """One profile along the straight line from the start to the targets, each axis'
@@ -354,12 +360,10 @@ def _vector_profiles(motion_type, starts, targets, finals,
     # list(map(...)) or a comprehension and less than a zip, each of which makes an object of its own)
     p0: list[float] = []
     v0: list[float] = []
-    accels: list[float] = []
     delta: list[float] = []
     for i, start in enumerate(starts):
         p0.append(start.position)
         v0.append(start.velocity)
-        accels.append(start.acceleration)
         delta.append(targets[i] - start.position)  # (as many targets as starts: _targets makes them)
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
@@ -379,7 +383,7 @@ def _vector_profiles(motion_type, starts, targets, finals,
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
-    accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
+    accel = _accel_along(starts, unit) if motion_type is _S_CURVE_JERK else 0.0  # (the others plan from a = 0)
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj, True)
     segments = line[0]
     profiles: list[Profile] = []

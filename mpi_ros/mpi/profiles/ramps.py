@@ -62,21 +62,22 @@ def _total_time(peak: float, cruise: float, v_start: float, v_final: float, acce
     return _ramp_time(v_start, peak, accel, decel) + cruise + _ramp_time(peak, v_final, accel, decel)
 
 
-def _coefficients(u0: float, uf: float, w: float, accel: float, decel: float) -> tuple[float, float]:
+def _coefficients(u0: float, uf: float, w: float, twice_accel: float, twice_decel: float) -> tuple[float, float]:
     """Distance of the ramps u0 -> w -> uf as alpha*w^2 + beta (directional coordinates), on
-    the piece of w that contains ``w``: the first ramp's alpha and beta plus the last's."""
+    the piece of w that contains ``w``: the first ramp's alpha and beta plus the last's.
+    ``twice_accel``, ``twice_decel``: 2 * accel and 2 * decel, calculated once per scan."""
     if u0 < 0.0:
-        a1, b1 = 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * decel)
+        a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_decel
     elif w >= u0:
-        a1, b1 = 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * accel)
+        a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_accel
     else:
-        a1, b1 = -1.0 / (2.0 * decel), u0 * u0 / (2.0 * decel)
+        a1, b1 = -1.0 / twice_decel, u0 * u0 / twice_decel
     if uf < 0.0:
-        a2, b2 = 1.0 / (2.0 * decel), -uf * uf / (2.0 * accel)
+        a2, b2 = 1.0 / twice_decel, -uf * uf / twice_accel
     elif w >= uf:
-        a2, b2 = 1.0 / (2.0 * decel), -uf * uf / (2.0 * decel)
+        a2, b2 = 1.0 / twice_decel, -uf * uf / twice_decel
     else:
-        a2, b2 = -1.0 / (2.0 * accel), uf * uf / (2.0 * accel)
+        a2, b2 = -1.0 / twice_accel, uf * uf / twice_accel
     return a1 + a2, b1 + b2
 
 
@@ -111,8 +112,9 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
     # Scan the pieces [points[k], points[k + 1]] from the top: the first breakpoint that does not
     # overshoot bounds w. F at vmax is the top piece's, at any other breakpoint the piece above's.
     top = len(points) - 2
+    twice_accel, twice_decel = 2.0 * accel, 2.0 * decel
     for k in range(top, -1, -1):
-        alpha, beta = _coefficients(u0, uf, 0.5 * (points[k] + points[k + 1]), accel, decel)
+        alpha, beta = _coefficients(u0, uf, 0.5 * (points[k] + points[k + 1]), twice_accel, twice_decel)
         if k == top:
             f_top = alpha * vmax * vmax + beta
             if not f_top > reach:  # even the top speed leaves distance: cruise at vmax
