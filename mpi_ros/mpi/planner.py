@@ -240,8 +240,8 @@ def _passes_checks(scaled: ScaledProfile, start: AxisStart, target: float) -> bo
     if not (abs(factor) <= 1.0 and _no_overflow(offset, line)):
         return False
     t, p, v, a, j = line[-1]
-    last = (t, offset + factor * p, factor * v, factor * a, factor * j)  # (scaled_profile's operations)
-    return _on_target(_end_position(last), start, target)
+    p, v, a, j = offset + factor * p, factor * v, factor * a, factor * j  # (scaled_profile's operations)
+    return _on_target(p + t * (v + t * (a / 2.0 + t * j / 6.0)), start, target)  # (_end_position's)
 
 
 def _cap_frames(segments: list[Segment], limit: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
