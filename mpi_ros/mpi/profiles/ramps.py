@@ -62,25 +62,6 @@ def _total_time(peak: float, cruise: float, v_start: float, v_final: float, acce
     return _ramp_time(v_start, peak, accel, decel) + cruise + _ramp_time(peak, v_final, accel, decel)
 
 
-def _coefficients(u0: float, uf: float, w: float, twice_accel: float, twice_decel: float) -> tuple[float, float]:
-    """Distance of the ramps u0 -> w -> uf as alpha*w^2 + beta (directional coordinates), on
-    the piece of w that contains ``w``: the first ramp's alpha and beta plus the last's.
-    ``twice_accel``, ``twice_decel``: 2 * accel and 2 * decel, calculated once per scan."""
-    if u0 < 0.0:
-        a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_decel
-    elif w >= u0:
-        a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_accel
-    else:
-        a1, b1 = -1.0 / twice_decel, u0 * u0 / twice_decel
-    if uf < 0.0:
-        a2, b2 = 1.0 / twice_decel, -uf * uf / twice_accel
-    elif w >= uf:
-        a2, b2 = 1.0 / twice_decel, -uf * uf / twice_decel
-    else:
-        a2, b2 = -1.0 / twice_accel, uf * uf / twice_accel
-    return a1 + a2, b1 + b2
-
-
 def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float, decel: float):
     """Fastest peak velocity w in [0, vmax] and cruise time for one travel direction.
 
@@ -114,13 +95,29 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
     top = len(points) - 2
     twice_accel, twice_decel = 2.0 * accel, 2.0 * decel
     for k in range(top, -1, -1):
-        alpha, beta = _coefficients(u0, uf, 0.5 * (points[k] + points[k + 1]), twice_accel, twice_decel)
+        lo, hi = points[k], points[k + 1]
+        # F on this piece, alpha*w^2 + beta: the first ramp's (u0 -> w) alpha and beta plus the
+        # last's (w -> uf), at the rates a w inside the piece gives them (here, not in a function
+        # of their own: a call per piece costs as much as this arithmetic)
+        w = 0.5 * (lo + hi)
+        if u0 < 0.0:
+            a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_decel
+        elif w >= u0:
+            a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_accel
+        else:
+            a1, b1 = -1.0 / twice_decel, u0 * u0 / twice_decel
+        if uf < 0.0:
+            a2, b2 = 1.0 / twice_decel, -uf * uf / twice_accel
+        elif w >= uf:
+            a2, b2 = 1.0 / twice_decel, -uf * uf / twice_decel
+        else:
+            a2, b2 = -1.0 / twice_accel, uf * uf / twice_accel
+        alpha, beta = a1 + a2, b1 + b2
         if k == top:
             f_top = alpha * vmax * vmax + beta
             if not f_top > reach:  # even the top speed leaves distance: cruise at vmax
                 cruise = (x - f_top) / vmax if vmax > 0.0 else 0.0
                 return vmax, cruise if cruise > 0.0 else 0.0
-        lo = points[k]
         f_lo = alpha * lo * lo + beta
         if f_lo > reach:
             continue
@@ -130,7 +127,6 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
         else:
             w = lo
         w = lo if lo > w else w
-        hi = points[k + 1]
         return hi if hi < w else w, 0.0
     return None
 
@@ -142,7 +138,7 @@ def _rest_to_rest(distance: float, vmax: float, accel: float, decel: float) -> t
 
     From rest to rest (u0 = uf = ±0) the direction away from the target is ruled out by
     _peak_in_direction's first test (its reach below 0, a finite alpha), and the scan toward it
-    has the one piece [0, vmax] (no inner breakpoint), where _coefficients answers
+    has the one piece [0, vmax] (no inner breakpoint), where its coefficients are
     alpha = 1/(2 accel) + 1/(2 decel) and beta = -0.0 (-u*u/(2 rate) of u = ±0 is -0.0 for
     positive rates; vmax >= 0 takes their branches); F at 0 is then 0, never past the reach."""
     size = abs(distance)
