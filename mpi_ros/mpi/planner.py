@@ -580,9 +580,17 @@ def _lone_axis_plan(motion_type: MPIMotionType, params: MotionParams, start: Axi
     target = positions[0] + start.origin  # (_targets' target: not RELATIVE)
     # (its segments as Rows, the Segments made when first asked for: RowAxisPlan)
     line = _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, 0.0, traj, True)
+    segments, end, duration = line
+    limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     # (chained: reshape's profile unless a jerk type's; one axis is neither padded nor composite)
-    return _checked_plan(line[0], line, motion_type is not _S_CURVE_JERK, start, target, 0.0,  # type: ignore[arg-type]
-                         VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate, notes, None, [], traj, "", RowAxisPlan)
+    chained = motion_type is not _S_CURVE_JERK
+    if chained and duration <= limit and _on_target(end, start, target):
+        # _checked's first answer, the usual one: on target, and no segment lasts longer than the
+        # limit (_within), so finite (_finite_if_it_ends): the plan as _checked_plan makes it
+        return RowAxisPlan.with_duration(segments, duration, start.axis, start.position, target, 0.0, None, [], False,
+                                         traj, start.velocity, start.acceleration, "")
+    return _checked_plan(segments, line, chained, start, target, 0.0, limit, notes, None, [],  # type: ignore[arg-type]
+                         traj, "", RowAxisPlan)
 
 
 def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: AxisStart, target: float,
