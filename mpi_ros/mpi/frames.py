@@ -13,13 +13,13 @@ import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Self
 
 import numpy as np
 
 from .events import MPIEventType
 from .params import Hold, Output, Trajectory
-from .profiles.segment import ScaledProfile, Segment, SegmentTable, end_time
+from .profiles.segment import Row, ScaledProfile, Segment, SegmentTable, end_time, segment_from
 from .types import MotionAttr, MPIMotionType
 
 if TYPE_CHECKING:
@@ -76,13 +76,58 @@ class AxisPlan:
             self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
         self.duration = end_time(self.segments, self.origin_time) if self.cam is None else self.cam.duration
 
+    @classmethod
+    def with_duration(cls, segments: list[Segment] | list[Row] | None, duration: float, axis: int,
+                      start_position: float, target: float, final_velocity: float, hold: Hold | None,
+                      outputs: list[Output], truncated: bool, limits: Trajectory | None, start_velocity: float,
+                      start_acceleration: float, composite: str) -> Self:
+        """A point-to-point plan (not a VELOCITY move, a path or a cam: origin_time 0) whose
+        ``duration``, ``end_time(segments)``, its planner has calculated already (with the
+        segments: scurve.reshaped), as ``cls(...)`` makes it. Its slots are filled here rather than
+        by the dataclass' __init__ and __post_init__, which would add the segments up again, a
+        pass of their own, behind two calls (a modify is planned while its command waits).
+        ``segments`` None: a ScaledAxisPlan's, made when first asked for; Rows: a RowAxisPlan's."""
+        if segments is not None and not segments:  # (as __post_init__: a plan holds at least its end)
+            segments = [Segment(0.0, target, final_velocity, 0.0, 0.0)]
+            duration = end_time(segments)
+        plan = _new_object(cls)
+        _segments_slot.__set__(plan, segments)  # (past ScaledAxisPlan's property)
+        plan.duration = duration
+        plan.axis = axis
+        plan.start_position = start_position
+        plan.target = target
+        plan.final_velocity = final_velocity
+        plan.hold = hold
+        plan.outputs = outputs
+        plan.truncated = truncated
+        _limits_slot.__set__(plan, limits)  # (past ScaledAxisPlan's property)
+        plan.start_velocity = start_velocity
+        plan.start_acceleration = start_acceleration
+        plan.composite = composite
+        # the other fields' defaults (test_planner checks that every field is as cls(...) makes it)
+        plan.velocity_target = None
+        plan.ramp_end = 0.0
+        plan.origin_time = 0.0
+        plan.point_times = None
+        plan.element_ids = ()
+        plan.timed_outputs = []
+        plan.feedforward = None
+        plan.cam = None
+        plan._table = None
+        return plan
+
     @property
     def table(self) -> SegmentTable:
         """The segments as arrays. Built on first use, not with the plan: numpy on a handful of
         segments costs more than planning them, and a modify is planned while its command waits."""
         if self._table is None:
-            self._table = SegmentTable(self.segments, self.origin_time)
+            self._table = SegmentTable(self._rows(), self.origin_time)
         return self._table
+
+    def _rows(self) -> Sequence[Row]:
+        """The segments' values, as the stepping reads them (by index): the segments themselves,
+        or a RowAxisPlan's Rows before its Segments are made."""
+        return self.segments
 
     @property
     def is_velocity(self) -> bool:
@@ -159,8 +204,8 @@ class AxisPlan:
         # bisect_right is searchsorted(side="right") (a nan rel too goes past the end); on a
         # handful of ends it costs a fraction of numpy's call, and it runs for every piece.
         i = min(bisect.bisect_right(table.end, rel), table.count - 1)
-        seg = self.segments[i]
-        return float(table.start[i]), [seg.p, seg.v, seg.a / 2.0, seg.j / 6.0]
+        _, p, v, a, j = self._rows()[i]
+        return float(table.start[i]), [p, v, a / 2.0, j / 6.0]
 
     def boundaries(self) -> np.ndarray:
         """Relative profile times at which the command polynomial (or the feedforward) changes."""
@@ -182,34 +227,36 @@ class AxisPlan:
 
 # The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
 _segments_slot = AxisPlan.__dict__["segments"]
-_init_plan = AxisPlan.__init__  # (ScaledAxisPlan.of: a global, not an attribute of the class looked up per plan)
+_limits_slot = AxisPlan.__dict__["limits"]  # (and its limits, likewise)
+_new_object = object.__new__
+_with_duration = AxisPlan.with_duration.__func__  # type: ignore[attr-defined]  # (ScaledAxisPlan.of's, for its class)
 
 
 class ScaledAxisPlan(AxisPlan):
     """An axis of a vector move whose segments are its share of the vector's 1-D profile
-    (``scaled``), made from it the first time they are asked for: by the stepping's table, a
-    cross-check or a plot, not while the command waits for its plan (a further axis of a
-    vector then costs little to plan). The segments, duration and frame count are those of an
-    AxisPlan made with ``scaled.segments()``, and so is every answer: the two are one plan.
-    Made by :meth:`of`."""
+    (``scaled``), and its limits its share of the vector's (``vector_limits``), each made the
+    first time it is asked for: by the stepping's table, a cross-check or a plot, not while the
+    command waits for its plan (a further axis of a vector then costs little to plan). The
+    segments, limits, duration and frame count are those of an AxisPlan made with
+    ``scaled.segments()`` and ``vector_limits.share(abs(scaled.factor))``, and so is every
+    answer: the two are one plan. Made by :meth:`of`."""
 
-    __slots__ = ("scaled",)
+    __slots__ = ("scaled", "vector_limits")
     scaled: ScaledProfile
+    vector_limits: Trajectory
 
     @classmethod
     def of(cls, scaled: ScaledProfile, duration: float, axis: int, start_position: float, target: float,
-           final_velocity: float, hold: Hold | None, outputs: list[Output], limits: Trajectory | None,
+           final_velocity: float, hold: Hold | None, outputs: list[Output], vector_limits: Trajectory,
            start_velocity: float, start_acceleration: float, composite: str) -> ScaledAxisPlan:
-        """The plan of a vector's axis: AxisPlan's fields of a point-to-point plan (not a
-        VELOCITY move, not truncated, origin_time 0), the segments left out. ``duration``:
-        ``end_time(scaled.line)``, the same durations added in the same order as
-        AxisPlan.__post_init__ adds the segments' (the vector's axes share it: calculated once).
-        (Named parameters, not ``*fields``: packing and unpacking them cost a third of the plan.)"""
-        plan = cls.__new__(cls)
+        """The plan of a vector's axis: AxisPlan.with_duration's, not truncated, the segments and
+        limits left out. ``duration``: ``end_time(scaled.line)``, the same durations added in the
+        same order as ``end_time(scaled.segments())`` adds the segments' (the vector's axes share
+        it: calculated once)."""
+        plan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold, outputs,
+                              False, None, start_velocity, start_acceleration, composite)
         plan.scaled = scaled
-        plan.duration = duration
-        _init_plan(plan, axis, None, start_position, target, final_velocity, hold, outputs,  # type: ignore[arg-type]
-                   None, 0.0, False, limits, start_velocity, start_acceleration, composite)  # (segments when asked for)
+        plan.vector_limits = vector_limits
         return plan
 
     def __post_init__(self) -> None:
@@ -230,10 +277,52 @@ class ScaledAxisPlan(AxisPlan):
         _segments_slot.__set__(self, value)
 
     @property
+    def limits(self) -> Trajectory | None:
+        made = _limits_slot.__get__(self, AxisPlan)
+        if made is None:
+            made = self.vector_limits.share(abs(self.scaled.factor))
+            _limits_slot.__set__(self, made)
+        return made
+
+    @limits.setter
+    def limits(self, value: Trajectory | None) -> None:
+        _limits_slot.__set__(self, value)
+
+    @property
     def segment_count(self) -> int:
         """As many as the 1-D profile's, without making them (the frame buffer counts them)."""
         made = _segments_slot.__get__(self, AxisPlan)
         return len(self.scaled.line) if made is None else len(made)
+
+
+class RowAxisPlan(AxisPlan):
+    """A plan whose segments may be kept as Rows (plain tuples: scurve.reshaped(rows=True), an
+    axis' own profile), which the stepping reads as they are (its table, segment_poly); the
+    Segments are made from them the first time they are asked for (a cross-check, a plot, a
+    copy). A Segment, a tuple subclass, takes three times as long to make as a tuple, and a
+    modify is planned while its command waits. Its segments, and every answer, are those of
+    the AxisPlan with the same values: the two are one plan. Made by ``with_duration``."""
+
+    __slots__ = ()
+
+    def _rows(self) -> Sequence[Row]:
+        return _segments_slot.__get__(self, AxisPlan)
+
+    @property
+    def segments(self) -> list[Segment]:
+        made = _segments_slot.__get__(self, AxisPlan)
+        if type(made[0]) is not Segment:  # (never empty: with_duration and __post_init__ see to it)
+            made = list(map(segment_from, made))
+            _segments_slot.__set__(self, made)
+        return made
+
+    @segments.setter
+    def segments(self, value: list[Segment]) -> None:
+        _segments_slot.__set__(self, value)
+
+    @property
+    def segment_count(self) -> int:
+        return len(_segments_slot.__get__(self, AxisPlan))
 
 
 @dataclass(slots=True)

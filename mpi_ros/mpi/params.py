@@ -179,6 +179,11 @@ class Trajectory:
     acceleration_jerk: float = 0.0
     deceleration_jerk: float = 0.0
 
+    def share(self, share: float) -> Trajectory:
+        """An axis' share of a vector's limits (jerk percent is a ratio and stays)."""
+        return Trajectory(self.velocity * share, self.acceleration * share, self.deceleration * share,
+                          self.jerk_percent, self.acceleration_jerk * share, self.deceleration_jerk * share)
+
     def validate(self) -> Outcome:
         """Magnitudes a controller can hold. Which must be positive depends on the motion
         type and is checked with the move (validate.check_params): VELOCITY ignores the

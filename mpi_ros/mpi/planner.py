@@ -19,20 +19,23 @@ moves on a straight line to the new targets (docs/decisions.md).
 from __future__ import annotations
 
 import math
+import sys
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Literal, overload
 
 from . import cams
 from .events import MPIEventType
-from .frames import AxisPlan, Move, ScaledAxisPlan, Stream
+from .frames import AxisPlan, Move, RowAxisPlan, ScaledAxisPlan, Stream
 from .messages import Message
 from .outcome import Refused
-from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, MotionParams, Trajectory
+from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, Hold, MotionParams, Output, Trajectory
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import reverses, velocity_move
 from .profiles.ramps import ProfileError, plan_point_to_point, ramps_between
-from .profiles.scurve import reshape
-from .profiles.segment import ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
+from .profiles.scurve import reshape, reshaped
+from .profiles.segment import Row, ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
 
 A = MotionAttr
@@ -47,10 +50,16 @@ _IN_MOTION_REFUSED = _DELAY | _HOLDS  # a move that starts in motion may not wai
 _PADDED = _SYNC | _DELAY  # profiles with wait frames: not reshape's chain of pieces
 _AXIS_BY_AXIS = _DELAY | _NO_REVERSAL  # a vector's axes made and checked one by one
 _HOLD_OR_OUTPUT = _HOLDS | _OUTPUT
+# The attributes that change a point-to-point axis' plan: without them one axis is planned by
+# _lone_axis_plan, the general path's lists and tests left out
+_GENERAL = _RELATIVE | _FINAL_VEL | _SYNC | _DELAY | _NO_REVERSAL | _HOLD_OR_OUTPUT
 # The motion types planning tells apart, looked up once: an enum member is a class attribute
 # lookup of ~0.1 us each time.
 _S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
 _VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
+# The types not planned as point-to-point moves: one test for the point-to-point types (the
+# starts and modifies a command waits for), a set lookup each for the others
+_NOT_POINT_TO_POINT = CAM_TYPES | STREAMED_TYPES | _VELOCITY_TYPES
 _NO_EVENTS = MPIEventType.NONE
 
 
@@ -152,21 +161,17 @@ def _check_lands(segments: list[Segment], start: AxisStart, target: float, end: 
 
 
 def _checked(segments: list[Segment], start: AxisStart, target: float, limit: float, notes: PlanNotes,
-             chained: bool) -> tuple[list[Segment], bool]:
+             end: float, duration: float | None) -> tuple[list[Segment], bool]:
     """An axis' plan after the landing, overflow and frame-limit checks: cut at the first frame
-    longer than ``limit`` seconds (16,384,000 samples), and whether it was. ``chained``: the
-    segments are reshape's, each starting where the one before ends, so that one that lands
-    is finite throughout (_finite_if_it_ends); otherwise one pass over them finds every segment
-    finite and within the limit, the usual case."""
-    end = _end_position(segments[-1]) if segments else start.position
+    longer than ``limit`` seconds (16,384,000 samples), and whether it was. ``end``: where the
+    segments end (_end_position of the last; the start without any). ``duration``: their
+    end_time when they are reshape's (each starting where the one before ends, so that one that
+    lands is finite throughout: _finite_if_it_ends), None otherwise: then one pass over them
+    finds every segment finite and within the limit, the usual case."""
     if not _on_target(end, start, target):
         _check_lands(segments, start, target, end)
-    if chained:
-        for segment in segments:
-            if segment[0] > limit:  # (its duration: a loop with an index costs half of max(map(...)))
-                break
-        else:
-            return segments, False  # landed: finite (and reshape's pieces are positive)
+    if duration is not None and _within(segments, duration, limit):
+        return segments, False  # landed: finite (and reshape's pieces are positive)
     for d, p, v, a, j in segments:
         # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
         if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
@@ -175,66 +180,81 @@ def _checked(segments: list[Segment], start: AxisStart, target: float, limit: fl
     return segments, False
 
 
-def _finite_if_it_ends(segments: list[Segment]) -> bool:
-    """Whether the end position of ``segments`` (reshape's: each starts at the position where
-    the one before ends, as Segment.end_state calculates it) is finite, which makes every value
+def _within(segments: Sequence[Row], duration: float, limit: float) -> bool:
+    """No segment of a 1-D profile (reshape's: finite if it lands, no duration below 0) lasts
+    longer than ``limit``; ``duration``: theirs. Durations of at least 0 add up to at least each
+    of them, in floating point too (rounding is monotonic), so one comparison answers the usual
+    case; a profile that lasts longer than the limit is asked segment by segment."""
+    return duration <= limit or not any(segment[0] > limit for segment in segments)  # (segment[0]: its duration)
+
+
+def _finite_if_it_ends(end: float) -> bool:
+    """Whether ``end``, the end position of reshape's segments (each starts at the position where
+    the one before ends, as Segment.end_state calculates it), is finite, which makes every value
     of every segment finite: each enters that end position through +, -, * and division by a
     constant, where an infinite or NaN operand gives an infinite or NaN result (a product too:
     the pieces last more than 0 s). This is what _check_finite's pass would find."""
-    return math.isfinite(_end_position(segments[-1]))
+    return math.isfinite(end)
 
 
-def _line_bound(line: list[Segment], limit: float, chained: bool) -> float | None:
-    """The largest |position| in a vector's 1-D profile if all its values are finite and no
-    frame exceeds ``limit`` (None otherwise, or for no profile). An axis' share of it, with
-    a factor of at most 1 and a start ``offset``, is then finite and within the limit too when
-    abs(offset) + this bound is finite: rounding to nearest is monotonic, so no product or sum
-    of the scaling exceeds it in magnitude. ``chained``: the profile is reshape's (_checked)."""
-    if not line:
-        return None
-    bound = 0.0
+def _line_passes(line: RowLine, limit: float, chained: bool) -> bool:
+    """Whether a vector's 1-D profile is not empty, all its values are finite and no frame exceeds
+    ``limit``. An axis' share of it, with a factor of at most 1 and a start ``offset``, is then
+    finite and within the limit too when abs(offset) + its largest |position| is finite
+    (_no_overflow): rounding to nearest is monotonic, so no product or sum of the scaling
+    exceeds that in magnitude. ``chained``: the profile is reshape's (_checked)."""
+    segments, end, duration = line
+    if not segments:
+        return False
     if chained:
-        if not _finite_if_it_ends(line):
-            return None
-        for segment in line:  # (a loop with indexes costs half of max(map(...)) twice)
-            if segment[0] > limit:  # (its duration)
-                return None
-            if abs(segment[1]) > bound:  # (its position)
-                bound = abs(segment[1])
-        return bound
-    for d, p, v, a, j in line:
-        # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
-        if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
-            return None
-        if abs(p) > bound:
-            bound = abs(p)
-    return bound
+        return _finite_if_it_ends(end) and _within(segments, duration, limit)
+    # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
+    return all(0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0
+               for d, p, v, a, j in segments)
 
 
-def _passes_checks(scaled: ScaledProfile, bound: float | None, start: AxisStart, target: float) -> bool:
-    """True when the vector axis' share ``scaled`` of the checked 1-D profile (``bound``:
-    _line_bound) passes _checked as it is, without making its segments: finite, no frame
+# Half a unit in the last place of the largest float: a finite x plus any |y| below it rounds to
+# at most the largest float, finite (a tie rounds to even, up: hence below)
+_HALF_ULP_OF_MAX = math.ulp(sys.float_info.max) / 2.0
+
+
+def _no_overflow(offset: float, segments: Sequence[Row]) -> bool:
+    """abs(offset) + the largest |position| of ``segments`` (finite: _line_passes) is finite. For
+    any offset below _HALF_ULP_OF_MAX it is, whatever that position (every offset a controller
+    holds), so the positions are looked at for a larger one only."""
+    if abs(offset) < _HALF_ULP_OF_MAX:
+        return True
+    bound = 0.0
+    for segment in segments:
+        if abs(segment[1]) > bound:  # (its position)
+            bound = abs(segment[1])
+    return math.isfinite(abs(offset) + bound)
+
+
+def _passes_checks(scaled: ScaledProfile, start: AxisStart, target: float) -> bool:
+    """True when the vector axis' share ``scaled`` of a 1-D profile that passed its checks
+    (_line_passes) passes _checked as it is, without making its segments: finite, no frame
     beyond the limit, and its last segment, scaled as scaled_profile scales it, ends on the
     target (within the rounding of the positions: otherwise _checked decides)."""
     line, factor, offset = scaled
-    if bound is None or not (abs(factor) <= 1.0 and math.isfinite(abs(offset) + bound)):
+    if not (abs(factor) <= 1.0 and _no_overflow(offset, line)):
         return False
     t, p, v, a, j = line[-1]
-    last = (t, offset + factor * p, factor * v, factor * a, factor * j)  # (scaled_profile's operations)
-    return _on_target(_end_position(last), start, target)
+    p, v, a, j = offset + factor * p, factor * v, factor * a, factor * j  # (scaled_profile's operations)
+    return _on_target(p + t * (v + t * (a / 2.0 + t * j / 6.0)), start, target)  # (_end_position's)
 
 
 def _cap_frames(segments: list[Segment], limit: float, axis: int, notes: PlanNotes) -> tuple[list[Segment], bool]:
-    """Cut the (finite) plan at the first frame longer than ``limit`` seconds."""
-    for i, seg in enumerate(segments):
-        if seg.duration > limit:
+    """Cut the (finite) plan at the first frame longer than ``limit`` seconds. (Its segments by
+    index: Segments or Rows, a lone axis': _lone_axis_plan.)"""
+    for i, (duration, p, v, a, j) in enumerate(segments):
+        if duration > limit:
             notes.events.append(
                 (MPIEventType.FRAME_TIME_LIMIT,
-                 f"axis {axis}: a frame of {seg.duration:.1f} s exceeds {VELOCITY_FRAME_LIMIT_SAMPLES} samples;"
+                 f"axis {axis}: a frame of {duration:.1f} s exceeds {VELOCITY_FRAME_LIMIT_SAMPLES} samples;"
                  " the axis will stop abruptly after it")
             )
-            cut = Segment(limit, seg.p, seg.v, seg.a, seg.j)
-            return segments[:i] + [cut], True
+            return segments[:i] + [Segment(limit, p, v, a, j)], True
     return segments, False
 
 
@@ -243,39 +263,49 @@ def _wait(position: float, duration: float) -> list[Segment]:
 
 
 def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float, v_final: float, traj: Trajectory):
-    return _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, v_final, traj)
+    return _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, v_final, traj)[0]
+
+
+# A 1-D profile: its segments, where they end (the position Segment.end_state gives at the end
+# of the last; the start without any) and its duration (end_time of the segments). The planner
+# checks and times every profile: reshape calculates both as it makes the segments. A vector's
+# line is made of Rows (its axes' Segments are made from it), an axis' own profile of Segments.
+Line = tuple[list[Segment], float, float]
+RowLine = tuple[list[Row], float, float]
+
+
+@overload
+def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
+                  traj: Trajectory, rows: Literal[False] = False) -> Line: ...
+
+
+@overload
+def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
+                  traj: Trajectory, rows: Literal[True]) -> RowLine: ...
 
 
 def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, target: float, v_final: float,
-                  traj: Trajectory) -> list[Segment]:
-    """The 1-D profile of a point-to-point type from (p0, v0, a0); a0 is read by the jerk types only."""
+                  traj: Trajectory, rows: bool = False) -> Line | RowLine:
+    """The 1-D profile of a point-to-point type from (p0, v0, a0); a0 is read by the jerk types
+    only. ``rows``: reshape's segments as Rows (scurve.reshaped; a jerk type's are Segments)."""
     if motion_type is _S_CURVE_JERK:
-        return point_to_point_jerk(
+        segments = point_to_point_jerk(
             p0, v0, a0, target, v_final, traj.velocity,
             (traj.acceleration, traj.acceleration_jerk), (traj.deceleration, traj.deceleration_jerk))
+        return segments, _end_position(segments[-1]) if segments else p0, end_time(segments)
     jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
     # point_to_point's two steps, without its call (a modify is planned while its command waits)
     plan = plan_point_to_point(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
-    return reshape(plan, p0, jerk_percent)
+    return reshaped(plan, p0, jerk_percent, True) if rows else reshaped(plan, p0, jerk_percent)
 
 
-def _scaled(traj: Trajectory, share: float) -> Trajectory:
-    """An axis' share of the vector's limits (jerk percent is a ratio and stays)."""
-    return Trajectory(traj.velocity * share, traj.acceleration * share, traj.deceleration * share,
-                      traj.jerk_percent, traj.acceleration_jerk * share, traj.deceleration_jerk * share)
-
-
-def _shares(traj: Trajectory, unit: list[float]) -> list[Trajectory]:
-    """Each axis' share of the vector's limits, ``_scaled(traj, abs(u))`` for each component u of
-    the line's unit vector (the trajectory's fields read once, not once per axis)."""
-    velocity, acceleration, deceleration = traj.velocity, traj.acceleration, traj.deceleration
-    jerk_percent, accel_jerk, decel_jerk = traj.jerk_percent, traj.acceleration_jerk, traj.deceleration_jerk
-    limits = []
-    for u in unit:
-        share = abs(u)
-        limits.append(Trajectory(velocity * share, acceleration * share, deceleration * share, jerk_percent,
-                                 accel_jerk * share, decel_jerk * share))
-    return limits
+def _limits_of(profile: Profile, limits: list[Trajectory] | None, i: int, traj: Trajectory) -> Trajectory:
+    """Axis i's limits: ``limits[i]``, or where a vector's shares are not made (None: every
+    profile a ScaledProfile), its share of the vector's ``traj``, by its factor (_vector_profiles)."""
+    if limits is not None:
+        return limits[i]
+    assert isinstance(profile, ScaledProfile)
+    return traj.share(abs(profile.factor))
 
 
 # An axis' profile: its segments, or (a vector's axis) its share of the vector's 1-D profile
@@ -311,21 +341,29 @@ def _along(vector, unit, scale: float) -> tuple[float, bool]:
     return along, True
 
 
-def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[Profile], list[Trajectory], str]:
+def _accel_along(starts: list[AxisStart], unit: list[float]) -> float:
+    """The component of the axes' acceleration along ``unit``: the jerk types plan from it."""
+    accels = [start.acceleration for start in starts]
+    return _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
+
+
+def _vector_profiles(motion_type, starts, targets, finals,
+                     traj) -> tuple[list[Profile], list[Trajectory] | None, str, RowLine | None]:
     """One profile along the straight line from the start to the targets, each axis'
-    effective limits (the vector's scaled by the axis' share of the line), and why the
-    profiles are not one profile per axis ("" when they are). Plain floats: a vector has at
-    most MEIXmpMAX_COORD_AXES components, too few for numpy to pay off."""
+    effective limits (the vector's scaled by the axis' share of the line: None when every
+    profile is a ScaledProfile, whose factor is that share, the limits then made when asked for,
+    _limits_of), why the profiles are not one profile per axis ("" when they are) and the 1-D
+    profile every axis has a share of (None when they have not: no move, or not one line).
+    Plain floats: a vector has at most MEIXmpMAX_COORD_AXES components, too few for numpy to
+    pay off."""
     # (loops of appends, lists alike by index: for one or two axes they cost about half of
     # list(map(...)) or a comprehension and less than a zip, each of which makes an object of its own)
     p0: list[float] = []
     v0: list[float] = []
-    accels: list[float] = []
     delta: list[float] = []
     for i, start in enumerate(starts):
         p0.append(start.position)
         v0.append(start.velocity)
-        accels.append(start.acceleration)
         delta.append(targets[i] - start.position)  # (as many targets as starts: _targets makes them)
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
@@ -338,20 +376,21 @@ def _vector_profiles(motion_type, starts, targets, finals, traj) -> tuple[list[P
     elif speed > 0.0:
         unit = [v / speed for v in v0]
     else:
-        return [[] for _ in starts], [traj for _ in starts], ""
+        return [[] for _ in starts], [traj for _ in starts], "", None
     along, parallel = _along(v0, unit, speed)
     final_along, final_parallel = _along(finals, unit, math.hypot(*finals))
     if not final_parallel:
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
-    accel = _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
-    line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj)
+    accel = _accel_along(starts, unit) if motion_type is _S_CURVE_JERK else 0.0  # (the others plan from a = 0)
+    line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj, True)
+    segments = line[0]
     profiles: list[Profile] = []
     for i, u in enumerate(unit):  # (unit and p0 are made alike above)
-        # (ScaledProfile(line, u, p0[i]) without the Python-level __new__ of a NamedTuple, as segments are made)
-        profiles.append(new_tuple(ScaledProfile, (line, u, p0[i])))
-    return profiles, _shares(traj, unit), ""
+        # (ScaledProfile(segments, u, p0[i]) without the Python-level __new__ of a NamedTuple, as segments are made)
+        profiles.append(new_tuple(ScaledProfile, (segments, u, p0[i])))
+    return profiles, None, "", line
 
 
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
@@ -367,10 +406,11 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     stopped_after = stop[-1].end_state()[0] if stop else 0.0
     rest = [p + h * stopped_after for p, h in zip(p0, heading, strict=True)]
     go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest, strict=True)]
-    go, limits, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
+    go, go_limits, _, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
     profiles = [scaled_profile(stop, h, p) + _segments(tail) for h, p, tail in zip(heading, p0, go, strict=True)]
-    limits = [_scaled(traj, max(abs(h), lim.velocity / traj.velocity)) for h, lim in zip(heading, limits, strict=True)]
-    return profiles, limits, STOP_THEN_LINE
+    limits = [traj.share(max(abs(h), _limits_of(tail, go_limits, i, traj).velocity / traj.velocity))
+              for i, (h, tail) in enumerate(zip(heading, go, strict=True))]
+    return profiles, limits, STOP_THEN_LINE, None
 
 
 def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) -> list[Segment]:
@@ -413,7 +453,7 @@ def compile_move(
     would stop the axes dead. A cam (``cam_masters``: each slave's master and its position
     now) is planned by cams.py.
     """
-    notes = PlanNotes()
+    notes = PlanNotes([])  # (its list given: the dataclass' default factory is a call more)
     bits = int(attrs)
     if bits & _IN_MOTION_REFUSED and any(s.velocity != 0.0 for s in starts):  # starts in motion
         if bits & _DELAY and any(d != 0.0 for d in params.delay):
@@ -422,15 +462,15 @@ def compile_move(
             raise Refused(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
     stream = None
     try:
-        if motion_type in CAM_TYPES:
+        if motion_type not in _NOT_POINT_TO_POINT:
+            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
+        elif motion_type in CAM_TYPES:
             assert cam_masters is not None  # (the supervisor reads each slave's master)
             plans = cams.cam_plans(motion_type, attrs, params, starts, cam_masters)
         elif motion_type in STREAMED_TYPES:
             plans, stream = _path_plans(motion_type, params, attrs, starts)
-        elif motion_type in _VELOCITY_TYPES:
-            plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
         else:
-            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
+            plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
     # (positional: a dataclass' __init__ matches keywords at a cost; the fields in their order)
@@ -467,9 +507,14 @@ def _holds_and_outputs(params: MotionParams, bits: int, index: int):
 def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits: int, starts: list[AxisStart],
                           sample_rate: float, notes: PlanNotes) -> list[AxisPlan]:
     """``bits``: the move's attributes as an int (compile_move's)."""
+    if len(starts) == 1 and not bits & _GENERAL:  # (the usual start or modify of an axis)
+        return [_lone_axis_plan(motion_type, params, starts[0], sample_rate, notes)]
     targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
+    line: Line | None = None  # the 1-D profile of one axis
+    vector: RowLine | None = None  # or the one of a vector's axes (_vector_profiles)
+    limits: list[Trajectory] | None  # (None: a vector's shares, _limits_of)
     if bits & _SYNC:
         profiles = [
             _scalar_profile(motion_type, start, target, final, traj)
@@ -479,26 +524,24 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         limits = list(params.trajectory)
     elif len(starts) == 1:
         one = starts[0]
-        profiles = [_profile_from(motion_type, one.position, one.velocity, one.acceleration, targets[0], finals[0],
-                                  params.trajectory[0])]
+        line = _profile_from(motion_type, one.position, one.velocity, one.acceleration, targets[0], finals[0],
+                             params.trajectory[0])
+        profiles = [line[0]]
         limits = [params.trajectory[0]]
     else:
-        profiles, limits, composite = _vector_profiles(motion_type, starts, targets, finals, params.trajectory[0])
+        profiles, limits, composite, vector = _vector_profiles(motion_type, starts, targets, finals,
+                                                               params.trajectory[0])
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
     # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
     # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
     chained = motion_type is not _S_CURVE_JERK and not bits & _PADDED and not composite
-    # ``bound`` (_line_bound) is not None only for a vector's shares (every profile a
-    # ScaledProfile) whose 1-D profile passed its checks; line_duration is then every
-    # ScaledAxisPlan's duration, the 1-D profile's, calculated once.
+    # ``shared`` only for a vector's shares (every profile a ScaledProfile) whose 1-D profile
+    # passed its checks; every ScaledAxisPlan's duration is then the 1-D profile's.
     first = profiles[0] if profiles else None
-    bound, line_duration = None, 0.0
-    if isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS:
-        bound = _line_bound(first.line, limit, chained)
-        if bound is not None:
-            line_duration = end_time(first.line)
+    shared = (vector is not None and isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS
+              and _line_passes(vector, limit, chained))
     plans: list[AxisPlan] = []
     # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
     # velocity and profile per start, made so above from a request check_params has found one
@@ -507,30 +550,67 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
         target, final, profile = targets[i], finals[i], profiles[i]
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
         if isinstance(profile, ScaledProfile):
-            if bound is not None and _passes_checks(profile, bound, start, target):
-                plans.append(ScaledAxisPlan.of(profile, line_duration, start.axis, start.position, target, final,
-                                               hold, outputs, limits[i], start.velocity, start.acceleration, composite))
+            if shared and _passes_checks(profile, start, target):
+                plans.append(ScaledAxisPlan.of(profile, vector[2], start.axis, start.position,  # type: ignore[index]
+                                               target, final, hold, outputs, params.trajectory[0], start.velocity,
+                                               start.acceleration, composite))
                 continue
             # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
-            prof, chain = profile.segments(), False
+            prof, own = profile.segments(), None
         else:
-            prof, chain = profile, chained
+            prof, own = profile, line  # (a lone axis' profile is its line; the other plain profiles have none)
         if bits & _NO_REVERSAL and reverses(prof, start.velocity):
             raise Refused(Message.MPIMotionMessagePROFILE_ERROR,
                             f"axis {start.axis}: NO_REVERSAL, but the target is behind the motion")
         if bits & _DELAY:
-            prof = _wait(start.position, params.delay[i]) + prof
-        prof, truncated = _checked(prof, start, target, limit, notes, chain)
-        # (positional, as Move above: the fields in their order, a third cheaper than keywords)
-        plans.append(AxisPlan(
-            start.axis, prof, start.position,  # axis, segments, start_position
-            prof[-1].end_state()[0] if truncated else target,  # target (truncated: where the cut plan ends)
-            0.0 if truncated else final,  # final_velocity
-            hold, outputs,
-            None, 0.0,  # velocity_target, ramp_end: not a VELOCITY move
-            truncated, limits[i], start.velocity, start.acceleration, composite,
-        ))
+            prof, own = _wait(start.position, params.delay[i]) + prof, None
+        plans.append(_checked_plan(prof, own, chained, start, target, final, limit, notes, hold, outputs,
+                                   _limits_of(profile, limits, i, params.trajectory[0]), composite))
     return plans
+
+
+def _lone_axis_plan(motion_type: MPIMotionType, params: MotionParams, start: AxisStart, sample_rate: float,
+                    notes: PlanNotes) -> AxisPlan:
+    """The plan of one axis whose attributes change nothing in it (none of _GENERAL's), as
+    _point_to_point_plans makes it: the same target, profile and checks, without the lists and
+    tests that further axes and those attributes need."""
+    positions, traj = params.position, params.trajectory[0]
+    if len(positions) != 1:  # (_targets' guard)
+        raise ValueError(f"{len(positions)} positions for 1 axes")
+    target = positions[0] + start.origin  # (_targets' target: not RELATIVE)
+    # (its segments as Rows, the Segments made when first asked for: RowAxisPlan)
+    line = _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, 0.0, traj, True)
+    segments, end, duration = line
+    limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
+    # (chained: reshape's profile unless a jerk type's; one axis is neither padded nor composite)
+    chained = motion_type is not _S_CURVE_JERK
+    if chained and duration <= limit and _on_target(end, start, target):
+        # _checked's first answer, the usual one: on target, and no segment lasts longer than the
+        # limit (_within), so finite (_finite_if_it_ends): the plan as _checked_plan makes it
+        return RowAxisPlan.with_duration(segments, duration, start.axis, start.position, target, 0.0, None, [], False,
+                                         traj, start.velocity, start.acceleration, "")
+    return _checked_plan(segments, line, chained, start, target, 0.0, limit, notes, None, [],  # type: ignore[arg-type]
+                         traj, "", RowAxisPlan)
+
+
+def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: AxisStart, target: float,
+                  final: float, limit: float, notes: PlanNotes, hold: Hold | None, outputs: list[Output],
+                  limits: Trajectory, composite: str, kind: type[AxisPlan] = AxisPlan) -> AxisPlan:
+    """An axis' plan of the segments ``prof`` after _checked. ``own``: the Line they are (where
+    they end and their duration, calculated with them), or None; ``chained``: they are
+    reshape's (_point_to_point_plans); ``kind``: the plan's class (RowAxisPlan for Rows)."""
+    if own is None:
+        end, duration = (_end_position(prof[-1]) if prof else start.position), None
+    else:
+        end, duration = own[1], own[2]
+    prof, truncated = _checked(prof, start, target, limit, notes, end, duration if chained else None)
+    if truncated:
+        # where the cut plan ends, at rest
+        return kind.with_duration(prof, end_time(prof), start.axis, start.position, prof[-1].end_state()[0],
+                                  0.0, hold, outputs, True, limits, start.velocity, start.acceleration, composite)
+    return kind.with_duration(prof, end_time(prof) if duration is None else duration, start.axis,
+                              start.position, target, final, hold, outputs, False, limits, start.velocity,
+                              start.acceleration, composite)
 
 
 def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:

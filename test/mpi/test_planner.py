@@ -11,10 +11,11 @@ import pytest
 
 from mpi_ros.mpi import Hold, HoldType, MotionAttr, MotionParams, MPIMotionType, Output, OutputType, Trajectory
 from mpi_ros.mpi.events import MPIEventType
-from mpi_ros.mpi.frames import AxisPlan, ScaledAxisPlan
+from mpi_ros.mpi.frames import AxisPlan, RowAxisPlan, ScaledAxisPlan
 from mpi_ros.mpi.messages import Message
 from mpi_ros.mpi.outcome import Refused
 from mpi_ros.mpi.planner import AxisStart, compile_move
+from mpi_ros.mpi.profiles.segment import Segment
 
 A = MotionAttr
 T = MPIMotionType
@@ -229,6 +230,44 @@ def _eager(plan: AxisPlan) -> AxisPlan:
     return AxisPlan(**{f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.init})
 
 
+def _fields(plan: AxisPlan) -> dict:
+    return {f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.compare}
+
+
+@pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
+@pytest.mark.parametrize("axes", [1, 2])
+@pytest.mark.parametrize("cut", [False, True])
+def test_a_plan_made_with_its_duration_is_the_dataclass_plan(kind, axes, cut):
+    # AxisPlan.with_duration fills the slots itself: every field as AxisPlan(...) makes it
+    trajectory = (Trajectory(1.0 if cut else 1000.0, 1e4, 1e4 if cut else 5e3, 40.0, 1e6, 2e6),)
+    position = (6e5, 8e5)[:axes] if cut else (3000.0, -4000.0)[:axes]
+    move, _ = compile_(position=position, kind=kind, trajectory=trajectory, rate=100.0 if cut else RATE)
+    for plan in move.plans:
+        assert plan.truncated == cut
+        assert _fields(plan) == _fields(_eager(plan))
+    empty = AxisPlan.with_duration([], 0.0, 3, 5.0, 5.0, 0.0, None, [], False, None, 0.0, 0.0, "")
+    assert _fields(empty) == _fields(AxisPlan(3, [], 5.0, 5.0))
+
+
+@pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
+@pytest.mark.parametrize("moving", [False, True])
+def test_a_lone_axis_is_stepped_from_its_rows_until_asked_for_its_segments(kind, moving):
+    # RowAxisPlan: the stepping reads the plan's Rows; the Segments are made when asked for
+    trajectory = (Trajectory(1000.0, 10_000.0, 5_000.0, 40.0, 1e6, 2e6),)
+    move, _ = compile_(position=(3000.0,), kind=kind, trajectory=trajectory, moving=moving)
+    (plan,) = move.plans
+    assert isinstance(plan, RowAxisPlan)
+    eager = _eager(plan)  # (made from the plan's fields: its Segments are made now)
+    again = compile_(position=(3000.0,), kind=kind, trajectory=trajectory, moving=moving)[0].plans[0]
+    times = np.linspace(-0.1, 8.0, 50)
+    assert again.frame_count == eager.frame_count
+    assert [again.segment_poly(t) for t in times] == [eager.segment_poly(t) for t in times]
+    for mine, theirs in zip(again.evaluate(times), eager.evaluate(times), strict=True):
+        assert np.array_equal(mine, theirs)
+    assert again.segments == eager.segments and all(type(s) is Segment for s in again.segments)
+    assert again == plan and _fields(copy.deepcopy(again)) == _fields(eager)
+
+
 @pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
 @pytest.mark.parametrize("moving", [False, True])
 def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving):
@@ -250,6 +289,7 @@ def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving)
         for again in (copy.deepcopy(plan), dataclasses.replace(plan)):
             assert (again.segments, again.duration, again.frame_count) == (plan.segments, plan.duration,
                                                                             plan.frame_count)
+            assert again.limits == plan.limits == trajectory[0].share(abs(plan.scaled.factor))
 
 
 def test_vector_axes_with_a_delay_or_a_cut_frame_are_made_and_checked_each():

@@ -62,24 +62,6 @@ def _total_time(peak: float, cruise: float, v_start: float, v_final: float, acce
     return _ramp_time(v_start, peak, accel, decel) + cruise + _ramp_time(peak, v_final, accel, decel)
 
 
-def _coefficients(u0: float, uf: float, w: float, accel: float, decel: float) -> tuple[float, float]:
-    """Distance of the ramps u0 -> w -> uf as alpha*w^2 + beta (directional coordinates), on
-    the piece of w that contains ``w``: the first ramp's alpha and beta plus the last's."""
-    if u0 < 0.0:
-        a1, b1 = 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * decel)
-    elif w >= u0:
-        a1, b1 = 1.0 / (2.0 * accel), -u0 * u0 / (2.0 * accel)
-    else:
-        a1, b1 = -1.0 / (2.0 * decel), u0 * u0 / (2.0 * decel)
-    if uf < 0.0:
-        a2, b2 = 1.0 / (2.0 * decel), -uf * uf / (2.0 * accel)
-    elif w >= uf:
-        a2, b2 = 1.0 / (2.0 * decel), -uf * uf / (2.0 * decel)
-    else:
-        a2, b2 = -1.0 / (2.0 * accel), uf * uf / (2.0 * accel)
-    return a1 + a2, b1 + b2
-
-
 def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float, decel: float):
     """Fastest peak velocity w in [0, vmax] and cruise time for one travel direction.
 
@@ -111,14 +93,31 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
     # Scan the pieces [points[k], points[k + 1]] from the top: the first breakpoint that does not
     # overshoot bounds w. F at vmax is the top piece's, at any other breakpoint the piece above's.
     top = len(points) - 2
+    twice_accel, twice_decel = 2.0 * accel, 2.0 * decel
     for k in range(top, -1, -1):
-        alpha, beta = _coefficients(u0, uf, 0.5 * (points[k] + points[k + 1]), accel, decel)
+        lo, hi = points[k], points[k + 1]
+        # F on this piece, alpha*w^2 + beta: the first ramp's (u0 -> w) alpha and beta plus the
+        # last's (w -> uf), at the rates a w inside the piece gives them (here, not in a function
+        # of their own: a call per piece costs as much as this arithmetic)
+        w = 0.5 * (lo + hi)
+        if u0 < 0.0:
+            a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_decel
+        elif w >= u0:
+            a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_accel
+        else:
+            a1, b1 = -1.0 / twice_decel, u0 * u0 / twice_decel
+        if uf < 0.0:
+            a2, b2 = 1.0 / twice_decel, -uf * uf / twice_accel
+        elif w >= uf:
+            a2, b2 = 1.0 / twice_decel, -uf * uf / twice_decel
+        else:
+            a2, b2 = -1.0 / twice_accel, uf * uf / twice_accel
+        alpha, beta = a1 + a2, b1 + b2
         if k == top:
             f_top = alpha * vmax * vmax + beta
             if not f_top > reach:  # even the top speed leaves distance: cruise at vmax
                 cruise = (x - f_top) / vmax if vmax > 0.0 else 0.0
                 return vmax, cruise if cruise > 0.0 else 0.0
-        lo = points[k]
         f_lo = alpha * lo * lo + beta
         if f_lo > reach:
             continue
@@ -128,9 +127,34 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
         else:
             w = lo
         w = lo if lo > w else w
-        hi = points[k + 1]
         return hi if hi < w else w, 0.0
     return None
+
+
+def _rest_to_rest(distance: float, vmax: float, accel: float, decel: float) -> tuple[float, float] | None:
+    """(peak velocity, cruise) of a move from rest to rest (every start from rest), as
+    plan_point_to_point finds them with _peak_in_direction in both directions, with the same
+    operations; None where it might find something else (then it asks both directions).
+
+    From rest to rest (u0 = uf = ±0) the direction away from the target is ruled out by
+    _peak_in_direction's first test (its reach below 0, a finite alpha), and the scan toward it
+    has the one piece [0, vmax] (no inner breakpoint), where its coefficients are
+    alpha = 1/(2 accel) + 1/(2 decel) and beta = -0.0 (-u*u/(2 rate) of u = ±0 is -0.0 for
+    positive rates; vmax >= 0 takes their branches); F at 0 is then 0, never past the reach."""
+    size = abs(distance)
+    margin = 1e-12 * (size if size > 1.0 else 1.0)  # (reach = x + margin, as _peak_in_direction's)
+    alpha = 1.0 / (2.0 * accel) + 1.0 / (2.0 * decel)
+    if not (-size + margin < 0.0 and alpha < math.inf and vmax >= 0.0):
+        return None  # (the way away not ruled out, or limits that are no positive numbers)
+    x, beta = size, -0.0  # toward the target, along it
+    sign = 1.0 if distance > 0.0 else -1.0  # (its distance is not 0: size > margin)
+    f_top = alpha * vmax * vmax + beta
+    if not f_top > x + margin:  # even the top speed leaves distance: cruise at vmax
+        cruise = (x - f_top) / vmax if vmax > 0.0 else 0.0
+        return sign * vmax, cruise if cruise > 0.0 else 0.0
+    square = (x - beta) / alpha
+    w = math.sqrt(square if square > 0.0 else 0.0)  # (>= 0: the scan's max with its lo of 0 keeps it)
+    return sign * (vmax if vmax < w else w), 0.0
 
 
 def plan_point_to_point(
@@ -151,20 +175,25 @@ def plan_point_to_point(
         raise ProfileError("velocity, acceleration and deceleration must be positive")
     if abs(v_final) > vmax * (1.0 + 1e-12):
         raise ProfileError("final velocity exceeds the trajectory velocity")
-    # The direction toward the target, then away from it (coordinates along each direction)
-    ahead = _peak_in_direction(distance, v_start, v_final, vmax, accel, decel)
-    behind = _peak_in_direction(-distance, -v_start, -v_final, vmax, accel, decel)
-    if ahead is None:
-        if behind is None:
-            raise ProfileError("no profile reaches the target")
-        peak, cruise = -behind[0], behind[1]
+    found = _rest_to_rest(distance, vmax, accel, decel) if v_start == 0.0 and v_final == 0.0 else None
+    if found is not None:
+        peak, cruise = found
     else:
-        peak, cruise = ahead
-        # Both directions reach the target: the other only if it is faster. The times are
-        # needed for this comparison alone, so they are not calculated otherwise.
-        if behind is not None and _total_time(-behind[0], behind[1], v_start, v_final, accel, decel) < _total_time(
-                peak, cruise, v_start, v_final, accel, decel) - 1e-15:
+        # The direction toward the target, then away from it (coordinates along each direction)
+        ahead = _peak_in_direction(distance, v_start, v_final, vmax, accel, decel)
+        behind = _peak_in_direction(-distance, -v_start, -v_final, vmax, accel, decel)
+        if ahead is None:
+            if behind is None:
+                raise ProfileError("no profile reaches the target")
             peak, cruise = -behind[0], behind[1]
+        else:
+            peak, cruise = ahead
+            # Both directions reach the target: the other only if it is faster. The times are
+            # needed for this comparison alone, so they are not calculated otherwise.
+            if behind is not None and _total_time(-behind[0], behind[1], v_start, v_final, accel,
+                                                  decel) < _total_time(peak, cruise, v_start, v_final, accel,
+                                                                       decel) - 1e-15:
+                peak, cruise = -behind[0], behind[1]
     plan: list[Any] = ramps_between(v_start, peak, accel, decel)  # (Ramps, and the cruise a while)
     # The cruise (if any) absorbs the last rounding error of the distance. (ramps_between makes
     # no ramp of constant velocity: a cruise can only be this one.) Until then it is a plain

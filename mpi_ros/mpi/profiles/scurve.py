@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any, Literal, overload
 
 from .ramps import ProfileError, Ramp
-from .segment import Segment, new_tuple
+from .segment import Row, Segment, new_tuple
 
 
 def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segment]:
@@ -23,6 +24,28 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
     lasts more than 0 s and starts at the position where the one before ends, as
     Segment.end_state calculates it: the planner relies on it (a profile whose end position
     is finite is finite throughout: planner._finite_if_it_ends)."""
+    return reshaped(plan, p0, jerk_percent)[0]
+
+
+@overload
+def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+             rows: Literal[False] = False) -> tuple[list[Segment], float, float]: ...
+
+
+@overload
+def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+             rows: Literal[True]) -> tuple[list[Row], float, float]: ...
+
+
+def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+             rows: bool = False) -> tuple[list[Any], float, float]:
+    """:func:`reshape`'s segments, where they end and how long they last: the position
+    Segment.end_state gives at the end of the last one (``p0`` without segments) and
+    ``end_time(segments)``, the same additions in the same order (0.0 without segments).
+    The planner needs both of every profile; here they are a by-product of the loop that makes
+    the segments (it calculates each segment's end to start the next), not a pass of their own.
+    ``rows``: the segments as plain tuples (Rows), for a vector's line, whose axes' Segments are
+    made from it: a tuple is made in a third of the time a Segment takes (a tuple subclass)."""
     if not 0.0 <= jerk_percent <= 100.0:
         raise ProfileError("jerkPercent must be within 0..100")
     fraction = jerk_percent / 100.0
@@ -31,10 +54,11 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
     half = 0.5 * fraction  # each jerk phase
     flat = 1.0 - fraction  # the constant-acceleration phase
     kept = 1.0 - half  # peak acceleration = dv / (duration * kept)
-    segments: list[Segment] = []
+    segments: list[Any] = []  # (Segments, or Rows)
     append = segments.append
     make, segment, isfinite = new_tuple, Segment, math.isfinite  # (locals: a global lookup per segment)
     p = p0
+    total = -0.0  # end_time's sum: -0.0 + d is d for every d, as its first term is
     # (each ramp's pieces in this loop, not a function of their own: a call per ramp costs as
     # much as a segment's arithmetic, and a modify is planned while its command waits)
     for duration, v, v_end in plan:
@@ -53,8 +77,9 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
         for t, a, j in pieces or ((duration, dv / duration if duration > 0.0 else 0.0, 0.0),):
             if t <= 0.0:
                 continue
-            append(make(segment, (t, p, v, a, j)))
+            append((t, p, v, a, j) if rows else make(segment, (t, p, v, a, j)))
             # Where the segment ends, as Segment.end_state computes it (the same operations in
             # the same order), without the method calls: the next piece starts there.
             p, v = p + t * (v + t * (a / 2.0 + t * j / 6.0)), v + t * (a + t * j / 2.0)
-    return segments
+            total += t
+    return segments, p, 0.0 + total  # (end_time's t0 + total, with t0 = 0.0)

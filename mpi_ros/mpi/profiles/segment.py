@@ -43,6 +43,11 @@ class Segment(NamedTuple):
                              factor * self.j))
 
 
+# A segment's values as a plain tuple, (duration, p, v, a, j): a vector's 1-D profile is made of
+# them (its axes' Segments are made from it, scaled), and a Segment is one too
+Row = tuple[float, float, float, float, float]
+
+
 # ``Segment(*values)`` without the Python-level __new__ of a NamedTuple: one C call. The loops
 # that make a segment per constant-jerk piece call ``new_tuple(Segment, values)``, a little
 # faster still (no partial in between).
@@ -50,7 +55,7 @@ new_tuple = tuple.__new__
 segment_from: Callable[[tuple[float, float, float, float, float]], Segment] = partial(new_tuple, Segment)
 
 
-def scaled_profile(segments: Iterable[Segment], factor: float, offset: float) -> list[Segment]:
+def scaled_profile(segments: Iterable[Row], factor: float, offset: float) -> list[Segment]:
     """``[seg.scaled(factor, offset) for seg in segments]``: the same operations, without a
     method call per segment (a vector move scales its profile for every axis)."""
     return [new_tuple(Segment, (d, offset + factor * p, factor * v, factor * a, factor * j))
@@ -58,10 +63,11 @@ def scaled_profile(segments: Iterable[Segment], factor: float, offset: float) ->
 
 
 class ScaledProfile(NamedTuple):
-    """An axis of a vector move: ``factor`` times the vector's 1-D profile ``line``, plus
-    ``offset`` (the axis' start): :func:`scaled_profile` of them, made when asked for."""
+    """An axis of a vector move: ``factor`` times the vector's 1-D profile ``line`` (its
+    segments, as Rows), plus ``offset`` (the axis' start): :func:`scaled_profile` of them, made
+    when asked for."""
 
-    line: list[Segment]
+    line: list[Row]
     factor: float
     offset: float
 
@@ -111,7 +117,7 @@ class SegmentTable:
 
     __slots__ = ("start", "end", "p", "v", "a", "j", "count")
 
-    def __init__(self, segments: Sequence[Segment], t0: float = 0.0):
+    def __init__(self, segments: Sequence[Row], t0: float = 0.0):
         # One array of every segment's fields in a row (np.fromiter: five np.array calls on
         # lists cost several times more for a few segments), whose columns are the fields.
         values = np.fromiter(_chain_iterables.from_iterable(segments), float, 5 * len(segments))
