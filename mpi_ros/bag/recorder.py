@@ -95,12 +95,13 @@ class Recorder:
     # -- hooks (periodic collection under the runner lock, writing after it) --------------------------
     def _collect_status(self, ctl: Controller) -> Output:
         t = self.log_time(ctl.sample)
+        motions, axes = ctl.motion_snapshots()  # every axis read once for both kinds of topic
         messages: list[tuple[str, object]] = [
-            (f"{self.ns}/ms{ms.number}/status", convert.motion_status(ms.snapshot(), ctl.rate, self.epoch))
-            for ms in ctl.supervisors
+            (f"{self.ns}/ms{number}/status", convert.motion_status(snap, ctl.rate, self.epoch))
+            for number, snap in motions.items()
         ]
-        messages += [(f"{self.ns}/axis{a.number}/status",
-                      convert.axis_status(ctl.axis_snapshot(a.number), ctl.rate, self.epoch)) for a in ctl.axes]
+        messages += [(f"{self.ns}/axis{snap.number}/status", convert.axis_status(snap, ctl.rate, self.epoch))
+                     for snap in axes]
 
         def write() -> None:
             for topic, msg in messages:

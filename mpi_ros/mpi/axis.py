@@ -350,18 +350,25 @@ class Axis:
     def feedforward(self) -> float:
         """The PTF/PVTF feedforward (raw DAC counts) now: interpolated along the plan that has
         one, else the value the last one left (MPI 000, MPIMotionPTF: not zeroed by other moves)."""
+        return self.feedforward_at(self.rel)
+
+    def feedforward_at(self, rel: float) -> float:
+        """:attr:`feedforward` at profile time ``rel`` of the plan."""
         plan = self.plan
         if plan is None:
             return self._held_feedforward
-        return plan.feedforward_at(self.rel, self._held_feedforward)
+        return plan.feedforward_at(rel, self._held_feedforward)
 
     def servo_effort(self) -> float:
         """The simulated servo's control effort now, counts/s^2 (plant.servo_effort); 0 while
         the amplifier is off (after ABORT the motor coasts)."""
         if not self.amp_enabled:
             return 0.0
-        return servo_effort(self.plant.config, self.cmd_p - self.act_p, self.cmd_v, self.act_v, self.cmd_a,
-                            self.feedforward)
+        return self.effort_of(self.cmd_p - self.act_p, self.cmd_v, self.act_v, self.cmd_a, self.feedforward)
+
+    def effort_of(self, error: float, cmd_v: float, act_v: float, cmd_a: float, feedforward: float) -> float:
+        """The servo's effort for these values of the axis (amplifier on)."""
+        return servo_effort(self.plant.config, error, cmd_v, act_v, cmd_a, feedforward)
 
     def _hold_feedforward(self) -> None:
         """Before the plan changes: keep the feedforward it has reached."""

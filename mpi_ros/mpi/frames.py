@@ -148,7 +148,7 @@ class AxisPlan:
         """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
         if self.cam is not None:
             return self.frame_count
-        done = int(np.searchsorted(self.table.end, rel, side="right"))
+        done = int(self.table.end.searchsorted(rel, side="right"))
         return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
 
     def points_left(self, rel: float | np.ndarray) -> int | np.ndarray:

@@ -16,7 +16,7 @@ SupervisorHost (host.py). Starting and modifying moves (planning them) is here.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -33,7 +33,7 @@ from .moves import Moves
 from .outcome import MoveEnd, Outcome, Refused
 from .params import AxisMaster, MotionConfig, MotionParams, check_position
 from .planner import AxisStart, compile_move
-from .snapshot import FrameBufferStatus, MotionSnapshot
+from .snapshot import AxisSnapshot, FrameBufferStatus, MotionSnapshot
 from .status import StretchStatus
 from .stretch import Stretch
 from .supervisor_actions import Actions
@@ -676,9 +676,14 @@ class MotionSupervisor:
         return paths.last_point_time(extended)
 
     # ================================================================= status ====
-    def snapshot(self) -> MotionSnapshot:
-        """mpiMotionStatus."""
-        axes = tuple(self._host.axis_snapshot(n) for n in self._axis_list.mapped)
+    def snapshot(self, axis_snapshots: Sequence[AxisSnapshot] | None = None) -> MotionSnapshot:
+        """mpiMotionStatus; ``axis_snapshots``: every axis' at this sample, when already taken
+        (Controller.motion_snapshots), else its axes' are taken here."""
+        mapped = self._axis_list.mapped
+        if axis_snapshots is None:
+            axes = tuple(self._host.axis_snapshots(mapped))
+        else:
+            axes = tuple(axis_snapshots[n] for n in mapped)
         move = self._moves.current or self._moves.last_move
         done = all(a.done for a in axes) if axes else True
         return MotionSnapshot(

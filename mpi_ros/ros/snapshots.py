@@ -4,10 +4,11 @@ The controller node publishes the AxisStatus of every axis and each supervisor n
 MotionStatus, which holds the AxisStatus of its axes: both at the status rate, so at the
 same samples, one after the other in the runner's periodic round. Reading the controller
 separately for each would take every mapped axis' snapshot twice a sample (an axis
-snapshot is the most expensive read of the controller: about 20 us at 32 axes, more than
-packing and publishing its message). Here the supervisors' snapshots are taken once a
-sample and the axis snapshots inside them serve the axis topics too: the same reading of
-the same axis at the same sample, so the values cannot differ.
+snapshot is the most expensive read of the controller, more than packing and publishing its
+message). Here every axis' snapshot is taken once a sample, from one read of the
+controller's arrays (Controller.motion_snapshots), and the supervisors' snapshots hold the
+same ones: the axis topics and the motion topics show the same reading of an axis at a
+sample, so their values cannot differ.
 
 Valid for one sample, and only until a command is applied at it (commands change the
 controller without stepping it): a periodic round runs under the runner's lock with no
@@ -43,10 +44,8 @@ class SampleSnapshots:
             self._forget()
             self._sample = ctl.sample
         if self._motions is None:
-            self._motions = {ms.number: ms.snapshot() for ms in ctl.supervisors}
-            for motion in self._motions.values():
-                for axis in motion.axes:
-                    self._axes.setdefault(axis.number, axis)
+            self._motions, axes = ctl.motion_snapshots()
+            self._axes = {axis.number: axis for axis in axes}
         return self._motions
 
     def motion(self, ctl: Controller, number: int) -> MotionSnapshot | None:
@@ -55,10 +54,7 @@ class SampleSnapshots:
     def axis(self, ctl: Controller, number: int) -> AxisSnapshot:
         """An axis' snapshot (mpiAxisStatus) at the controller's sample."""
         self.motions(ctl)
-        snap = self._axes.get(number)
-        if snap is None:  # an axis no supervisor maps
-            snap = self._axes[number] = ctl.axis_snapshot(number)
-        return snap
+        return self._axes[number]
 
 
     def taken_axes(self, ctl: Controller) -> dict[int, AxisSnapshot] | None:

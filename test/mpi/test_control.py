@@ -7,7 +7,16 @@ import time
 import numpy as np
 import pytest
 
-from mpi_ros.mpi import Controller, ControllerConfig, IoSpace, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi import (
+    Controller,
+    ControllerConfig,
+    IoSpace,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Trajectory,
+)
 from mpi_ros.mpi.messages import Message
 
 T = MPIMotionType
@@ -177,3 +186,42 @@ def test_settling_at_rest_does_not_depend_on_how_samples_are_batched():
     lumpy = run(iter(lambda: int(rng.integers(1, 400)), None))
     different = [s for s, values in lumpy.items() if one_by_one[s] != values]
     assert not different, f"{len(different)} samples differ, first {different[:3]}"
+
+
+def test_axis_snapshots_read_together_are_each_axis_own_values():
+    # MPI 002, mpiAxisStatus: the snapshots read from the arrays at once (axis_snapshots) hold
+    # what each axis reports on its own, moving, with an origin, with its amplifier off (ABORT:
+    # no servo effort) and unmapped (no supervisor: IDLE, no frames)
+    ctl = Controller(ControllerConfig(axis_count=5, supervisor_count=2))
+    _, first = ctl.create_motion(0)
+    first.axis_list_set([0, 1])
+    _, second = ctl.create_motion(1)
+    second.axis_list_set([3])
+    ctl.axes[1].origin = 12.5
+    first.start(T.S_CURVE, params=MotionParams(trajectory=[Trajectory(4000.0, 40000.0, 40000.0, 50.0)],
+                                               position=[1234.5, -20.0]))
+    second.start(T.VELOCITY, params=MotionParams(trajectory=[Trajectory(-700.0, 9000.0, 9000.0, 0.0)]))
+    seen = set()
+    for step in range(40):
+        ctl.step(29)
+        if step == 20:
+            second.action(MPIAction.ABORT)
+        together = ctl.axis_snapshots()
+        assert ctl.axis_snapshots([3, 1]) == [together[3], together[1]]
+        for axis, snap in zip(ctl.axes, together, strict=True):
+            owner = ctl.supervisor(axis.owner)
+            assert (snap.number, snap.sample, snap.supervisor) == (axis.number, ctl.sample, axis.owner)
+            assert snap.state is (owner.own_state if owner is not None else MPIState.IDLE)
+            assert (snap.command_position, snap.actual_position, snap.position_error) == (
+                axis.command_position, axis.actual_position, axis.position_error)
+            assert (snap.command_velocity, snap.actual_velocity, snap.command_acceleration) == (
+                axis.cmd_v, axis.act_v, axis.cmd_a)
+            assert (snap.done, snap.settled, snap.at_velocity) == (
+                axis.status.done, axis.status.settled, axis.status.at_velocity)
+            assert (snap.servo_effort, snap.feedforward, snap.element_id, snap.frame_count, snap.amp_enabled) == (
+                axis.servo_effort(), axis.feedforward, axis.current_element_id, ctl.frame_count(axis.number),
+                axis.amp_enabled)
+            seen.add((snap.state, snap.amp_enabled, snap.servo_effort != 0.0))
+    assert (MPIState.IDLE, True, False) in seen  # the unmapped axes
+    assert (MPIState.MOVING, True, True) in seen
+    assert (MPIState.ERROR, False, False) in seen  # axis 3 after ABORT
