@@ -33,7 +33,7 @@ from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, Hold, Mot
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import reverses, velocity_move
-from .profiles.ramps import ProfileError, plan_point_to_point, ramps_between
+from .profiles.ramps import ProfileError, ramps_between, trapezoid_rows
 from .profiles.scurve import reshape, reshaped
 from .profiles.segment import Row, ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
@@ -295,7 +295,7 @@ def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, t
         return segments, _end_position(segments[-1]) if segments else p0, end_time(segments)
     jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
     # point_to_point's two steps, without its call (a modify is planned while its command waits)
-    plan = plan_point_to_point(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
+    plan = trapezoid_rows(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
     return reshaped(plan, p0, jerk_percent, True) if rows else reshaped(plan, p0, jerk_percent)
 
 

@@ -13,7 +13,8 @@ acceleration for every ramp (MPI 000 MPIMotionVelocity: "deceleration is ignored
 from __future__ import annotations
 
 import math
-from typing import Any, NamedTuple
+from functools import partial
+from typing import NamedTuple
 
 
 class ProfileError(ValueError):
@@ -39,18 +40,32 @@ class Ramp(NamedTuple):
 # ``_new(Ramp, (duration, v_start, v_end))``: ``Ramp(duration, v_start, v_end)`` without the
 # Python-level __new__ of a NamedTuple (nor a partial in between, which costs a quarter more)
 _new = tuple.__new__
+_ramp_of = partial(_new, Ramp)  # (the Ramp of a RampRow, for map)
+
+# A ramp as a plain tuple (duration, v_start, v_end): the planner's trapezoid is made of them
+# (trapezoid_rows); a tuple is made and unpacked faster than a Ramp (a tuple subclass)
+RampRow = tuple[float, float, float]
 
 
 def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> list[Ramp]:
     """The ramp(s) from one velocity to another, split at zero when the sign changes."""
+    rows: list[RampRow] = []
+    _add_ramps(rows, v_from, v_to, accel, decel)
+    return list(map(_ramp_of, rows))
+
+
+def _add_ramps(rows: list[RampRow], v_from: float, v_to: float, accel: float, decel: float) -> None:
+    """Append ramps_between's ramps to ``rows``, as plain tuples (trapezoid_rows')."""
     if v_from == v_to:
-        return []
+        return
     if v_from * v_to < 0.0:
         # to rest (lowering |v|: the deceleration), then from it (the acceleration): the ramps
-        # ramps_between(v_from, 0.0) and ramps_between(0.0, v_to) make, without their calls
-        return [_new(Ramp, (abs(v_from) / decel, v_from, 0.0)), _new(Ramp, (abs(v_to) / accel, 0.0, v_to))]
+        # from v_from to 0.0 and from 0.0 to v_to, without a call each
+        rows.append((abs(v_from) / decel, v_from, 0.0))
+        rows.append((abs(v_to) / accel, 0.0, v_to))
+        return
     rate = accel if abs(v_to) > abs(v_from) else decel  # the ramp does not cross zero
-    return [_new(Ramp, (abs(v_to - v_from) / rate, v_from, v_to))]
+    rows.append((abs(v_to - v_from) / rate, v_from, v_to))
 
 
 def _ramp_time(v_from: float, v_to: float, accel: float, decel: float) -> float:
@@ -228,6 +243,12 @@ def plan_point_to_point(
     limit (ramps down to it) and a start velocity toward or away from the target that
     cannot stop in time (decelerates, reverses and comes back).
     """
+    return list(map(_ramp_of, trapezoid_rows(distance, v_start, v_final, vmax, accel, decel)))
+
+
+def trapezoid_rows(distance: float, v_start: float, v_final: float, vmax: float, accel: float,
+                   decel: float) -> list[RampRow]:
+    """plan_point_to_point's ramps as plain tuples (RampRows), which the planner reshapes."""
     if vmax <= 0.0 or accel <= 0.0 or decel <= 0.0:
         raise ProfileError("velocity, acceleration and deceleration must be positive")
     if abs(v_final) > vmax * (1.0 + 1e-12):
@@ -255,14 +276,14 @@ def plan_point_to_point(
                                                   decel) < _total_time(peak, cruise, v_start, v_final, accel,
                                                                        decel) - 1e-15:
                 peak, cruise = -behind[0], behind[1]
-    plan: list[Any] = ramps_between(v_start, peak, accel, decel)  # (Ramps, and the cruise a while)
+    plan: list[RampRow] = []
+    _add_ramps(plan, v_start, peak, accel, decel)
     # The cruise (if any) absorbs the last rounding error of the distance. (ramps_between makes
-    # no ramp of constant velocity: a cruise can only be this one.) Until then it is a plain
-    # tuple: a Ramp is made once, with its final duration.
+    # no ramp of constant velocity: a cruise can only be this one.)
     at = len(plan)
     if cruise > 0.0:
         plan.append((cruise, peak, peak))
-    plan += ramps_between(peak, v_final, accel, decel)
+    _add_ramps(plan, peak, v_final, accel, decel)
     # each ramp's distance as Ramp.distance calculates it, without a call per ramp, added in order
     travelled = 0.0
     for duration, v0, v1 in plan:
@@ -274,7 +295,7 @@ def plan_point_to_point(
         if peak != 0.0:
             cruise += error / peak  # (not below 0: a conditional rather than max, as above)
             cruise = cruise if cruise > 0.0 else 0.0
-        plan[at] = _new(Ramp, (cruise, peak, peak))
+        plan[at] = (cruise, peak, peak)
     return plan
 
 

@@ -14,11 +14,11 @@ import math
 from collections.abc import Sequence
 from typing import Any, Literal, overload
 
-from .ramps import ProfileError, Ramp
+from .ramps import ProfileError, RampRow
 from .segment import Row, Segment, segment_from
 
 
-def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segment]:
+def reshape(plan: Sequence[RampRow], p0: float, jerk_percent: float) -> list[Segment]:
     """Segments of a velocity plan starting at position ``p0`` with zero acceleration
     at every ramp boundary (the standard S-curve starts each ramp from a = 0). Each segment
     lasts more than 0 s and starts at the position where the one before ends, as
@@ -28,16 +28,16 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
 
 
 @overload
-def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
              rows: Literal[False] = False) -> tuple[list[Segment], float, float]: ...
 
 
 @overload
-def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
              rows: Literal[True]) -> tuple[list[Row], float, float]: ...
 
 
-def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
              rows: bool = False) -> tuple[list[Any], float, float]:
     """:func:`reshape`'s segments, where they end and how long they last: the position
     Segment.end_state gives at the end of the last one (``p0`` without segments) and
