@@ -237,7 +237,8 @@ def _passes_checks(scaled: ScaledProfile, start: AxisStart, target: float) -> bo
     beyond the limit, and its last segment, scaled as scaled_profile scales it, ends on the
     target (within the rounding of the positions: otherwise _checked decides)."""
     line, factor, offset = scaled
-    if not (abs(factor) <= 1.0 and _no_overflow(offset, line)):
+    # (_no_overflow's first answer, the usual one, without its call)
+    if not (abs(factor) <= 1.0 and (abs(offset) < _HALF_ULP_OF_MAX or _no_overflow(offset, line))):
         return False
     t, p, v, a, j = line[-1]
     p, v, a, j = offset + factor * p, factor * v, factor * a, factor * j  # (scaled_profile's operations)
@@ -378,7 +379,8 @@ def _vector_profiles(motion_type, starts, targets, finals,
     else:
         return [[] for _ in starts], [traj for _ in starts], "", None
     along, parallel = _along(v0, unit, speed)
-    final_along, final_parallel = _along(finals, unit, math.hypot(*finals))
+    # (_along's answer without a final velocity, without the length of the zeros it needs otherwise)
+    final_along, final_parallel = _along(finals, unit, math.hypot(*finals)) if any(finals) else (0.0, True)
     if not final_parallel:
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
@@ -463,7 +465,10 @@ def compile_move(
     stream = None
     try:
         if motion_type not in _NOT_POINT_TO_POINT:
-            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
+            if len(starts) == 1 and not bits & _GENERAL:  # (the usual start or modify of an axis)
+                plans = [_lone_axis_plan(motion_type, params, starts[0], sample_rate, notes)]
+            else:
+                plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
         elif motion_type in CAM_TYPES:
             assert cam_masters is not None  # (the supervisor reads each slave's master)
             plans = cams.cam_plans(motion_type, attrs, params, starts, cam_masters)
@@ -506,9 +511,8 @@ def _holds_and_outputs(params: MotionParams, bits: int, index: int):
 
 def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits: int, starts: list[AxisStart],
                           sample_rate: float, notes: PlanNotes) -> list[AxisPlan]:
-    """``bits``: the move's attributes as an int (compile_move's)."""
-    if len(starts) == 1 and not bits & _GENERAL:  # (the usual start or modify of an axis)
-        return [_lone_axis_plan(motion_type, params, starts[0], sample_rate, notes)]
+    """``bits``: the move's attributes as an int (compile_move's). Not a lone axis without any of
+    _GENERAL's attributes: compile_move plans that with _lone_axis_plan."""
     targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""
