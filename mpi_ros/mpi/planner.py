@@ -478,13 +478,13 @@ def compile_move(
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
-    # (positional: a dataclass' __init__ matches keywords at a cost; the fields in their order)
-    move = Move(
+    # (positional: keywords are matched at a cost; serial is the supervisor's to give)
+    move = Move.planned(
         supervisor, motion_type, attrs, plans,
         _truncate_id(params.id, notes) if bits & _ID else 0,  # id
         int(params.element_id[0]) if bits & _ELEMENT_ID and params.element_id else 0,  # element_id
         params.event_mask if bits & _EVENT else _NO_EVENTS,  # event_mask
-        0, stream,  # serial (the supervisor's to give), stream
+        stream,
     )
     return move, notes
 
