@@ -10,7 +10,6 @@ f = 0 is the trapezoid itself.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any, Literal, overload
 
@@ -55,7 +54,7 @@ def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
     flat = 1.0 - fraction  # the constant-acceleration phase
     kept = 1.0 - half  # peak acceleration = dv / (duration * kept)
     segments: list[Any] = []  # (Rows, made Segments at the end unless ``rows``)
-    append, isfinite = segments.append, math.isfinite  # (locals: a lookup per ramp otherwise)
+    append = segments.append  # (a local: a lookup per piece otherwise)
     p = p0
     total = -0.0  # end_time's sum: -0.0 + d is d for every d, as its first term is
     # (each ramp's pieces written out in this loop, not a function of their own nor a loop over a
@@ -73,7 +72,7 @@ def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
         if not (v == v_end or jerk_time <= 0.0):
             peak = dv / (duration * kept)
             jerk = peak / jerk_time
-            if isfinite(jerk):
+            if jerk - jerk == 0.0:  # finite (x - x is NaN for an infinite or NaN x): no call of isfinite
                 # jerk_time > 0 here (not <= 0, and not NaN: the jerk is finite): no test
                 t = jerk_time
                 append((t, p, v, 0.0, jerk))
