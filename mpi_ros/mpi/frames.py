@@ -379,6 +379,26 @@ class Move:
             moving = moving or plan.final_velocity != 0.0
         self.plan_axes, self.is_velocity, self.ends_moving = tuple(axes), velocity, moving
 
+    @classmethod
+    def planned(cls, supervisor: int, motion_type: MPIMotionType, attributes: MotionAttr, plans: list[AxisPlan],
+                id: int, element_id: int, event_mask: MPIEventType, stream: Stream | None) -> Self:
+        """``cls(supervisor, motion_type, attributes, plans, id, element_id, event_mask, 0, stream)``,
+        a planned move not yet taken (serial 0), as the dataclass' __init__ makes it: its slots are
+        filled here, without that call in between (compile_move makes a Move for every start and
+        modify while the command waits; test_frames checks every field)."""
+        move = _new_object(cls)
+        move.supervisor = supervisor
+        move.type = motion_type
+        move.attributes = attributes
+        move.plans = plans
+        move.id = id
+        move.element_id = element_id
+        move.event_mask = event_mask
+        move.serial = 0
+        move.stream = stream
+        move.__post_init__()
+        return move
+
     @property
     def axes(self) -> list[int]:
         return [plan.axis for plan in self.plans]

@@ -33,7 +33,7 @@ from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, Hold, Mot
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import reverses, velocity_move
-from .profiles.ramps import ProfileError, plan_point_to_point, ramps_between
+from .profiles.ramps import ProfileError, ramps_between, trapezoid_rows
 from .profiles.scurve import reshape, reshaped
 from .profiles.segment import Row, ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
@@ -237,7 +237,8 @@ def _passes_checks(scaled: ScaledProfile, start: AxisStart, target: float) -> bo
     beyond the limit, and its last segment, scaled as scaled_profile scales it, ends on the
     target (within the rounding of the positions: otherwise _checked decides)."""
     line, factor, offset = scaled
-    if not (abs(factor) <= 1.0 and _no_overflow(offset, line)):
+    # (_no_overflow's first answer, the usual one, without its call)
+    if not (abs(factor) <= 1.0 and (abs(offset) < _HALF_ULP_OF_MAX or _no_overflow(offset, line))):
         return False
     t, p, v, a, j = line[-1]
     p, v, a, j = offset + factor * p, factor * v, factor * a, factor * j  # (scaled_profile's operations)
@@ -295,7 +296,7 @@ def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, t
         return segments, _end_position(segments[-1]) if segments else p0, end_time(segments)
     jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
     # point_to_point's two steps, without its call (a modify is planned while its command waits)
-    plan = plan_point_to_point(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
+    plan = trapezoid_rows(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
     return reshaped(plan, p0, jerk_percent, True) if rows else reshaped(plan, p0, jerk_percent)
 
 
@@ -378,7 +379,8 @@ def _vector_profiles(motion_type, starts, targets, finals,
     else:
         return [[] for _ in starts], [traj for _ in starts], "", None
     along, parallel = _along(v0, unit, speed)
-    final_along, final_parallel = _along(finals, unit, math.hypot(*finals))
+    # (_along's answer without a final velocity, without the length of the zeros it needs otherwise)
+    final_along, final_parallel = _along(finals, unit, math.hypot(*finals)) if any(finals) else (0.0, True)
     if not final_parallel:
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
@@ -463,7 +465,10 @@ def compile_move(
     stream = None
     try:
         if motion_type not in _NOT_POINT_TO_POINT:
-            plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
+            if len(starts) == 1 and not bits & _GENERAL:  # (the usual start or modify of an axis)
+                plans = [_lone_axis_plan(motion_type, params, starts[0], sample_rate, notes)]
+            else:
+                plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
         elif motion_type in CAM_TYPES:
             assert cam_masters is not None  # (the supervisor reads each slave's master)
             plans = cams.cam_plans(motion_type, attrs, params, starts, cam_masters)
@@ -473,13 +478,13 @@ def compile_move(
             plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
-    # (positional: a dataclass' __init__ matches keywords at a cost; the fields in their order)
-    move = Move(
+    # (positional: keywords are matched at a cost; serial is the supervisor's to give)
+    move = Move.planned(
         supervisor, motion_type, attrs, plans,
         _truncate_id(params.id, notes) if bits & _ID else 0,  # id
         int(params.element_id[0]) if bits & _ELEMENT_ID and params.element_id else 0,  # element_id
         params.event_mask if bits & _EVENT else _NO_EVENTS,  # event_mask
-        0, stream,  # serial (the supervisor's to give), stream
+        stream,
     )
     return move, notes
 
@@ -506,9 +511,8 @@ def _holds_and_outputs(params: MotionParams, bits: int, index: int):
 
 def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits: int, starts: list[AxisStart],
                           sample_rate: float, notes: PlanNotes) -> list[AxisPlan]:
-    """``bits``: the move's attributes as an int (compile_move's)."""
-    if len(starts) == 1 and not bits & _GENERAL:  # (the usual start or modify of an axis)
-        return [_lone_axis_plan(motion_type, params, starts[0], sample_rate, notes)]
+    """``bits``: the move's attributes as an int (compile_move's). Not a lone axis without any of
+    _GENERAL's attributes: compile_move plans that with _lone_axis_plan."""
     targets = _targets(params, bits, starts, notes)
     finals = list(params.final_velocity) if bits & _FINAL_VEL else [0.0] * len(starts)
     composite = ""

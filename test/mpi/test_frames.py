@@ -4,6 +4,8 @@ frame buffer overflow)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -133,6 +135,19 @@ def test_frames_needed_counts_per_axis():
     assert move.frame_counts == {0: 2, 1: 4}
     assert frames_needed([move, move], 1) == 8 and frames_needed([move], 2) == 0
     assert move.plan_for(1) is b and move.plan_for(3) is None and move.axes == [0, 1]
+
+
+@pytest.mark.parametrize("final_velocity", [0.0, 5.0])
+@pytest.mark.parametrize("velocity_target", [None, 2.0])
+def test_a_planned_move_is_the_dataclass_move(final_velocity, velocity_target):
+    # Move.planned fills the slots itself (compile_move's): every field as Move(...) makes it
+    a = AxisPlan(2, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)], 0.0, 1.0, final_velocity, velocity_target=velocity_target)
+    b = AxisPlan(0, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)], 0.0, 1.0)
+    for plans in ([a], [a, b], []):
+        made = Move(3, T.S_CURVE, A.ID, plans, 7, 9, MPIEventType.MOTION_DONE, 0, None)
+        planned = Move.planned(3, T.S_CURVE, A.ID, plans, 7, 9, MPIEventType.MOTION_DONE, None)
+        assert type(planned) is Move
+        assert all(getattr(planned, f.name) == getattr(made, f.name) for f in dataclasses.fields(Move))
 
 
 def test_frame_count_after_abort_and_reset(ctl, ms, bring):

@@ -13,7 +13,8 @@ acceleration for every ramp (MPI 000 MPIMotionVelocity: "deceleration is ignored
 from __future__ import annotations
 
 import math
-from typing import Any, NamedTuple
+from functools import partial
+from typing import NamedTuple
 
 
 class ProfileError(ValueError):
@@ -39,18 +40,32 @@ class Ramp(NamedTuple):
 # ``_new(Ramp, (duration, v_start, v_end))``: ``Ramp(duration, v_start, v_end)`` without the
 # Python-level __new__ of a NamedTuple (nor a partial in between, which costs a quarter more)
 _new = tuple.__new__
+_ramp_of = partial(_new, Ramp)  # (the Ramp of a RampRow, for map)
+
+# A ramp as a plain tuple (duration, v_start, v_end): the planner's trapezoid is made of them
+# (trapezoid_rows); a tuple is made and unpacked faster than a Ramp (a tuple subclass)
+RampRow = tuple[float, float, float]
 
 
 def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> list[Ramp]:
     """The ramp(s) from one velocity to another, split at zero when the sign changes."""
+    rows: list[RampRow] = []
+    _add_ramps(rows, v_from, v_to, accel, decel)
+    return list(map(_ramp_of, rows))
+
+
+def _add_ramps(rows: list[RampRow], v_from: float, v_to: float, accel: float, decel: float) -> None:
+    """Append ramps_between's ramps to ``rows``, as plain tuples (trapezoid_rows')."""
     if v_from == v_to:
-        return []
+        return
     if v_from * v_to < 0.0:
         # to rest (lowering |v|: the deceleration), then from it (the acceleration): the ramps
-        # ramps_between(v_from, 0.0) and ramps_between(0.0, v_to) make, without their calls
-        return [_new(Ramp, (abs(v_from) / decel, v_from, 0.0)), _new(Ramp, (abs(v_to) / accel, 0.0, v_to))]
+        # from v_from to 0.0 and from 0.0 to v_to, without a call each
+        rows.append((abs(v_from) / decel, v_from, 0.0))
+        rows.append((abs(v_to) / accel, 0.0, v_to))
+        return
     rate = accel if abs(v_to) > abs(v_from) else decel  # the ramp does not cross zero
-    return [_new(Ramp, (abs(v_to - v_from) / rate, v_from, v_to))]
+    rows.append((abs(v_to - v_from) / rate, v_from, v_to))
 
 
 def _ramp_time(v_from: float, v_to: float, accel: float, decel: float) -> float:
@@ -116,19 +131,76 @@ def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float
         if k == top:
             f_top = alpha * vmax * vmax + beta
             if not f_top > reach:  # even the top speed leaves distance: cruise at vmax
-                cruise = (x - f_top) / vmax if vmax > 0.0 else 0.0
-                return vmax, cruise if cruise > 0.0 else 0.0
+                return _cruise_at(x, f_top, vmax)
         f_lo = alpha * lo * lo + beta
         if f_lo > reach:
             continue
-        if alpha > 0.0:
-            square = (x - beta) / alpha
-            w = math.sqrt(square if square > 0.0 else 0.0)
-        else:
-            w = lo
-        w = lo if lo > w else w
-        return hi if hi < w else w, 0.0
+        return _peak_on(x, lo, hi, alpha, beta), 0.0
     return None
+
+
+def _cruise_at(x: float, f_top: float, vmax: float) -> tuple[float, float]:
+    """The peak and cruise where even the top speed leaves distance (F(vmax) = f_top <= x): the
+    cruise at vmax covers the rest."""
+    cruise = (x - f_top) / vmax if vmax > 0.0 else 0.0
+    return vmax, cruise if cruise > 0.0 else 0.0
+
+
+def _peak_on(x: float, lo: float, hi: float, alpha: float, beta: float) -> float:
+    """The largest w in the piece [lo, hi] where F(w) = alpha*w^2 + beta reaches x (F(lo) does
+    not overshoot, F(hi) does): lo where F does not grow on the piece."""
+    if alpha > 0.0:
+        square = (x - beta) / alpha
+        w = math.sqrt(square if square > 0.0 else 0.0)
+    else:
+        w = lo
+    w = lo if lo > w else w
+    return hi if hi < w else w
+
+
+def _peak_to_rest(x: float, u0: float, vmax: float, accel: float, decel: float) -> tuple[float, float] | None:
+    """_peak_in_direction(x, u0, uf, vmax, accel, decel) for a final velocity uf of ±0 and finite
+    limits (greater than 0: plan_point_to_point's checks), the usual start or modify, which ends at
+    rest: the same operations on the pieces the scan looks at, written out for the one or two
+    pieces there are (the scan's list of breakpoints and its loop cost as much as its arithmetic,
+    and a modify is planned while its command waits).
+
+    With uf = ±0 the last ramp's coefficients are 1/(2 decel) and -uf*uf/(2 decel) = -0.0 on every
+    piece (each piece's midpoint w is at least 0, so w >= uf), and beta + -0.0 is beta. The
+    breakpoints are 0, vmax and u0 when 0 < u0 < vmax; then the top piece's midpoint
+    0.5 * (u0 + vmax) is at least u0 (the first ramp accelerates from u0: rounding is monotonic)
+    and the lower piece's 0.5 * u0 is below u0 (it decelerates to w)."""
+    size = abs(x)
+    reach = x + 1e-12 * (size if size > 1.0 else 1.0)  # F(w) may exceed x by this much (rounding)
+    twice_accel, twice_decel = 2.0 * accel, 2.0 * decel
+    up, down = 1.0 / twice_accel, 1.0 / twice_decel  # (-1.0 / twice_decel, the scan's, is -down)
+    if u0 == 0.0 and reach < 0.0 and up + down < math.inf:
+        return None  # (from rest to rest, away from the target: _peak_in_direction's first test)
+    if 0.0 < u0 < vmax:
+        alpha, beta = up + down, -u0 * u0 / twice_accel  # the top piece [u0, vmax]
+        f_top = alpha * vmax * vmax + beta
+        if not f_top > reach:  # even the top speed leaves distance: cruise at vmax
+            return _cruise_at(x, f_top, vmax)
+        if not alpha * u0 * u0 + beta > reach:
+            return _peak_on(x, u0, vmax, alpha, beta), 0.0
+        alpha, beta, hi = -down + down, u0 * u0 / twice_decel, u0  # the piece [0, u0]
+    else:
+        # the one piece [0, vmax], its first ramp's coefficients at its midpoint as the scan chooses them
+        w = 0.5 * (0.0 + vmax)
+        if u0 < 0.0:
+            a1, beta = up, -u0 * u0 / twice_decel
+        elif w >= u0:
+            a1, beta = up, -u0 * u0 / twice_accel
+        else:
+            a1, beta = -down, u0 * u0 / twice_decel
+        alpha = a1 + down
+        f_top = alpha * vmax * vmax + beta
+        if not f_top > reach:
+            return _cruise_at(x, f_top, vmax)
+        hi = vmax
+    if alpha * 0.0 * 0.0 + beta > reach:  # (F at the piece's lo, 0, as the scan calculates it)
+        return None
+    return _peak_on(x, 0.0, hi, alpha, beta), 0.0
 
 
 def _rest_to_rest(distance: float, vmax: float, accel: float, decel: float) -> tuple[float, float] | None:
@@ -171,6 +243,12 @@ def plan_point_to_point(
     limit (ramps down to it) and a start velocity toward or away from the target that
     cannot stop in time (decelerates, reverses and comes back).
     """
+    return list(map(_ramp_of, trapezoid_rows(distance, v_start, v_final, vmax, accel, decel)))
+
+
+def trapezoid_rows(distance: float, v_start: float, v_final: float, vmax: float, accel: float,
+                   decel: float) -> list[RampRow]:
+    """plan_point_to_point's ramps as plain tuples (RampRows), which the planner reshapes."""
     if vmax <= 0.0 or accel <= 0.0 or decel <= 0.0:
         raise ProfileError("velocity, acceleration and deceleration must be positive")
     if abs(v_final) > vmax * (1.0 + 1e-12):
@@ -180,8 +258,12 @@ def plan_point_to_point(
         peak, cruise = found
     else:
         # The direction toward the target, then away from it (coordinates along each direction)
-        ahead = _peak_in_direction(distance, v_start, v_final, vmax, accel, decel)
-        behind = _peak_in_direction(-distance, -v_start, -v_final, vmax, accel, decel)
+        if v_final == 0.0 and vmax + accel + decel < math.inf:  # (finite limits: not NaN nor inf)
+            ahead = _peak_to_rest(distance, v_start, vmax, accel, decel)
+            behind = _peak_to_rest(-distance, -v_start, vmax, accel, decel)
+        else:
+            ahead = _peak_in_direction(distance, v_start, v_final, vmax, accel, decel)
+            behind = _peak_in_direction(-distance, -v_start, -v_final, vmax, accel, decel)
         if ahead is None:
             if behind is None:
                 raise ProfileError("no profile reaches the target")
@@ -194,14 +276,14 @@ def plan_point_to_point(
                                                   decel) < _total_time(peak, cruise, v_start, v_final, accel,
                                                                        decel) - 1e-15:
                 peak, cruise = -behind[0], behind[1]
-    plan: list[Any] = ramps_between(v_start, peak, accel, decel)  # (Ramps, and the cruise a while)
+    plan: list[RampRow] = []
+    _add_ramps(plan, v_start, peak, accel, decel)
     # The cruise (if any) absorbs the last rounding error of the distance. (ramps_between makes
-    # no ramp of constant velocity: a cruise can only be this one.) Until then it is a plain
-    # tuple: a Ramp is made once, with its final duration.
+    # no ramp of constant velocity: a cruise can only be this one.)
     at = len(plan)
     if cruise > 0.0:
         plan.append((cruise, peak, peak))
-    plan += ramps_between(peak, v_final, accel, decel)
+    _add_ramps(plan, peak, v_final, accel, decel)
     # each ramp's distance as Ramp.distance calculates it, without a call per ramp, added in order
     travelled = 0.0
     for duration, v0, v1 in plan:
@@ -213,7 +295,7 @@ def plan_point_to_point(
         if peak != 0.0:
             cruise += error / peak  # (not below 0: a conditional rather than max, as above)
             cruise = cruise if cruise > 0.0 else 0.0
-        plan[at] = _new(Ramp, (cruise, peak, peak))
+        plan[at] = (cruise, peak, peak)
     return plan
 
 

@@ -10,15 +10,14 @@ f = 0 is the trapezoid itself.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any, Literal, overload
 
-from .ramps import ProfileError, Ramp
-from .segment import Row, Segment, new_tuple
+from .ramps import ProfileError, RampRow
+from .segment import Row, Segment, segment_from
 
 
-def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segment]:
+def reshape(plan: Sequence[RampRow], p0: float, jerk_percent: float) -> list[Segment]:
     """Segments of a velocity plan starting at position ``p0`` with zero acceleration
     at every ramp boundary (the standard S-curve starts each ramp from a = 0). Each segment
     lasts more than 0 s and starts at the position where the one before ends, as
@@ -28,16 +27,16 @@ def reshape(plan: Sequence[Ramp], p0: float, jerk_percent: float) -> list[Segmen
 
 
 @overload
-def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
              rows: Literal[False] = False) -> tuple[list[Segment], float, float]: ...
 
 
 @overload
-def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
              rows: Literal[True]) -> tuple[list[Row], float, float]: ...
 
 
-def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
+def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
              rows: bool = False) -> tuple[list[Any], float, float]:
     """:func:`reshape`'s segments, where they end and how long they last: the position
     Segment.end_state gives at the end of the last one (``p0`` without segments) and
@@ -54,13 +53,15 @@ def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
     half = 0.5 * fraction  # each jerk phase
     flat = 1.0 - fraction  # the constant-acceleration phase
     kept = 1.0 - half  # peak acceleration = dv / (duration * kept)
-    segments: list[Any] = []  # (Segments, or Rows)
-    append = segments.append
-    make, segment, isfinite = new_tuple, Segment, math.isfinite  # (locals: a global lookup per segment)
+    segments: list[Any] = []  # (Rows, made Segments at the end unless ``rows``)
+    append = segments.append  # (a local: a lookup per piece otherwise)
     p = p0
     total = -0.0  # end_time's sum: -0.0 + d is d for every d, as its first term is
-    # (each ramp's pieces in this loop, not a function of their own: a call per ramp costs as
-    # much as a segment's arithmetic, and a modify is planned while its command waits)
+    # (each ramp's pieces written out in this loop, not a function of their own nor a loop over a
+    # tuple of them: a call per ramp costs as much as a segment's arithmetic, and a modify is
+    # planned while its command waits). Each piece ends where Segment.end_state puts it: its
+    # operations in their order, with the piece's constant acceleration or jerk written in
+    # (a / 2.0 of a = 0.0 is 0.0, which Python folds; every other operation is made).
     for duration, v, v_end in plan:
         dv = v_end - v
         jerk_time = half * duration
@@ -68,18 +69,31 @@ def reshaped(plan: Sequence[Ramp], p0: float, jerk_percent: float,
         # cruise, f = 0, the jerk phases are too short to represent (tiny jerkPercent, or a ramp
         # of ~1e-324 s), or the jerk overflows (jerkPercent ~1e-308: the positions would be NaN).
         # Then the trapezoid's ramp.
-        pieces = None
         if not (v == v_end or jerk_time <= 0.0):
             peak = dv / (duration * kept)
             jerk = peak / jerk_time
-            if isfinite(jerk):
-                pieces = ((jerk_time, 0.0, jerk), (flat * duration, peak, 0.0), (jerk_time, peak, -jerk))
-        for t, a, j in pieces or ((duration, dv / duration if duration > 0.0 else 0.0, 0.0),):
-            if t <= 0.0:
+            if jerk - jerk == 0.0:  # finite (x - x is NaN for an infinite or NaN x): no call of isfinite
+                # jerk_time > 0 here (not <= 0, and not NaN: the jerk is finite): no test
+                t = jerk_time
+                append((t, p, v, 0.0, jerk))
+                p, v = p + t * (v + t * (0.0 / 2.0 + t * jerk / 6.0)), v + t * (0.0 + t * jerk / 2.0)
+                total += t
+                t = flat * duration
+                if not t <= 0.0:  # (no piece of 0 s; a NaN one is kept, as the trapezoid's below)
+                    append((t, p, v, peak, 0.0))
+                    p, v = p + t * (v + t * (peak / 2.0 + t * 0.0 / 6.0)), v + t * (peak + t * 0.0 / 2.0)
+                    total += t
+                t, jerk = jerk_time, -jerk
+                append((t, p, v, peak, jerk))
+                p, v = p + t * (v + t * (peak / 2.0 + t * jerk / 6.0)), v + t * (peak + t * jerk / 2.0)
+                total += t
                 continue
-            append((t, p, v, a, j) if rows else make(segment, (t, p, v, a, j)))
-            # Where the segment ends, as Segment.end_state computes it (the same operations in
-            # the same order), without the method calls: the next piece starts there.
-            p, v = p + t * (v + t * (a / 2.0 + t * j / 6.0)), v + t * (a + t * j / 2.0)
-            total += t
+        if not duration <= 0.0:
+            a = dv / duration if duration > 0.0 else 0.0
+            append((duration, p, v, a, 0.0))
+            t = duration
+            p, v = p + t * (v + t * (a / 2.0 + t * 0.0 / 6.0)), v + t * (a + t * 0.0 / 2.0)
+            total += duration
+    if not rows:
+        segments = list(map(segment_from, segments))
     return segments, p, 0.0 + total  # (end_time's t0 + total, with t0 = 0.0)
