@@ -33,7 +33,7 @@ from .params import ID_BITS, VELOCITY_FRAME_LIMIT_SAMPLES, AxisMaster, Hold, Mot
 from .paths import STREAMED_TYPES, PathStart, compile_path
 from .profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from .profiles.point_to_point import reverses, velocity_move
-from .profiles.ramps import ProfileError, ramps_between, trapezoid_rows
+from .profiles.ramps import ProfileError, ramp_rows, trapezoid_rows
 from .profiles.scurve import reshape, reshaped
 from .profiles.segment import Row, ScaledProfile, Segment, chain, end_time, new_tuple, scaled_profile
 from .types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
@@ -420,7 +420,7 @@ def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) ->
     if motion_type is MPIMotionType.S_CURVE_JERK:
         return chain(0.0, speed, 0.0, velocity_change(speed, 0.0, 0.0, traj.deceleration, traj.deceleration_jerk))
     jerk_percent = traj.jerk_percent if motion_type is MPIMotionType.S_CURVE else 0.0
-    return reshape(ramps_between(speed, 0.0, traj.acceleration, traj.deceleration), 0.0, jerk_percent)
+    return reshape(ramp_rows(speed, 0.0, traj.acceleration, traj.deceleration), 0.0, jerk_percent)
 
 
 def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], bits: int):

@@ -7,7 +7,7 @@ position and velocity with zero acceleration (docs/profiles.md, "Modify: from th
 
 from __future__ import annotations
 
-from .ramps import Ramp, plan_point_to_point, plan_velocity
+from .ramps import Ramp, plan_velocity, trapezoid_rows
 from .scurve import reshape
 from .segment import Segment
 
@@ -23,7 +23,8 @@ def point_to_point(
     jerk_percent: float,
 ) -> list[Segment]:
     """S_CURVE (jerk_percent > 0) or TRAPEZOIDAL (jerk_percent = 0) from (p0, v0)."""
-    plan = plan_point_to_point(target - p0, v0, v_final, velocity, acceleration, deceleration)
+    # (the trapezoid as plain rows: reshape reads them as they are, no Ramp made for each)
+    plan = trapezoid_rows(target - p0, v0, v_final, velocity, acceleration, deceleration)
     return reshape(plan, p0, jerk_percent)
 
 

@@ -49,9 +49,14 @@ RampRow = tuple[float, float, float]
 
 def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> list[Ramp]:
     """The ramp(s) from one velocity to another, split at zero when the sign changes."""
+    return list(map(_ramp_of, ramp_rows(v_from, v_to, accel, decel)))
+
+
+def ramp_rows(v_from: float, v_to: float, accel: float, decel: float) -> list[RampRow]:
+    """:func:`ramps_between`'s ramps as plain tuples (what the planner reshapes)."""
     rows: list[RampRow] = []
     _add_ramps(rows, v_from, v_to, accel, decel)
-    return list(map(_ramp_of, rows))
+    return rows
 
 
 def _add_ramps(rows: list[RampRow], v_from: float, v_to: float, accel: float, decel: float) -> None:
@@ -69,7 +74,7 @@ def _add_ramps(rows: list[RampRow], v_from: float, v_to: float, accel: float, de
 
 
 def _ramp_time(v_from: float, v_to: float, accel: float, decel: float) -> float:
-    return sum(r.duration for r in ramps_between(v_from, v_to, accel, decel))
+    return sum(duration for duration, _, _ in ramp_rows(v_from, v_to, accel, decel))
 
 
 def _total_time(peak: float, cruise: float, v_start: float, v_final: float, accel: float, decel: float) -> float:
