@@ -5,10 +5,11 @@ entity of its node on every round (about 0.6 ms for a supervisor node's 36 entit
 goal costs at least two rounds (its request, its result request) plus the task that serves
 it. Under a stream of modifies those rounds took more of the suite's CPU than applying the
 commands did (bench/RESULTS.md, "The goal path without the executors"). This loop's wait set
-holds only the goal servers' handles (three services and a timer each) and a guard
-condition: made once, refilled each round with a few C calls. What a round takes is served
-on a pool of threads (a goal's command waits there for its sample, never in this thread),
-each server's batches in the order they were taken, by one task at a time (GoalServer.serve).
+holds only the goal servers' services (three each) and a guard condition: made once,
+refilled each round with a few C calls; each round also lets the servers forget expired
+results. What a round takes is served on a pool of threads (a goal's command waits there for
+its sample, never in this thread), each server's batches in the order they were taken, by
+one task at a time (GoalServer.serve).
 
 The loop must be stopped (``stop``) before the nodes holding its servers are destroyed.
 """

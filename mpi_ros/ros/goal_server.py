@@ -5,16 +5,21 @@ request, result request and finished goal is a task and an executor round of its
 goal keeps a Future that the executor walks on every round (all goals kept until their
 result expires: at 100 goals a second and result_timeout 60 s, 6,000 of them), and every
 state change publishes the status of every goal kept. The suite's goals run no callback: the
-controller answers them (goal_tracker.py). GoalServer speaks the same protocol (the same
-services and topics, made by rcl_action, so ``ros2 action`` and any client see no
-difference) and does per batch what rclpy does per goal:
+controller answers them (goal_tracker.py). GoalServer speaks the same protocol on the same
+services and topics (``<action>/_action/send_goal``, ``cancel_goal``, ``get_result`` and
+``status``, of the action's own types and QoS; the node publishes ``feedback``), so
+``ros2 action``, rclpy's and rclcpp's clients see an action server like any other. It keeps
+the goals itself (goal_table.py): rcl_action's goal handles cost time in proportion to the
+goals kept for every goal accepted and ended. And it does per batch what rclpy does per goal:
 
 - every round takes all the requests waiting (goal, cancel, result), not one of each;
 - the goal requests taken together are handed to ``apply`` together: the node applies their
   commands under one lock, at one sample, in the order they came;
 - a finished goal's result is stored and sent at once to whoever asked for it; a result
   request for a finished goal is answered at once, for a running one when it finishes;
-- the status array is published once per batch of changes, not once per change.
+- the status array is published once per batch of changes, not once per change;
+- results expire ``result_timeout`` after their goal ended (the goal loop's rounds look),
+  in turn with the requests: a result request taken before the result expired is answered.
 
 The suite's GoalLoop (goal_loop.py) waits on every server's handle in one thread, takes what
 is ready (``take_data``) and, when no thread is serving this server, hands ``serve`` to a
@@ -32,28 +37,21 @@ import threading
 import traceback
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
-from action_msgs.msg import GoalInfo, GoalStatus
+from action_msgs.msg import GoalInfo, GoalStatusArray
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.qos import QoSProfile, qos_profile_action_status_default
 from rclpy.type_support import check_for_type_support
 
-GoalEvent = _rclpy.GoalEvent
-# the events that end a goal, by how it ended
-SUCCEED, ABORT, CANCELED = GoalEvent.SUCCEED, GoalEvent.ABORT, GoalEvent.CANCELED
-_CANCELABLE = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING)  # rcl_action's CANCEL_GOAL starts there
+from . import goal_table
+from .goal_table import GoalTable, KeptGoal
 
-
-@dataclass(eq=False, slots=True)
-class _Goal:
-    handle: Any  # rclpy's C ActionGoalHandle: the goal's state in rcl_action
-    response: Any = None  # the GetResult response, once the goal has ended
-    waiting: list = field(default_factory=list)  # headers of result requests to answer when it ends
-
-
-_NO_GOAL = _Goal(handle=None)
+# how a goal ended: its terminal status
+SUCCEED, ABORT, CANCELED = goal_table.SUCCEEDED, goal_table.ABORTED, goal_table.CANCELED
+_KINDS = ("goal", "cancel", "result")  # the action's services, in the order each round serves them
+_NO_GOAL = KeptGoal(b"", 0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,20 +77,30 @@ class GoalServer:
     ``start(id)`` when its move runs, ``finish(id, event, result)`` when it has ended."""
 
     def __init__(self, node, action_type, name: str, callbacks: Callbacks, *,
-                 service_qos: QoSProfile, feedback_qos: QoSProfile, result_timeout: float):
+                 service_qos: QoSProfile, result_timeout: float):
         self._node = node
         self._type = action_type
         self._callbacks = callbacks
-        check_for_type_support(action_type)  # loads the action's C type support, which the handle needs
-        self._lock = threading.RLock()  # the C handle and the goals (a finished goal's result
+        impl = action_type.Impl
+        self._request_types = {"goal": impl.SendGoalService.Request, "cancel": impl.CancelGoalService.Request,
+                               "result": impl.GetResultService.Request}
+        service_types = {"goal": impl.SendGoalService, "cancel": impl.CancelGoalService,
+                         "result": impl.GetResultService}
+        names = {"goal": "send_goal", "cancel": "cancel_goal", "result": "get_result"}
+        self._lock = threading.RLock()  # the services and the goals (a finished goal's result
         # is sent from whichever thread ran the controller's outputs)
-        with node.handle, node.get_clock().handle:
-            self._handle = _rclpy.ActionServer(
-                node.handle, node.get_clock().handle, action_type, name, service_qos.get_c_qos_profile(),
-                service_qos.get_c_qos_profile(), service_qos.get_c_qos_profile(), feedback_qos.get_c_qos_profile(),
-                qos_profile_action_status_default.get_c_qos_profile(), result_timeout)
-        self._goals: dict[bytes, _Goal] = {}
+        with node.handle:
+            self._services = {}
+            for kind in _KINDS:
+                check_for_type_support(service_types[kind])  # loads the C type support the service needs
+                self._services[kind] = _rclpy.Service(node.handle, service_types[kind],
+                                                      f"{name}/_action/{names[kind]}", service_qos.get_c_qos_profile())
+        self._status_publisher = node.create_publisher(GoalStatusArray, f"{name}/_action/status",
+                                                       qos_profile_action_status_default)
+        self._goals = GoalTable(result_timeout)
+        self._indices = (0, 0, 0)  # each service's place in the goal loop's wait set
         self._ready = (False, False, False, False)
+        self._expiring = False  # an expiry is queued with the requests taken (one at a time)
         self._taken: deque[dict[str, list]] = deque()
         self._queue = threading.Lock()  # _taken and _scheduled, together
         self._scheduled = False  # a serve task is queued or running
@@ -105,38 +113,29 @@ class GoalServer:
 
     def unfiled(self) -> int:
         """Requests taken and not yet handled."""
-        return sum(len(requests) for batch in list(self._taken) for requests in batch.values())
+        return sum(len(requests) for batch in list(self._taken) for kind, requests in batch.items()
+                   if kind != "expired")
 
     def status(self, key: bytes) -> int:
         with self._lock:
-            goal = self._goals.get(key)
-            return goal.handle.get_status() if goal is not None else GoalStatus.STATUS_UNKNOWN
+            return self._goals.status(key)
 
     # -- what the node changes ------------------------------------------------------------
     def start(self, key: bytes) -> None:
         """The goal's move runs: EXECUTING (an accepted goal only; a cancelled one is CANCELING)."""
         with self._lock:
-            goal = self._goals.get(key)
-            if goal is not None and goal.handle.get_status() == GoalStatus.STATUS_ACCEPTED:
-                goal.handle.update_goal_state(GoalEvent.EXECUTE)
+            if self._goals.execute(key):
                 self._status_changed = True
 
-    def finish(self, key: bytes, event, result) -> None:
+    def finish(self, key: bytes, event: int, result) -> None:
         """The goal has ended (``event``: SUCCEED, ABORT or CANCELED): its terminal state, and
         its result to every client that asked. CANCELED needs the goal CANCELING (its cancel
         accepted); otherwise the goal ends ABORTED."""
         with self._lock:
-            goal = self._goals.get(key)
-            if goal is None or goal.response is not None:
+            goal = self._goals.end(key, event)  # its result expires result_timeout from now
+            if goal is None:
                 return
-            status = goal.handle.get_status()
-            if status == GoalStatus.STATUS_ACCEPTED:
-                goal.handle.update_goal_state(GoalEvent.EXECUTE)  # rcl_action ends only what runs
-            if event == CANCELED and status != GoalStatus.STATUS_CANCELING:
-                event = ABORT
-            goal.handle.update_goal_state(event)
-            self._handle.notify_goal_done()  # starts the goal's result_timeout
-            goal.response = self._type.Impl.GetResultService.Response(status=goal.handle.get_status(), result=result)
+            goal.response = self._type.Impl.GetResultService.Response(status=goal.status, result=result)
             self._status_changed = True
             if goal.waiting:
                 self.publish_status()  # a client hears of the terminal state before its result
@@ -149,64 +148,69 @@ class GoalServer:
         with self._lock:
             if self._status_changed:
                 self._status_changed = False
-                self._handle.publish_status()
+                self._status_publisher.publish(self._goals.status_array())  # CDR, published raw
 
     def destroy(self) -> None:
         with self._lock:
-            for goal in self._goals.values():
-                goal.handle.destroy_when_not_in_use()
             self._goals.clear()
-            self._handle.destroy_when_not_in_use()
+            for service in self._services.values():
+                service.destroy_when_not_in_use()
+            self._node.destroy_publisher(self._status_publisher)
 
     # -- what the goal loop calls (its thread; ``serve`` on its pool) ------------------------
     def __enter__(self):
-        return self._handle.__enter__()
+        for service in self._services.values():
+            service.__enter__()
+        return self
 
     def __exit__(self, t, v, tb):
-        self._handle.__exit__(t, v, tb)
+        for service in self._services.values():
+            service.__exit__(t, v, tb)
 
-    def entity_counts(self) -> tuple[int, ...]:
-        """What the handle puts in a wait set: subscriptions, guard conditions, timers,
-        clients, services."""
-        return tuple(self._handle.get_num_entities())
+    @staticmethod
+    def entity_counts() -> tuple[int, ...]:
+        """What the server puts in a wait set: subscriptions, guard conditions, timers,
+        clients, services (no timer: expired results are looked for every round)."""
+        return 0, 0, 0, 0, len(_KINDS)
 
     def add_to_wait_set(self, wait_set) -> None:
         with self._lock:
-            self._handle.add_to_waitset(wait_set)
+            self._indices = tuple(wait_set.add_service(self._services[kind]) for kind in _KINDS)
 
     def is_ready(self, wait_set) -> bool:
         with self._lock:
-            self._ready = tuple(self._handle.is_ready(wait_set))
+            self._ready = (*(wait_set.is_ready("service", index) for index in self._indices),
+                           self._goals.expire_due())
         return any(self._ready)
 
     def take_data(self) -> bool:
         """Take everything waiting of each kind the wait set found ready and queue it for
         ``serve``. True when the caller must hand ``serve`` to a thread: none is serving."""
-        goal, cancel, result, expired = self._ready
-        impl = self._type.Impl
         taken: dict[str, list] = {}
         with self._lock:
-            if goal:
-                taken["goal"] = self._take_all(self._handle.take_goal_request, impl.SendGoalService.Request)
-            if cancel:
-                taken["cancel"] = self._take_all(self._handle.take_cancel_request, impl.CancelGoalService.Request)
-            if result:
-                taken["result"] = self._take_all(self._handle.take_result_request, impl.GetResultService.Request)
-            if expired:
-                taken["expired"] = list(self._handle.expire_goals(len(self._goals)))
+            for kind, ready in zip(_KINDS, self._ready, strict=False):
+                if ready:
+                    taken[kind] = self._take_all(self._services[kind], self._request_types[kind])
+            if self._ready[-1] and not self._expiring:
+                # forgotten in turn: result requests taken before are still answered
+                taken["expired"] = [self._goals.now()]
+                self._expiring = True
+        if not taken:
+            return False
         with self._queue:
             self._taken.append(taken)
             scheduled, self._scheduled = self._scheduled, True
         return not scheduled
 
     @staticmethod
-    def _take_all(take, request_type) -> list:
+    def _take_all(service, request_type) -> list:
+        """Every request waiting: [(its header's request id, the request)]."""
         requests: list[tuple[Any, Any]] = []
         while True:
-            header, request = take(request_type)
+            request, header = service.service_take_request(request_type)
             if header is None or request is None:
                 return requests
-            requests.append((header, request))
+            requests.append((header.request_id, request))
 
     def serve(self) -> None:
         """Handle everything taken so far, batch after batch, until nothing is left."""
@@ -264,11 +268,11 @@ class GoalServer:
                 for header, _ in fresh:
                     self._respond_goal(header, False, None)
             return
-        stamp = self._node.get_clock().now().to_msg()
+        now = self._node.get_clock().now()
+        stamp = now.to_msg()
         with self._lock:  # the goals exist before their commands run: what ends them finds them
             for _, request in fresh:
-                self._goals[bytes(request.goal_id.uuid)] = _Goal(
-                    _rclpy.ActionGoalHandle(self._handle, GoalInfo(goal_id=request.goal_id, stamp=stamp)))
+                self._goals.accept(bytes(request.goal_id.uuid), now.nanoseconds)
             self._status_changed = True
         try:
             self._callbacks.apply([(bytes(r.goal_id.uuid), r.goal) for _, r in fresh])
@@ -287,25 +291,24 @@ class GoalServer:
         if stamp is not None:
             response.stamp = stamp
         try:
-            self._handle.send_goal_response(header, response)
+            self._services["goal"].service_send_response(response, header)
         except _rclpy.RCLError:  # the client went away; its goal (if accepted) runs without it
             self._node.get_logger().warning("a goal response could not be sent (the client may have gone away)")
 
     def _cancel_requests(self, requests: list) -> None:
+        response_type = self._type.Impl.CancelGoalService.Response
         for header, request in requests:
+            info = request.goal_info
             with self._lock:
-                response = self._handle.process_cancel_request(request, self._type.Impl.CancelGoalService.Response)
-            canceling = []
-            for info in response.goals_canceling:
-                key = bytes(info.goal_id.uuid)
-                if key in self._goals and self._callbacks.cancel(key) and self._to_canceling(key):
-                    canceling.append(info)
-            response.goals_canceling = canceling
-            if not canceling and response.return_code == response.ERROR_NONE:
+                code, named = self._goals.to_cancel(bytes(info.goal_id.uuid),
+                                                    info.stamp.sec * 1_000_000_000 + info.stamp.nanosec)
+            canceling = [goal for goal in named if self._callbacks.cancel(goal.key) and self._to_canceling(goal.key)]
+            response = response_type(return_code=code, goals_canceling=[self._info(goal) for goal in canceling])
+            if not canceling and code == response.ERROR_NONE:
                 response.return_code = response.ERROR_REJECTED
             try:
                 with self._lock:
-                    self._handle.send_cancel_response(header, response)
+                    self._services["cancel"].service_send_response(response, header)
             except _rclpy.RCLError:
                 self._node.get_logger().warning("a cancel response could not be sent (the client may have gone away)")
         self.publish_status()
@@ -313,12 +316,17 @@ class GoalServer:
 
     def _to_canceling(self, key: bytes) -> bool:
         with self._lock:
-            goal = self._goals.get(key)
-            if goal is None or goal.handle.get_status() not in _CANCELABLE:
+            if not self._goals.cancel(key):
                 return False  # ended meanwhile
-            goal.handle.update_goal_state(GoalEvent.CANCEL_GOAL)
             self._status_changed = True
             return True
+
+    @staticmethod
+    def _info(goal: KeptGoal) -> GoalInfo:
+        info = GoalInfo()
+        info.goal_id.uuid = list(goal.key)
+        info.stamp.sec, info.stamp.nanosec = divmod(goal.stamp_ns, 1_000_000_000)
+        return info
 
     def _result_requests(self, requests: list) -> None:
         # A client asks for the result once its goal was accepted, so it follows the goal's
@@ -326,28 +334,27 @@ class GoalServer:
         # (a refused command) had its terminal status published before its client had the
         # goal's answer, and rclpy's client ignores the status of goals it does not know yet.
         with self._lock:
-            if any(self._goals.get(bytes(r.goal_id.uuid), _NO_GOAL).response is not None for _, r in requests):
+            if any((self._goals.get(bytes(r.goal_id.uuid)) or _NO_GOAL).response is not None for _, r in requests):
                 self._status_changed = True
                 self.publish_status()
             for header, request in requests:
                 goal = self._goals.get(bytes(request.goal_id.uuid))
                 if goal is None:  # never accepted, or its result expired
-                    unknown = self._type.Impl.GetResultService.Response(status=GoalStatus.STATUS_UNKNOWN)
+                    unknown = self._type.Impl.GetResultService.Response(status=goal_table.UNKNOWN)
                     self._send_result(header, unknown)
                 elif goal.response is not None:
                     self._send_result(header, goal.response)
                 else:
                     goal.waiting.append(header)
 
+    def _expire(self, taken_at: list[float]) -> None:
+        with self._lock:
+            self._goals.expire(until=taken_at[-1])
+            self._expiring = False
+
     def _send_result(self, header, response) -> None:
         try:
-            self._handle.send_result_response(header, response)
+            self._services["result"].service_send_response(response, header)
         except _rclpy.RCLError:
             self._node.get_logger().warning("a result could not be sent (the client may have gone away)")
 
-    def _expire(self, expired: list) -> None:
-        with self._lock:
-            for info in expired:
-                goal = self._goals.pop(bytes(info.goal_id.uuid), None)
-                if goal is not None:
-                    goal.handle.destroy_when_not_in_use()

@@ -77,8 +77,8 @@ FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feed
 # that at once would drop results. Deep enough for every goal a frame buffer can queue.
 ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 TRIGGER_ACTIONS = {"stop": "STOP", "e_stop": "E_STOP", "abort": "ABORT", "reset": "RESET", "resume": "RESUME"}
-# A goal whose cancel was accepted is still in one of these until rclpy has moved it to
-# CANCELING (right after our cancel callback returns); only then may it end CANCELED.
+# A goal whose cancel was accepted is still in one of these until its GoalServer has moved it
+# to CANCELING (right after our cancel callback returns); only then may it end CANCELED.
 _NOT_YET_CANCELING = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING)
 
 
@@ -150,7 +150,7 @@ class SupervisorNode(Node):
                               apply=partial(self._on_goals, action_type, operation), cancel=self._on_cancel,
                               cancelled=lambda: self.runner.update(self._review))
         return GoalServer(self, action_type, f"~/{name}", callbacks, service_qos=ACTION_SERVICE_QOS,
-                          feedback_qos=FEEDBACK_QOS, result_timeout=self.settings.result_timeout)
+                          result_timeout=self.settings.result_timeout)
 
     def _service(self, srv_type, name, callback):
         """A service of this supervisor: /<ns>/ms<n>/<name>."""
@@ -278,7 +278,7 @@ class SupervisorNode(Node):
 
     @staticmethod
     def _may_end(goal: TrackedGoal) -> bool:
-        # A cancelled goal ends CANCELED, which rcl_action allows only from CANCELING: its
+        # A cancelled goal ends CANCELED, which the protocol allows only from CANCELING: its
         # server moves it there right after the cancel callback accepted.
         return not goal.cancel or goal.payload.server.status(goal.key) not in _NOT_YET_CANCELING
 
@@ -311,8 +311,8 @@ class SupervisorNode(Node):
         Hundreds of goals may be in flight, and the feedback of one goal differs from its
         neighbour's only in the goal id: each message is serialized once (per action type
         and "is the goal's move current") and published raw, with each goal's id in place,
-        on the action's feedback topic (``<action>/_action/feedback``, where rcl_action
-        publishes it; the goal id is the FeedbackMessage's first field, 16 bytes after the
+        on the action's feedback topic (``<action>/_action/feedback``, where action clients
+        subscribe; the goal id is the FeedbackMessage's first field, 16 bytes after the
         4-byte CDR header). ServerGoalHandle.publish_feedback would build and convert a
         message per goal: four times the work, all of it holding the GIL that an E_STOP
         service needs."""

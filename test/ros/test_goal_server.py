@@ -1,0 +1,81 @@
+"""GoalServer on the graph: an action server like any other, with the protocol's cancel
+policy and status topic (mpi_ros/ros/goal_server.py, goal_table.py; in-process)."""
+
+from __future__ import annotations
+
+import threading
+
+from action_msgs.msg import GoalStatus, GoalStatusArray
+from action_msgs.srv import CancelGoal
+from rclpy.action.graph import get_action_server_names_and_types_by_node
+from rclpy.qos import qos_profile_action_status_default
+
+from .conftest import WAIT, call
+from .test_supervisor_node import move
+
+
+def test_the_graph_sees_each_supervisors_action_servers(suite, probe):
+    found: list = []
+    event = threading.Event()
+    for _ in range(int(WAIT / 0.05)):
+        found = sorted(get_action_server_names_and_types_by_node(probe, "ms0", "/mpi"))
+        if len(found) == 2 or event.wait(0.05):  # discovery on this host: wait on it, not for a fixed time
+            break
+    assert found == [("/mpi/ms0/motion_modify", ["mpi_ros/action/MotionModify"]),
+                     ("/mpi/ms0/motion_start", ["mpi_ros/action/MotionStart"])]
+
+
+def test_cancel_every_goal_cancels_the_running_one(suite, client, applied, drive, probe):
+    goal = client.start(move([20000.0, 0.0]))
+    applied.wait(1)
+    drive(lambda: suite.runner.ctl.axes[0].cmd_v > 1000.0)
+    answers: list = []
+    asked = threading.Thread(target=lambda: answers.append(
+        call(probe, CancelGoal, "/mpi/ms0/motion_start/_action/cancel_goal", CancelGoal.Request())))
+    asked.start()
+    drive(lambda: goal.done)
+    asked.join(WAIT)
+    (response,) = answers
+    assert response.return_code == CancelGoal.Response.ERROR_NONE
+    assert [bytes(info.goal_id.uuid) for info in response.goals_canceling] == [bytes(goal.handle.goal_id.uuid)]
+    goal.wait(raise_on_error=False)
+    assert goal.handle.status == GoalStatus.STATUS_CANCELED
+    assert applied.commands[1][1].request == {"action": "STOP"}
+
+
+def test_cancel_requests_naming_no_goal_get_the_protocols_codes(suite, client, applied, drive, probe):
+    unknown = CancelGoal.Request()
+    unknown.goal_info.goal_id.uuid = [7] * 16
+    assert call(probe, CancelGoal, "/mpi/ms0/motion_start/_action/cancel_goal", unknown).return_code == (
+        CancelGoal.Response.ERROR_UNKNOWN_GOAL_ID)
+    goal = client.start(move([10.0, 0.0]))
+    applied.wait(1)
+    drive(lambda: goal.done)
+    goal.wait()
+    ended = CancelGoal.Request()
+    ended.goal_info.goal_id = goal.handle.goal_id
+    assert call(probe, CancelGoal, "/mpi/ms0/motion_start/_action/cancel_goal", ended).return_code == (
+        CancelGoal.Response.ERROR_GOAL_TERMINATED)
+    # nothing left to cancel: every goal named (none) -> rejected
+    assert call(probe, CancelGoal, "/mpi/ms0/motion_start/_action/cancel_goal", CancelGoal.Request()).return_code == (
+        CancelGoal.Response.ERROR_REJECTED)
+
+
+def test_a_late_subscriber_gets_the_status_of_every_goal_kept(suite, client, applied, drive, probe):
+    goal = client.start(move([10.0, 0.0]))
+    applied.wait(1)
+    drive(lambda: goal.done)
+    goal.wait()
+    arrays: list = []
+    got = threading.Event()
+
+    def on_array(msg):
+        arrays.append(msg)
+        got.set()
+
+    # transient local, as action clients subscribe: the last array published is delivered on joining
+    probe.create_subscription(GoalStatusArray, "/mpi/ms0/motion_start/_action/status", on_array,
+                              qos_profile_action_status_default)
+    assert got.wait(WAIT), "no status array"
+    statuses = {bytes(s.goal_info.goal_id.uuid): s.status for s in arrays[-1].status_list}
+    assert statuses == {bytes(goal.handle.goal_id.uuid): GoalStatus.STATUS_SUCCEEDED}
