@@ -51,7 +51,6 @@ from .goal_table import GoalTable, KeptGoal
 # how a goal ended: its terminal status
 SUCCEED, ABORT, CANCELED = goal_table.SUCCEEDED, goal_table.ABORTED, goal_table.CANCELED
 _KINDS = ("goal", "cancel", "result")  # the action's services, in the order each round serves them
-_NO_GOAL = KeptGoal(b"", 0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -334,7 +333,8 @@ class GoalServer:
         # (a refused command) had its terminal status published before its client had the
         # goal's answer, and rclpy's client ignores the status of goals it does not know yet.
         with self._lock:
-            if any((self._goals.get(bytes(r.goal_id.uuid)) or _NO_GOAL).response is not None for _, r in requests):
+            # a goal's result is set when it ends, under this lock: ended means answered
+            if any(self._goals.status(bytes(r.goal_id.uuid)) in goal_table.TERMINAL for _, r in requests):
                 self._status_changed = True
                 self.publish_status()
             for header, request in requests:
