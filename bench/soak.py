@@ -343,6 +343,17 @@ def _minutes(pid: int, topics: dict[str, SampleOrder], diagnostics: Diagnostics,
     return rows
 
 
+def suite_tree() -> str:
+    """Which suite runs: this tree (bench_suite puts it first on the suite's PYTHONPATH, so a
+    PYTHONPATH given by hand does not choose it) and its revision, marked if it has changes."""
+    try:
+        revision = subprocess.run(["git", "-C", str(REPO), "describe", "--always", "--dirty"], capture_output=True,
+                                  text=True, timeout=30, check=True).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        revision = "no git history"
+    return f"{REPO} at {revision}"
+
+
 def report(rows: list[Minute], totals: dict, args) -> str:
     sent = totals.get("sent", 0)
     lines = [
@@ -351,7 +362,7 @@ def report(rows: list[Minute], totals: dict, args) -> str:
         "",
         f"`python -P bench/soak.py --minutes {args.minutes:g} --modify-rate {args.modify_rate:g} --status-rate "
         f"{args.status_rate:g} --result-timeout {args.result_timeout:g}` on {time.strftime('%Y-%m-%d')} "
-        f"(2 cores, load {load_average()} at the end).",
+        f"(2 cores, load {load_average()} at the end), the suite from {suite_tree()}.",
         "",
         "| minute | suite RSS MB | suite CPU (one core) | statuses received | gaps | samples behind | "
         "goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
@@ -385,6 +396,7 @@ def main() -> None:
     parser.add_argument("--result-timeout", type=float, default=60.0, help="ros.result_timeout of the suite (s)")
     parser.add_argument("--append", action="store_true", help="append the report to bench/RESULTS.md")
     args = parser.parse_args()
+    print(f"the suite from {suite_tree()}", flush=True)
     rows, totals = soak(args.minutes, args.modify_rate, args.status_rate, args.result_timeout)
     text = report(rows, totals, args)
     print(text)
