@@ -354,7 +354,7 @@ def suite_tree() -> str:
     return f"{REPO} at {revision}"
 
 
-def report(rows: list[Minute], totals: dict, args) -> str:
+def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
     sent = totals.get("sent", 0)
     lines = [
         f"## Soak (bench/soak.py): {args.minutes:g} min, {SUPERVISORS} supervisors, {args.modify_rate:g} modifies/s "
@@ -362,7 +362,7 @@ def report(rows: list[Minute], totals: dict, args) -> str:
         "",
         f"`python -P bench/soak.py --minutes {args.minutes:g} --modify-rate {args.modify_rate:g} --status-rate "
         f"{args.status_rate:g} --result-timeout {args.result_timeout:g}` on {time.strftime('%Y-%m-%d')} "
-        f"(2 cores, load {load_average()} at the end), the suite from {suite_tree()}.",
+        f"(2 cores, load {load_average()} at the end), the suite from {tree}.",
         "",
         "| minute | suite RSS MB | suite CPU (one core) | statuses received | gaps | samples behind | "
         "goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
@@ -396,9 +396,10 @@ def main() -> None:
     parser.add_argument("--result-timeout", type=float, default=60.0, help="ros.result_timeout of the suite (s)")
     parser.add_argument("--append", action="store_true", help="append the report to bench/RESULTS.md")
     args = parser.parse_args()
-    print(f"the suite from {suite_tree()}", flush=True)
+    tree = suite_tree()  # read once, before the run: what the report names is what ran
+    print(f"the suite from {tree}", flush=True)
     rows, totals = soak(args.minutes, args.modify_rate, args.status_rate, args.result_timeout)
-    text = report(rows, totals, args)
+    text = report(rows, totals, args, tree)
     print(text)
     print("per topic (received, gaps, missing):", totals["per_topic"])
     if args.append:
