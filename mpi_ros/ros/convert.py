@@ -14,9 +14,11 @@ from __future__ import annotations
 
 import array
 import math
+import operator
 import time
 import weakref
 from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -34,46 +36,75 @@ from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 def to_dict(msg) -> dict[str, Any]:
     """A ROS message as a dict of plain Python values (nested messages as dicts); also a
     message read from a bag by the definition the bag stores (its fields are its slots)."""
-    readers = _readers(type(msg))
-    if readers is None:
+    plan = _reading(type(msg))
+    if plan is None:
         return {name: _plain(getattr(msg, name)) for name in _fields(msg)}
-    return {name: getattr(msg, name) if read is None else read(getattr(msg, name)) for name, read in readers}
+    values = dict(zip(plan.names, plan.read_all(msg), strict=True))
+    for name, read in plan.converted:
+        values[name] = read(values[name])
+    return values
 
 
-Readers = tuple[tuple[str, Callable[[Any], Any] | None], ...]
-_READERS: dict[type, Readers] = {}  # generated classes only: a bag's message classes come and go
+@dataclass(frozen=True, slots=True)
+class _Reading:
+    """How a generated message class becomes a dict, decided once from its declared types: a
+    goal has some thirty fields and arrives hundreds of times a second."""
+
+    names: tuple[str, ...]
+    read_all: Callable[[Any], tuple[Any, ...]]  # every field's value at once (its slot, not its property)
+    converted: tuple[tuple[str, Callable[[Any], Any]], ...]  # the fields not plain already, and how
 
 
-def _readers(cls: type) -> Readers | None:
-    readers = _READERS.get(cls)
-    if readers is None:
-        readers = _plan(cls)
-        if readers is not None:
-            _READERS[cls] = readers
-    return readers
+_READINGS: dict[type, _Reading] = {}  # generated classes only: a bag's message classes come and go
 
 
-def _plan(cls: type) -> Readers | None:
-    """For a generated message class: each field with how its value becomes plain (None: it
-    is plain already), decided once from the field's declared type; a goal has some thirty
-    fields and arrives hundreds of times a second. None for other classes (read by value)."""
+def _reading(cls: type) -> _Reading | None:
+    plan = _READINGS.get(cls)
+    if plan is None:
+        plan = _plan(cls)
+        if plan is not None:
+            _READINGS[cls] = plan
+    return plan
+
+
+def _plan(cls: type) -> _Reading | None:
+    """None for classes other than generated ones (those are read by value). A generated
+    class keeps field ``x`` in slot ``_x`` behind a property; reading the slots directly
+    takes a third of the time (the properties are Python functions)."""
     slot_types = getattr(cls, "SLOT_TYPES", None)
     if slot_types is None or not hasattr(cls, "get_fields_and_field_types"):
         return None
-    return tuple((name, _reader(slot_type))
-                 for name, slot_type in zip(cls.get_fields_and_field_types(), slot_types, strict=True))
+    names = tuple(cls.get_fields_and_field_types())
+    slots = set(getattr(cls, "__slots__", ()))
+    attributes = [f"_{name}" if f"_{name}" in slots else name for name in names]
+    getter = operator.attrgetter(*attributes)
+    read_all = getter if len(names) > 1 else (lambda msg: (getter(msg),))
+    readers = ((name, _reader(slot_type)) for name, slot_type in zip(names, slot_types, strict=True))
+    return _Reading(names, read_all, tuple((name, read) for name, read in readers if read is not None))
 
 
 def _reader(slot_type) -> Callable[[Any], Any] | None:
+    """How a field's value becomes plain; None when it is plain already."""
     from rosidl_parser import definition
 
     if isinstance(slot_type, definition.NamespacedType):
         return to_dict
     if isinstance(slot_type, definition.AbstractNestedType):
-        if isinstance(slot_type.value_type, definition.NamespacedType):
+        value_type = slot_type.value_type
+        if isinstance(value_type, definition.NamespacedType):
             return _dicts
-        return _plain  # numbers (array.array, numpy) or strings: plain lists
+        if isinstance(value_type, definition.BasicType) and value_type.typename in _NUMBERS:
+            return _numbers  # array.array (sequences) or numpy (fixed arrays)
+        return _plain  # strings, booleans, bytes: plain lists
     return None
+
+
+# element types rosidl keeps in array.array or numpy arrays (both have tolist)
+_NUMBERS = frozenset({"float", "double", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64"})
+
+
+def _numbers(value) -> list:
+    return value.tolist()  # Python numbers
 
 
 def _dicts(messages) -> list[dict[str, Any]]:
