@@ -88,16 +88,29 @@ class SampleOrder:
 
 @dataclass
 class Diagnostics:
-    """The latest "<ns>/suite" diagnostic values, and the most samples behind seen."""
+    """The latest "<ns>/suite" diagnostic values (published every second), and the most
+    samples behind seen: in the whole run, and since :meth:`minute_most` was last asked."""
 
     values: dict[str, int] = field(default_factory=dict)
     most_behind: int = 0
+    _minute_most: int = 0
+    lock: threading.Lock = field(default_factory=threading.Lock)
 
     def on_message(self, msg) -> None:
         for status in msg.status:
             if status.name.endswith("/suite"):
-                self.values = {v.key: int(v.value) for v in status.values}
-                self.most_behind = max(self.most_behind, self.values.get("samples_behind", 0))
+                values = {v.key: int(v.value) for v in status.values}
+                behind = values.get("samples_behind", 0)
+                with self.lock:
+                    self.values = values
+                    self.most_behind = max(self.most_behind, behind)
+                    self._minute_most = max(self._minute_most, behind)
+
+    def minute_most(self) -> int:
+        """The most samples behind since the last call (a minute's worst, not its last)."""
+        with self.lock:
+            most, self._minute_most = self._minute_most, 0
+        return most
 
 
 def rss_mb(pid: int) -> float:
@@ -259,6 +272,7 @@ class Minute:
     statuses: int
     gaps: int
     diagnostics: dict[str, int]
+    most_behind: int  # the most samples behind in the minute (diagnostics every second)
 
 
 def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout: float) -> tuple[list[Minute], dict]:
@@ -336,10 +350,10 @@ def _minutes(pid: int, topics: dict[str, SampleOrder], diagnostics: Diagnostics,
         pause.wait(max(0.0, began + 60.0 * minute - time.monotonic()))
         cpu1 = cpu_seconds(pid)
         rows.append(Minute(minute, rss_mb(pid), (cpu1 - cpu0) / 60.0, sum(t.count for t in topics.values()),
-                           sum(t.gaps for t in topics.values()), dict(diagnostics.values)))
+                           sum(t.gaps for t in topics.values()), dict(diagnostics.values), diagnostics.minute_most()))
         cpu0 = cpu1
         print(f"minute {minute}: RSS {rows[-1].rss_mb:.0f} MB, CPU {rows[-1].cpu:.0%}, statuses {rows[-1].statuses:,}, "
-              f"gaps {rows[-1].gaps}, {rows[-1].diagnostics}", flush=True)
+              f"gaps {rows[-1].gaps}, at most {rows[-1].most_behind} behind, {rows[-1].diagnostics}", flush=True)
     return rows
 
 
@@ -364,8 +378,8 @@ def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
         f"{args.status_rate:g} --result-timeout {args.result_timeout:g}` on {time.strftime('%Y-%m-%d')} "
         f"(2 cores, load {load_average()} at the end), the suite from {tree}.",
         "",
-        "| minute | suite RSS MB | suite CPU (one core) | statuses received | gaps | samples behind | "
-        "goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
+        "| minute | suite RSS MB | suite CPU (one core) | statuses received | gaps | samples behind (at the mark, "
+        "most in the minute) | goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for row in rows:
@@ -374,7 +388,7 @@ def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
         kept = sum(v for k, v in d.items() if k.endswith("goals_kept"))
         unfiled = sum(v for k, v in d.items() if k.endswith("requests_unfiled"))
         lines.append(f"| {row.minute} | {row.rss_mb:.0f} | {row.cpu:.0%} | {row.statuses:,} | {row.gaps} | "
-                     f"{d.get('samples_behind', '?')} | {tracked} / {kept} / {unfiled} | "
+                     f"{d.get('samples_behind', '?')}, {row.most_behind} | {tracked} / {kept} / {unfiled} | "
                      f"{d.get('outputs_queued', '?')} |")
     lines += ["", f"Goals: {sent:,} sent ({totals.get('ticks', 0) * SUPERVISORS / max(totals.get('sending', 1), 1):.0f}"
               f"/s offered while sending; the load process used {totals.get('load_cpu', 0):.0f} s of CPU), "
