@@ -23,6 +23,7 @@ At the end the load E-stops every supervisor and waits for every goal's result.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import multiprocessing
 import os
@@ -49,11 +50,11 @@ _SAMPLE = struct.Struct("<Q")  # MotionStatus/AxisStatus: stamp (8 bytes), then 
 _SAMPLE_AT = 4 + 8
 
 
-def suite_yaml(directory: Path, status_rate: float, result_timeout: float) -> Path:
+def suite_yaml(directory: Path, status_rate: float, result_timeout: float, goal_process: bool) -> Path:
     raw = yaml.safe_load((REPO / "config" / "default.yaml").read_text(encoding="utf-8"))
     raw["axes"]["count"] = SUPERVISORS
     raw["supervisors"] = [{"number": n, "axes": [n]} for n in range(SUPERVISORS)]
-    raw["ros"].update(status_rate=status_rate, result_timeout=result_timeout)
+    raw["ros"].update(status_rate=status_rate, result_timeout=result_timeout, goal_process=goal_process)
     path = directory / "soak.yaml"
     path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
     return path
@@ -273,15 +274,18 @@ class Minute:
     gaps: int
     diagnostics: dict[str, int]
     most_behind: int  # the most samples behind in the minute (diagnostics every second)
+    children_cpu: float  # share of one core the suite's child processes used (the goal front)
+    children_rss_mb: float
 
 
-def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout: float) -> tuple[list[Minute], dict]:
+def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout: float,
+         goal_process: bool) -> tuple[list[Minute], dict]:
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
 
     seconds = minutes * 60.0
     with tempfile.TemporaryDirectory(prefix="soak_") as tmp:
-        config = suite_yaml(Path(tmp), status_rate, result_timeout)
+        config = suite_yaml(Path(tmp), status_rate, result_timeout, goal_process)
         log_path = Path(tmp) / "suite.log"
         with open(log_path, "w") as log:
             suite = subprocess.Popen([sys.executable, "-P", "-m", "mpi_ros.cli", "run", "--time-scale", "1",
@@ -346,15 +350,31 @@ def _minutes(pid: int, topics: dict[str, SampleOrder], diagnostics: Diagnostics,
     pause = threading.Event()
     began = time.monotonic()
     cpu0 = cpu_seconds(pid)
+    children0 = _children_cpu(pid)
     for minute in range(1, int(minutes) + 1):
         pause.wait(max(0.0, began + 60.0 * minute - time.monotonic()))
         cpu1 = cpu_seconds(pid)
+        children1 = _children_cpu(pid)
+        children = sum(cpu - children0.get(child, (0.0, 0.0))[0] for child, (cpu, _) in children1.items()) / 60.0
         rows.append(Minute(minute, rss_mb(pid), (cpu1 - cpu0) / 60.0, sum(t.count for t in topics.values()),
-                           sum(t.gaps for t in topics.values()), dict(diagnostics.values), diagnostics.minute_most()))
-        cpu0 = cpu1
-        print(f"minute {minute}: RSS {rows[-1].rss_mb:.0f} MB, CPU {rows[-1].cpu:.0%}, statuses {rows[-1].statuses:,}, "
+                           sum(t.gaps for t in topics.values()), dict(diagnostics.values), diagnostics.minute_most(),
+                           children, sum(rss for _, rss in children1.values())))
+        cpu0, children0 = cpu1, children1
+        print(f"minute {minute}: RSS {rows[-1].rss_mb:.0f} MB, CPU {rows[-1].cpu:.0%} (its children "
+              f"{rows[-1].children_cpu:.0%}, {rows[-1].children_rss_mb:.0f} MB), statuses {rows[-1].statuses:,}, "
               f"gaps {rows[-1].gaps}, at most {rows[-1].most_behind} behind, {rows[-1].diagnostics}", flush=True)
     return rows
+
+
+def _children_cpu(pid: int) -> dict[int, tuple[float, float]]:
+    """(CPU seconds, RSS MB) of each child process of ``pid`` (the goal front,
+    multiprocessing's resource tracker); none when the suite has no children."""
+    found = {}
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        for child in map(int, (task / "children").read_text().split()):
+            with contextlib.suppress(OSError):  # a child that ended meanwhile is not counted
+                found[child] = (cpu_seconds(child), rss_mb(child))
+    return found
 
 
 def suite_tree() -> str:
@@ -372,22 +392,27 @@ def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
     sent = totals.get("sent", 0)
     lines = [
         f"## Soak (bench/soak.py): {args.minutes:g} min, {SUPERVISORS} supervisors, {args.modify_rate:g} modifies/s "
-        f"each, status {args.status_rate:g} Hz, result_timeout {args.result_timeout:g} s",
+        f"each, status {args.status_rate:g} Hz, result_timeout {args.result_timeout:g} s"
+        + (", goal front (ros.goal_process)" if args.goal_process else ""),
         "",
         f"`python -P bench/soak.py --minutes {args.minutes:g} --modify-rate {args.modify_rate:g} --status-rate "
-        f"{args.status_rate:g} --result-timeout {args.result_timeout:g}` on {time.strftime('%Y-%m-%d')} "
+        f"{args.status_rate:g} --result-timeout {args.result_timeout:g}"
+        f"{' --goal-process' if args.goal_process else ''}` "
+        f"on {time.strftime('%Y-%m-%d')} "
         f"(2 cores, load {load_average()} at the end), the suite from {tree}.",
         "",
-        "| minute | suite RSS MB | suite CPU (one core) | statuses received | gaps | samples behind (at the mark, "
-        "most in the minute) | goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
-        "|---|---|---|---|---|---|---|---|",
+        "| minute | suite RSS MB | suite CPU (one core) | its child processes (goal front): CPU, RSS MB | "
+        "statuses received | gaps | samples behind (at the mark, most in the minute) | "
+        "goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for row in rows:
         d = row.diagnostics
         tracked = sum(v for k, v in d.items() if k.endswith("goals_tracked"))
         kept = sum(v for k, v in d.items() if k.endswith("goals_kept"))
         unfiled = sum(v for k, v in d.items() if k.endswith("requests_unfiled"))
-        lines.append(f"| {row.minute} | {row.rss_mb:.0f} | {row.cpu:.0%} | {row.statuses:,} | {row.gaps} | "
+        lines.append(f"| {row.minute} | {row.rss_mb:.0f} | {row.cpu:.0%} | {row.children_cpu:.0%}, "
+                     f"{row.children_rss_mb:.0f} | {row.statuses:,} | {row.gaps} | "
                      f"{d.get('samples_behind', '?')}, {row.most_behind} | {tracked} / {kept} / {unfiled} | "
                      f"{d.get('outputs_queued', '?')} |")
     lines += ["", f"Goals: {sent:,} sent ({totals.get('ticks', 0) * SUPERVISORS / max(totals.get('sending', 1), 1):.0f}"
@@ -408,11 +433,13 @@ def main() -> None:
     parser.add_argument("--modify-rate", type=float, default=100.0, help="modify goals per second per supervisor")
     parser.add_argument("--status-rate", type=float, default=1000.0)
     parser.add_argument("--result-timeout", type=float, default=60.0, help="ros.result_timeout of the suite (s)")
+    parser.add_argument("--goal-process", action="store_true",
+                        help="ros.goal_process: the action servers' services in the goal front, a process of their own")
     parser.add_argument("--append", action="store_true", help="append the report to bench/RESULTS.md")
     args = parser.parse_args()
     tree = suite_tree()  # read once, before the run: what the report names is what ran
     print(f"the suite from {tree}", flush=True)
-    rows, totals = soak(args.minutes, args.modify_rate, args.status_rate, args.result_timeout)
+    rows, totals = soak(args.minutes, args.modify_rate, args.status_rate, args.result_timeout, args.goal_process)
     text = report(rows, totals, args, tree)
     print(text)
     print("per topic (received, gaps, missing):", totals["per_topic"])

@@ -97,6 +97,10 @@ class RosSettings:
     # publishes the status of all it keeps at every goal's change, so at 100 goals a second
     # rclpy's 900 s meant 90,000 goals kept and ever larger status messages.
     result_timeout: float = 60.0
+    # The action servers' services in a process of their own, the goal front (ros/goal_front.py):
+    # taking and answering goal requests then costs the suite's interpreter a few microseconds
+    # instead of about 0.2 ms a goal. For goal rates of hundreds a second (docs/reliability.md).
+    goal_process: bool = False
 
     @property
     def joint_states_topic(self) -> str:

@@ -23,6 +23,7 @@ from contextlib import ExitStack
 from rclpy.context import Context
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
+from .goal_endpoints import KINDS, LocalEndpoints
 from .goal_server import GoalServer
 
 # The longest a round waits. A request that arrives while its reader is being re-matched
@@ -47,9 +48,15 @@ class GoalLoop:
         self._stopping = False
         self._thread: threading.Thread | None = None
 
+    def endpoints(self, node, action_type, name: str, qos) -> LocalEndpoints:
+        """The services of a server this loop will wait on (on ``node``, in this process)."""
+        return LocalEndpoints(node, action_type, name, qos)
+
     def add(self, server: GoalServer) -> None:
         if self._thread is not None:
             raise RuntimeError("goal servers are added before the goal loop starts")
+        if not isinstance(server.endpoints, LocalEndpoints):
+            raise TypeError("the goal loop waits on services in this process (GoalLoop.endpoints)")
         self._servers.append(server)
 
     def start(self) -> None:
@@ -69,9 +76,10 @@ class GoalLoop:
         try:
             with ExitStack() as held:  # no server's C handle is destroyed while it is waited on
                 for server in self._servers:
-                    held.enter_context(server)
+                    for service in self._services(server):
+                        held.enter_context(service)
                 held.enter_context(self._handle)
-                wait_set = self._wait_set()
+                wait_set = _rclpy.WaitSet(0, 1, 0, 0, len(KINDS) * len(self._servers), 0, self._handle)
                 while not self._stopping:
                     self._round(wait_set)
         except _rclpy.RCLError:
@@ -80,22 +88,25 @@ class GoalLoop:
             if self._context.ok():
                 raise
 
-    def _wait_set(self):
-        counts = [0] * 5  # subscriptions, guard conditions, timers, clients, services
-        for server in self._servers:
-            for kind, count in enumerate(server.entity_counts()):
-                counts[kind] += count
-        subscriptions, guards, timers, clients, services = counts
-        return _rclpy.WaitSet(subscriptions, guards + 1, timers, clients, services, 0, self._handle)
+    @staticmethod
+    def _services(server: GoalServer):
+        endpoints = server.endpoints
+        assert isinstance(endpoints, LocalEndpoints)  # add() checked
+        return [endpoints.services[kind] for kind in KINDS]
 
     def _round(self, wait_set) -> None:
+        """Wait (at most ROUND_NS), then take every request waiting on a ready service and
+        look for results due to expire; what a server was given is served on the pool."""
         wait_set.clear_entities()
         wait_set.add_guard_condition(self._wake)
-        for server in self._servers:
-            server.add_to_wait_set(wait_set)
+        indices = [[wait_set.add_service(service) for service in self._services(server)] for server in self._servers]
         wait_set.wait(ROUND_NS)
         if self._stopping:
             return
-        for server in self._servers:
-            if server.is_ready(wait_set) and server.take_data():
+        for server, places in zip(self._servers, indices, strict=True):
+            endpoints = server.endpoints
+            assert isinstance(endpoints, LocalEndpoints)
+            taken = {kind: endpoints.take(kind) for kind, place in zip(KINDS, places, strict=True)
+                     if wait_set.is_ready("service", place)}
+            if server.deliver(taken, server.expire_due()):
                 self._pool.submit(server.serve)

@@ -40,17 +40,15 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from action_msgs.msg import GoalInfo, GoalStatusArray
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-from rclpy.qos import QoSProfile, qos_profile_action_status_default
-from rclpy.type_support import check_for_type_support
+from action_msgs.msg import GoalStatusArray
+from rclpy.qos import qos_profile_action_status_default
 
 from . import goal_table
-from .goal_table import GoalTable, KeptGoal
+from .goal_endpoints import Endpoints
+from .goal_table import GoalTable
 
 # how a goal ended: its terminal status
 SUCCEED, ABORT, CANCELED = goal_table.SUCCEEDED, goal_table.ABORTED, goal_table.CANCELED
-_KINDS = ("goal", "cancel", "result")  # the action's services, in the order each round serves them
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,7 +56,7 @@ class Callbacks:
     """What the node decides (each called with no lock of the server held).
 
     accepting(): whether new goals are accepted now (else the batch is rejected).
-    apply(goals): the accepted goals of a batch, [(goal id, goal message)] in order: apply
+    apply(goals): the accepted goals of a batch, [(goal id, goal as a dict)] in order: apply
         their commands and follow the goals (``finish`` ends each); their clients are
         answered after it returns, so a command has taken effect when its client hears.
     cancel(id): a client asks to cancel this goal: True to accept (the goal goes CANCELING).
@@ -75,30 +73,17 @@ class GoalServer:
     """One action (``<node>/<name>``) of one node. The goals' outcome comes from the node:
     ``start(id)`` when its move runs, ``finish(id, event, result)`` when it has ended."""
 
-    def __init__(self, node, action_type, name: str, callbacks: Callbacks, *,
-                 service_qos: QoSProfile, result_timeout: float):
+    def __init__(self, node, action_type, name: str, callbacks: Callbacks, endpoints: Endpoints, *,
+                 result_timeout: float):
         self._node = node
         self._type = action_type
         self._callbacks = callbacks
-        impl = action_type.Impl
-        self._request_types = {"goal": impl.SendGoalService.Request, "cancel": impl.CancelGoalService.Request,
-                               "result": impl.GetResultService.Request}
-        service_types = {"goal": impl.SendGoalService, "cancel": impl.CancelGoalService,
-                         "result": impl.GetResultService}
-        names = {"goal": "send_goal", "cancel": "cancel_goal", "result": "get_result"}
-        self._lock = threading.RLock()  # the services and the goals (a finished goal's result
+        self.endpoints = endpoints  # the action's services: here (LocalEndpoints) or in the goal front
+        self._lock = threading.RLock()  # the goals and the responses (a finished goal's result
         # is sent from whichever thread ran the controller's outputs)
-        with node.handle:
-            self._services = {}
-            for kind in _KINDS:
-                check_for_type_support(service_types[kind])  # loads the C type support the service needs
-                self._services[kind] = _rclpy.Service(node.handle, service_types[kind],
-                                                      f"{name}/_action/{names[kind]}", service_qos.get_c_qos_profile())
         self._status_publisher = node.create_publisher(GoalStatusArray, f"{name}/_action/status",
                                                        qos_profile_action_status_default)
         self._goals = GoalTable(result_timeout)
-        self._indices = (0, 0, 0)  # each service's place in the goal loop's wait set
-        self._ready = (False, False, False, False)
         self._expiring = False  # an expiry is queued with the requests taken (one at a time)
         self._taken: deque[dict[str, list]] = deque()
         self._queue = threading.Lock()  # _taken and _scheduled, together
@@ -134,13 +119,14 @@ class GoalServer:
             goal = self._goals.end(key, event)  # its result expires result_timeout from now
             if goal is None:
                 return
-            goal.response = self._type.Impl.GetResultService.Response(status=goal.status, result=result)
+            goal.response = (goal.status, result)
             self._status_changed = True
             if goal.waiting:
                 self.publish_status()  # a client hears of the terminal state before its result
-            for header in goal.waiting:
-                self._send_result(header, goal.response)
-            goal.waiting.clear()
+                for header in goal.waiting:
+                    self.endpoints.respond("result", header, goal.response)
+                goal.waiting.clear()
+                self.endpoints.flush()
 
     def publish_status(self) -> None:
         """The status of every goal kept, if any changed since it was last published."""
@@ -152,45 +138,22 @@ class GoalServer:
     def destroy(self) -> None:
         with self._lock:
             self._goals.clear()
-            for service in self._services.values():
-                service.destroy_when_not_in_use()
+            self.endpoints.destroy()
             self._node.destroy_publisher(self._status_publisher)
 
-    # -- what the goal loop calls (its thread; ``serve`` on its pool) ------------------------
-    def __enter__(self):
-        for service in self._services.values():
-            service.__enter__()
-        return self
-
-    def __exit__(self, t, v, tb):
-        for service in self._services.values():
-            service.__exit__(t, v, tb)
-
-    @staticmethod
-    def entity_counts() -> tuple[int, ...]:
-        """What the server puts in a wait set: subscriptions, guard conditions, timers,
-        clients, services (no timer: expired results are looked for every round)."""
-        return 0, 0, 0, 0, len(_KINDS)
-
-    def add_to_wait_set(self, wait_set) -> None:
+    # -- what the goal loop (or the goal front's relay) calls ---------------------------------
+    def expire_due(self) -> bool:
+        """Whether a kept result is due to be forgotten."""
         with self._lock:
-            self._indices = tuple(wait_set.add_service(self._services[kind]) for kind in _KINDS)
+            return self._goals.expire_due()
 
-    def is_ready(self, wait_set) -> bool:
+    def deliver(self, taken: dict[str, list], expire: bool) -> bool:
+        """Requests taken (kind: [(header, plain request)]), and whether results are due to
+        expire, queued for ``serve``. True when the caller must hand ``serve`` to a thread:
+        none is serving."""
+        taken = {kind: requests for kind, requests in taken.items() if requests}
         with self._lock:
-            self._ready = (*(wait_set.is_ready("service", index) for index in self._indices),
-                           self._goals.expire_due())
-        return any(self._ready)
-
-    def take_data(self) -> bool:
-        """Take everything waiting of each kind the wait set found ready and queue it for
-        ``serve``. True when the caller must hand ``serve`` to a thread: none is serving."""
-        taken: dict[str, list] = {}
-        with self._lock:
-            for kind, ready in zip(_KINDS, self._ready, strict=False):
-                if ready:
-                    taken[kind] = self._take_all(self._services[kind], self._request_types[kind])
-            if self._ready[-1] and not self._expiring:
+            if expire and not self._expiring:
                 # forgotten in turn: result requests taken before are still answered
                 taken["expired"] = [self._goals.now()]
                 self._expiring = True
@@ -200,16 +163,6 @@ class GoalServer:
             self._taken.append(taken)
             scheduled, self._scheduled = self._scheduled, True
         return not scheduled
-
-    @staticmethod
-    def _take_all(service, request_type) -> list:
-        """Every request waiting: [(its header's request id, the request)]."""
-        requests: list[tuple[Any, Any]] = []
-        while True:
-            request, header = service.service_take_request(request_type)
-            if header is None or request is None:
-                return requests
-            requests.append((header.request_id, request))
 
     def serve(self) -> None:
         """Handle everything taken so far, batch after batch, until nothing is left."""
@@ -248,70 +201,59 @@ class GoalServer:
                     self._node.get_logger().error(f"{len(taken[kind])} {kind} request(s) failed:\n"
                                                   f"{traceback.format_exc()}")
         self.publish_status()
+        self.endpoints.flush()
 
     def _goal_requests(self, requests: list) -> None:
         fresh = []
         seen: set[bytes] = set()
         with self._lock:
-            for header, request in requests:
-                key = bytes(request.goal_id.uuid)
+            for header, (key, goal) in requests:
                 if key in self._goals or key in seen:
-                    self._respond_goal(header, False, None)  # a goal id in use: rejected, as rclpy does
+                    self.endpoints.respond("goal", header, (False, None))  # a goal id in use: rejected, as rclpy does
                 else:
                     seen.add(key)
-                    fresh.append((header, request))
+                    fresh.append((header, key, goal))
         if not fresh:
             return
         if not self._callbacks.accepting():
             with self._lock:
-                for header, _ in fresh:
-                    self._respond_goal(header, False, None)
+                for header, _, _ in fresh:
+                    self.endpoints.respond("goal", header, (False, None))
             return
-        now = self._node.get_clock().now()
-        stamp = now.to_msg()
+        now = self._node.get_clock().now().nanoseconds
         with self._lock:  # the goals exist before their commands run: what ends them finds them
-            for _, request in fresh:
-                self._goals.accept(bytes(request.goal_id.uuid), now.nanoseconds)
+            for _, key, _ in fresh:
+                self._goals.accept(key, now)
             self._status_changed = True
         try:
-            self._callbacks.apply([(bytes(r.goal_id.uuid), r.goal) for _, r in fresh])
+            self._callbacks.apply([(key, goal) for _, key, goal in fresh])
         except Exception:
-            for _, request in fresh:  # not followed by the node: ended here, the error logged by _serve
-                self.finish(bytes(request.goal_id.uuid), ABORT, self._type.Result())
+            for _, key, _ in fresh:  # not followed by the node: ended here, the error logged by _serve
+                self.finish(key, ABORT, self._type.Result())
             raise
         finally:  # accepted goals are answered whatever happened to them
             with self._lock:
-                for header, _ in fresh:
-                    self._respond_goal(header, True, stamp)
+                for header, _, _ in fresh:
+                    self.endpoints.respond("goal", header, (True, now))
                 self.publish_status()
 
-    def _respond_goal(self, header, accepted: bool, stamp) -> None:
-        response = self._type.Impl.SendGoalService.Response(accepted=accepted)
-        if stamp is not None:
-            response.stamp = stamp
-        try:
-            self._services["goal"].service_send_response(response, header)
-        except _rclpy.RCLError:  # the client went away; its goal (if accepted) runs without it
-            self._node.get_logger().warning("a goal response could not be sent (the client may have gone away)")
-
     def _cancel_requests(self, requests: list) -> None:
-        response_type = self._type.Impl.CancelGoalService.Response
-        for header, request in requests:
-            info = request.goal_info
+        none, rejected = self._cancel_codes
+        for header, (key, stamp_ns) in requests:
             with self._lock:
-                code, named = self._goals.to_cancel(bytes(info.goal_id.uuid),
-                                                    info.stamp.sec * 1_000_000_000 + info.stamp.nanosec)
+                code, named = self._goals.to_cancel(key, stamp_ns)
             canceling = [goal for goal in named if self._callbacks.cancel(goal.key) and self._to_canceling(goal.key)]
-            response = response_type(return_code=code, goals_canceling=[self._info(goal) for goal in canceling])
-            if not canceling and code == response.ERROR_NONE:
-                response.return_code = response.ERROR_REJECTED
-            try:
-                with self._lock:
-                    self._services["cancel"].service_send_response(response, header)
-            except _rclpy.RCLError:
-                self._node.get_logger().warning("a cancel response could not be sent (the client may have gone away)")
+            if not canceling and code == none:
+                code = rejected
+            with self._lock:
+                self.endpoints.respond("cancel", header, (code, [(goal.key, goal.stamp_ns) for goal in canceling]))
         self.publish_status()
         self._callbacks.cancelled()
+
+    @property
+    def _cancel_codes(self) -> tuple[int, int]:
+        response = self._type.Impl.CancelGoalService.Response
+        return response.ERROR_NONE, response.ERROR_REJECTED
 
     def _to_canceling(self, key: bytes) -> bool:
         with self._lock:
@@ -320,13 +262,6 @@ class GoalServer:
             self._status_changed = True
             return True
 
-    @staticmethod
-    def _info(goal: KeptGoal) -> GoalInfo:
-        info = GoalInfo()
-        info.goal_id.uuid = list(goal.key)
-        info.stamp.sec, info.stamp.nanosec = divmod(goal.stamp_ns, 1_000_000_000)
-        return info
-
     def _result_requests(self, requests: list) -> None:
         # A client asks for the result once its goal was accepted, so it follows the goal's
         # status from now on: the status again, then the results. A goal that ended at once
@@ -334,16 +269,15 @@ class GoalServer:
         # goal's answer, and rclpy's client ignores the status of goals it does not know yet.
         with self._lock:
             # a goal's result is set when it ends, under this lock: ended means answered
-            if any(self._goals.status(bytes(r.goal_id.uuid)) in goal_table.TERMINAL for _, r in requests):
+            if any(self._goals.status(key) in goal_table.TERMINAL for _, key in requests):
                 self._status_changed = True
                 self.publish_status()
-            for header, request in requests:
-                goal = self._goals.get(bytes(request.goal_id.uuid))
+            for header, key in requests:
+                goal = self._goals.get(key)
                 if goal is None:  # never accepted, or its result expired
-                    unknown = self._type.Impl.GetResultService.Response(status=goal_table.UNKNOWN)
-                    self._send_result(header, unknown)
+                    self.endpoints.respond("result", header, (goal_table.UNKNOWN, self._type.Result()))
                 elif goal.response is not None:
-                    self._send_result(header, goal.response)
+                    self.endpoints.respond("result", header, goal.response)
                 else:
                     goal.waiting.append(header)
 
@@ -351,10 +285,3 @@ class GoalServer:
         with self._lock:
             self._goals.expire(until=taken_at[-1])
             self._expiring = False
-
-    def _send_result(self, header, response) -> None:
-        try:
-            self._services["result"].service_send_response(response, header)
-        except _rclpy.RCLError:
-            self._node.get_logger().warning("a result could not be sent (the client may have gone away)")
-

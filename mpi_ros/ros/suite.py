@@ -23,6 +23,7 @@ from ..config import SuiteConfig
 from ..runner import ControllerRunner
 from . import convert
 from .controller_node import ControllerNode
+from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
 from .supervisor_node import SupervisorNode
 
@@ -46,7 +47,9 @@ class Suite:
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)
         self.runner = ControllerRunner(self.controller, time_scale)
         self.controller_node = ControllerNode(self.runner, config.ros, context=context)
-        self.goal_loop = GoalLoop(self.controller_node.context, config.ros.executor_threads)
+        self.goal_loop: GoalLoop | GoalRelay = (
+            GoalRelay(config.ros.namespace, config.ros.executor_threads) if config.ros.goal_process
+            else GoalLoop(self.controller_node.context, config.ros.executor_threads))
         self.supervisor_nodes = [
             SupervisorNode(self.runner, spec.number, config.ros, self.goal_loop, spec.lost_client_timeout,
                            context=context)

@@ -60,6 +60,8 @@ from ..mpi.outcome import MoveEnd, Outcome
 from ..mpi.snapshot import MotionFeedback
 from ..runner import ControllerRunner, Output
 from . import convert, snapshots, wire
+from .goal_endpoints import ACTION_SERVICE_QOS
+from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
 from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
 from .goal_tracker import GoalBook, TrackedGoal
@@ -73,9 +75,6 @@ from .watchdog import LostClientWatchdog
 # they ask for.
 STATUS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feedback publisher
-# The action's services default to a history of 10: an E_STOP that ends more goals than
-# that at once would drop results. Deep enough for every goal a frame buffer can queue.
-ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 TRIGGER_ACTIONS = {"stop": "STOP", "e_stop": "E_STOP", "abort": "ABORT", "reset": "RESET", "resume": "RESUME"}
 # A goal whose cancel was accepted is still in one of these until its GoalServer has moved it
 # to CANCELING (right after our cancel callback returns); only then may it end CANCELED.
@@ -91,7 +90,7 @@ class _RosGoal:
 
 
 class SupervisorNode(Node):
-    def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings, goal_loop: GoalLoop,
+    def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings, goal_loop: GoalLoop | GoalRelay,
                  lost_client_timeout: float = 0.0, **kwargs):
         super().__init__(f"ms{number}", namespace=settings.namespace, **kwargs)
         self.runner = runner
@@ -102,6 +101,7 @@ class SupervisorNode(Node):
         self._book = GoalBook(number)
         self._snapshots = snapshots.shared(runner)
         self._closing = threading.Condition()
+        self._goal_loop = goal_loop
         self._unfinished = 0  # goals ended whose result has not been handed to their server yet
         actions = ((MotionStart, "motion_start", MOTION_START), (MotionModify, "motion_modify", MOTION_MODIFY))
         # each action's feedback topic: its clients subscribe there (the watchdog looks for them)
@@ -149,7 +149,8 @@ class SupervisorNode(Node):
         callbacks = Callbacks(accepting=lambda: not self._shutting_down,
                               apply=partial(self._on_goals, action_type, operation), cancel=self._on_cancel,
                               cancelled=lambda: self.runner.update(self._review))
-        return GoalServer(self, action_type, f"~/{name}", callbacks, service_qos=ACTION_SERVICE_QOS,
+        endpoints = self._goal_loop.endpoints(self, action_type, f"~/{name}", ACTION_SERVICE_QOS)
+        return GoalServer(self, action_type, f"~/{name}", callbacks, endpoints,
                           result_timeout=self.settings.result_timeout)
 
     def _service(self, srv_type, name, callback):
@@ -183,18 +184,16 @@ class SupervisorNode(Node):
         return lambda: convert.publish(self, self._pub_status, msg)
 
     # -- goals: acceptance and cancel (executor threads) -------------------------------
-    def _on_goals(self, action_type, operation: str, goals: list[tuple[bytes, object]]) -> None:
-        """A batch of accepted goals: their commands applied now, together, in order, and the
-        goals filed in the book under the same hold of the lock (GoalServer answers their
-        clients after this: a client that sends a modify on receiving its start's answer
-        finds the move). A refused command ends its goal ABORTED; a command that raised (an
-        internal error) ends it ABORTED with the error in its detail, and the error is logged."""
-        commands: dict[bytes, Command | Exception] = {}
-        for key, message in goals:
-            try:
-                commands[key] = Command(operation, self.number, request=convert.to_dict(message))
-            except Exception as exc:  # noqa: BLE001 - not swallowed: the goal is aborted with it (_tracked)
-                commands[key] = exc
+    def _on_goals(self, action_type, operation: str, goals: list[tuple[bytes, dict | Exception]]) -> None:
+        """A batch of accepted goals (each as a dict, or the exception reading it raised):
+        their commands applied now, together, in order, and the goals filed in the book under
+        the same hold of the lock (GoalServer answers their clients after this: a client that
+        sends a modify on receiving its start's answer finds the move). A refused command ends
+        its goal ABORTED; a command that raised, or a goal that could not be read (internal
+        errors), ends it ABORTED with the error in its detail, and the error is logged."""
+        commands: dict[bytes, Command | Exception] = {
+            key: goal if isinstance(goal, Exception) else Command(operation, self.number, request=goal)
+            for key, goal in goals}
         valid = [(key, command) for key, command in commands.items() if isinstance(command, Command)]
         payload = _RosGoal(self._servers[action_type], action_type)
 
