@@ -70,6 +70,14 @@ class GoalRelay:
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
 
+    @property
+    def front_pid(self) -> int | None:
+        """The front's process id, once started."""
+        return self._process.pid
+
+    def front_alive(self) -> bool:
+        return self._process.is_alive()
+
     def endpoints(self, node, action_type, name: str, qos) -> RelayedEndpoints:
         """The services of a server, in the front (``qos`` must be ACTION_SERVICE_QOS, the
         front's)."""
@@ -96,7 +104,11 @@ class GoalRelay:
         if not self._connection.poll(START_TIMEOUT_S):
             self._process.kill()
             raise RuntimeError(f"the goal front did not start within {START_TIMEOUT_S:g} s")
-        ready = self._connection.recv()
+        try:
+            ready = self._connection.recv()
+        except EOFError:  # it ended before it was ready; its traceback is on stderr
+            self._process.join(START_TIMEOUT_S)
+            raise RuntimeError(f"the goal front ended as it started (exit code {self._process.exitcode})") from None
         if ready != "ready":
             self._process.kill()
             raise RuntimeError(f"the goal front failed to start: {ready}")
