@@ -91,7 +91,8 @@ def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_
     sample, command, reply = seen.wait_command(
         CLIENT_LOST, LEASE + TIMEOUT + LOADED,
         lambda: f"watched: {watchdog.describe_watched()}; subscribers of the feedback topic: "
-                f"{suite.supervisor_nodes[1].get_subscriptions_info_by_topic(FEEDBACK)}")
+                + ", ".join(f"{info.node_namespace}/{info.node_name}"
+                            for info in suite.supervisor_nodes[1].get_subscriptions_info_by_topic(FEEDBACK)))
     took = time.monotonic() - killed_at
     assert TIMEOUT <= took < LEASE + TIMEOUT + LOADED
     assert command.supervisor == 1 and reply.message.name == "MPIMessageOK" and reply.state is MPIState.STOPPING
