@@ -155,10 +155,29 @@ class Load:
             self.clients[n, "action"] = node.create_client(MotionAction, f"{base}/action")
         self._by_pointer = {client.handle.pointer: client for client in self.clients.values()}
         self._wait_set = None
+        self._answered: set = set()  # result clients that answered a round trip (wait_for_services)
 
     def wait_for_services(self) -> None:
+        """Every service seen, then a round trip on each action: a new client's first request
+        can be answered before the server has matched the client's response reader, and the
+        answer is lost (docs/reliability.md, "A client's first goal and the middleware's
+        discovery"). A result request for a goal that does not exist changes nothing; it is
+        sent again each second until answered, as MotionClient.wait_for_server does."""
         for client in self.clients.values():
             client.wait_for_service(timeout_sec=WAIT)
+        probes = [client for (_, kind), client in self.clients.items() if kind.endswith("_result")]
+        deadline = time.monotonic() + WAIT
+        while probes and time.monotonic() < deadline:
+            for client in probes:
+                request = client.srv_type.Request()
+                request.goal_id.uuid = list(uuid.uuid4().bytes)
+                self._send(client, request, ("probe", client))
+            until = time.monotonic() + 1.0
+            while probes and time.monotonic() < until:
+                self.serve(until - time.monotonic())
+                probes = [client for client in probes if client not in self._answered]
+        if probes:
+            raise RuntimeError(f"{len(probes)} result service(s) never answered a round trip")
 
     def send_goal(self, n: int, kind: str, request) -> None:
         """``request``: a SendGoal request whose goal is set; it gets a new goal id here."""
@@ -207,6 +226,8 @@ class Load:
             request = client.srv_type.Request()
             request.goal_id.uuid = list(goal_id)
             self._send(client, request, ("result",))
+        elif then[0] == "probe":
+            self._answered.add(then[1])
         elif then[0] == "result":
             self.counts["results"] += 1
             self.counts[f"result {response.result.message or f'(none: goal status {response.status})'}"] += 1
@@ -342,7 +363,10 @@ def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout:
 
 
 def _errors(log: str) -> int:
-    return sum(1 for line in log.splitlines() if "Traceback" in line or "[ERROR]" in line)
+    """Error lines, and answers the middleware could not deliver (a lost answer is a goal its
+    client never hears of)."""
+    return sum(1 for line in log.splitlines()
+               if "Traceback" in line or "[ERROR]" in line or "failed to send response" in line)
 
 
 def _minutes(pid: int, topics: dict[str, SampleOrder], diagnostics: Diagnostics, minutes: float) -> list[Minute]:

@@ -73,15 +73,16 @@ class GoalLoop:
         self._wake.destroy_when_not_in_use()
 
     def _run(self) -> None:
+        waited = [(server, self._endpoints(server)) for server in self._servers]
         try:
             with ExitStack() as held:  # no server's C handle is destroyed while it is waited on
-                for server in self._servers:
-                    for service in self._services(server):
-                        held.enter_context(service)
+                for _, endpoints in waited:
+                    for kind in KINDS:
+                        held.enter_context(endpoints.services[kind])
                 held.enter_context(self._handle)
-                wait_set = _rclpy.WaitSet(0, 1, 0, 0, len(KINDS) * len(self._servers), 0, self._handle)
+                wait_set = _rclpy.WaitSet(0, 1, 0, 0, len(KINDS) * len(waited), 0, self._handle)
                 while not self._stopping:
-                    self._round(wait_set)
+                    self._round(wait_set, waited)
         except _rclpy.RCLError:
             # The context shut down (Ctrl-C) before the loop was stopped: nothing can be
             # waited on any more. Anything else is a real error.
@@ -89,24 +90,22 @@ class GoalLoop:
                 raise
 
     @staticmethod
-    def _services(server: GoalServer):
+    def _endpoints(server: GoalServer) -> LocalEndpoints:
         endpoints = server.endpoints
         assert isinstance(endpoints, LocalEndpoints)  # add() checked
-        return [endpoints.services[kind] for kind in KINDS]
+        return endpoints
 
-    def _round(self, wait_set) -> None:
+    def _round(self, wait_set, waited: list[tuple[GoalServer, LocalEndpoints]]) -> None:
         """Wait (at most ROUND_NS), then take every request waiting on a ready service and
         look for results due to expire; what a server was given is served on the pool."""
         wait_set.clear_entities()
         wait_set.add_guard_condition(self._wake)
-        indices = [[wait_set.add_service(service) for service in self._services(server)] for server in self._servers]
+        places = [[wait_set.add_service(endpoints.services[kind]) for kind in KINDS] for _, endpoints in waited]
         wait_set.wait(ROUND_NS)
         if self._stopping:
             return
-        for server, places in zip(self._servers, indices, strict=True):
-            endpoints = server.endpoints
-            assert isinstance(endpoints, LocalEndpoints)
-            taken = {kind: endpoints.take(kind) for kind, place in zip(KINDS, places, strict=True)
+        for (server, endpoints), where in zip(waited, places, strict=True):
+            taken = {kind: endpoints.take(kind) for kind, place in zip(KINDS, where, strict=True)
                      if wait_set.is_ready("service", place)}
             if server.deliver(taken, server.expire_due()):
                 self._pool.submit(server.serve)

@@ -21,9 +21,11 @@ goals kept for every goal accepted and ended. And it does per batch what rclpy d
 - results expire ``result_timeout`` after their goal ended (the goal loop's rounds look),
   in turn with the requests: a result request taken before the result expired is answered.
 
-The suite's GoalLoop (goal_loop.py) waits on every server's handle in one thread, takes what
-is ready (``take_data``) and, when no thread is serving this server, hands ``serve`` to a
-pool. Requests are handled in the order they were taken: takes never overlap, and one
+The server reads and answers requests as plain values through its endpoints (goal_endpoints.py):
+the action's three services in this process, or in the goal front (goal_front.py). The suite's
+GoalLoop (goal_loop.py; with the front, its relay) takes what is waiting for every server in one
+thread, gives it to the server (``deliver``) and, when no thread is serving this server, hands
+``serve`` to a pool. Requests are handled in the order they were taken: takes never overlap, and one
 ``serve`` at a time handles everything taken so far, until nothing is left. At most one task
 per server is ever queued: a task per take piled up by the thousand while the serving task
 waited for its commands' sample (12,000 futures, locks and conditions at 400 goals a second,
