@@ -120,7 +120,7 @@ from mpi_ros import config
 from mpi_ros.ros.suite import Suite
 import rclpy
 rclpy.init()
-suite = Suite(config.load(overrides={"ros": {"goal_process": True}}), time_scale=None)
+suite = Suite(config.load(overrides={"ros": {"goal_process": True, "namespace": "/killed"}}), time_scale=None)
 suite.start(spin_in_thread=True)
 print(suite.goal_loop.front_pid, flush=True)
 sys.stdin.read()  # until killed
@@ -128,6 +128,7 @@ sys.stdin.read()  # until killed
 
 
 def test_the_front_ends_when_the_suite_is_killed():
+    # its own namespace: the killed suite's endpoints stay on the graph until its lease ends
     suite = subprocess.Popen([sys.executable, "-P", "-c", _KILLED_SUITE], stdin=subprocess.PIPE,
                              stdout=subprocess.PIPE, text=True)
     try:
