@@ -487,9 +487,17 @@ class _Endpoint:
     def close(self) -> None:
         self._executor.shutdown(timeout_sec=2.0)
         self._thread.join(timeout=2.0)
+        # destroy_node leaves a node's action clients (and their feedback and status
+        # subscriptions) on the graph until they are garbage collected: a closed client would
+        # still look present, to the suite's lost-client watchdog among others
+        for action_client in self._action_clients():
+            action_client.destroy()
         self.node.destroy_node()
         if self._own_context:
             rclpy.try_shutdown()
+
+    def _action_clients(self) -> list[ActionClient]:
+        return []
 
     def __enter__(self) -> Self:
         return self
@@ -743,6 +751,9 @@ class MotionClient(_Endpoint):
             except NoResponse:
                 continue
         return False
+
+    def _action_clients(self) -> list[ActionClient]:
+        return [self._start, self._modify]
 
     # -- goals ---------------------------------------------------------------------------
     def start(self, goal: Mapping[str, Any] | Any, feedback: Callable[[Any], None] | None = None) -> Goal:

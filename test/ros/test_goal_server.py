@@ -127,3 +127,24 @@ def test_a_late_subscriber_gets_the_status_of_every_goal_kept(suite, client, app
     assert got.wait(WAIT), "no status array"
     statuses = {bytes(s.goal_info.goal_id.uuid): s.status for s in arrays[-1].status_list}
     assert statuses == {bytes(goal.handle.goal_id.uuid): GoalStatus.STATUS_SUCCEEDED}
+
+
+def test_a_closed_client_leaves_the_graph(suite, ros_context):
+    """MotionClient.close destroys its action clients too: the node's destroy_node leaves them,
+    with their feedback subscriptions, on the graph while the client object lives, and the
+    lost-client watchdog would count a closed client as present."""
+    from mpi_ros.client import MotionClient
+
+    topic = "/mpi/ms1/motion_start/_action/feedback"
+    node = suite.supervisor_nodes[1]
+    client = MotionClient(1, context=ros_context, timeout=WAIT, node_name="test_closed_client")
+    assert client.wait_for_server(WAIT)
+    assert "test_closed_client" in [info.node_name for info in node.get_subscriptions_info_by_topic(topic)]
+    client.close()
+    gone = threading.Event()
+    for _ in range(int(WAIT / 0.05)):  # the graph's update: waited on, not for a fixed time
+        if "test_closed_client" not in [info.node_name for info in node.get_subscriptions_info_by_topic(topic)]:
+            gone.set()
+            break
+        gone.wait(0.05)
+    assert gone.is_set(), "a closed client's feedback subscription is still on the graph"  # (``client`` still held)
