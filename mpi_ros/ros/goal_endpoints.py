@@ -123,6 +123,22 @@ def request_types(action_type) -> dict[str, Any]:
             "result": impl.GetResultService.Request}
 
 
+def take_ready(wait_set, guard, each: list[LocalEndpoints], timeout_ns: int) -> list[dict[str, list]] | None:
+    """Wait (up to ``timeout_ns``, -1: no limit) on ``guard`` and on every service of ``each``,
+    then take what is waiting on each ready service: per endpoints, {kind: [(header, plain
+    request)]}. None when ``guard`` was triggered (the caller stops). The goal loop's rounds
+    and the goal front's are this."""
+    wait_set.clear_entities()
+    wait_set.add_guard_condition(guard)
+    places = [[wait_set.add_service(endpoints.services[kind]) for kind in KINDS] for endpoints in each]
+    wait_set.wait(timeout_ns)
+    if wait_set.is_ready("guard_condition", 0):
+        return None
+    return [{kind: endpoints.take(kind) for kind, place in zip(KINDS, where, strict=True)
+             if wait_set.is_ready("service", place)}
+            for endpoints, where in zip(each, places, strict=True)]
+
+
 class LocalEndpoints:
     """The services in this process, on ``node``. The GoalLoop waits on them (``services``)."""
 

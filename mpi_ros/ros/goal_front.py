@@ -36,7 +36,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
-from .goal_endpoints import ACTION_SERVICE_QOS, KINDS, LocalEndpoints, Outbox, RelayedEndpoints
+from .goal_endpoints import ACTION_SERVICE_QOS, KINDS, LocalEndpoints, Outbox, RelayedEndpoints, take_ready
 from .goal_server import GoalServer
 
 ROUND_S = 0.1  # the longest the relay waits before it looks for results due to expire
@@ -58,7 +58,6 @@ class GoalRelay:
     ``add`` every server, then ``start``; ``stop`` before the servers are destroyed."""
 
     def __init__(self, namespace: str, threads: int):
-        self._namespace = namespace
         self._front_servers: list[FrontServer] = []
         self._servers: list[GoalServer] = []
         context = multiprocessing.get_context("spawn")  # a fresh interpreter: no rclpy state of ours
@@ -195,34 +194,26 @@ def _take(connection, node, endpoints: list[LocalEndpoints], headers: dict[int, 
     from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
     tokens = itertools.count()
-    services = [[e.services[kind] for kind in KINDS] for e in endpoints]
     with node.context.handle:
         wait_set = _rclpy.WaitSet(0, 1, 0, 0, len(KINDS) * len(endpoints), 0, node.context.handle)
         while True:
-            wait_set.clear_entities()
-            wait_set.add_guard_condition(stop)
-            places = [[wait_set.add_service(service) for service in each] for each in services]
-            wait_set.wait(-1)
-            if wait_set.is_ready("guard_condition", 0):
+            taken = take_ready(wait_set, stop, endpoints, -1)
+            if taken is None:
                 return
-            batch = []
-            for index, (each, where) in enumerate(zip(endpoints, places, strict=True)):
-                taken = {}
-                for kind, place in zip(KINDS, where, strict=True):
-                    if wait_set.is_ready("service", place):
-                        requests = []
-                        for header, plain in each.take(kind):
-                            token = next(tokens)
-                            headers[token] = header
-                            requests.append((token, plain))
-                        taken[kind] = requests
-                if taken:
-                    batch.append((index, taken))
+            batch = [(index, {kind: [_held(headers, next(tokens), header, plain) for header, plain in requests]
+                              for kind, requests in given.items()})
+                     for index, given in enumerate(taken) if given]
             if batch:
                 try:
                     connection.send(batch)
                 except (OSError, ValueError):  # the suite is gone: nothing to take for
                     return
+
+
+def _held(headers: dict[int, Any], token: int, header: Any, plain: Any) -> tuple[int, Any]:
+    """A request as the suite gets it: a token in place of its header, which the front keeps."""
+    headers[token] = header
+    return token, plain
 
 
 def _respond(connection, endpoints: list[LocalEndpoints], headers: dict[int, Any], stop) -> None:

@@ -23,7 +23,7 @@ from contextlib import ExitStack
 from rclpy.context import Context
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
-from .goal_endpoints import KINDS, LocalEndpoints
+from .goal_endpoints import KINDS, LocalEndpoints, take_ready
 from .goal_server import GoalServer
 
 # The longest a round waits. A request that arrives while its reader is being re-matched
@@ -98,14 +98,9 @@ class GoalLoop:
     def _round(self, wait_set, waited: list[tuple[GoalServer, LocalEndpoints]]) -> None:
         """Wait (at most ROUND_NS), then take every request waiting on a ready service and
         look for results due to expire; what a server was given is served on the pool."""
-        wait_set.clear_entities()
-        wait_set.add_guard_condition(self._wake)
-        places = [[wait_set.add_service(endpoints.services[kind]) for kind in KINDS] for _, endpoints in waited]
-        wait_set.wait(ROUND_NS)
-        if self._stopping:
+        taken = take_ready(wait_set, self._wake, [endpoints for _, endpoints in waited], ROUND_NS)
+        if taken is None or self._stopping:
             return
-        for (server, endpoints), where in zip(waited, places, strict=True):
-            taken = {kind: endpoints.take(kind) for kind, place in zip(KINDS, where, strict=True)
-                     if wait_set.is_ready("service", place)}
-            if server.deliver(taken, server.expire_due()):
+        for (server, _), given in zip(waited, taken, strict=True):
+            if server.deliver(given, server.expire_due()):
                 self._pool.submit(server.serve)
