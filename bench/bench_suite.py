@@ -41,6 +41,7 @@ leaves); ``--profile CASE`` runs it under cProfile (slower: ``--profile-time-sca
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import random
@@ -124,6 +125,24 @@ def thread_cpu(pid: int) -> Counter:
         name = stat[stat.index("(") + 1: stat.rindex(")")]
         out[name] += _ticks(stat) / os.sysconf("SC_CLK_TCK")
     return out
+
+
+def runnable_wait_seconds(pid: int) -> float:
+    """Seconds the threads of a process have spent ready to run but waiting for a CPU (the
+    scheduler's run-queue delay, /proc/<pid>/task/*/schedstat, second field; threads that
+    ended are not counted). Time a process waited for a core is time the machine, not the
+    process, was short of."""
+    total = 0
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        with contextlib.suppress(OSError):  # the thread ended
+            total += int((task / "schedstat").read_text().split()[1])
+    return total / 1e9
+
+
+def idle_seconds() -> float:
+    """Seconds all the machine's cores have been idle (/proc/stat: idle and iowait)."""
+    fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()
+    return (int(fields[4]) + int(fields[5])) / os.sysconf("SC_CLK_TCK")
 
 
 def load_average() -> str:

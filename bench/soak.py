@@ -43,7 +43,16 @@ from typing import Any
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_suite, beside this file (python -P adds nothing)
-from bench_suite import REPO, WAIT, Probe, cpu_seconds, load_average, topic_type  # noqa: E402
+from bench_suite import (  # noqa: E402
+    REPO,
+    WAIT,
+    Probe,
+    cpu_seconds,
+    idle_seconds,
+    load_average,
+    runnable_wait_seconds,
+    topic_type,
+)
 
 SUPERVISORS = 8
 _SAMPLE = struct.Struct("<Q")  # MotionStatus/AxisStatus: stamp (8 bytes), then uint64 sample, after the CDR header
@@ -297,6 +306,8 @@ class Minute:
     most_behind: int  # the most samples behind in the minute (diagnostics every second)
     children_cpu: float  # share of one core the suite's child processes used (the goal front)
     children_rss_mb: float
+    waited: float  # share of the minute the suite's threads, summed, were ready to run but had no core
+    idle: float  # share of the machine's cores idle over the minute
 
 
 def soak(minutes: float, modify_rate: float, status_rate: float, result_timeout: float,
@@ -373,19 +384,22 @@ def _minutes(pid: int, topics: dict[str, SampleOrder], diagnostics: Diagnostics,
     rows = []
     pause = threading.Event()
     began = time.monotonic()
-    cpu0 = cpu_seconds(pid)
+    cpu0, waited0, idle0 = cpu_seconds(pid), runnable_wait_seconds(pid), idle_seconds()
     children0 = _children_cpu(pid)
+    cores = os.cpu_count() or 1
     for minute in range(1, int(minutes) + 1):
         pause.wait(max(0.0, began + 60.0 * minute - time.monotonic()))
-        cpu1 = cpu_seconds(pid)
+        cpu1, waited1, idle1 = cpu_seconds(pid), runnable_wait_seconds(pid), idle_seconds()
         children1 = _children_cpu(pid)
         children = sum(cpu - children0.get(child, (0.0, 0.0))[0] for child, (cpu, _) in children1.items()) / 60.0
         rows.append(Minute(minute, rss_mb(pid), (cpu1 - cpu0) / 60.0, sum(t.count for t in topics.values()),
                            sum(t.gaps for t in topics.values()), dict(diagnostics.values), diagnostics.minute_most(),
-                           children, sum(rss for _, rss in children1.values())))
-        cpu0, children0 = cpu1, children1
+                           children, sum(rss for _, rss in children1.values()), (waited1 - waited0) / 60.0,
+                           (idle1 - idle0) / 60.0 / cores))
+        cpu0, waited0, idle0, children0 = cpu1, waited1, idle1, children1
         print(f"minute {minute}: RSS {rows[-1].rss_mb:.0f} MB, CPU {rows[-1].cpu:.0%} (its children "
-              f"{rows[-1].children_cpu:.0%}, {rows[-1].children_rss_mb:.0f} MB), statuses {rows[-1].statuses:,}, "
+              f"{rows[-1].children_cpu:.0%}, {rows[-1].children_rss_mb:.0f} MB), waited for a core "
+              f"{rows[-1].waited:.0%}, machine idle {rows[-1].idle:.0%}, statuses {rows[-1].statuses:,}, "
               f"gaps {rows[-1].gaps}, at most {rows[-1].most_behind} behind, {rows[-1].diagnostics}", flush=True)
     return rows
 
@@ -426,9 +440,10 @@ def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
         f"(2 cores, load {load_average()} at the end), the suite from {tree}.",
         "",
         "| minute | suite RSS MB | suite CPU (one core) | its child processes (goal front): CPU, RSS MB | "
-        "statuses received | gaps | samples behind (at the mark, most in the minute) | "
+        "suite waited for a core | machine idle | statuses received | gaps | "
+        "samples behind (at the mark, most in the minute) | "
         "goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for row in rows:
         d = row.diagnostics
@@ -436,7 +451,7 @@ def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
         kept = sum(v for k, v in d.items() if k.endswith("goals_kept"))
         unfiled = sum(v for k, v in d.items() if k.endswith("requests_unfiled"))
         lines.append(f"| {row.minute} | {row.rss_mb:.0f} | {row.cpu:.0%} | {row.children_cpu:.0%}, "
-                     f"{row.children_rss_mb:.0f} | {row.statuses:,} | {row.gaps} | "
+                     f"{row.children_rss_mb:.0f} | {row.waited:.0%} | {row.idle:.0%} | {row.statuses:,} | {row.gaps} | "
                      f"{d.get('samples_behind', '?')}, {row.most_behind} | {tracked} / {kept} / {unfiled} | "
                      f"{d.get('outputs_queued', '?')} |")
     lines += ["", f"Goals: {sent:,} sent ({totals.get('ticks', 0) * SUPERVISORS / max(totals.get('sending', 1), 1):.0f}"
