@@ -76,7 +76,11 @@ _ENDED = frozenset({GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_CANCELED, Goa
 # Every node of a process is announced together (one DDS participant per context), but give
 # a late announcement a moment before saying a supervisor is not there.
 _GRACE = 0.5
-_PROBE_ANSWER = 1.0  # s: an unanswered readiness round trip (MotionClient.wait_for_server) is sent again
+# An unanswered readiness round trip (MotionClient.wait_for_server) is sent again after
+# _PROBE_FIRST s, then after twice as long each time, up to _PROBE_ANSWER s: a lost first
+# answer (see wait_for_server) costs a tenth of a second, not a second.
+_PROBE_FIRST = 0.1
+_PROBE_ANSWER = 1.0
 
 
 # -- typed arguments and answers --------------------------------------------------------------
@@ -736,21 +740,30 @@ class MotionClient(_Endpoint):
         return (all(wait(timeout_sec=timeout) for wait in (self._start.wait_for_server,
                                                           self._modify.wait_for_server,
                                                           self._action.wait_for_service))
-                and all(self._answered(client, action_type, deadline)
-                        for client, action_type in ((self._start, MotionStart), (self._modify, MotionModify))))
+                and self._answered({self._start: MotionStart, self._modify: MotionModify}, deadline))
 
-    def _answered(self, action_client: ActionClient, action_type: Any, deadline: float) -> bool:
-        """A result request for an unknown goal, sent again each _PROBE_ANSWER s until answered."""
-        while (remaining := deadline - time.monotonic()) > 0:
-            handle = ClientGoalHandle(action_client, UUID(uuid=list(uuid.uuid4().bytes)),
-                                      action_type.Impl.SendGoalService.Response(accepted=True))
-            try:
-                self._wait_future(self._on_executor(handle.get_result_async), min(_PROBE_ANSWER, remaining),
-                                  "a result request")
-                return True
-            except NoResponse:
-                continue
-        return False
+    def _answered(self, actions: dict[ActionClient, Any], deadline: float) -> bool:
+        """Both actions at once: a result request for an unknown goal to each, sent again
+        (after _PROBE_FIRST s, then twice as long each time, up to _PROBE_ANSWER) until any
+        request to it is answered. An earlier request may still be answered after a later
+        one is sent; any answer will do, so none is given up."""
+        answered = threading.Event()
+        requests: dict[ActionClient, list[Any]] = {client: [] for client in actions}
+        waiting = dict(actions)
+        resend = _PROBE_FIRST
+        while waiting and (remaining := deadline - time.monotonic()) > 0:
+            for client, action_type in waiting.items():
+                handle = ClientGoalHandle(client, UUID(uuid=list(uuid.uuid4().bytes)),
+                                          action_type.Impl.SendGoalService.Response(accepted=True))
+                request = self._on_executor(handle.get_result_async)
+                request.add_done_callback(lambda _request: answered.set())
+                requests[client].append(request)
+            answered.wait(min(resend, remaining))
+            answered.clear()
+            waiting = {client: action_type for client, action_type in waiting.items()
+                       if not any(request.done() for request in requests[client])}
+            resend = min(2.0 * resend, _PROBE_ANSWER)
+        return not waiting
 
     def _action_clients(self) -> list[ActionClient]:
         return [self._start, self._modify]

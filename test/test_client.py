@@ -8,18 +8,21 @@ from __future__ import annotations
 import subprocess
 import sys
 import threading
+import time
 from concurrent.futures import Future
 from types import SimpleNamespace
 
 import pytest
 from action_msgs.msg import GoalStatus
 
+from mpi_ros import client as client_module
 from mpi_ros import errors
 from mpi_ros.action import MotionStart
 from mpi_ros.client import (
     Action,
     EventType,
     Goal,
+    MotionClient,
     MotionResult,
     MotionType,
     Outcome,
@@ -379,3 +382,46 @@ def test_a_goal_whose_status_ended_without_a_result_asks_for_it_again():
     goal = Goal(client, handle, Future(), threading.Event(), server)  # type: ignore[arg-type]
     result = goal.wait(10.0)
     assert result.message == "MPIMessageOK" and goal.asked_again == 1 and len(asked) == 1
+
+
+class _Dropping:
+    """An action client whose server loses its first ``lost`` result requests' answers (the
+    discovery race MotionClient.wait_for_server guards against); the rest are answered at once."""
+
+    def __init__(self, lost: int):
+        self.lost = lost
+        self.requests: list[Future] = []
+
+    def _get_result_async(self, _handle) -> Future:
+        request: Future = Future()
+        if len(self.requests) >= self.lost:
+            request.set_result(MotionStart.Impl.GetResultService.Response(status=GoalStatus.STATUS_UNKNOWN))
+        self.requests.append(request)
+        return request
+
+
+def _probe(actions: dict, seconds: float) -> tuple[bool, float]:
+    prober = SimpleNamespace(_on_executor=lambda call: call())
+    began = time.monotonic()
+    answered = MotionClient._answered(prober, actions, began + seconds)  # type: ignore[arg-type]
+    return answered, time.monotonic() - began
+
+
+def test_a_lost_readiness_answer_costs_a_resend_not_a_second():
+    start, modify = _Dropping(lost=1), _Dropping(lost=0)
+    answered, took = _probe({start: MotionStart, modify: MotionStart}, 10.0)
+    assert answered and len(start.requests) == 2 and len(modify.requests) == 1
+    assert took < client_module._PROBE_ANSWER  # the second request went out after _PROBE_FIRST
+
+
+def test_a_late_answer_to_an_earlier_readiness_request_counts():
+    start = _Dropping(lost=100)
+    threading.Timer(0.25, lambda: start.requests[0].set_result("late")).start()
+    answered, _ = _probe({start: MotionStart}, 10.0)
+    assert answered and 2 <= len(start.requests) < 100
+
+
+def test_readiness_without_any_answer_is_false_at_the_deadline():
+    start = _Dropping(lost=100)
+    answered, took = _probe({start: MotionStart}, 0.5)
+    assert not answered and took >= 0.5 and len(start.requests) >= 3  # 0, 0.1, 0.3 s
