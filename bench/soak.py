@@ -442,8 +442,9 @@ def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
         "| minute | suite RSS MB | suite CPU (one core) | its child processes (goal front): CPU, RSS MB | "
         "suite waited for a core | machine idle | statuses received | gaps | "
         "samples behind (at the mark, most in the minute) | "
-        "goals tracked / kept / requests unfiled (all supervisors) | publications queued |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "goals tracked / kept / requests unfiled (all supervisors) | publications queued | "
+        "Python's blocks (sys.getallocatedblocks) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for row in rows:
         d = row.diagnostics
@@ -453,7 +454,7 @@ def report(rows: list[Minute], totals: dict, args, tree: str) -> str:
         lines.append(f"| {row.minute} | {row.rss_mb:.0f} | {row.cpu:.0%} | {row.children_cpu:.0%}, "
                      f"{row.children_rss_mb:.0f} | {row.waited:.0%} | {row.idle:.0%} | {row.statuses:,} | {row.gaps} | "
                      f"{d.get('samples_behind', '?')}, {row.most_behind} | {tracked} / {kept} / {unfiled} | "
-                     f"{d.get('outputs_queued', '?')} |")
+                     f"{d.get('outputs_queued', '?')} | {d.get('python_blocks', '?')} |")
     lines += ["", f"Goals: {sent:,} sent ({totals.get('ticks', 0) * SUPERVISORS / max(totals.get('sending', 1), 1):.0f}"
               f"/s offered while sending; the load process used {totals.get('load_cpu', 0):.0f} s of CPU), "
               f"{totals.get('accepted', 0):,} accepted, {totals.get('rejected', 0):,} rejected, "

@@ -61,6 +61,7 @@ from .types import ActionSource, IoSpace, MPIAction, MPIState
 from .wrap import wrap_position, wrap_positions
 
 MAX_STRETCH = 4096  # samples computed at once
+EVENTS_KEPT = 10_000  # events Controller.events keeps for a caller that drains them
 # Elements (axes x samples) of a stretch at most: its arrays stay a few megabytes (they live in
 # a scratch reused from stretch to stretch), and with many axes a shorter stretch loses nothing.
 _STRETCH_ELEMENTS = 32 * MAX_STRETCH
@@ -99,7 +100,10 @@ class Controller:
         self._sources: tuple[Stretch, Sources] | None = None  # where the cam slaves of a stretch read masters
         self.motion_defaults = motion_config or MotionConfig()
         self._supervisors: dict[int, MotionSupervisor] = {}
-        self.events: deque[Event] = deque()
+        # The latest events, for a caller that drains them (drain_events); the oldest go first,
+        # so a suite that never drains them (its listeners get every event) holds no more than
+        # EVENTS_KEPT.
+        self.events: deque[Event] = deque(maxlen=EVENTS_KEPT)
         self.listeners: list[EventListener] = []
         self.faults = FaultMonitor(self)
         self.move_log = MoveLog()  # how moves ended: what their goals wait for (move_end)

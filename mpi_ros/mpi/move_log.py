@@ -26,29 +26,40 @@ from collections import OrderedDict, deque
 
 from .outcome import MoveEnd
 
-KEPT = 100_000  # moves whose ends are kept (the oldest go first): far more than goals wait at once
+# What is kept is bounded, so that a suite that runs for days holds no more than one that ran a
+# minute. Goals read their ends at the review after every step batch and every command
+# (mpi_ros/ros/goal_tracker.py), so they need an end only until then; the bounds are far above
+# what one review can meet.
+KEPT = 10_000  # moves whose ends are kept (the oldest go first)
+ENDS_PER_MOVE = 64  # the latest ends kept of one move: a move modified for hours ends again at every DONE
 RECENT = 1024  # ends kept in the order they came, for a look at what ended lately
 
 
 class MoveLog:
-    """The ends of the last KEPT moves, by serial, in the order they were recorded."""
+    """The ends of the last KEPT moves, by serial, in the order they were recorded (the
+    latest ENDS_PER_MOVE of each)."""
 
-    def __init__(self, kept: int = KEPT):
+    def __init__(self, kept: int = KEPT, ends_per_move: int = ENDS_PER_MOVE):
         self._kept = kept
-        self._ends: OrderedDict[int, list[MoveEnd]] = OrderedDict()
+        self._ends_per_move = ends_per_move
+        self._ends: OrderedDict[int, deque[MoveEnd]] = OrderedDict()
         self._recent: deque[MoveEnd] = deque(maxlen=RECENT)
 
     def __len__(self) -> int:
         return len(self._ends)
 
     def record(self, end: MoveEnd) -> None:
-        self._ends.setdefault(end.serial, []).append(end)
+        ends = self._ends.get(end.serial)
+        if ends is None:
+            ends = self._ends[end.serial] = deque(maxlen=self._ends_per_move)
+        ends.append(end)
         self._recent.append(end)
         while len(self._ends) > self._kept:
             self._ends.popitem(last=False)
 
     def ends(self, serial: int) -> tuple[MoveEnd, ...]:
-        """Every end recorded for move ``serial`` (a modified move can have several)."""
+        """The ends recorded for move ``serial`` (a modified move can have several), at
+        most the latest ENDS_PER_MOVE."""
         return tuple(self._ends.get(serial, ()))
 
     def since(self, serial: int, sample: int) -> MoveEnd | None:

@@ -12,6 +12,7 @@ executors at all: one GoalLoop waits for all of them (goal_loop.py).
 
 from __future__ import annotations
 
+import sys
 import threading
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
@@ -79,7 +80,10 @@ class Suite:
         the suite holds (publications queued, goals per supervisor), so a long run shows
         whether anything grows. Runner lock held."""
         behind = self.runner.due_sample() - self.controller.sample
-        values = {"samples_behind": behind, "outputs_queued": self.runner.backlog()}
+        # Python's allocated blocks: whether the objects grow, apart from the allocators'
+        # fragmentation and C's heaps that RSS also counts (cheap: a walk of pymalloc's arenas).
+        values = {"samples_behind": behind, "outputs_queued": self.runner.backlog(),
+                  "python_blocks": sys.getallocatedblocks()}
         for node in self.supervisor_nodes:
             values.update({f"ms{node.number}.{key}": value for key, value in node.held().items()})
         status = DiagnosticStatus(name=f"{self.config.ros.namespace.strip('/')}/suite",

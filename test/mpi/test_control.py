@@ -146,6 +146,20 @@ def test_drain_events_empties_the_queue(ctl, ms, params):
     assert ctl.drain_events() == []
 
 
+def test_events_not_drained_are_bounded_the_oldest_going_first(ctl, ms, params, monkeypatch):
+    # A suite gives every event to its listeners and never drains: the queue keeps the latest.
+    from mpi_ros.mpi import control
+
+    assert ctl.events.maxlen == control.EVENTS_KEPT
+    monkeypatch.setattr(control, "EVENTS_KEPT", 3)
+    bounded = control.Controller()
+    heard = []
+    bounded.listeners.append(heard.append)
+    for n in range(5):
+        bounded.emit(control.MPIEventType.MOTION_DONE, sample=n)
+    assert [e.sample for e in bounded.events] == [2, 3, 4] and [e.sample for e in heard] == [0, 1, 2, 3, 4]
+
+
 def test_motion_snapshot(ctl, ms, params, run_to):
     # MPI 000, mpiMotionStatus mpiMotionStatus "gets a Motion's status"
     ms.start(T.S_CURVE, params=params((1000.0, 0.0), jerk_percent=20.0))

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState, Trajectory
 from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.move_log import MoveLog
+from mpi_ros.mpi.move_log import ENDS_PER_MOVE, MoveLog
 from mpi_ros.mpi.outcome import MoveEnd, Outcome
 
 OK = Outcome(Message.MPIMessageOK, "motion done")
@@ -22,6 +22,17 @@ def test_ends_are_kept_by_serial_in_order_and_the_oldest_moves_go_first():
     assert len(log) == 2 and log.ends(1) == ()  # move 1 was the oldest of three
     assert [e.sample for e in log.ends(3)] == [40]
     assert [(e.serial, e.sample) for e in log.recent()] == [(1, 10), (2, 20), (1, 30), (3, 40)]
+
+
+def test_a_move_modified_for_hours_keeps_only_its_latest_ends():
+    # A move modified again and again keeps its serial and ends at every DONE: at 8 ends a
+    # second its list would grow for as long as the suite runs (issue 14's soak found it).
+    log = MoveLog(ends_per_move=4)
+    for sample in range(0, 1000, 10):
+        log.record(end(7, sample))
+    assert [e.sample for e in log.ends(7)] == [960, 970, 980, 990]
+    assert log.since(7, 975).sample == 980 and log.since(7, 991) is None
+    assert [e.sample for e in MoveLog().ends(7)] == [] and MoveLog()._ends_per_move == ENDS_PER_MOVE
 
 
 def test_since_is_the_first_end_at_or_after_the_goals_sample():

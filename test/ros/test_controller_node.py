@@ -83,6 +83,7 @@ def test_diagnostics_go_to_error_on_e_stop(suite, client, probe, applied, drive)
     # publications of the batch being stepped (500 samples) queued until it ends, fewer than one a sample
     held = {v.key: int(v.value) for v in diagnostics.messages[0].status[-1].values}
     assert held.pop("outputs_queued") <= 500
+    assert held.pop("python_blocks") > 10_000  # the suite's objects: rclpy, the controller, the interfaces
     assert held == {"samples_behind": 0, **{
         f"ms{n}.{key}": 0 for n in (0, 1) for key in ("goals_tracked", "goals_kept", "requests_unfiled")}}
     client.e_stop()

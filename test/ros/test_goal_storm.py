@@ -232,11 +232,13 @@ def test_e_stop_is_answered_as_fast_as_idle_with_hundreds_of_goals_in_flight(liv
         # MPI 000, MPIMotionMessageERROR: the motion is in an error state due to an E_STOP action
         assert {(r.status, r.result.message) for r in results} == {
             (GoalStatus.STATUS_ABORTED, "MPIMotionMessageERROR")}
-        # Generous bounds, against the idle figures of this run: the machine is shared and noisy
-        # (2 cores), and this process also runs the client of every goal. Starvation (issue 9)
-        # took seconds; bench/goal_storm.py measures the figures precisely, in separate processes.
+        # What this guards against is starvation (issue 9: the E_STOP waited seconds behind the
+        # goals), so the bound is a starved answer's, against the idle figures of this run, not
+        # a speed target: the machine is shared and noisy (2 cores), this process also runs the
+        # client of every goal, and a loaded answer once took 106 ms against an idle 8 ms here.
+        # bench/goal_storm.py measures the figures precisely, in separate processes.
         def bound(idle_figure: float) -> float:
-            return idle_figure + max(0.050, 5 * idle_figure)
+            return idle_figure + max(0.500, 5 * idle_figure)
 
         assert max(elapsed for elapsed, _ in e_stops) < bound(idle_e_stop)
         assert statistics.median(probes_loaded) < bound(statistics.median(probes_idle))
