@@ -42,17 +42,16 @@ class MoveLog:
     def __init__(self, kept: int = KEPT, ends_per_move: int = ENDS_PER_MOVE):
         self._kept = kept
         self._ends_per_move = ends_per_move
-        self._ends: OrderedDict[int, deque[MoveEnd]] = OrderedDict()
+        # A tuple per move: most moves end once, and a deque each would weigh ten times as much.
+        self._ends: OrderedDict[int, tuple[MoveEnd, ...]] = OrderedDict()
         self._recent: deque[MoveEnd] = deque(maxlen=RECENT)
 
     def __len__(self) -> int:
         return len(self._ends)
 
     def record(self, end: MoveEnd) -> None:
-        ends = self._ends.get(end.serial)
-        if ends is None:
-            ends = self._ends[end.serial] = deque(maxlen=self._ends_per_move)
-        ends.append(end)
+        ends = (*self._ends.get(end.serial, ()), end)
+        self._ends[end.serial] = ends[-self._ends_per_move:]  # a move's place in the order stays its first end's
         self._recent.append(end)
         while len(self._ends) > self._kept:
             self._ends.popitem(last=False)
@@ -60,7 +59,7 @@ class MoveLog:
     def ends(self, serial: int) -> tuple[MoveEnd, ...]:
         """The ends recorded for move ``serial`` (a modified move can have several), at
         most the latest ENDS_PER_MOVE."""
-        return tuple(self._ends.get(serial, ()))
+        return self._ends.get(serial, ())
 
     def since(self, serial: int, sample: int) -> MoveEnd | None:
         """The first end of move ``serial`` recorded at or after ``sample``."""

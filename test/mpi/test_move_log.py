@@ -32,7 +32,11 @@ def test_a_move_modified_for_hours_keeps_only_its_latest_ends():
         log.record(end(7, sample))
     assert [e.sample for e in log.ends(7)] == [960, 970, 980, 990]
     assert log.since(7, 975).sample == 980 and log.since(7, 991) is None
-    assert [e.sample for e in MoveLog().ends(7)] == [] and MoveLog()._ends_per_move == ENDS_PER_MOVE
+    one = MoveLog(ends_per_move=1)
+    for sample in (10, 20):
+        one.record(end(7, sample))
+    assert [e.sample for e in one.ends(7)] == [20]
+    assert MoveLog().ends(7) == () and MoveLog()._ends_per_move == ENDS_PER_MOVE
 
 
 def test_since_is_the_first_end_at_or_after_the_goals_sample():
