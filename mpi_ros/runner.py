@@ -98,8 +98,9 @@ class ControllerRunner:
 
     def on_change(self, hook: Callable[[Controller], Output | None]) -> None:
         """Call ``hook(controller)`` (under the lock) after every step batch and every command
-        (the moves that ended are in the controller's move log then); what it returns is run
-        after the lock is released, in order with the other deferred work."""
+        (the moves that ended are in the controller's move log then; after the hooks the
+        runner marks them read, Controller.ends_read); what it returns is run after the lock is
+        released, in order with the other deferred work."""
         self._change_hooks.append(hook)
 
     def on_event(self, listener: Callable[[Event], None]) -> None:
@@ -230,15 +231,19 @@ class ControllerRunner:
 
     def _changed(self) -> None:
         """After a step batch or a command (under the lock): hooks, waiters."""
+        read = True
         for hook in self._change_hooks:
             try:
                 output = hook(self.ctl)
             except Exception:  # noqa: BLE001 - the step or command is done; a hook must not undo
                 # that for its caller (an E_STOP service, the clock thread): log it and go on
                 _log.exception("controller runner: a change hook failed")
+                read = False  # (it may not have read the ends it follows: they stay)
                 continue
             if output is not None:
                 self._outputs.append(output)
+        if read:
+            self.ctl.ends_read()  # the goals' reviews are hooks: they have read every end so far
         self.changed.notify_all()
 
     # -- access -------------------------------------------------------------------------

@@ -6,6 +6,7 @@ import threading
 
 from mpi_ros import config
 from mpi_ros.commands import Command
+from mpi_ros.mpi.move_log import MoveLog
 from mpi_ros.runner import ControllerRunner
 
 GOAL = {"type": "TRAPEZOIDAL", "position": [100.0, 0.0],
@@ -80,6 +81,33 @@ def test_change_hooks_see_every_batch_and_command_with_the_moves_ended_in_the_lo
     assert seen == [(0, []), ("output", False)]
     runner.step(2000)  # the move ends within this batch: the hook sees its end
     assert seen[2:] == [(2000, [(reply.serial, "MPIMessageOK")]), ("output", False)]
+
+
+def test_after_the_change_hooks_the_ends_are_read_and_the_log_may_let_them_go(caplog):
+    # mpi_ros/mpi/move_log.py: the goals' reviews are change hooks; once they ran, every end
+    # recorded so far is read, and beyond KEPT_READ moves the log lets it go.
+    runner = manual()
+    runner.ctl.move_log = MoveLog(kept_read=1)
+    seen = []
+    runner.on_change(lambda ctl: seen.append(sorted({e.serial for e in ctl.move_log.recent()
+                                                     if ctl.move_log.ends(e.serial)})))
+    first, _ = runner.submit(Command("motion_start", 0, request=GOAL))
+    runner.step(2000)
+    second, _ = runner.submit(Command("motion_start", 0, request=GOAL))
+    runner.step(2000)
+    assert seen[1] == [first.serial] and seen[-1] == [second.serial]  # each end read by the hook
+    assert runner.ctl.move_log.ends(first.serial) == ()
+
+    def failing(ctl):
+        raise RuntimeError("a hook that did not read")
+
+    runner.on_change(failing)  # a hook failed: what it may not have read stays
+    third, _ = runner.submit(Command("motion_start", 0, request=GOAL))
+    runner.step(2000)
+    fourth, _ = runner.submit(Command("motion_start", 0, request=GOAL))
+    runner.step(2000)
+    assert runner.ctl.move_log.ends(third.serial) and runner.ctl.move_log.ends(fourth.serial)
+    assert "a change hook failed" in caplog.text
 
 
 def test_a_modified_move_keeps_each_of_its_outcomes_in_order():

@@ -217,6 +217,11 @@ class Controller:
             ends.append(end)
         return ends
 
+    def ends_read(self) -> None:
+        """Every goal that follows a move has read the ends recorded so far (the runner, after
+        the reviews of a step batch or command): the log may let them go (move_log.py)."""
+        self.move_log.mark_read()
+
     def current_serial(self, supervisor: int) -> int | None:
         """The serial of the move supervisor ``supervisor`` runs now (None: none, or no such one)."""
         ms = self._supervisors.get(supervisor)

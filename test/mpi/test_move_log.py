@@ -15,13 +15,32 @@ def end(serial: int, sample: int, supervisor: int = 0) -> MoveEnd:
     return MoveEnd(serial, OK, sample, supervisor=supervisor)
 
 
-def test_ends_are_kept_by_serial_in_order_and_the_oldest_moves_go_first():
+def test_ends_are_kept_by_serial_and_the_moves_ended_longest_ago_go_first():
     log = MoveLog(kept=2)
     for e in (end(1, 10), end(2, 20), end(1, 30), end(3, 40)):
         log.record(e)
-    assert len(log) == 2 and log.ends(1) == ()  # move 1 was the oldest of three
-    assert [e.sample for e in log.ends(3)] == [40]
+    assert len(log) == 2 and log.ends(2) == ()  # move 1 ended again at 30: move 2 ended longest ago
+    assert [e.sample for e in log.ends(1)] == [10, 30] and [e.sample for e in log.ends(3)] == [40]
     assert [(e.serial, e.sample) for e in log.recent()] == [(1, 10), (2, 20), (1, 30), (3, 40)]
+
+
+def test_ends_read_are_kept_for_kept_read_moves_and_ends_not_read_yet_for_kept():
+    # A stream ended at once ends all its unreached chunks together (one serial each): the
+    # goals that follow them read their ends at the next review, however many there are.
+    log = MoveLog(kept=100, kept_read=3)
+    for serial in range(1, 51):
+        log.record(end(serial, 500))
+    assert len(log) == 50 and all(log.ends(serial) for serial in range(1, 51))  # none read yet
+    log.mark_read()
+    assert len(log) == 3 and [s for s in range(1, 51) if log.ends(s)] == [48, 49, 50]
+    log.record(end(51, 600))  # a move read long ago goes for it; the new one stays until read
+    assert [s for s in range(1, 52) if log.ends(s)] == [49, 50, 51]
+    for serial in range(52, 200):
+        log.record(end(serial, 700))
+    assert len(log) == 100 and log.ends(99) == () and log.ends(100)  # KEPT bounds what is not read
+    log.mark_read()
+    assert [s for s in range(1, 200) if log.ends(s)] == [197, 198, 199]
+    assert MoveLog(kept=2, kept_read=5)._kept_read == 2  # never more read than kept at all
 
 
 def test_a_move_modified_for_hours_keeps_only_its_latest_ends():
