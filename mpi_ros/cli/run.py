@@ -14,7 +14,8 @@ the plant network can command it by accident. Told otherwise by, first to last:
 --discovery subnet (or localhost, system_default, off), ROS_AUTOMATIC_DISCOVERY_RANGE in
 the environment, ros.discovery in the YAML (default localhost). ROS_STATIC_PEERS adds named
 hosts with any range. DDS security (SROS2) is not available in the PyPI wheels. Stop it
-with Ctrl-C: goals end, the nodes are destroyed and the controller stops. Then, from
+with Ctrl-C (SIGINT) or SIGTERM: goals end with their results, the nodes are destroyed and
+the controller stops; a second Ctrl-C ends the process at once. Then, from
 another shell: `mpi-ros status`, `mpi-ros move ...` (see `mpi-ros --help`); or, instead
 of run, `mpi-ros demo` for a narrated, recorded tour.
 """
@@ -23,9 +24,12 @@ from __future__ import annotations
 
 import argparse
 import ctypes
+import faulthandler
 import gc
 import os
 import sys
+
+from . import stop_signals
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -80,11 +84,26 @@ def release_large_buffers() -> bool:
     return bool(mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD))
 
 
+def report_crashes(stream) -> bool:
+    """Have a crash in C code (SIGSEGV, SIGABRT, SIGBUS, SIGFPE, SIGILL) write every thread's
+    Python stack to ``stream`` (the suite's log) before the process dies: without it such a
+    crash in the middleware ends the suite with no word of where. False when the stream has no
+    file descriptor to write to from a signal handler (stderr captured in-process, as in tests
+    that call ``run`` directly); nothing is changed then."""
+    try:
+        stream.fileno()
+    except (AttributeError, OSError, ValueError):  # io.UnsupportedOperation is both of the latter
+        return False
+    faulthandler.enable(stream, all_threads=True)
+    return True
+
+
 def run(args) -> int:
     from mpi_ros import config as suite_config
 
     # The name the user started: `mpi-ros run`, `mpi-ros record` or `mpi_ros suite` (ros2 run, launch).
     prog = getattr(args, "_prog", "mpi-ros run")
+    report_crashes(sys.stderr)
     if args.time_scale < 0:
         print(f"{prog}: --time-scale must be >= 0", file=sys.stderr)
         return 2
@@ -95,14 +114,21 @@ def run(args) -> int:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         return 2
     os.environ[RANGE_VARIABLE] = reach
+    # Blocked before rclpy starts the middleware's threads, taken by this thread (stop_signals.py).
+    with stop_signals.held() as stops:
+        return _serve(args, prog, (reach, told_by), stops)
 
+
+def _serve(args, prog: str, discovery: tuple[str, str], stops: stop_signals.StopSignals) -> int:
+    """Bring the suite up, serve until a stop signal (or an executor fails), take it down."""
     import rclpy
+    from rclpy.signals import SignalHandlerOptions
 
+    from mpi_ros import config as suite_config
     from mpi_ros.ros import parameters
     from mpi_ros.ros.suite import Suite
 
-    # rclpy's own SIGINT/SIGTERM handling shuts the context down and wakes the executor.
-    rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])])
+    rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])], signal_handler_options=SignalHandlerOptions.NO)
     try:
         cfg, time_scale = parameters.resolve(None, args.config, args.time_scale, getattr(args, "namespace", None))
     except suite_config.ConfigError as exc:
@@ -125,7 +151,7 @@ def run(args) -> int:
     log = suite.controller_node.get_logger()
     log.info(f"mpi_ros suite up: {len(cfg.supervisors)} supervisor(s), {cfg.axis_count} axes, "
              f"{cfg.controller.sample_rate:g} Hz, time scale {time_scale:g}, config {cfg.source}, "
-             f"namespace {cfg.ros.namespace}, discovery {reach} ({told_by}"
+             f"namespace {cfg.ros.namespace}, discovery {discovery[0]} ({discovery[1]}"
              + (f", static peers {os.environ['ROS_STATIC_PEERS']}" if os.environ.get("ROS_STATIC_PEERS") else "")
              + ")")
     # What start-up built (rclpy, numpy, the suite) lives as long as the process: frozen, a full
@@ -142,16 +168,20 @@ def run(args) -> int:
     # collector and the goal queue".
     gc.set_threshold(*GC_THRESHOLDS)
     release_large_buffers()
-    suite.start(spin_in_thread=False)
+    suite.start()
+    received = stops.wait(done=lambda: bool(suite.failed()))
+    stops.insist()
+    if received is not None:
+        log.info(f"{received.name}: stopping (once more to end the process at once)")
+    else:
+        log.error(f"the executor(s) of {', '.join(s.name for s in suite.failed())} stopped on their own: "
+                  f"stopping the suite")
     try:
-        suite.spin()
-    except KeyboardInterrupt:
-        pass
+        clean = suite.shutdown()
     finally:
-        suite.shutdown()
         if recorder is not None:
             recorder.close()
             print(f"recorded to {args.record}", file=sys.stderr)
         rclpy.try_shutdown()
     print("mpi_ros suite stopped", file=sys.stderr)
-    return 0
+    return 0 if received is not None and clean else 1

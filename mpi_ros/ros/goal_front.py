@@ -161,6 +161,9 @@ def run_front(connection, namespace: str) -> None:
     # Ctrl-C in a terminal reaches the whole process group: the suite decides when the front
     # ends (it closes the pipe once its goals are answered), so the front ignores it.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # The suite blocks its stop signals (cli/stop_signals.py) and a child inherits the mask:
+    # SIGTERM must still end the front.
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     servers: list[FrontServer] = connection.recv()
     rclpy.init(args=[], signal_handler_options=SignalHandlerOptions.NO)
     try:

@@ -13,12 +13,10 @@ executors at all: one GoalLoop waits for all of them (goal_loop.py).
 from __future__ import annotations
 
 import sys
-import threading
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
 from ..config import SuiteConfig
 from ..runner import ControllerRunner
@@ -26,6 +24,7 @@ from . import convert
 from .controller_node import ControllerNode
 from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
+from .spinner import Spinner
 from .supervisor_node import SupervisorNode
 
 
@@ -60,7 +59,7 @@ class Suite:
         self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
         self.controller_node.add_diagnostic(lambda ctl: [self._suite_status()])
         self.executors = [_executor(node, config.ros.executor_threads, context) for node in self.nodes]
-        self._spin_thread: threading.Thread | None = None
+        self.spinners: list[Spinner] = []
 
     def _crosscheck(self):
         """ros.crosscheck: every started/modified move is checked against ruckig; a
@@ -98,56 +97,45 @@ class Suite:
         return [self.controller_node, *self.supervisor_nodes]
 
     def start(self, spin_in_thread: bool = True) -> None:
-        """Start the controller clock and (optionally) spin the executor in a thread."""
+        """Start the controller clock, the goal loop and (unless told not to) every node's
+        executor, each in a thread of its own (spinner.py)."""
         self.runner.start()
         self.goal_loop.start()
         if spin_in_thread:
-            self._spin_thread = threading.Thread(target=self.spin, name="mpi-ros-executor", daemon=True)
-            self._spin_thread.start()
+            pairs = zip(self.nodes, self.executors, strict=True)
+            self.spinners = [Spinner(node, executor) for node, executor in pairs]
+            for spinner in self.spinners:
+                spinner.start()
 
-    def spin(self) -> None:
-        """Spin every node's executor until the context shuts down (or ``shutdown``): the
-        supervisors' in threads of their own, the controller node's in the calling thread."""
-        threads = [threading.Thread(target=_spin, args=(executor,), name=f"mpi-ros-{node.get_name()}", daemon=True)
-                   for node, executor in zip(self.nodes[1:], self.executors[1:], strict=True)]
-        for thread in threads:
-            thread.start()
-        _spin(self.executors[0])
-        for thread in threads:
-            thread.join(timeout=5.0)
+    def failed(self) -> list[Spinner]:
+        """The executors that stopped on their own (an error, or their context shut down)."""
+        return [spinner for spinner in self.spinners if spinner.ended]
 
-    def shutdown(self) -> None:
-        """Stop goals, the clock and the executor; destroy the nodes."""
+    def shutdown(self, timeout: float = 5.0) -> bool:
+        """Take the suite down in the order that keeps every goal answered and no node destroyed
+        while it is waited on: the supervisors end their goals (their results go out while ROS
+        still runs), then the clock and the goal loop stop, then the executors (each thread
+        joined), and only then are the nodes destroyed. False if an executor did not stop within
+        ``timeout`` s: its node is then left to the process' exit rather than destroyed under it."""
         for node in self.supervisor_nodes:
             node.shutdown()
         self.runner.stop()
-        self.goal_loop.stop()
-        for executor in self.executors:
-            executor.shutdown(timeout_sec=5.0)
-        if self._spin_thread is not None:
-            self._spin_thread.join(timeout=5.0)
-        for node in self.nodes:
+        self.goal_loop.stop(timeout)
+        stopped = {spinner.executor for spinner in self.spinners if spinner.stop(timeout)}
+        spun = {spinner.executor for spinner in self.spinners}
+        for node, executor in zip(self.nodes, self.executors, strict=True):
+            if executor in spun and executor not in stopped:
+                node.get_logger().error(f"its executor did not stop within {timeout:g} s: the node is not destroyed")
+                continue
+            executor.shutdown(timeout_sec=timeout)
             node.destroy_node()
+        return len(stopped) == len(spun)
 
 
 def _executor(node, threads: int, context: Context | None) -> MultiThreadedExecutor:
     executor = MultiThreadedExecutor(num_threads=threads, context=context)
     executor.add_node(node)
     return executor
-
-
-def _spin(executor: MultiThreadedExecutor) -> None:
-    from rclpy.executors import ExternalShutdownException
-
-    try:
-        executor.spin()
-    except ExternalShutdownException:
-        pass
-    except _rclpy.RCLError:
-        # The context shut down (Ctrl-C) while this executor was between its check and its
-        # wait: it cannot make the wait set any more. Anything else is a real error.
-        if executor.context.ok():
-            raise
 
 
 def _crosscheck_status(name: str, summary: dict):

@@ -40,3 +40,32 @@ def test_large_buffers_go_back_to_the_system_once_the_threshold_is_pinned():
     # from the heap and stays there (the refused-goal memory growth, docs/hostile-input.md)
     assert probe("default") == "True False"
     assert probe("pinned") == "True True"
+
+
+_CRASH = """
+import faulthandler, sys, threading
+from mpi_ros.cli.run import report_crashes
+assert report_crashes(sys.stderr)
+def clock_thread(): threading.Event().wait()
+threading.Thread(target=clock_thread, name="clock", daemon=True).start()
+faulthandler._sigsegv()
+"""
+
+
+def test_a_crash_in_c_code_leaves_every_threads_stack_in_the_log():
+    # the middleware crashing at shutdown once ended the suite with SIGSEGV and no word of where
+    done = subprocess.run([sys.executable, "-c", _CRASH], capture_output=True, text=True, timeout=60)
+    assert done.returncode == -11, done.stderr
+    assert "Fatal Python error: Segmentation fault" in done.stderr
+    assert "clock_thread" in done.stderr  # not only the crashing thread's stack
+
+
+def test_crash_reports_are_left_alone_without_a_file_descriptor():
+    import faulthandler
+    import io
+
+    from mpi_ros.cli.run import report_crashes
+
+    before = faulthandler.is_enabled()
+    assert report_crashes(io.StringIO()) is False  # stderr captured in-process, as run() in tests
+    assert faulthandler.is_enabled() == before

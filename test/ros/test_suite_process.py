@@ -51,3 +51,26 @@ def test_move_e_stop_reset_across_processes_and_clean_ctrl_c(suite_process, ros_
     out, err = suite_process.communicate(timeout=WAIT)
     assert suite_process.returncode == 0, err
     assert "Traceback" not in err and "mpi_ros suite stopped" in err
+
+
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_stop_signal_ends_the_goal_in_progress_with_its_result(suite_process, ros_context, stop):
+    # The suite takes the stop signals itself (mpi_ros/cli/stop_signals.py): ROS still runs
+    # while the supervisors end their goals, so the client gets a result, not silence.
+    from mpi_ros import errors
+    from mpi_ros.client import MotionClient
+
+    with MotionClient(0, context=ros_context, timeout=WAIT) as ms0:
+        assert ms0.wait_for_server(WAIT), "the suite did not come up"
+        # 1,000,000 counts at 100 counts/s: still moving when the signal comes, however slow the machine
+        goal = ms0.start({"type": "S_CURVE", "position": [1e6, 0.0],
+                          "trajectory": [{"velocity": 100.0, "acceleration": 1000.0, "deceleration": 1000.0,
+                                          "jerk_percent": 50.0}]})
+        assert goal.wait_started(WAIT)
+        suite_process.send_signal(stop)
+        with pytest.raises(errors.MPIMotionMessageSTOPPED) as ended:
+            goal.wait(WAIT)
+        assert ended.value.detail == "the suite is shutting down"
+    out, err = suite_process.communicate(timeout=WAIT)
+    assert suite_process.returncode == 0, err
+    assert f"{stop.name}: stopping" in err and "mpi_ros suite stopped" in err and "Traceback" not in err
