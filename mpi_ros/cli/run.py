@@ -99,14 +99,21 @@ def report_crashes(stream) -> bool:
 
 
 def run(args) -> int:
-    from mpi_ros import config as suite_config
-
     # The name the user started: `mpi-ros run`, `mpi-ros record` or `mpi_ros suite` (ros2 run, launch).
     prog = getattr(args, "_prog", "mpi-ros run")
     report_crashes(sys.stderr)
     if args.time_scale < 0:
         print(f"{prog}: --time-scale must be >= 0", file=sys.stderr)
         return 2
+    # Blocked before anything starts a thread (numpy's OpenBLAS when imported, the middleware in
+    # rclpy.init), taken by this thread (stop_signals.py).
+    with stop_signals.held() as stops:
+        return _serve(args, prog, stops)
+
+
+def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
+    """Bring the suite up, serve until a stop signal (or an executor fails), take it down."""
+    from mpi_ros import config as suite_config
 
     try:  # before rclpy.init: the middleware reads it when the context starts
         reach, told_by = discovery_range(getattr(args, "discovery", None), args.config, os.environ)
@@ -114,17 +121,10 @@ def run(args) -> int:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         return 2
     os.environ[RANGE_VARIABLE] = reach
-    # Blocked before rclpy starts the middleware's threads, taken by this thread (stop_signals.py).
-    with stop_signals.held() as stops:
-        return _serve(args, prog, (reach, told_by), stops)
 
-
-def _serve(args, prog: str, discovery: tuple[str, str], stops: stop_signals.StopSignals) -> int:
-    """Bring the suite up, serve until a stop signal (or an executor fails), take it down."""
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
-    from mpi_ros import config as suite_config
     from mpi_ros.ros import parameters
     from mpi_ros.ros.suite import Suite
 
@@ -151,7 +151,7 @@ def _serve(args, prog: str, discovery: tuple[str, str], stops: stop_signals.Stop
     log = suite.controller_node.get_logger()
     log.info(f"mpi_ros suite up: {len(cfg.supervisors)} supervisor(s), {cfg.axis_count} axes, "
              f"{cfg.controller.sample_rate:g} Hz, time scale {time_scale:g}, config {cfg.source}, "
-             f"namespace {cfg.ros.namespace}, discovery {discovery[0]} ({discovery[1]}"
+             f"namespace {cfg.ros.namespace}, discovery {reach} ({told_by}"
              + (f", static peers {os.environ['ROS_STATIC_PEERS']}" if os.environ.get("ROS_STATIC_PEERS") else "")
              + ")")
     # What start-up built (rclpy, numpy, the suite) lives as long as the process: frozen, a full

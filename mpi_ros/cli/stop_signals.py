@@ -1,18 +1,19 @@
 """SIGINT and SIGTERM, taken by the suite's main thread when it is ready for them.
 
-Why not rclpy's signal handlers: they shut the context down from the signal and trust every
-executor to wake and see it. In the suite (an executor per node, each in a thread) a SIGINT
-did not wake them all: 4 of 43 runs of `mpi-ros run` sent SIGINT within a second of "suite up"
-hung, with executors asleep in their wait and the context shut down (docs/reliability.md,
-"Stopping").
+Why not rclpy's signal handlers: they shut the context down from the signal, chain to Python's
+handler, and trust every executor to wake and see it. In the suite (an executor per node, each in
+a thread) SIGINT soon after start-up could hang it (executors asleep in their wait; 8 of 60 runs
+on a busy machine, SIGINT inherited ignored) or crash it (KeyboardInterrupt skipped the join of
+the executors' threads and the nodes were destroyed under them; 2 of 60 with the default
+disposition). docs/reliability.md, "Stopping"; bench/RESULTS.md, "Stopping under a signal".
 
 So the suite takes the signals itself, synchronously. They are blocked in every thread started
 from here on: threads inherit the mask of the thread that starts them, so the block comes before
 rclpy starts the middleware's threads. The main thread waits for one with ``sigtimedwait``; no
 handler runs in the middle of other code, and nothing is missed. A thread started before the
-block (numpy's OpenBLAS starts one when it is imported) can still be handed one by the kernel.
-Python then runs the handler installed here, in the main thread; it only notes the signal, and
-``wait`` reports it too.
+block (numpy's OpenBLAS starts one when numpy is imported: `mpi-ros run` blocks first) could
+still be handed one by the kernel. Python then runs the handler installed here, in the main
+thread; it only notes the signal, and ``wait`` reports it too.
 
 A second SIGINT or SIGTERM while the suite is stopping ends the process at once (the default
 action): the user or launch insisting.

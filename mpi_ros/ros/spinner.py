@@ -3,8 +3,9 @@
 Why not ``Executor.spin`` in a thread: rclpy's ``spin`` ends only when the context shuts down
 or ``Executor.shutdown`` is called, and neither waits for the spinning thread. ``shutdown``
 destroys the executor's guard condition while that thread may be between its checks and its
-next wait, and a context shut down by a signal woke only some of the suite's executors (the
-suite hung at SIGINT, its main executor asleep in its wait; docs/reliability.md, "Stopping").
+next wait; a context shut down by a signal did not wake every executor of the suite (it hung);
+and destroying a node while its executor's thread is in its wait crashed the process (SIGSEGV;
+docs/reliability.md, "Stopping").
 A Spinner owns its loop: ``stop`` sets a flag, wakes the executor and joins the thread, so the
 nodes are destroyed only once nothing waits on them. The wake is a guard condition of the node
 with a callback that does nothing: ``Executor.wake`` would not do, since it wakes the executor's
