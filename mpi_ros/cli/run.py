@@ -101,7 +101,6 @@ def report_crashes(stream) -> bool:
 def run(args) -> int:
     # The name the user started: `mpi-ros run`, `mpi-ros record` or `mpi_ros suite` (ros2 run, launch).
     prog = getattr(args, "_prog", "mpi-ros run")
-    report_crashes(sys.stderr)
     if args.time_scale < 0:
         print(f"{prog}: --time-scale must be >= 0", file=sys.stderr)
         return 2
@@ -121,6 +120,7 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         return 2
     os.environ[RANGE_VARIABLE] = reach
+    report_crashes(sys.stderr)  # from here on C code runs: the middleware's
 
     import rclpy
     from rclpy.signals import SignalHandlerOptions
