@@ -121,15 +121,14 @@ class Suite:
             node.shutdown()
         self.runner.stop()
         self.goal_loop.stop(timeout)
-        stopped = {spinner.executor for spinner in self.spinners if spinner.stop(timeout)}
-        spun = {spinner.executor for spinner in self.spinners}
+        stuck = {spinner.executor for spinner in self.spinners if not spinner.stop(timeout)}
         for node, executor in zip(self.nodes, self.executors, strict=True):
-            if executor in spun and executor not in stopped:
+            if executor in stuck:
                 node.get_logger().error(f"its executor did not stop within {timeout:g} s: the node is not destroyed")
                 continue
             executor.shutdown(timeout_sec=timeout)
             node.destroy_node()
-        return len(stopped) == len(spun)
+        return not stuck
 
 
 def _executor(node, threads: int, context: Context | None) -> MultiThreadedExecutor:
