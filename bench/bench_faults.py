@@ -31,7 +31,7 @@ case, watched = json.loads(sys.argv[3]), sys.argv[4] == "1"
 if watched:
     make = b._controller
     def _controller(axes, supervisors):
-        from mpi_ros.mpi.params import AxisFaultConfig
+        from mpi_ros.mpi.base.params import AxisFaultConfig
         ctl = make(axes, supervisors)
         for n in range(axes):
             assert ctl.axis_fault_config_set(n, AxisFaultConfig(

@@ -24,8 +24,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState  # noqa: E402
-from mpi_ros.mpi.planner import AxisStart, compile_move  # noqa: E402
-from mpi_ros.mpi.types import MotionAttr  # noqa: E402
+from mpi_ros.mpi.base.types import MotionAttr  # noqa: E402
+from mpi_ros.mpi.planning.planner import compile_move  # noqa: E402
+from mpi_ros.mpi.planning.start import AxisStart  # noqa: E402
 
 POINTS = 1000
 KINDS = (MPIMotionType.PT, MPIMotionType.PVT, MPIMotionType.SPLINE, MPIMotionType.BESSEL, MPIMotionType.BSPLINE,

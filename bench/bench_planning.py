@@ -48,9 +48,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from mpi_ros.crosscheck import check_plan  # noqa: E402
 from mpi_ros.crosscheck.result import RuckigLimits  # noqa: E402
-from mpi_ros.mpi.params import MotionParams, Trajectory  # noqa: E402
-from mpi_ros.mpi.planner import AxisStart, compile_move  # noqa: E402
-from mpi_ros.mpi.types import MotionAttr, MPIMotionType  # noqa: E402
+from mpi_ros.mpi.base.params import MotionParams, Trajectory  # noqa: E402
+from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType  # noqa: E402
+from mpi_ros.mpi.planning.planner import compile_move  # noqa: E402
+from mpi_ros.mpi.planning.start import AxisStart  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 SAMPLE_RATE = 2000.0

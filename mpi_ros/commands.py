@@ -10,7 +10,7 @@ params.MAX_REQUEST_TEXT characters is refused (MPIMessagePARAM_INVALID, "request
 large: ...") before any of it is read, and recorded compacted (:meth:`Command.to_json`),
 so input refused for its size costs a bounded time and leaves nothing large behind.
 
-Errors: a request that cannot be read (:class:`mpi_ros.mpi.outcome.Refused`) is the
+Errors: a request that cannot be read (:class:`mpi_ros.mpi.base.outcome.Refused`) is the
 user's and answers its message (MPIMessagePARAM_INVALID unless named). Any other
 exception is a bug of this package, not of the request: it is logged with its traceback
 and answered with :data:`INTERNAL_ERROR`, so it never passes for the user's fault, and
@@ -25,13 +25,14 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import CarriesOutcome, Outcome, Refused
+from mpi_ros.mpi.base.params import check_position, check_settling_reachable, first_refusal, shown
+from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
+from mpi_ros.mpi.control import Controller
+
 from . import requests as rq
-from .mpi.control import Controller
-from .mpi.events import MPIEventType
-from .mpi.messages import Message
-from .mpi.outcome import CarriesOutcome, Outcome, Refused
-from .mpi.params import check_position, check_settling_reachable, first_refusal, shown
-from .mpi.types import ActionSource, IoSpace, MPIAction, MPIState
 
 MOTION_START = "motion_start"
 MOTION_MODIFY = "motion_modify"

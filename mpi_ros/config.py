@@ -2,7 +2,7 @@
 
 Validated when loaded: every error names its key (``supervisors[1].axes[0]: axis 7
 does not exist (4 axes)``) so a wrong file never starts a half-configured suite. The
-ranges are the structs' own validators (mpi_ros/mpi/params.py), the ones the controller
+ranges are the structs' own validators (mpi_ros/mpi/base/params.py), the ones the controller
 and the services use, and building the controller checks every call's answer: a value
 the controller refuses stops the suite with its key named, it is never dropped. The
 same configuration builds the controller for the ROS suite, the CLI tools and replay.
@@ -20,11 +20,11 @@ from typing import Any
 
 import yaml
 
-from .mpi.control import Controller
-from .mpi.events import MPIEventType
-from .mpi.messages import Message
-from .mpi.outcome import VALID, Outcome
-from .mpi.params import (
+from mpi_ros.mpi.axes.plant import Plant
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import VALID, Outcome
+from mpi_ros.mpi.base.params import (
     MAX_COORD_AXES,
     MAX_OBJECTS,
     AxisFaultConfig,
@@ -39,8 +39,8 @@ from .mpi.params import (
     check_settling_reachable,
     first_refusal,
 )
-from .mpi.plant import Plant
-from .mpi.types import AxisMasterType, MPIAction
+from mpi_ros.mpi.base.types import AxisMasterType, MPIAction
+from mpi_ros.mpi.control import Controller
 
 
 def default_config_path() -> Path:

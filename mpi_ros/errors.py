@@ -2,7 +2,7 @@
 
 ``mpi_ros.errors.MPIMotionMessageMOVING`` is raised when a start is refused because the
 supervisor is moving, and so on for every message the controller can answer
-(``mpi_ros.mpi.messages.Message``; a test keeps the two lists equal, names and codes).
+(``mpi_ros.mpi.base.messages.Message``; a test keeps the two lists equal, names and codes).
 All derive from :class:`MpiError` (``.message`` the spec's name, ``.code`` its number,
 ``.detail`` the controller's words, ``.result`` the reply or result that carried it); the
 six refusals for the supervisor's state also derive from :class:`StateError`.

@@ -7,7 +7,7 @@ prefix (type "S_CURVE", attribute "APPEND", hold type "GATE", event "MOTION_DONE
 Parsing only checks that a request can be read (a mapping where one is expected, a
 number where a number is): anything else raises :class:`Refused`, the only error
 the command layer answers as the user's (MPIMessagePARAM_INVALID unless named). Ranges
-are the structs' validators' business (mpi_ros/mpi/params.py), run by the controller.
+are the structs' validators' business (mpi_ros/mpi/base/params.py), run by the controller.
 
 Size: before any of it is read, a request must be small enough (:func:`check_size`: at
 most params.MAX_REQUEST_VALUES array elements and params.MAX_REQUEST_TEXT characters of
@@ -24,10 +24,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
-from .mpi.events import MPIEventType
-from .mpi.messages import Message
-from .mpi.outcome import Refused
-from .mpi.params import (
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import Refused
+from mpi_ros.mpi.base.params import (
     MAX_REQUEST_TEXT,
     MAX_REQUEST_VALUES,
     AxisFaultConfig,
@@ -43,7 +43,7 @@ from .mpi.params import (
     UserFrame,
     shown,
 )
-from .mpi.types import AxisMasterType, HoldType, MotionAttr, MPIMotionType, OutputType
+from mpi_ros.mpi.base.types import AxisMasterType, HoldType, MotionAttr, MPIMotionType, OutputType
 
 
 @dataclass(frozen=True, slots=True)

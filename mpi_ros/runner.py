@@ -24,9 +24,10 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from mpi_ros.mpi.base.events import Event
+from mpi_ros.mpi.control import Controller
+
 from .commands import Command, Reply, apply
-from .mpi.control import Controller
-from .mpi.events import Event
 
 _log = logging.getLogger("mpi_ros.runner")
 FAST_BATCH = 2000  # samples per batch when running as fast as possible

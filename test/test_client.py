@@ -31,9 +31,9 @@ from mpi_ros.client import (
     message_class,
     message_to_dict,
 )
-from mpi_ros.mpi.events import MPIEventType
-from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.types import MPIState
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.types import MPIState
 
 
 def test_one_exception_class_per_message_with_the_same_name_and_code():

@@ -11,8 +11,8 @@ import pytest
 
 from mpi_ros import config
 from mpi_ros.commands import INTERNAL_ERROR, Command, apply
-from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.types import MPIState
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.types import MPIState
 
 GOAL = {"type": "TRAPEZOIDAL", "position": [100.0, 0.0],
         "trajectory": [{"velocity": 1000.0, "acceleration": 10000.0, "deceleration": 10000.0}]}

@@ -8,7 +8,7 @@ import pytest
 
 from mpi_ros import config, requests
 from mpi_ros.commands import Command, apply
-from mpi_ros.mpi.types import MPIState
+from mpi_ros.mpi.base.types import MPIState
 
 
 def test_default_config_builds_the_documented_controller():

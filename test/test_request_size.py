@@ -12,10 +12,10 @@ import pytest
 from mpi_ros import config
 from mpi_ros import requests as rq
 from mpi_ros.commands import Command, apply
-from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.params import MAX_REQUEST_TEXT, MAX_REQUEST_VALUES, shown
-from mpi_ros.mpi.types import MPIState
-from mpi_ros.mpi.validate import MAX_PATH_VALUES
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.params import MAX_REQUEST_TEXT, MAX_REQUEST_VALUES, shown
+from mpi_ros.mpi.base.types import MPIState
+from mpi_ros.mpi.planning.validate import MAX_PATH_VALUES
 
 PARAM = Message.MPIMessagePARAM_INVALID
 TOO_LARGE = "request too large"

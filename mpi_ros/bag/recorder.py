@@ -22,12 +22,13 @@ from pathlib import Path
 
 import yaml
 
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.control import Controller
+
 from .. import __version__
 from ..commands import Command as ControllerCommand
 from ..commands import Reply
 from ..config import SuiteConfig
-from ..mpi.control import Controller
-from ..mpi.events import MPIEventType
 from ..ros import convert
 from ..runner import ControllerRunner, Output
 from .writer import BagWriter, TopicQos

@@ -1,6 +1,6 @@
 """Cross-check one axis' plan (or a 1-D request) against ruckig.
 
-:func:`check_plan` takes an :class:`~mpi_ros.mpi.frames.AxisPlan` as the controller compiled
+:func:`check_plan` takes an :class:`~mpi_ros.mpi.planning.frames.AxisPlan` as the controller compiled
 it (its ``limits`` are the Trajectory the axis' profile was planned with: for a vector move
 the vector's limits scaled by the axis' share) and answers a
 :class:`~mpi_ros.crosscheck.result.CrossCheck`:
@@ -27,9 +27,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from ..mpi.frames import AxisPlan
-from ..mpi.profiles.segment import Segment
-from ..mpi.types import MPIMotionType
+from mpi_ros.mpi.base.types import MPIMotionType
+from mpi_ros.mpi.planning.frames import AxisPlan
+from mpi_ros.mpi.planning.profiles.segment import Segment
+
 from .limits import check_profile, strip_waits
 from .mapping import INF, Mapping, map_point_to_point, map_velocity, peak_acceleration
 from .request import ProfileRequest

@@ -26,7 +26,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ..mpi.profiles.segment import Segment
+from mpi_ros.mpi.planning.profiles.segment import Segment
+
 from .mapping import peak_acceleration, ramp_jerk, reverses
 from .result import LIMIT_RTOL, TIME_RESOLUTION, StateDifference
 

@@ -22,9 +22,10 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from ..mpi.control import Controller
-from ..mpi.events import MPIEventType
-from ..mpi.frames import Move
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.control import Controller
+from mpi_ros.mpi.planning.frames import Move
+
 from .check import check_plan
 from .request import SUPPORTED_TYPES
 from .result import CrossCheck, Verdict

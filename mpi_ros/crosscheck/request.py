@@ -21,12 +21,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
-from ..mpi import validate
-from ..mpi.frames import AxisPlan
-from ..mpi.outcome import Refused
-from ..mpi.params import MotionParams, Trajectory
-from ..mpi.planner import AxisStart, compile_move
-from ..mpi.types import MotionAttr, MPIMotionType
+from mpi_ros.mpi.base.outcome import Refused
+from mpi_ros.mpi.base.params import MotionParams, Trajectory
+from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
+from mpi_ros.mpi.planning import validate
+from mpi_ros.mpi.planning.frames import AxisPlan
+from mpi_ros.mpi.planning.planner import compile_move
+from mpi_ros.mpi.planning.start import AxisStart
 
 SUPPORTED_TYPES = (MPIMotionType.TRAPEZOIDAL, MPIMotionType.S_CURVE, MPIMotionType.VELOCITY)
 _ALIASES = {"jerk": "jerk_percent", "jerkpercent": "jerk_percent", "v0": "start_velocity",

@@ -17,7 +17,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..mpi.profiles.segment import Segment, SegmentTable
+from mpi_ros.mpi.planning.profiles.segment import Segment, SegmentTable
+
 from .result import StateDifference
 
 MERGE_RTOL = 1e-9

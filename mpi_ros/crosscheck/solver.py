@@ -13,7 +13,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..mpi.profiles.segment import Segment
+from mpi_ros.mpi.planning.profiles.segment import Segment
+
 from .result import RuckigLimits
 
 

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..mpi.types import MPIMotionType
+from mpi_ros.mpi.base.types import MPIMotionType
+
 from .check import check_request
 from .request import ProfileRequest, RequestInvalid
 from .result import CrossCheck, Reason, StateDifference, Verdict

@@ -18,31 +18,10 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from . import stretch as stretches
-from .axis import Axis
-from .bank import AxisBank
-from .clock import ProfileClock
-from .events import Event, MPIEventType
-from .faults import FaultMonitor
-from .io import IoImage
-from .masters import SecondaryInputs, Sources
-from .messages import STATE_MESSAGES, Message
-from .motion import MotionSupervisor
-from .move_log import MoveLog
-from .outcome import MoveEnd, Outcome
-from .params import (
-    AxisFaultConfig,
-    AxisInPosition,
-    AxisMaster,
-    ControllerConfig,
-    MotionConfig,
-    PlantConfig,
-    SecondaryFeedback,
-    check_position,
-    check_settling_reachable,
-)
-from .snapshot import AxisSnapshot, MotionFeedback, MotionSnapshot
-from .status import (
+from mpi_ros.mpi.axes.axis import Axis
+from mpi_ros.mpi.axes.bank import AxisBank
+from mpi_ros.mpi.axes.scratch import Scratch
+from mpi_ros.mpi.axes.status import (
     AT_TARGET,
     AT_VELOCITY,
     BITS,
@@ -56,9 +35,31 @@ from .status import (
     compute,
     rising_edges,
 )
-from .stretch import Stretch
-from .types import ActionSource, IoSpace, MPIAction, MPIState
-from .wrap import wrap_position, wrap_positions
+from mpi_ros.mpi.axes.stretch import Stretch
+from mpi_ros.mpi.axes.trace import trace
+from mpi_ros.mpi.base.clock import ProfileClock
+from mpi_ros.mpi.base.events import Event, MPIEventType
+from mpi_ros.mpi.base.io import IoImage
+from mpi_ros.mpi.base.masters import SecondaryInputs, Sources
+from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
+from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
+from mpi_ros.mpi.base.params import (
+    AxisFaultConfig,
+    AxisInPosition,
+    AxisMaster,
+    ControllerConfig,
+    MotionConfig,
+    PlantConfig,
+    SecondaryFeedback,
+    check_position,
+    check_settling_reachable,
+)
+from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionFeedback, MotionSnapshot
+from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
+from mpi_ros.mpi.base.wrap import wrap_position, wrap_positions
+from mpi_ros.mpi.faults.monitor import FaultMonitor
+from mpi_ros.mpi.move_log import MoveLog
+from mpi_ros.mpi.supervisor.motion import MotionSupervisor
 
 MAX_STRETCH = 4096  # samples computed at once
 EVENTS_KEPT = 10_000  # events Controller.events keeps for a caller that drains them
@@ -90,7 +91,7 @@ class Controller:
         self.rate = float(self.config.sample_rate)
         self.sample = 0
         self.bank = AxisBank(self.config.axis_count, self.config.supervisor_count)
-        self._scratch = stretches.Scratch()  # the arrays of a stretch, reused by the next one
+        self._scratch = Scratch()  # the arrays of a stretch, reused by the next one
         self.axes = [
             Axis(n, self.bank, self.rate, in_position or AxisInPosition(), plant or PlantConfig())
             for n in range(self.config.axis_count)
@@ -532,7 +533,7 @@ class Controller:
         k0 = self.sample
         self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])),
                           lambda row: self.axes[row].reanchor(self._clock(self.axes[row])))
-        stretch = stretches.trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch,
+        stretch = trace(self.bank, self.axes, self._clock, k0, k1, self.rate, self._scratch,
                                   self._cam_inputs)
         status = compute(stretch, self.bank.status, self.bank.runs, self._scratch)
         stop = len(stretch) - 1

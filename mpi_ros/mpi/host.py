@@ -1,7 +1,7 @@
 """What a motion supervisor (and the fault monitor) needs of its controller, and nothing more.
 
-A supervisor and its collaborators (axis_list.py, moves.py, supervisor_actions.py,
-supervisor_stepping.py) are given a :class:`SupervisorHost`, never the Controller itself:
+A supervisor and its collaborators (supervisor/: axis_list.py, moves.py, actions.py,
+stepping.py) are given a :class:`SupervisorHost`, never the Controller itself:
 the controller's time, its axes and I/O, its events and move outcomes, and the answers
 that concern other supervisors (who commands an axis, in what state, on what clock).
 Questions across supervisors are the controller's to answer; a supervisor does not reach
@@ -14,16 +14,15 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
-    from .axis import Axis
-    from .clock import ProfileClock
-    from .events import MPIEventType
-    from .faults import FaultMonitor
-    from .io import IoImage
-    from .masters import Sources
-    from .outcome import MoveEnd, Outcome
-    from .params import ControllerConfig
-    from .snapshot import AxisSnapshot
-    from .types import ActionSource, MPIAction, MPIState
+    from mpi_ros.mpi.axes.axis import Axis
+    from mpi_ros.mpi.base.clock import ProfileClock
+    from mpi_ros.mpi.base.events import MPIEventType
+    from mpi_ros.mpi.base.io import IoImage
+    from mpi_ros.mpi.base.masters import Sources
+    from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
+    from mpi_ros.mpi.base.params import ControllerConfig
+    from mpi_ros.mpi.base.snapshot import AxisSnapshot
+    from mpi_ros.mpi.base.types import ActionSource, MPIAction, MPIState
 
 
 class ControllerView(Protocol):
@@ -46,13 +45,24 @@ class ControllerView(Protocol):
     def act_on(self, supervisor: int, action: MPIAction, source: ActionSource) -> Outcome: ...
 
 
+class SupervisorFaults(Protocol):
+    """What a supervisor asks of the fault monitor (faults/monitor.py's FaultMonitor): RESET
+    reads and clears the latched faults of its axes, an open path reports an empty buffer."""
+
+    def latched_on(self, numbers: list[int]) -> bool: ...
+    def persisting(self, numbers: list[int]) -> list[str]: ...
+    def clear(self, numbers: list[int]) -> set[int]: ...
+    def watches_underflow(self, numbers: Sequence[int]) -> bool: ...
+    def underflow(self, numbers: Sequence[int]) -> None: ...
+
+
 class SupervisorHost(ControllerView, Protocol):
     """The controller as a supervisor sees it (Controller implements it)."""
 
     @property
     def io(self) -> IoImage: ...
     @property
-    def faults(self) -> FaultMonitor: ...
+    def faults(self) -> SupervisorFaults: ...
     @property
     def sample(self) -> int: ...
 
@@ -69,6 +79,6 @@ class SupervisorHost(ControllerView, Protocol):
 
 
 class FaultHost(ControllerView, Protocol):
-    """The controller as its fault monitor (faults.py) sees it (Controller implements it)."""
+    """The controller as its fault monitor (faults/monitor.py) sees it (Controller implements it)."""
 
     def responsible_for(self, axis: int) -> list[int]: ...

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections import OrderedDict, deque
 
-from .outcome import MoveEnd
+from mpi_ros.mpi.base.outcome import MoveEnd
 
 # What is kept is bounded, so that a suite that runs for days holds no more than one that ran a
 # minute. Goals read their ends at the review after every step batch and every command

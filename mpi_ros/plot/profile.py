@@ -16,14 +16,15 @@ from pathlib import Path
 
 import numpy as np
 
+from mpi_ros.mpi.base.types import MPIMotionType
+from mpi_ros.mpi.planning.profiles.segment import Segment
+
 from ..crosscheck.check import check_plan
 from ..crosscheck.limits import strip_waits
 from ..crosscheck.mapping import peak_acceleration
 from ..crosscheck.request import ProfileRequest
 from ..crosscheck.result import CrossCheck
 from ..crosscheck.solver import RuckigFailed, solve
-from ..mpi.profiles.segment import Segment
-from ..mpi.types import MPIMotionType
 
 POINTS_PER_SEGMENT = 60
 

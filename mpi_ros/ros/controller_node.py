@@ -30,6 +30,9 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import Refused
+from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.msg import AxisStatus, MotionEvent, SuiteConfiguration
 from mpi_ros.msg import Command as CommandMsg
 from mpi_ros.srv import (
@@ -49,9 +52,6 @@ from mpi_ros.srv import (
 from .. import requests as rq
 from ..commands import Command, Reply, io_space
 from ..config import RosSettings
-from ..mpi.messages import Message
-from ..mpi.outcome import Refused
-from ..mpi.types import MPIState
 from ..runner import ControllerRunner
 from . import convert, snapshots, wire
 from .supervisor_node import STATUS_QOS

@@ -26,11 +26,10 @@ from builtin_interfaces.msg import Time
 from rclpy._rclpy_pybind11 import RCLError
 from sensor_msgs.msg import JointState
 
+from mpi_ros.mpi.base.events import Event
+from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 from mpi_ros.msg import Command as CommandMsg
-
-from ..mpi.events import Event
-from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 
 
 def to_dict(msg) -> dict[str, Any]:

@@ -15,8 +15,8 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from ..mpi.control import Controller
-from ..mpi.outcome import MoveEnd
+from mpi_ros.mpi.base.outcome import MoveEnd
+from mpi_ros.mpi.control import Controller
 
 
 @dataclass(eq=False, slots=True)

@@ -19,8 +19,9 @@ from __future__ import annotations
 
 import weakref
 
-from ..mpi.control import Controller
-from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
+from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
+from mpi_ros.mpi.control import Controller
+
 from ..runner import ControllerRunner
 
 _SHARED: weakref.WeakKeyDictionary[ControllerRunner, SampleSnapshots] = weakref.WeakKeyDictionary()

@@ -31,6 +31,10 @@ from rclpy.serialization import serialize_message
 from std_srvs.srv import Trigger
 
 from mpi_ros.action import MotionModify, MotionStart
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
+from mpi_ros.mpi.base.snapshot import MotionFeedback
+from mpi_ros.mpi.control import Controller
 from mpi_ros.msg import FrameBufferStatus as FrameBufferStatusMsg
 from mpi_ros.msg import MotionParams as MotionParamsMsg
 from mpi_ros.msg import MotionStatus
@@ -54,10 +58,6 @@ from mpi_ros.srv import (
 from .. import requests as rq
 from ..commands import ACTION, CLIENT_LOST, MOTION_MODIFY, MOTION_START, Command, Reply
 from ..config import RosSettings
-from ..mpi.control import Controller
-from ..mpi.messages import Message
-from ..mpi.outcome import MoveEnd, Outcome
-from ..mpi.snapshot import MotionFeedback
 from ..runner import ControllerRunner, Output
 from . import convert, snapshots, wire
 from .goal_endpoints import ACTION_SERVICE_QOS

@@ -33,9 +33,9 @@ from typing import Any
 
 from sensor_msgs.msg import JointState
 
+from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.msg import AxisStatus, MotionStatus
 
-from ..mpi.snapshot import AxisSnapshot, MotionSnapshot
 from . import convert
 
 HEADER = b"\x00\x01\x00\x00"  # CDR, little endian, no options

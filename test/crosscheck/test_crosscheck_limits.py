@@ -10,12 +10,13 @@ from dataclasses import replace
 import pytest
 
 from mpi_ros.crosscheck import ProfileRequest, Reason, Verdict, check_plan
-from mpi_ros.mpi.frames import AxisPlan
-from mpi_ros.mpi.params import MotionParams, Trajectory
-from mpi_ros.mpi.planner import AxisStart, compile_move
-from mpi_ros.mpi.profiles.point_to_point import point_to_point
-from mpi_ros.mpi.profiles.segment import Segment
-from mpi_ros.mpi.types import MotionAttr, MPIMotionType
+from mpi_ros.mpi.base.params import MotionParams, Trajectory
+from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
+from mpi_ros.mpi.planning.frames import AxisPlan
+from mpi_ros.mpi.planning.planner import compile_move
+from mpi_ros.mpi.planning.profiles.point_to_point import point_to_point
+from mpi_ros.mpi.planning.profiles.segment import Segment
+from mpi_ros.mpi.planning.start import AxisStart
 
 S = MPIMotionType.S_CURVE
 LIMITS = Trajectory(500.0, 5000.0, 5000.0, 50.0)

@@ -22,7 +22,7 @@ from mpi_ros.crosscheck.mapping import (
 from mpi_ros.crosscheck.result import RuckigLimits
 from mpi_ros.crosscheck.sampling import sample
 from mpi_ros.crosscheck.solver import RuckigFailed, solve
-from mpi_ros.mpi.types import MPIMotionType
+from mpi_ros.mpi.base.types import MPIMotionType
 
 
 def test_peak_acceleration_is_100_133_200_percent():

@@ -11,8 +11,8 @@ from mpi_ros.commands import Command
 from mpi_ros.crosscheck import Verdict
 from mpi_ros.crosscheck import monitor as monitor_module
 from mpi_ros.crosscheck.monitor import CrosscheckMonitor
-from mpi_ros.mpi import motion as motion_module
-from mpi_ros.mpi.events import MPIEventType
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.supervisor import motion as motion_module
 from mpi_ros.runner import ControllerRunner
 
 

@@ -17,7 +17,7 @@ from mpi_ros.mpi import (
     MPIState,
     Trajectory,
 )
-from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.base.messages import Message
 
 T = MPIMotionType
 M = Message

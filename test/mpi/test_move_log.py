@@ -4,9 +4,9 @@ follows a move is over (Controller.move_ends)."""
 from __future__ import annotations
 
 from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState, Trajectory
-from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
 from mpi_ros.mpi.move_log import ENDS_PER_MOVE, MoveLog
-from mpi_ros.mpi.outcome import MoveEnd, Outcome
 
 OK = Outcome(Message.MPIMessageOK, "motion done")
 

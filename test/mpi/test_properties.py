@@ -33,7 +33,7 @@ from mpi_ros.mpi import (
     MPIState,
     Trajectory,
 )
-from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.base.messages import Message
 
 T = MPIMotionType
 RATE = 2000.0

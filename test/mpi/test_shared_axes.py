@@ -12,10 +12,10 @@ import math
 import pytest
 
 from mpi_ros.mpi import Controller, MotionAttr, MPIAction, MPIMotionType, MPIState
-from mpi_ros.mpi.messages import Message
+from mpi_ros.mpi.base.messages import Message
 
 from .conftest import LONG_MOVE, drive_to, make_params, run_to_state, sharing_axis_1
-from .test_state_machine import CELLS, command, observe
+from .supervisor.test_state_machine import CELLS, command, observe
 
 S = MPIState
 T = MPIMotionType

@@ -48,8 +48,8 @@ HOSTILE_NAMES = ("", " ", "BOGUS", "NONE", "INVALID", "\u00e9\u00e8", "S_CURVE\x
 
 
 def _motion_names():
-    from mpi_ros.mpi.events import MPIEventType
-    from mpi_ros.mpi.types import HoldType, MotionAttr, MPIAction, MPIMotionType, OutputType
+    from mpi_ros.mpi.base.events import MPIEventType
+    from mpi_ros.mpi.base.types import HoldType, MotionAttr, MPIAction, MPIMotionType, OutputType
 
     return {
         "type": [m.name for m in MPIMotionType],
@@ -458,7 +458,7 @@ SERVICE_TYPES: dict[str, type] = _LazyTypes()
 
 
 def _short(value: Any, limit: int = 60) -> str:
-    from mpi_ros.mpi.params import shown
+    from mpi_ros.mpi.base.params import shown
 
     text = shown(value)
     return text if len(text) <= limit else text[:limit - 3] + "..."
@@ -728,7 +728,7 @@ class Harness:
 
     def _check_message(self, message: str, code, label: str) -> None:
         from mpi_ros.commands import INTERNAL_ERROR
-        from mpi_ros.mpi.messages import Message
+        from mpi_ros.mpi.base.messages import Message
 
         known = Message.__members__.get(message)
         if known is None:

@@ -13,7 +13,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from std_srvs.srv import Trigger
 
 from mpi_ros.bag import cdr
-from mpi_ros.mpi.types import MPIState
+from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.msg import AxisStatus, MotionEvent
 from mpi_ros.ros import convert, wire
 from mpi_ros.srv import AxisFaultConfigGet, AxisFaultConfigSet, AxisFaultInject, MotionAction

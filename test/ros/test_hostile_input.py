@@ -73,8 +73,8 @@ def _expected(request: Request, firmware_option_21: bool) -> str | None:
     """What MPI 000 mpiMotionStart answers first for the request's type and attribute, from
     IDLE (check_type, then the ATTRIBUTE_INVALID lists); None when both pass."""
     from mpi_ros import requests as rq
-    from mpi_ros.mpi import validate
-    from mpi_ros.mpi.types import MotionAttr
+    from mpi_ros.mpi.base.types import MotionAttr
+    from mpi_ros.mpi.planning import validate
     from mpi_ros.ros import convert
 
     parsed = rq.motion_request(convert.to_dict(request.message))

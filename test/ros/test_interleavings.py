@@ -108,7 +108,7 @@ def _clients(tmp_path) -> list[tuple[subprocess.Popen, Path]]:
 
 def test_random_interleavings_from_several_clients_on_shared_axes(shared_suite, probe, tmp_path):
     from mpi_ros.client import MotionClient
-    from mpi_ros.mpi.messages import Message
+    from mpi_ros.mpi.base.messages import Message
 
     process, log = shared_suite
     with MotionClient(0, context=probe.context, timeout=WAIT, node_name="interleavings_check") as ms0:

@@ -94,7 +94,7 @@ def test_stamps_of_every_topic_are_the_wall_anchored_controller_time(suite, prob
 
 
 def test_joint_effort_is_the_servo_loop_output():
-    """effort = w^2 (u - y) + 2 zeta w (kv u' - y') + ka u'' (counts/s^2, mpi_ros/mpi/plant.py):
+    """effort = w^2 (u - y) + 2 zeta w (kv u' - y') + ka u'' (counts/s^2, mpi_ros/mpi/axes/plant.py):
     on a steady ramp the loop tracks, so it equals the commanded acceleration; at constant
     velocity and at rest it is 0; with the amplifier off (ABORT) it is 0."""
     from mpi_ros import config

@@ -13,8 +13,8 @@ from hypothesis import strategies as st
 
 from mpi_ros import config
 from mpi_ros.commands import Command, apply
-from mpi_ros.mpi.messages import Message
-from mpi_ros.mpi.types import MPIState
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.types import MPIState
 
 TYPES = ["S_CURVE", "TRAPEZOIDAL", "VELOCITY", "S_CURVE_JERK", "VELOCITY_JERK", "PT", "PVT", "SPLINE", "FRAME",
          "CAM_LINEAR", "BOGUS", "", "s_curve"]

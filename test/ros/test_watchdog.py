@@ -17,7 +17,7 @@ import pytest
 
 from mpi_ros import config
 from mpi_ros.commands import CLIENT_LOST, Command, apply
-from mpi_ros.mpi.types import MPIState
+from mpi_ros.mpi.base.types import MPIState
 
 from .conftest import WAIT
 

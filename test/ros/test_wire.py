@@ -14,7 +14,7 @@ from rclpy.serialization import deserialize_message
 from mpi_ros import config
 from mpi_ros.bag import cdr
 from mpi_ros.mpi import MotionAttr, MotionParams, MPIAction, MPIMotionType, Trajectory
-from mpi_ros.mpi.types import MPIState
+from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.ros import convert, wire
 
 EPOCH = 1_795_000_000_123_456_789

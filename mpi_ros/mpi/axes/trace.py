@@ -1,0 +1,405 @@
+"""Every axis over a stretch of samples at once: (axes, samples) arrays.
+
+The controller computes the samples k0+1 .. k1 of every axis from the rows in its
+AxisBank: an axis at rest repeats its values; an axis whose command piece and plant
+anchor hold over the whole stretch (nearly every axis, nearly always) is one row of
+closed forms evaluated together with the others (its supervisor's feedrate clock, the
+constant-jerk segment, the servo's steady response and transient); the rest (coasting,
+command following the actual, a breakpoint inside the stretch) are traced one axis at a
+time (Axis.trace). Every element is computed by the same operations as the one-axis code
+computes it, or by fewer that give the same bits (each such shortcut says why), so a
+value never depends on which way it was computed, and so never on how the samples were
+batched.
+
+The arrays live in a :class:`Scratch` and are reused by the next stretch.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from mpi_ros.mpi.axes.axis import Axis
+from mpi_ros.mpi.axes.bank import VALUES, AxisBank, ClockColumns, CommandRows, Kind, PlantRows
+from mpi_ros.mpi.axes.scratch import Scratch
+from mpi_ros.mpi.axes.stretch import Stretch
+from mpi_ros.mpi.base.clock import ProfileClock
+
+# A cam slave's inputs over a stretch: its master position and feedrate ratio at each sample,
+# read from the stretch as far as it is traced (controller.py).
+CamInputs = Callable[[Axis, Stretch], tuple[np.ndarray, np.ndarray]]
+
+
+def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileClock | None],
+          k0: int, k1: int, rate: float, scratch: Scratch, cam_inputs: CamInputs | None = None) -> Stretch:
+    """Samples k0+1 .. k1 of every axis, from the bank's (fresh) rows; changes nothing but
+    the cam slaves' progress, kept aside until the controller commits."""
+    samples = np.arange(k0 + 1, k1 + 1, dtype=np.int64)
+    t = samples / rate
+    values = scratch.take("values", (len(VALUES), bank.count, len(samples)))
+    cmd_p, cmd_v, cmd_a, act_p, act_v, rel = values  # bank.VALUES order
+    out = Stretch(samples, t, cmd_p, cmd_v, cmd_a, act_p, act_v, rel, values=values, scratch=scratch)
+    _steady(bank, bank.of_kind(Kind.STEADY), out)
+    rows = bank.of_kind(Kind.PIECE)
+    if len(rows):
+        _command(bank, rows, out)
+        act_p, act_v = _servo(bank.plant, bank.tables, rows, out, direct=True)
+        out.place("act_p", rows, act_p)
+        out.place("act_v", rows, act_v)
+        ending = t[-1] >= bank.plant.piece_end[rows]
+        out.pieces = rows[~ending]
+        if ending.any():
+            _following_pieces(bank, axes, clock_of, rows[ending], out)
+    for row in _sampled_order(bank.of_kind(Kind.SAMPLED).tolist(), axes):
+        axis = axes[row]
+        cam = cam_inputs(axis, out) if cam_inputs is not None and axis.camming else None
+        one = axis.trace(k0, k1, clock_of(axis), cam)
+        out.anchors[row] = one.anchors
+        for name in VALUES:
+            getattr(out, name)[row] = getattr(one, name)
+    return out
+
+
+def _sampled_order(rows: list[int], axes: list[Axis]) -> list[int]:
+    """The axes traced one at a time, in an order in which a cam's slave comes after every
+    axis its master position reads (a start refuses a cam whose masters would form a loop)."""
+    slaves = [row for row in rows if axes[row].camming]
+    if not slaves:
+        return rows
+    ordered = [row for row in rows if not axes[row].camming]
+    waiting = set(slaves)
+    while waiting:
+        ready = sorted(row for row in waiting if not axes[row].cam_reads() & waiting)
+        assert ready, f"cam masters form a loop among axes {sorted(waiting)}"  # refused at the start
+        ordered += ready
+        waiting -= set(ready)
+    return ordered
+
+
+def _steady(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
+    """At rest and settled: the command rests, the encoder reads what it reads now."""
+    if not len(rows):
+        return
+    out.cmd_p[rows] = bank.command.rest[rows, None]
+    out.act_p[rows] = bank.act_p[rows, None]
+    for values in (out.cmd_v, out.cmd_a, out.act_v):
+        values[rows] = 0.0
+    out.rel[rows] = math.nan
+
+
+# -- the command ------------------------------------------------------------------------
+def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
+    """Command of ``rows``: a plan read through the supervisor's clock, or the rest."""
+    planned = bank.command.planned[rows]
+    resting = rows[~planned]
+    if len(resting):
+        out.cmd_p[resting] = bank.command.rest[resting, None]
+        out.cmd_v[resting] = out.cmd_a[resting] = 0.0
+        out.rel[resting] = math.nan
+    if planned.any():
+        _planned(bank, rows[planned], out)
+
+
+def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
+    """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate)."""
+    cmd = bank.command
+    numbers = cmd.clock[rows]  # (the clocks the rows run on: the key, as a modify keeps them)
+    which, clocks = bank.clock_memo(numbers.tobytes(), lambda: _clocks_of(bank, numbers))
+    tau, f, df = clocks.evaluate(out.t, out.scratch)
+    rel = np.take(tau, which, axis=0, out=out.target("rel", rows))
+    rel -= cmd.tau_start[rows, None]
+    lo, hi = rel.min(axis=1), rel.max(axis=1)
+    duration = cmd.duration[rows]
+    # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
+    single = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
+    if single.all():
+        p, dp, ddp = _segment(cmd, rows, rel, lo, hi, out)
+    else:
+        p, dp, ddp = _segments(bank, rows, rel, lo, hi, single, out)
+    f, df = f[which], df[which]
+    out.place("cmd_p", rows, p)
+    out.place("cmd_v", rows, np.multiply(dp, f, out=out.into_if_full("cmd_v", rows, dp, f)))
+    # ddp f f + dp df; dp and ddp are both columns or both full, f and df likewise.
+    acceleration = np.multiply(ddp, f, out=out.into_if_full("cmd_a", rows, ddp, f))
+    acceleration *= f
+    acceleration += dp * df
+    out.place("cmd_a", rows, acceleration)
+    out.place("rel", rows, rel)
+
+
+def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+              single: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_segment` for the rows that stay in one segment; the plan's own evaluation
+    (AxisPlan.evaluate, one row at a time) for those that move on to another inside the stretch."""
+    shape = rel.shape
+    p, dp, ddp = np.empty(shape), np.empty(shape), np.empty(shape)
+    if single.any():
+        p[single], dp[single], ddp[single] = _segment(bank.command, rows[single], rel[single], lo[single],
+                                                      hi[single], None)
+    for i in np.flatnonzero(~single).tolist():
+        p[i], dp[i], ddp[i] = bank.plans[int(rows[i])].evaluate(rel[i])
+    return p, dp, ddp
+
+
+def _clocks_of(bank: AxisBank, numbers: np.ndarray) -> tuple[np.ndarray, ClockColumns]:
+    """Each row's index among the clocks (``numbers``: each row's) its rows run on, and those clocks."""
+    distinct, which = np.unique(numbers, return_inverse=True)
+    return which, bank.clocks.columns(distinct)
+
+
+def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Per row: does the whole stretch (profile times ``lo`` .. ``hi`` in the table) fall in
+    one segment of the plan? A row that moved on to another segment gets it here (one axis
+    at a time, only when that happens)."""
+    cmd = bank.command
+    keep = (lo >= cmd.seg_lo[rows]) & (hi < cmd.seg_hi[rows])
+    for i in np.flatnonzero(~keep).tolist():
+        row = int(rows[i])
+        plan = bank.plans[row]
+        table = plan.table
+        # SegmentTable.index of the two times (bisect_right is its searchsorted on two values,
+        # without numpy's cost per call)
+        first, last = (min(bisect.bisect_right(table.end, x), table.count - 1) for x in (lo[i], hi[i]))
+        if first == last:
+            cmd.set_segment(row, plan, first)
+            keep[i] = True
+    return keep
+
+
+def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+             out: Stretch | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position, d/dtau, d2/dtau2 of each row's plan at profile times ``rel`` (whose extremes
+    are ``lo``, ``hi``): its segment (SegmentTable.evaluate) until the plan's end, the end
+    state from there on (AxisPlan.evaluate). Velocity and acceleration may come back as
+    (rows, 1) columns, constant over the stretch."""
+    duration = cmd.duration[rows]
+    inside = rel if (hi < duration).all() else np.minimum(rel, duration[:, None])
+    linear = _linear(cmd, rows, np.minimum(lo, duration))
+    position = out.into("cmd_p", rows) if out is not None else None
+    if linear.all():
+        pos, vel, acc = _linear_segment(cmd, rows, inside, position)
+    elif not linear.any():
+        pos, vel, acc = _cubic_segment(cmd, rows, inside, position)
+    else:
+        pos, vel, acc = np.empty_like(rel), np.empty_like(rel), np.empty_like(rel)
+        for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
+            pos[group], vel[group], acc[group] = evaluate(cmd, rows[group], inside[group], None)
+    if (hi >= duration).any():
+        duration = duration[:, None]
+        complete = rel >= duration
+        target, final = cmd.target[rows, None], cmd.final_velocity[rows, None]
+        extra = np.maximum(rel - duration, 0.0)
+        pos = np.where(complete, target + final * extra, pos)
+        vel = np.where(complete, final, vel)
+        acc = np.where(complete, 0.0, acc)
+    return pos, vel, acc
+
+
+def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
+    """Rows whose segment has acceleration and jerk +0.0 (CommandRows.linear) and whose
+    stretch starts in it (dt >= +0): SegmentTable.evaluate's sums reduce there to p + dt v'
+    and v', v' = v + 0.0, to the bit (+0 times a finite dt >= +0 is +0, and x + +0 is x but
+    for x = -0.0)."""
+    return cmd.linear[rows] & (lo >= cmd.seg_start[rows])
+
+
+def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+                    into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    velocity = cmd.v[rows, None] + 0.0
+    pos = np.subtract(inside, cmd.seg_start[rows, None], out=into)
+    pos *= velocity
+    pos += cmd.p[rows, None]
+    return pos, velocity, np.zeros_like(velocity)
+
+
+def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+                   into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """SegmentTable.evaluate's sums, operation for operation (x + y and x y commute)."""
+    start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
+    dt = inside - start
+    jerk = dt * j
+    pos = np.divide(jerk, 6.0, out=into)
+    pos += a / 2.0
+    pos *= dt
+    pos += v
+    pos *= dt
+    pos += p
+    vel = jerk / 2.0
+    vel += a
+    vel *= dt
+    vel += v
+    jerk += a
+    return pos, vel, jerk
+
+
+# -- the servo ----------------------------------------------------------------------------
+def _servo(plant: PlantRows, tables: list, rows: np.ndarray, out: Stretch, direct: bool,
+           following: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Actual position and velocity (Plant.response, read) of ``rows`` of ``plant``, at
+    every sample of the stretch; ``direct``: into the stretch's own arrays where it can;
+    ``following``: pieces that start inside the stretch (the samples before a row's anchor
+    come out meaningless, to be left out)."""
+    s = np.subtract(out.t, plant.anchor_t[rows, None], out=out.temporary("s", rows))
+    y, dy = _steady_response(plant, rows, s, out)
+    y, dy = _add_transient(plant, tables, rows, s, y, dy, out, following)
+    return _read(plant.resolution[rows], y, out.into("act_p", rows) if direct else None), dy
+
+
+def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileClock | None],
+                      rows: np.ndarray, out: Stretch) -> None:
+    """Axes whose command piece ends inside the stretch: every following piece, from its
+    plant anchor (advanced from piece to piece by the scalar code), is one more row, all
+    evaluated together, each kept over the samples of its piece."""
+    t = out.t
+    pieces: list[tuple[int, float, float]] = []  # axis, start, end
+    followers = []
+    for row in rows.tolist():
+        axis = axes[row]
+        out.anchors[row] = [axis.state]
+        for anchor, start, end, forced in axis.continuations(float(t[-1]), clock_of(axis)):
+            followers.append((anchor, end, forced, axis.plant, axis.rate))
+            pieces.append((row, start, end))
+            out.anchors[row].append(anchor)
+    rows_of = PlantRows.of_pieces(followers, bank.table_index)
+    act_p, act_v = _servo(rows_of, bank.tables, np.arange(len(pieces)), out, direct=False, following=True)
+    shape = (len(pieces), len(t))
+    act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
+    spans = np.searchsorted(t, [(start, end) for _, start, end in pieces], side="left").tolist()
+    for i, ((row, _, _), (first, last)) in enumerate(zip(pieces, spans, strict=True)):
+        out.act_p[row, first:last] = act_p[i, first:last]
+        out.act_v[row, first:last] = act_v[i, first:last]
+
+
+def _steady_response(plant: PlantRows, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
+    """The steady response's polynomials, rows of the same length at once (a constant one
+    as a column)."""
+    terms = plant.terms[rows]
+    if (terms == terms[0]).all():
+        return _steady_group(plant, rows, s, int(terms[0]), out.temporary("y", rows))
+    y, dy = np.empty_like(s), np.empty_like(s)
+    for count in np.unique(terms).tolist():
+        group = np.flatnonzero(terms == count)
+        y[group], dy[group] = _steady_group(plant, rows[group], s[group], count, None)
+    return y, dy
+
+
+def _steady_group(plant: PlantRows, rows: np.ndarray, s: np.ndarray, terms: int,
+                  into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    return (_horner(plant.steady_y[rows, :terms], s, into),
+            _horner(plant.steady_dy[rows, :max(1, terms - 1)], s, None))
+
+
+def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) -> np.ndarray:
+    """plant.poly_eval, one polynomial per row (coefficients low first); a constant stays
+    a column."""
+    count = coefficients.shape[1]
+    if count == 1:
+        return coefficients.copy()
+    out = np.multiply(coefficients[:, -1:], s, out=into)
+    out += coefficients[:, -2, None]
+    for k in range(count - 3, -1, -1):
+        out *= s
+        out += coefficients[:, k, None]
+    return out
+
+
+def _add_transient(plant: PlantRows, tables: list, rows: np.ndarray, s: np.ndarray, y: np.ndarray,
+                   dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Plant.response's transient added to the rows that have one."""
+    if following:
+        live = plant.decayed_after[rows] > -math.inf
+    else:
+        live = _live_transients(plant, rows, int(out.samples[0]), y, dy, out)
+    if not live.any():
+        return y, dy
+    y, dy = _full(y, s.shape, out, "y"), _full(dy, s.shape, out, "dy")
+    sub = slice(None) if live.all() else np.flatnonzero(live)
+    rows, decayed = rows[sub], plant.decayed_after[rows[sub]]
+    p, q = _free(plant, tables, rows, out.samples, out.scratch, following)
+    h0 = np.multiply(p, plant.v0[rows, None], out=out.temporary("h0", rows))
+    h0 += np.multiply(q, plant.m0[rows, None], out=out.temporary("product", rows))
+    h1 = np.multiply(p, plant.v1[rows, None], out=out.temporary("h1", rows))
+    h1 += np.multiply(q, plant.m1[rows, None], out=out.temporary("product", rows))
+    if np.isposinf(decayed).all():
+        y[sub] += h0
+        dy[sub] += h1
+        return y, dy
+    # At rest on a constant command the transient is dropped once it has decayed.
+    settled = s[sub] >= decayed[:, None]
+    y[sub] = np.where(settled, y[sub], y[sub] + h0)
+    dy[sub] = np.where(settled, dy[sub], dy[sub] + h1)
+    return y, dy
+
+
+def _full(values: np.ndarray, shape: tuple[int, int], out: Stretch, name: str) -> np.ndarray:
+    """``values`` (or a column) as a full array of ``shape`` that may be changed in place."""
+    if values.shape == shape:
+        return values
+    full = out.scratch.take("~full." + name, shape)
+    full[...] = values
+    return full
+
+
+def _live_transients(plant: PlantRows, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray,
+                     out: Stretch) -> np.ndarray:
+    """Per row: must its transient be added? Not without one; nor where the free response
+    has underflowed to exact zeros over the whole stretch (a long-settled loop), since
+    adding a zero changes nothing, unless a value is itself a zero (whose sign it might
+    flip): there it is added as ever."""
+    live = plant.decayed_after[rows] > -math.inf
+    if not live.any():
+        return live
+    vanished = live & (first >= plant.vanishing[rows])
+    if vanished.any():
+        vanished &= ~(_has_zero(y, vanished, out) | _has_zero(dy, vanished, out))
+    return live & ~vanished
+
+
+def _has_zero(values: np.ndarray, rows: np.ndarray, out: Stretch) -> np.ndarray:
+    """Per row (False where ``rows`` is not set): does it hold a zero?"""
+    if values.shape[1] == 1:
+        return rows & (values[:, 0] == 0.0)
+    zero = np.equal(values, 0.0, out=out.scratch.take("zero", values.shape, bool))
+    return rows & zero.any(axis=1)
+
+
+def _free(plant: PlantRows, tables: list, rows: np.ndarray, samples: np.ndarray, scratch: Scratch,
+          following: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(p, q) of the free response at every sample of each row, from its loop's table (for
+    ``following`` rows, sample counts before the anchor read as 0)."""
+    which = plant.table[rows]
+    first, n = int(samples[0]), len(samples)
+    if not following and (which == which[0]).all():
+        return tables[int(which[0])].window(first - plant.k0[rows], n, scratch)
+    p, q = np.empty((len(rows), n)), np.empty((len(rows), n))
+    for index in np.unique(which).tolist():
+        group = np.flatnonzero(which == index)
+        if following:
+            p[group], q[group] = tables[index].at(np.maximum(samples - plant.k0[rows[group], None], 0))
+        else:
+            p[group], q[group] = tables[index].window(first - plant.k0[rows[group]], n)
+    return p, q
+
+
+def _read(resolution: np.ndarray, y: np.ndarray, into: np.ndarray | None) -> np.ndarray:
+    """Plant.read, one encoder per row (y/1.0 and x*1.0 are x to the bit: skipped)."""
+    if (resolution == resolution[0]).all():
+        step = float(resolution[0])
+        if step <= 0.0:
+            return y
+        if step == 1.0:
+            out = np.add(y, 0.5, out=into if y.shape[1] > 1 else None)
+            return np.floor(out, out=out)
+        out = np.divide(y, step, out=into if y.shape[1] > 1 else None)
+        out += 0.5
+        np.floor(out, out=out)
+        out *= step
+        return out
+    out = np.broadcast_to(y, (len(resolution), y.shape[1])).copy()
+    counted = np.flatnonzero(resolution > 0.0)
+    steps = resolution[counted, None]
+    out[counted] = np.floor(out[counted] / steps + 0.5) * steps
+    return out

@@ -1,0 +1,78 @@
+"""The one outcome type: how a call, a check, a plan or a move turned out.
+
+Every answer in the project is an :class:`Outcome` (the reference's message and why in words),
+from a field's validator through the planner, the controller and the commands to the ROS
+result: no tuples of (message, detail), no per-layer copies. Where an answer cannot be
+returned (deep in the planner, while a request is read) it is raised as :class:`Refused`,
+which carries one. :class:`MoveEnd` is an outcome of a move with where its axes were.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mpi_ros.mpi.base.messages import Message
+
+
+@dataclass(frozen=True, slots=True)
+class Outcome:
+    """OK, or the reference's message and why (``detail`` names the field first: "field: why")."""
+
+    message: Message
+    detail: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.message is Message.MPIMessageOK
+
+    def prefixed(self, prefix: str) -> Outcome:
+        """The same outcome with ``prefix`` before the field it names (for nested structs)."""
+        return self if self.ok else Outcome(self.message, prefix + self.detail)
+
+
+VALID = Outcome(Message.MPIMessageOK)
+
+
+class CarriesOutcome:
+    """What carries an outcome with more around it (a raised refusal, a move's end, a
+    command's reply) reads its message and detail through to it: ``outcome`` is the one
+    attribute a subclass provides."""
+
+    __slots__ = ()
+    outcome: Outcome
+
+    @property
+    def message(self) -> Message:
+        return self.outcome.message
+
+    @property
+    def detail(self) -> str:
+        return self.outcome.detail
+
+
+class Refused(CarriesOutcome, Exception):
+    """An outcome that is not OK, raised where it cannot be returned (the planner, a request
+    being read); caught where the answer is given."""
+
+    def __init__(self, message: Message, detail: str):
+        super().__init__(detail)
+        self.outcome = Outcome(message, detail)
+
+
+@dataclass(frozen=True, slots=True)
+class MoveEnd(CarriesOutcome):
+    """An outcome of a move at a sample, with the supervisor's axis positions then: how the
+    move ended, or (a VELOCITY move) that it reached its velocity, which is what its goals
+    wait for. A modify keeps the move's serial: an outcome before the modify's sample is not
+    its own."""
+
+    serial: int
+    outcome: Outcome
+    sample: int
+    command_position: tuple[float, ...] = ()
+    actual_position: tuple[float, ...] = ()
+    supervisor: int = -1
+
+    @property
+    def succeeded(self) -> bool:
+        return self.outcome.ok

@@ -1,0 +1,423 @@
+"""Moves as the controller buffers them: per-axis frames, and frame-buffer accounting.
+
+A move compiles, for each axis, into constant-jerk segments in profile time (motion,
+DELAY and SYNC wait frames alike) plus one final frame that holds the end state; a
+HOLD adds one hold frame in front. Those frames occupy the axis' frame buffer
+(128 by default) from the moment the move is loaded until the axis has executed them.
+MPI 000 mpiMotionStart: "Each axis has a 128 frame buffer (FIFO)".
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Self
+
+import numpy as np
+
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.params import Hold, Output, Trajectory
+from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
+from mpi_ros.mpi.planning.profiles.segment import Row, ScaledProfile, Segment, SegmentTable, end_time, segment_from
+
+if TYPE_CHECKING:
+    from mpi_ros.mpi.planning.cam_follow import CamFollow
+
+# A point's time is a sum of its dts in floating point, off the sample grid by rounding: a
+# point counts as reached from the sample within this many seconds of its time (far below
+# one sample at any rate the controller takes).
+POINT_TIME_TOLERANCE = 1e-9
+
+
+def reached(rel):
+    """The profile time up to which points count as reached at profile time ``rel``."""
+    return rel + POINT_TIME_TOLERANCE
+
+
+@dataclass(slots=True)
+class AxisPlan:
+    """One axis' part of a move; times are profile time from the axis' start."""
+
+    axis: int
+    segments: list[Segment]
+    start_position: float
+    target: float  # raw (origin-free) position where the plan ends
+    final_velocity: float = 0.0
+    hold: Hold | None = None
+    outputs: list[Output] = field(default_factory=list)
+    velocity_target: float | None = None  # VELOCITY moves: the commanded velocity
+    ramp_end: float = 0.0  # VELOCITY moves: profile time at which the ramp is done
+    truncated: bool = False  # a frame hit the 16,384,000-sample limit
+    limits: Trajectory | None = None  # the limits this axis' profile was planned with
+    start_velocity: float = 0.0  # velocity (profile time) the profile starts from
+    start_acceleration: float = 0.0
+    composite: str = ""  # why the segments are more than one profile (e.g. stop, then a new line)
+    # Paths (paths.py): profile time of the first segment (executed points are flushed from
+    # a streamed path), the time each point is reached, the element id while running toward
+    # each point, outputs applied at a later point (pointIndex > 0) with their times.
+    origin_time: float = 0.0
+    point_times: np.ndarray | None = None
+    element_ids: tuple[int, ...] = ()
+    timed_outputs: list[tuple[float, Output]] = field(default_factory=list)
+    # PTF/PVTF: the feedforward's knots (profile times, values), linear between them and held
+    # after the last; the first value is NaN until the axis fills in the one it holds (the
+    # feedforward is kept from move to move: MPI 000, MPIMotionPTF).
+    feedforward: tuple[np.ndarray, np.ndarray] | None = None
+    # Cams (cams.py): the slave's table, master and progress; its "profile time" is the
+    # progress along the table (status, progress and frames read it as they read time).
+    cam: CamFollow | None = None
+    duration: float = field(init=False)
+    _table: SegmentTable | None = field(init=False, default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not self.segments:
+            self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
+        self.duration = end_time(self.segments, self.origin_time) if self.cam is None else self.cam.duration
+
+    @classmethod
+    def with_duration(cls, segments: list[Segment] | list[Row] | None, duration: float, axis: int,
+                      start_position: float, target: float, final_velocity: float, hold: Hold | None,
+                      outputs: list[Output], truncated: bool, limits: Trajectory | None, start_velocity: float,
+                      start_acceleration: float, composite: str) -> Self:
+        """A point-to-point plan (not a VELOCITY move, a path or a cam: origin_time 0) whose
+        ``duration``, ``end_time(segments)``, its planner has calculated already (with the
+        segments: scurve.reshaped), as ``cls(...)`` makes it. Its slots are filled here rather than
+        by the dataclass' __init__ and __post_init__, which would add the segments up again, a
+        pass of their own, behind two calls (a modify is planned while its command waits).
+        ``segments`` None: a ScaledAxisPlan's, made when first asked for; Rows: a RowAxisPlan's."""
+        if segments is not None and not segments:  # (as __post_init__: a plan holds at least its end)
+            segments = [Segment(0.0, target, final_velocity, 0.0, 0.0)]
+            duration = end_time(segments)
+        plan = _new_object(cls)
+        _segments_slot.__set__(plan, segments)  # (past ScaledAxisPlan's property)
+        plan.duration = duration
+        plan.axis = axis
+        plan.start_position = start_position
+        plan.target = target
+        plan.final_velocity = final_velocity
+        plan.hold = hold
+        plan.outputs = outputs
+        plan.truncated = truncated
+        _limits_slot.__set__(plan, limits)  # (past ScaledAxisPlan's property)
+        plan.start_velocity = start_velocity
+        plan.start_acceleration = start_acceleration
+        plan.composite = composite
+        # the other fields' defaults (test_planner checks that every field is as cls(...) makes it)
+        plan.velocity_target = None
+        plan.ramp_end = 0.0
+        plan.origin_time = 0.0
+        plan.point_times = None
+        plan.element_ids = ()
+        plan.timed_outputs = []
+        plan.feedforward = None
+        plan.cam = None
+        plan._table = None
+        return plan
+
+    @property
+    def table(self) -> SegmentTable:
+        """The segments as arrays. Built on first use, not with the plan: numpy on a handful of
+        segments costs more than planning them, and a modify is planned while its command waits."""
+        if self._table is None:
+            self._table = SegmentTable(self._rows(), self.origin_time)
+        return self._table
+
+    def _rows(self) -> Sequence[Row]:
+        """The segments' values, as the stepping reads them (by index): the segments themselves,
+        or a RowAxisPlan's Rows before its Segments are made."""
+        return self.segments
+
+    @property
+    def is_velocity(self) -> bool:
+        return self.velocity_target is not None
+
+    @property
+    def frame_count(self) -> int:
+        """Frames this plan loads: its segments, the final frame, and a hold frame."""
+        if self.cam is not None:
+            return self.cam.table.frames  # the whole table stays loaded (a repeat runs it again)
+        return self.segment_count + 1 + (1 if self.hold is not None else 0)
+
+    @property
+    def segment_count(self) -> int:
+        return len(self.segments)
+
+    def frames_left(self, rel: float) -> int:
+        """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
+        if self.cam is not None:
+            return self.frame_count
+        done = int(self.table.end.searchsorted(rel, side="right"))
+        return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
+
+    def points_left(self, rel: float | np.ndarray) -> int | np.ndarray:
+        """Points of a path not reached by profile time ``rel`` (0 for other plans)."""
+        if self.point_times is None:
+            return 0 if np.ndim(rel) == 0 else np.zeros(np.shape(rel), dtype=np.int64)
+        return len(self.point_times) - np.searchsorted(self.point_times, reached(rel), side="right")
+
+    def element_at(self, rel: float) -> int | None:
+        """The element id of the point a path runs toward at ``rel`` (its last one once
+        there); None without per-point ids."""
+        if not self.element_ids or self.point_times is None:
+            return None
+        i = int(np.searchsorted(self.point_times, reached(rel), side="right"))
+        return self.element_ids[min(i, len(self.element_ids) - 1)]
+
+    def start_feedforward(self, held: float) -> None:
+        """The axis loads the plan holding feedforward ``held``: its feedforward starts there."""
+        if self.feedforward is not None and math.isnan(self.feedforward[1][0]):
+            self.feedforward[1][0] = held
+
+    def feedforward_at(self, rel: float, held: float) -> float:
+        """The feedforward at profile time ``rel`` (``held`` before the plan's first point, or
+        without a feedforward of its own)."""
+        if self.feedforward is None:
+            return held
+        times, values = self.feedforward
+        if not math.isfinite(rel) or rel <= times[0]:
+            return held if math.isnan(values[0]) else float(values[0])
+        return float(np.interp(rel, times, values))
+
+    def evaluate(self, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, d/dtau and d2/dtau2 of the plan at relative profile times.
+
+        From the end on the command is exactly the end state: on target (spec: AT_TARGET
+        is "command = target") at the final velocity, with zero acceleration.
+        """
+        inside = np.minimum(rel, self.duration)
+        p, v, a, _ = self.table.evaluate(inside)
+        complete = rel >= self.duration
+        if complete.any():
+            extra = np.maximum(rel - self.duration, 0.0)
+            p = np.where(complete, self.target + self.final_velocity * extra, p)
+            v = np.where(complete, self.final_velocity, v)
+            a = np.where(complete, 0.0, a)
+        return p, v, a
+
+    def segment_poly(self, rel: float) -> tuple[float, list[float]]:
+        """(start time, polynomial coefficients in time from it) of the piece at ``rel``."""
+        if rel >= self.duration:
+            return self.duration, [self.target, self.final_velocity]
+        table = self.table
+        # bisect_right is searchsorted(side="right") (a nan rel too goes past the end); on a
+        # handful of ends it costs a fraction of numpy's call, and it runs for every piece.
+        i = min(bisect.bisect_right(table.end, rel), table.count - 1)
+        _, p, v, a, j = self._rows()[i]
+        return float(table.start[i]), [p, v, a / 2.0, j / 6.0]
+
+    def boundaries(self) -> np.ndarray:
+        """Relative profile times at which the command polynomial (or the feedforward) changes."""
+        if self.feedforward is None:
+            return self.table.end
+        return np.union1d(self.table.end, self.feedforward[0])
+
+    def feedforward_poly(self, rel: float, held: float) -> tuple[float, list[float]]:
+        """(start time, [value, slope]) of the feedforward's linear piece at ``rel``."""
+        if self.feedforward is None:
+            return 0.0, [held]
+        times, values = self.feedforward
+        i = int(np.searchsorted(times, rel, side="right"))
+        if i == 0 or i >= len(times):  # before the first knot, or held after the last
+            return 0.0, [self.feedforward_at(rel, held)]
+        slope = (values[i] - values[i - 1]) / (times[i] - times[i - 1])
+        return float(times[i - 1]), [float(values[i - 1]), float(slope)]
+
+
+# The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
+_segments_slot = AxisPlan.__dict__["segments"]
+_limits_slot = AxisPlan.__dict__["limits"]  # (and its limits, likewise)
+_new_object = object.__new__
+_with_duration = AxisPlan.with_duration.__func__  # type: ignore[attr-defined]  # (ScaledAxisPlan.of's, for its class)
+
+
+class ScaledAxisPlan(AxisPlan):
+    """An axis of a vector move whose segments are its share of the vector's 1-D profile
+    (``scaled``), and its limits its share of the vector's (``vector_limits``), each made the
+    first time it is asked for: by the stepping's table, a cross-check or a plot, not while the
+    command waits for its plan (a further axis of a vector then costs little to plan). The
+    segments, limits, duration and frame count are those of an AxisPlan made with
+    ``scaled.segments()`` and ``vector_limits.share(abs(scaled.factor))``, and so is every
+    answer: the two are one plan. Made by :meth:`of`."""
+
+    __slots__ = ("scaled", "vector_limits")
+    scaled: ScaledProfile
+    vector_limits: Trajectory
+
+    @classmethod
+    def of(cls, scaled: ScaledProfile, duration: float, axis: int, start_position: float, target: float,
+           final_velocity: float, hold: Hold | None, outputs: list[Output], vector_limits: Trajectory,
+           start_velocity: float, start_acceleration: float, composite: str) -> ScaledAxisPlan:
+        """The plan of a vector's axis: AxisPlan.with_duration's, not truncated, the segments and
+        limits left out. ``duration``: ``end_time(scaled.line)``, the same durations added in the
+        same order as ``end_time(scaled.segments())`` adds the segments' (the vector's axes share
+        it: calculated once)."""
+        plan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold, outputs,
+                              False, None, start_velocity, start_acceleration, composite)
+        plan.scaled = scaled
+        plan.vector_limits = vector_limits
+        return plan
+
+    def __post_init__(self) -> None:
+        if _segments_slot.__get__(self, AxisPlan) is not None:
+            AxisPlan.__post_init__(self)  # made with its segments (dataclasses.replace, a copy): as any AxisPlan
+        # (made by of(): the duration is given)
+
+    @property
+    def segments(self) -> list[Segment]:
+        made = _segments_slot.__get__(self, AxisPlan)
+        if made is None:
+            made = self.scaled.segments()
+            _segments_slot.__set__(self, made)
+        return made
+
+    @segments.setter
+    def segments(self, value: list[Segment] | None) -> None:
+        _segments_slot.__set__(self, value)
+
+    @property
+    def limits(self) -> Trajectory | None:
+        made = _limits_slot.__get__(self, AxisPlan)
+        if made is None:
+            made = self.vector_limits.share(abs(self.scaled.factor))
+            _limits_slot.__set__(self, made)
+        return made
+
+    @limits.setter
+    def limits(self, value: Trajectory | None) -> None:
+        _limits_slot.__set__(self, value)
+
+    @property
+    def segment_count(self) -> int:
+        """As many as the 1-D profile's, without making them (the frame buffer counts them)."""
+        made = _segments_slot.__get__(self, AxisPlan)
+        return len(self.scaled.line) if made is None else len(made)
+
+
+class RowAxisPlan(AxisPlan):
+    """A plan whose segments may be kept as Rows (plain tuples: scurve.reshaped(rows=True), an
+    axis' own profile), which the stepping reads as they are (its table, segment_poly); the
+    Segments are made from them the first time they are asked for (a cross-check, a plot, a
+    copy). A Segment, a tuple subclass, takes three times as long to make as a tuple, and a
+    modify is planned while its command waits. Its segments, and every answer, are those of
+    the AxisPlan with the same values: the two are one plan. Made by ``with_duration``."""
+
+    __slots__ = ()
+
+    def _rows(self) -> Sequence[Row]:
+        return _segments_slot.__get__(self, AxisPlan)
+
+    @property
+    def segments(self) -> list[Segment]:
+        made = _segments_slot.__get__(self, AxisPlan)
+        if type(made[0]) is not Segment:  # (never empty: with_duration and __post_init__ see to it)
+            made = list(map(segment_from, made))
+            _segments_slot.__set__(self, made)
+        return made
+
+    @segments.setter
+    def segments(self, value: list[Segment]) -> None:
+        _segments_slot.__set__(self, value)
+
+    @property
+    def segment_count(self) -> int:
+        return len(_segments_slot.__get__(self, AxisPlan))
+
+
+@dataclass(slots=True)
+class Stream:
+    """The streaming state of an open path (MPIMotionPoint, MPIMotionPathAttrMask)."""
+
+    open: bool  # final was false: more points are expected
+    empty_count: int  # E_STOP when fewer points are left while open (<= 0: disabled)
+    low_count: int  # FRAMES_LOW below this many points while open
+    low_sent: bool = False  # FRAMES_LOW sent since the buffer was last refilled
+    empty_sent: bool = False
+    peaks: list[tuple[float, float]] = field(default_factory=list)  # per axis: max |v|, max |a|
+    # Appended points not yet executed: (serial of the append, profile time of its last point
+    # on each axis). An append is a command of its own: it ends when its points are done.
+    chunks: list[tuple[int, dict[int, float]]] = field(default_factory=list)
+
+    def append(self, chunk: Stream | None, open_: bool) -> None:
+        """Points were appended (``chunk``: theirs; None: none, the path is only closed)."""
+        self.open = open_
+        self.low_sent = self.empty_sent = False
+        if chunk is not None:
+            self.peaks = [(max(v, cv), max(a, ca)) for (v, a), (cv, ca) in zip(self.peaks, chunk.peaks, strict=True)]
+
+    def describe_peaks(self, axes: Sequence[int]) -> str:
+        parts = [f"axis {n}: |v| {v:.6g} counts/s, |a| {a:.6g} counts/s^2"
+                 for n, (v, a) in zip(axes, self.peaks, strict=True)]
+        return "path peaks " + "; ".join(parts)
+
+
+@dataclass(slots=True)
+class Move:
+    """A started (or appended) move of a supervisor."""
+
+    supervisor: int
+    type: MPIMotionType
+    attributes: MotionAttr
+    plans: list[AxisPlan]
+    id: int = 0
+    element_id: int = 0
+    event_mask: MPIEventType = MPIEventType.NONE
+    serial: int = 0  # given when a supervisor takes the move (SupervisorHost.next_serial)
+    stream: Stream | None = None  # a path move: its streaming state
+    # Facts the controller asks every stretch (a move's plans never change once compiled).
+    is_velocity: bool = field(init=False)  # a VELOCITY move
+    ends_moving: bool = field(init=False)  # FINAL_VEL: the axes go on at their final velocity
+    plan_axes: tuple[int, ...] = field(init=False)  # the axes of its plans, in order
+
+    def __post_init__(self) -> None:
+        # one pass over the plans (a move is made for every start and modify)
+        axes, velocity, moving = [], False, False
+        for plan in self.plans:
+            axes.append(plan.axis)
+            velocity = velocity or plan.velocity_target is not None  # AxisPlan.is_velocity
+            moving = moving or plan.final_velocity != 0.0
+        self.plan_axes, self.is_velocity, self.ends_moving = tuple(axes), velocity, moving
+
+    @classmethod
+    def planned(cls, supervisor: int, motion_type: MPIMotionType, attributes: MotionAttr, plans: list[AxisPlan],
+                id: int, element_id: int, event_mask: MPIEventType, stream: Stream | None) -> Self:
+        """``cls(supervisor, motion_type, attributes, plans, id, element_id, event_mask, 0, stream)``,
+        a planned move not yet taken (serial 0), as the dataclass' __init__ makes it: its slots are
+        filled here, without that call in between (compile_move makes a Move for every start and
+        modify while the command waits; test_frames checks every field)."""
+        move = _new_object(cls)
+        move.supervisor = supervisor
+        move.type = motion_type
+        move.attributes = attributes
+        move.plans = plans
+        move.id = id
+        move.element_id = element_id
+        move.event_mask = event_mask
+        move.serial = 0
+        move.stream = stream
+        move.__post_init__()
+        return move
+
+    @property
+    def axes(self) -> list[int]:
+        return [plan.axis for plan in self.plans]
+
+    def serials(self) -> set[int]:
+        """Its serial and those of the appends to it not yet done."""
+        chunks = self.stream.chunks if self.stream is not None else ()
+        return {self.serial, *(serial for serial, _ in chunks)}
+
+    def plan_for(self, axis: int) -> AxisPlan | None:
+        for plan in self.plans:
+            if plan.axis == axis:
+                return plan
+        return None
+
+    @property
+    def frame_counts(self) -> dict[int, int]:
+        return {plan.axis: plan.frame_count for plan in self.plans}
+
+
+def frames_needed(moves: Sequence[Move], axis: int) -> int:
+    return sum(move.frame_counts.get(axis, 0) for move in moves)

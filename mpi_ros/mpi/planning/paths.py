@@ -1,0 +1,239 @@
+"""Path (streaming point) moves: PT, PTF, PVT, PVTF, SPLINE, BESSEL, BSPLINE, BSPLINE2, FRAME.
+
+A path request compiles, per axis, into constant-jerk segments (profiles/path.py computes
+them; FRAME moves give them directly), the same AxisPlan every move runs on. What makes a
+path different from a point-to-point move lives here:
+
+- it starts at the command position when the move begins; point i is reached dt_i after
+  point i-1, the first dt_0 after the start (MPI 000, Streaming Point Motion Type
+  Calculations: "Any given dt defining a point also specifies how long it will take to
+  arrive at that point"); positions are interleaved by axis, one time per point;
+- the shortest-path rule for the first point (MPI 000, MPIMotionType, example): the
+  controller's positions are 32-bit, so the first point is taken as the one of its values
+  2^32 apart that lies nearest the current position; the points after it keep their
+  distances to it (the rule "DOES NOT apply to points within the points list");
+- it may be open (MPIMotionPoint.final false): more points arrive with APPEND and extend
+  the path where it ends; executed points are flushed (docs/paths.md);
+- per point: an element id (ELEMENT_ID), outputs by pointIndex (OUTPUT), the frame count.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mpi_ros.mpi.base.params import MotionParams, Output
+from mpi_ros.mpi.base.types import HOLD_ATTRS, MotionAttr, MPIMotionType
+from mpi_ros.mpi.base.wrap import WRAP
+from mpi_ros.mpi.planning.frames import AxisPlan, reached
+from mpi_ros.mpi.planning.profiles.path import PathKind, path_segments, peaks
+from mpi_ros.mpi.planning.profiles.segment import Segment
+
+A = MotionAttr
+
+KINDS: dict[MPIMotionType, PathKind] = {
+    MPIMotionType.PT: PathKind.PT,
+    MPIMotionType.PTF: PathKind.PT,
+    MPIMotionType.PVT: PathKind.PVT,
+    MPIMotionType.PVTF: PathKind.PVT,
+    MPIMotionType.SPLINE: PathKind.SPLINE,
+    MPIMotionType.BESSEL: PathKind.BESSEL,
+    MPIMotionType.BSPLINE: PathKind.BSPLINE,
+    MPIMotionType.BSPLINE2: PathKind.BSPLINE2,
+}
+STREAMED_TYPES = frozenset(KINDS) | {MPIMotionType.FRAME}
+FEEDFORWARD_TYPES = frozenset({MPIMotionType.PTF, MPIMotionType.PVTF})
+
+
+@dataclass(slots=True)
+class PathStart:
+    """Where an axis' points start: raw command position and velocity (profile time), and
+    the axis' origin (user positions are raw minus origin)."""
+
+    axis: int
+    position: float
+    velocity: float
+    origin: float
+
+
+def point_count(motion_type: MPIMotionType, params: MotionParams, axes: int) -> int:
+    """pointCount of a request: frames per axis for FRAME, else one per time."""
+    if motion_type is MPIMotionType.FRAME:
+        return len(params.frames) // axes if axes else 0
+    return len(params.time)
+
+
+def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams,
+                 starts: list[PathStart], relative: bool) -> tuple[list[AxisPlan], list[tuple[float, float]]]:
+    """Per-axis plans of a (validated) path request starting at ``starts``, and each axis'
+    peak velocity and acceleration. Times in the plans are profile time from the start."""
+    axes = len(starts)
+    if motion_type is MPIMotionType.FRAME:
+        per_axis = _frame_segments(params, starts)
+        times = [[f.time for f in params.frames[k::axes]] for k in range(axes)]
+        ends = [segments[-1].end_state()[0] if segments else start.position
+                for segments, start in zip(per_axis, starts, strict=True)]
+    else:
+        points = _points(params, starts, relative)
+        velocities = np.asarray(params.point_velocity, dtype=float).reshape(-1, axes) if \
+            KINDS[motion_type] is PathKind.PVT else None
+        per_axis = [
+            path_segments(KINDS[motion_type], start.position, start.velocity, points[:, k], params.time,
+                          None if velocities is None else velocities[:, k])
+            for k, start in enumerate(starts)
+        ]
+        times = [list(params.time)] * axes
+        # Every kind ends exactly on its last point (the segments reach it within rounding;
+        # the command is put on it when the path is done, AxisPlan.evaluate).
+        ends = [float(points[-1, k]) for k in range(axes)]
+    element_ids = _element_ids(params, attrs, len(times[0]) if times else 0)
+    feedforward = _feedforward(motion_type, params, axes)
+    plans = []
+    for k, (start, segments) in enumerate(zip(starts, per_axis, strict=True)):
+        point_times = np.cumsum(np.asarray(times[k], dtype=float))
+        timed = timed_outputs(params, attrs, point_times, 0.0) if k == 0 else []
+        plans.append(AxisPlan(
+            axis=start.axis, segments=segments, start_position=start.position, target=ends[k],
+            outputs=[out for when, out in timed if when <= 0.0], start_velocity=start.velocity,
+            point_times=point_times, element_ids=element_ids,
+            timed_outputs=[(when, out) for when, out in timed if when > 0.0],
+            hold=params.hold[k] if attrs & HOLD_ATTRS else None,
+            feedforward=None if feedforward is None else _knots(0.0, math.nan, point_times, feedforward[:, k]),
+        ))
+    return plans, [peaks(plan.segments) for plan in plans]
+
+
+def _feedforward(motion_type: MPIMotionType, params: MotionParams, axes: int) -> np.ndarray | None:
+    """PTF/PVTF: (points, axes) feedforward values (raw DAC counts), else None."""
+    if motion_type not in FEEDFORWARD_TYPES:
+        return None
+    return np.asarray(params.feedforward, dtype=float).reshape(-1, axes)
+
+
+def _knots(begin: float, first: float, point_times: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Feedforward knots: ``first`` at ``begin`` (NaN: the value the axis holds then), each
+    value at its point's time (MPI 000, MPIMotionPTF: "When the motion reaches a specified
+    position ... the interpolated feedforward value will be equal to what is specified")."""
+    return np.concatenate([[begin], begin + point_times]), np.concatenate([[first], values])
+
+
+def _points(params: MotionParams, starts: list[PathStart], relative: bool) -> np.ndarray:
+    """(points, axes) raw positions: RELATIVE from the start, else absolute with the
+    shortest-path rule applied to the first point."""
+    axes = len(starts)
+    given = np.asarray(params.position, dtype=float).reshape(-1, axes)
+    start = np.array([s.position for s in starts])
+    if relative:
+        return given + start
+    absolute = given + np.array([s.origin for s in starts])
+    turns = np.round((absolute[0] - start) / WRAP) if len(absolute) else np.zeros(axes)
+    return absolute - turns * WRAP
+
+
+def _frame_segments(params: MotionParams, starts: list[PathStart]) -> list[list[Segment]]:
+    """FRAME: the user's frames (MEIXmpFrame) run as given, interleaved by axis; positions
+    are user positions (raw = position + origin)."""
+    axes = len(starts)
+    return [
+        [Segment(f.time, f.position + start.origin, f.velocity, f.acceleration, f.jerk)
+         for f in params.frames[k::axes] if f.time > 0.0]
+        for k, start in enumerate(starts)
+    ]
+
+
+def _element_ids(params: MotionParams, attrs: MotionAttr, count: int) -> tuple[int, ...]:
+    """ELEMENT_ID: one id per point (the id while the path runs toward it), or one for all."""
+    if A.ELEMENT_ID not in attrs or not params.element_id:
+        return ()
+    if len(params.element_id) == 1:
+        return (int(params.element_id[0]),) * count
+    return tuple(int(x) for x in params.element_id[:count])
+
+
+def timed_outputs(params: MotionParams, attrs: MotionAttr, point_times: np.ndarray,
+                  begin: float) -> list[tuple[float, Output]]:
+    """OUTPUT on a path: each output with the profile time at which it is applied, as the
+    segment toward its point (MEIMotionAttrOutput.pointIndex) begins: index 0 when the
+    points begin (``begin``), index i when point i-1 is reached."""
+    if A.OUTPUT not in attrs:
+        return []
+    return [(begin if out.point_index == 0 else float(point_times[out.point_index - 1]), out)
+            for out in params.output]
+
+
+def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.ndarray,
+           element_ids: tuple[int, ...], outputs: list[tuple[float, Output]], target: float,
+           feedforward: np.ndarray | None = None, held: float = 0.0) -> AxisPlan:
+    """``plan`` with points appended (profile time ``now`` into it): the executed segments
+    and points are flushed; the new ones follow the last point, or start now if the path
+    has run out of points (it rests on its last point meanwhile). ``point_times``: when the
+    new points are reached, from the time they begin; ``outputs``: (time from
+    the first new point's interval, output); ``target``: where the new points end;
+    ``feedforward``: the new points' values (PTF/PVTF), ``held`` the axis' feedforward now."""
+    begin = append_time(plan, now)
+    kept = [s for s, end in zip(plan.segments, plan.table.end, strict=True) if end > now]
+    first = float(plan.table.start[len(plan.segments) - len(kept)]) if kept else begin
+    old_times = plan.point_times
+    assert old_times is not None  # the plan of a path (compile_path)
+    pending = old_times > reached(now)
+    new_times = begin + point_times
+    shifted = [*kept, *segments]
+    ids = _pending_ids(plan, pending, element_ids, len(point_times))
+    return AxisPlan(
+        axis=plan.axis, segments=shifted, start_position=plan.start_position, target=target,
+        start_velocity=plan.start_velocity, origin_time=first,
+        point_times=np.concatenate([old_times[pending], new_times]),
+        element_ids=ids,
+        timed_outputs=[(w, o) for w, o in plan.timed_outputs if w > now] + [(begin + w, o) for w, o in outputs],
+        feedforward=_extended_feedforward(plan, begin, point_times, feedforward, held),
+    )
+
+
+def _extended_feedforward(plan: AxisPlan, begin: float, point_times: np.ndarray, values: np.ndarray | None,
+                          held: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The feedforward knots of a plan with points appended: the old ones, then the new
+    points' values (from the value reached where they begin); points without values hold
+    it. ``held``: the axis' feedforward where the old plan has none."""
+    if plan.feedforward is None and values is None:
+        return None
+    last = plan.feedforward_at(begin, held)
+    old_t, old_v = plan.feedforward if plan.feedforward is not None else (np.array([begin]), np.array([last]))
+    if values is None:
+        return old_t, old_v
+    new_t, new_v = _knots(begin, last, point_times, values)
+    return np.concatenate([old_t, new_t]), np.concatenate([old_v, new_v])
+
+
+def _pending_ids(plan: AxisPlan, pending: np.ndarray, new: tuple[int, ...], count: int) -> tuple[int, ...]:
+    """Element ids of the points still to come and of ``count`` new ones (ids ``new``, or
+    none): points without ids of their own keep the last id (the field is not filled), and
+    points before the first ids read 0."""
+    old = plan.element_ids
+    if not old and not new:
+        return ()
+    kept = tuple(int(x) for x in np.asarray(old)[pending]) if old else (0,) * int(np.count_nonzero(pending))
+    added = new if new else (old[-1],) * count
+    return kept + added
+
+
+def append_time(plan: AxisPlan, now: float) -> float:
+    """Profile time at which appended points begin: the end of the path, or now if the path
+    has already run out of points."""
+    return max(plan.duration, now)
+
+
+def last_point_time(plan: AxisPlan) -> float:
+    """Profile time at which the plan's last point is reached (its end, if none is left)."""
+    times = plan.point_times
+    return float(times[-1]) if times is not None and len(times) else plan.duration
+
+
+def end_state(plan: AxisPlan, now: float) -> tuple[float, float]:
+    """Position and velocity (profile time) the next appended points start from: the last
+    point's, or at rest on it once the path has run out."""
+    if now >= plan.duration:
+        return plan.target, 0.0
+    _, v, _ = plan.segments[-1].end_state()
+    return plan.target, v

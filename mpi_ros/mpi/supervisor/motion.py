@@ -1,0 +1,723 @@
+"""MotionSupervisor: the Motion object of MPI 000 (mpiMotion*).
+
+Every method answers a :class:`Message` (and a value where the C API writes one), or an
+Outcome where the words matter. A refused call changes nothing. State transitions follow
+MPI 000 and docs/state-machine.md; the controller calls :meth:`scan`/:meth:`transition`
+while it steps so motion-driven transitions (DONE, stop complete, hold release) happen at
+the exact sample their condition is met.
+
+The supervisor is a facade over collaborators, each owning one concept and given what it
+needs: the axis list (axis_list.py), its moves (moves.py), its actions
+(actions.py) and its transitions (stepping.py), sharing the
+supervisor's state (state.py) and reaching the controller only through
+SupervisorHost (host.py). Starting and modifying moves (planning them) is here.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from mpi_ros.mpi.axes.axis import Axis
+from mpi_ros.mpi.axes.status import StretchStatus
+from mpi_ros.mpi.axes.trace import Stretch
+from mpi_ros.mpi.base.clock import ProfileClock
+from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
+from mpi_ros.mpi.base.outcome import MoveEnd, Outcome, Refused
+from mpi_ros.mpi.base.params import AxisMaster, MotionConfig, MotionParams, check_position
+from mpi_ros.mpi.base.snapshot import AxisSnapshot, FrameBufferStatus, MotionSnapshot
+from mpi_ros.mpi.base.types import (
+    CAM_TYPES,
+    HOLD_ATTRS,
+    ActionSource,
+    MotionAttr,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+)
+from mpi_ros.mpi.host import SupervisorHost
+from mpi_ros.mpi.planning import cams, paths, validate
+from mpi_ros.mpi.planning.frames import AxisPlan, Move, frames_needed
+from mpi_ros.mpi.planning.planner import compile_move
+from mpi_ros.mpi.planning.start import AxisStart
+from mpi_ros.mpi.supervisor.actions import Actions
+from mpi_ros.mpi.supervisor.axis_list import AxisList
+from mpi_ros.mpi.supervisor.log import MotionLog
+from mpi_ros.mpi.supervisor.moves import Moves
+from mpi_ros.mpi.supervisor.state import SupervisorState
+from mpi_ros.mpi.supervisor.stepping import Transitions
+
+OK = Message.MPIMessageOK
+# Attributes that belong to a start, not to the on-the-fly modify of mpiMotionParamsSet.
+# Bits read on every start and modify, as plain ints (an IntFlag's ``in`` is a Python call).
+_APPEND, _AUTO_START, _DELAY = int(MotionAttr.APPEND), int(MotionAttr.AUTO_START), int(MotionAttr.DELAY)
+_NO_WAIT, _NO_HANDSHAKE = int(MotionAttr.NO_WAIT), int(MotionAttr.NO_HANDSHAKE)
+_START_ONLY = (MotionAttr.APPEND | MotionAttr.AUTO_START | MotionAttr.DELAY | MotionAttr.HOLD
+               | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER)
+# meiMotionActionFunction: called with (motion, motion type, action name) on every
+# start ("START"), modify ("MODIFY") and action ("STOP", "E_STOP", ...).
+ActionCallback = Callable[["MotionSupervisor", MPIMotionType, str], object]
+
+
+class MotionSupervisor:
+    def __init__(self, host: SupervisorHost, number: int, config: MotionConfig):
+        self._host = host
+        self.number = number
+        self.valid = True
+        t = host.time
+        self._state = SupervisorState(number, config.copy(),
+                                      ProfileClock(t, t, config.normal_feedrate, config.normal_feedrate, t),
+                                      host.clock_changed)
+        self._axis_list = AxisList(host.axes, host.config)
+        self._moves = Moves(host, self._state, self._axis_list)
+        self._actions = Actions(host, self._state, self._moves, self._axis_list)
+        self._transitions = Transitions(host, self._state, self._moves, self._actions)
+        self.stored_params = MotionParams()
+        self.stored_type = MPIMotionType.INVALID
+        self.notify_mask = host.config.event_notify
+        self.latched = MPIEventType.NONE
+        self.log: MotionLog | None = None
+        self.action_callback: ActionCallback | None = None
+
+    # ================================================================= queries ====
+    @property
+    def config(self) -> MotionConfig:
+        return self._state.config
+
+    @property
+    def clock(self) -> ProfileClock:
+        """The feedrate clock this supervisor's axes read their plans through (clock.py)."""
+        return self._state.clock
+
+    @property
+    def own_state(self) -> MPIState:
+        """This supervisor's own state (without the motions of others on its axes)."""
+        return self._state.own_state
+
+    @property
+    def last_action(self) -> str:
+        return self._state.last_action
+
+    @property
+    def action_source(self) -> ActionSource:
+        return self._state.action_source
+
+    @property
+    def axis_list(self) -> list[int]:
+        """The axis list as the host holds it (a copy: change it with the axis calls)."""
+        return list(self._axis_list.listed)
+
+    @property
+    def frame_buffer_size(self) -> int:
+        """The frame buffer size of the supervisor's axes (they all have the same: AXIS_FRAME_COUNT)."""
+        return self._axis_list.frame_buffer_size
+
+    @property
+    def mapped(self) -> list[int]:
+        """The axes mapped to the supervisor (MEIActionMAP)."""
+        return list(self._axis_list.mapped)
+
+    @property
+    def current(self) -> Move | None:
+        """The move in progress."""
+        return self._moves.current
+
+    @property
+    def queue(self) -> tuple[Move, ...]:
+        """The moves appended behind it."""
+        return tuple(self._moves.queue)
+
+    @property
+    def last_move(self) -> Move | None:
+        """The last move that ran (the current one while one runs)."""
+        return self._moves.last_move
+
+    def move(self, serial: int) -> Move | None:
+        """The current or queued move with ``serial``."""
+        return self._moves.find(serial)
+
+    def pending_serials(self) -> set[int]:
+        """The serials of the current and queued moves (and of the points appended to them)."""
+        return self._moves.pending_serials()
+
+    def end_now(self, serial: int) -> MoveEnd | None:
+        """How move ``serial`` stands ended now without an end of its own (moves.Moves.end_now)."""
+        return self._moves.end_now(serial)
+
+    def frames_queued(self, axis: int) -> int:
+        """Frames axis ``axis`` holds for this supervisor beyond the plan it runs."""
+        return self._moves.frames_queued(axis)
+
+    def cruising(self) -> bool:
+        """A FINAL_VEL move has reached its target and the axes go on at its final velocity."""
+        return self._moves.cruising()
+
+    def progress(self) -> float:
+        """0..1 along the current move (profile time over its duration)."""
+        return self._moves.progress()
+
+    @property
+    def element_id(self) -> int:
+        """The element id status shows: the current (else last) move's; a path's, of the
+        point it runs toward."""
+        return self._moves.element_id(self._moves.current or self._moves.last_move)
+
+    # ================================================================= handles ====
+    def validate(self) -> Message:
+        """mpiMotionValidate."""
+        return OK if self.valid else Message.MPIMessageHANDLE_INVALID
+
+    def _axis(self, number: int) -> Axis:
+        return self._host.axes[number]
+
+    @property
+    def axes(self) -> list[Axis]:
+        """The mapped axes."""
+        return self._moves.axes
+
+    # ================================================================= state ====
+    @property
+    def state(self) -> MPIState:
+        """The most severe of this supervisor's state and the states of the supervisors
+        commanding its axes (MPI 000: status is derived from each axis' status)."""
+        return self._moves.shown_state()
+
+    def _state_message(self) -> Message:
+        return STATE_MESSAGES[self.state.name]
+
+    # ================================================================= axis list ====
+    def axis_append(self, number: int) -> Message:
+        """mpiMotionAxisAppend."""
+        return self._axis_list.append(number) if self.valid else Message.MPIMessageHANDLE_INVALID
+
+    def axis_insert(self, after: int | None, number: int) -> Message:
+        """mpiMotionAxisInsert: insert ``number`` just after axis ``after`` (None: first)."""
+        return self._axis_list.insert(after, number) if self.valid else Message.MPIMessageHANDLE_INVALID
+
+    def axis_remove(self, number: int) -> Message:
+        """mpiMotionAxisRemove."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        return self._axis_list.remove(number, self._state.own_state, self._state_message())
+
+    def axis_list_set(self, numbers: list[int]) -> Message:
+        """mpiMotionAxisListSet: the coordinate system is completely replaced."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        return self._axis_list.set(numbers, self._state.own_state, self._state_message())
+
+    def axis_list_get(self) -> tuple[Message, list[int]]:
+        return (OK, self.axis_list) if self.valid else (Message.MPIMessageHANDLE_INVALID, [])
+
+    def axis_count(self) -> int:
+        """mpiMotionAxisCount: -1 if the handle is invalid."""
+        return len(self._axis_list.listed) if self.valid else -1
+
+    def axis_index(self, number: int) -> int:
+        """mpiMotionAxisIndex: -1 if invalid or not on the list."""
+        return self._axis_list.index(number) if self.valid else -1
+
+    def axis_at(self, index: int) -> tuple[Message, int | None]:
+        """mpiMotionAxis: the axis at ``index`` (None = MPIHandleVOID)."""
+        return self._axis_list.at(index) if self.valid else (Message.MPIMessageHANDLE_INVALID, None)
+
+    def axis_first(self) -> tuple[Message, int | None]:
+        return self.axis_at(0) if self._axis_list.listed or not self.valid else (OK, None)
+
+    def axis_last(self) -> tuple[Message, int | None]:
+        listed = self._axis_list.listed
+        return self.axis_at(len(listed) - 1) if listed or not self.valid else (OK, None)
+
+    def axis_next(self, number: int) -> tuple[Message, int | None]:
+        return self._axis_list.neighbour(number, +1) if self.valid else (Message.MPIMessageHANDLE_INVALID, None)
+
+    def axis_previous(self, number: int) -> tuple[Message, int | None]:
+        return self._axis_list.neighbour(number, -1) if self.valid else (Message.MPIMessageHANDLE_INVALID, None)
+
+    # ================================================================= actions ====
+    def action(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Message:
+        """mpiMotionAction."""
+        return self.action_detail(action, source).message
+
+    def action_detail(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Outcome:
+        """mpiMotionAction, with why in words."""
+        if not self.valid:
+            return Outcome(Message.MPIMessageHANDLE_INVALID, "invalid motion handle")
+        if not self._actions.knows(action):
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"unknown action {action!r}")
+        current = self._moves.current
+        self._notify_action(current.type if current else MPIMotionType.INVALID, MPIAction(action).name)
+        return self._actions.act(action, source)
+
+    def e_stop(self, source: ActionSource, reason: str) -> Outcome:
+        """E_STOP with a reason in its event (the controller's own: a fault, a lost client)."""
+        return self._actions.e_stop(source, reason=reason)
+
+    # ================================================================= stepping ====
+    def scan(self, stretch: Stretch, status: StretchStatus) -> int | None:
+        """The first sample of ``stretch`` at which a transition of this supervisor happens."""
+        return self._transitions.scan(stretch, status)
+
+    def transition(self, index: int, samples: np.ndarray) -> None:
+        """Apply what :meth:`scan` found at stretch sample ``index`` (the controller is there)."""
+        self._transitions.transition(index, samples)
+
+    def release_holds(self) -> None:
+        """Release holds whose trigger is true now (after a gate or I/O change)."""
+        self._moves.release_holds()
+
+    # ================================================================= config ====
+    def config_get(self) -> tuple[Message, MotionConfig]:
+        config = self._state.config.copy()
+        config.axis_numbers = list(self._axis_list.mapped)
+        return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), config
+
+    def config_set(self, config: MotionConfig) -> Message:
+        """mpiMotionConfigSet; a new normal feedrate applies on the fly (ramped over the
+        stop time while moving)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        if not self._axis_list.listed:  # MPI 000 MPIMotionMessageAXIS_COUNT: "from mpiMotionConfigSet ... no axes"
+            return Message.MPIMotionMessageAXIS_COUNT
+        verdict = config.validate()  # the one MotionConfig validator (params.py): YAML and services too
+        if not verdict.ok:
+            return verdict.message
+        old_normal = self._state.config.normal_feedrate
+        kept_axes = self._state.config.axis_numbers
+        self._state.config = config.copy()
+        self._state.config.axis_numbers = kept_axes
+        if config.normal_feedrate != old_normal and self._state.own_state is MPIState.MOVING:
+            t = self._host.time
+            self._moves.rebase(t)
+            self._state.clock = self._state.clock.ramp_to(t, config.normal_feedrate, config.decel_time.stop)
+        elif self._state.own_state is MPIState.IDLE:
+            t = self._host.time
+            self._moves.rebase(t)
+            self._state.clock = self._state.clock.ramp_to(t, config.normal_feedrate, 0.0)
+        return OK
+
+    # ================================================================= params ====
+    def params_get(self) -> tuple[Message, MotionParams]:
+        """mpiMotionParamsGet: the parameters a start with null params uses."""
+        return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.stored_params.copy()
+
+    def params_set(self, params: MotionParams) -> Message:
+        """mpiMotionParamsSet. While a motion runs the parameters apply "on-the-fly" (MPI 000,
+        mpiMotionParamsSet): a modify of the running move's type with its attributes (less
+        those that only make sense at a start), refused as that modify would be, in which
+        case nothing is stored either."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        current = self._moves.current
+        if self._state.own_state is MPIState.MOVING and current is not None:
+            outcome = self._command(current.type, current.attributes & ~_START_ONLY, params, modify=True)
+            if not outcome.ok:
+                return outcome.message
+        self.stored_params = params.copy()
+        return OK
+
+    # ================================================================= positions ====
+    def position_get(self) -> tuple[Message, list[float], list[float]]:
+        """mpiMotionPositionGet: (actual, command), one value per axis."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, [], []
+        axes = self._list_axes()
+        return OK, [a.actual_position for a in axes], [a.command_position for a in axes]
+
+    def position_set(self, actual: list[float], command: list[float]) -> Message:
+        """mpiMotionPositionSet: both arrays one value per axis; each command position is set
+        under the rule of mpiAxisCommandPositionSet (Axis.can_set_command), all or none."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        axes = self._list_axes()
+        if not axes:
+            return Message.MPIMotionMessageAXIS_COUNT
+        if len(actual) != len(axes) or len(command) != len(axes):
+            return Message.MPIMessagePARAM_INVALID
+        if not all(check_position("position", x).ok for x in list(actual) + list(command)):
+            return Message.MPIMessagePARAM_INVALID
+        # an axis is in the state of the supervisor commanding it (IDLE without one)
+        states = [_or_idle(self._host.own_state_of(a.owner)) for a in axes]
+        if not all(a.can_set_command(state) for a, state in zip(axes, states, strict=True)):
+            return Message.MPIAxisMessageCOMMAND_NOT_SET
+        t = self._host.time
+        for axis, act, cmd in zip(axes, actual, command, strict=True):
+            axis.set_actual_position(act, t)
+            axis.set_command_position(cmd, t)
+        return OK
+
+    def _list_axes(self) -> list[Axis]:
+        return [self._axis(n) for n in self._axis_list.listed]
+
+    def trajectory(self) -> tuple[Message, list[tuple[float, float]]]:
+        """mpiMotionTrajectory: (velocity, acceleration) per axis; deceleration,
+        jerkPercent and the jerks cannot be read and are zero."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, []
+        return OK, [(a.cmd_v, a.cmd_a) for a in self._list_axes()]
+
+    # ================================================================= events ====
+    def event_notify_get(self) -> tuple[Message, MPIEventType]:
+        return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.notify_mask
+
+    def event_notify_set(self, mask: MPIEventType) -> Message:
+        """mpiMotionEventNotifySet (also maps the axes, MPI 002 NOT_MAPPED_TO_MS)."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        if self._state.own_state in (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR):
+            message = self._moves.remap()
+            if not message.ok:
+                return message
+        self.notify_mask = MPIEventType(mask)
+        return OK
+
+    def event_reset(self, mask: MPIEventType) -> Message:
+        """mpiMotionEventReset: clear latched events."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        self.latched &= ~MPIEventType(mask)
+        return OK
+
+    def frame_buffer_status(self) -> tuple[Message, list[FrameBufferStatus]]:
+        """meiMotionFrameBufferStatus for each mapped axis."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID, []
+        size = self._host.config.frame_buffer_size_of
+        return OK, [FrameBufferStatus(a.number, size(a.number), self._host.frame_count(a.number)) for a in self.axes]
+
+    # ================================================================= log ====
+    def log_open(self, max_entries: int) -> Message:
+        """meiMotionLogOpen."""
+        if not self.valid:
+            return Message.MPIMessageHANDLE_INVALID
+        if max_entries <= 0:
+            return Message.MPIMessagePARAM_INVALID
+        self.log = MotionLog(max_entries)
+        return OK
+
+    def log_print(self, filename: str) -> Message:
+        """meiMotionLogPrint."""
+        if self.log is None:
+            return Message.MPIMessageHANDLE_INVALID
+        return self.log.write(filename, self._axis_list.mapped)
+
+    def log_close(self) -> Message:
+        """meiMotionLogClose."""
+        self.log = None
+        return OK
+
+    def action_function(self, callback: ActionCallback | None) -> ActionCallback | None:
+        """meiMotionActionFunction: returns the previous callback."""
+        previous, self.action_callback = self.action_callback, callback
+        return previous
+
+    def _notify_action(self, motion_type: MPIMotionType, action: str) -> None:
+        if self.action_callback is not None:
+            self.action_callback(self, motion_type, action)
+
+    # ================================================================= start/modify ====
+    def start(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
+              params: MotionParams | None = None) -> Message:
+        """mpiMotionStart (params None: the parameters stored with params_set)."""
+        return self.command(motion_type, attrs, params, modify=False)[0].message
+
+    def modify(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
+               params: MotionParams | None = None) -> Message:
+        """mpiMotionModify."""
+        return self.command(motion_type, attrs, params, modify=True)[0].message
+
+    def command(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
+                modify: bool) -> tuple[Outcome, int]:
+        """Start or modify; returns the outcome and the serial of the move it made or changed."""
+        bits = int(attrs)
+        if bits & _NO_WAIT:
+            # nothing to follow: the call did not wait for the move
+            return self._command_no_wait(motion_type, attrs, params, modify), 0
+        outcome = self._command(motion_type, attrs, params, modify)
+        if outcome.ok and bits & (_NO_HANDSHAKE | _NO_WAIT):
+            self._state.unacknowledged = self._host.sample  # status reads IDLE until the next sample
+        current = self._moves.current
+        serial = current.serial if current is not None else 0
+        if outcome.message in (OK, Message.MPIMotionMessageAUTO_START) and bits & _APPEND:
+            if self._moves.queue:
+                serial = self._moves.queue[-1].serial
+            elif current is not None and current.stream is not None and current.stream.chunks:
+                serial = current.stream.chunks[-1][0]  # the points just appended to the open path
+        return outcome, serial
+
+    def _command(self, motion_type, attrs, params, modify) -> Outcome:
+        if not self.valid:
+            return Outcome(Message.MPIMessageHANDLE_INVALID, "invalid motion handle")
+        self._notify_action(motion_type, "MODIFY" if modify else "START")
+        if params is None:
+            params = self.stored_params
+        if not self._axis_list.listed:
+            return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes")
+        bits = int(attrs)
+        verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21,
+                                      append=bool(bits & _APPEND))
+        if not verdict.ok:
+            return verdict
+        state = self._moves.state_for(self._axis_list.listed)
+        held = self._moves.held_by_others(self._axis_list.listed)
+        if held:
+            # A start or modify would take the axis out of the other supervisor's vector (its
+            # motion, running or stopped, keeps it until it ends or is RESET): answered with the
+            # state the axes show (docs/decisions.md, "Supervisors and axes": a supervisor's state
+            # includes its axes' commanders).
+            axis, other, other_state = held[0]
+            return Outcome(STATE_MESSAGES[state.name], (f"axis {axis} is in the {other_state.name} motion of "
+                                                        f"supervisor {other}: command it there, or RESET it"))
+        append = bool(bits & _APPEND)
+        auto_start = False
+        if modify:
+            if state is MPIState.IDLE:
+                if not bits & _AUTO_START:
+                    return Outcome(Message.MPIMotionMessageIDLE, "no motion in progress to modify")
+                auto_start = True
+            elif state is not MPIState.MOVING:
+                return Outcome(STATE_MESSAGES[state.name], f"supervisor is {state.name}")
+        elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
+            return Outcome(STATE_MESSAGES[state.name], f"supervisor is {state.name}")
+        open_path = self._moves.open_path() if append and state is MPIState.MOVING else None
+        if open_path is not None and motion_type not in paths.STREAMED_TYPES:
+            return Outcome(Message.MPIMotionMessagePATH_ERROR, "the path in progress is open (final false): append "
+                                                               "its points, or close it with final true, first")
+        verdict = self._check_request(motion_type, attrs, params, modify, append_to=open_path is not None)
+        if not verdict.ok:
+            return verdict
+        if open_path is not None:
+            return self._append_points(open_path, motion_type, attrs, params)
+        if modify and not auto_start and bits & _DELAY and any(d != 0.0 for d in params.delay):
+            # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
+            # motion" (the supervisor's motion, even while its axes wait out a DELAY).
+            return Outcome(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
+        # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
+        # (docs/state-machine.md), and behind a move already cruising at its final velocity there
+        # is nothing to wait for: the new move starts from where the axes are (a modify).
+        queued = append and state is MPIState.MOVING and (bool(self._moves.queue) or not self._moves.cruising())
+        starts = self._starts(queued, state, modify and not auto_start)
+        try:
+            # (a cam also needs each slave's master; other moves are planned from the starts alone)
+            cams_of = (self._cam_masters(),) if motion_type in CAM_TYPES else ()
+            move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._host.rate, *cams_of)
+        except Refused as exc:
+            return exc.outcome
+        move.serial = self._host.next_serial()  # (a modify keeps the serial of the move it changes: Moves.replace)
+        if move.stream is not None:
+            move.stream.low_count = self._low_count(attrs, params)
+        if queued:
+            current = [self._moves.current] if self._moves.current else []
+            message = self._check_frames(list(self._moves.queue) + current + [move])
+        else:
+            message = self._check_frames([move])
+        if not message.ok:
+            return Outcome(message, "the move does not fit in the frame buffer")
+        message = self._moves.remap()
+        if not message.ok:
+            return Outcome(message, "an axis that leaves the mapping still moves (pauseFeedrate); RESET first")
+        for kind, detail in notes.events:
+            self._moves.emit(kind, detail=detail, move=move)
+        if queued:
+            self._moves.queue.append(move)
+        elif modify and not auto_start:
+            self._moves.replace(move)
+        else:
+            self._moves.begin(move)
+        if auto_start or not modify:
+            # MPI 000, mpiMotionParamsGet: the parameters are set by mpiMotionParamsSet "or
+            # mpiMotionStart", so a start's parameters are the ones a later get returns.
+            self.stored_params = params.copy()
+        if auto_start:
+            return Outcome(Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)")
+        return Outcome(OK)
+
+    def _check_request(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
+                       append_to: bool) -> Outcome:
+        """The attributes and values of a start or modify (validate.py)."""
+        # MPI 000, mpiMotionModify: HOLD is impossible with a modify "even when using the AUTO_START attribute"
+        verdict = validate.check_attributes(motion_type, attrs, params, modify)
+        if not verdict.ok:
+            return verdict
+        return validate.check_params(
+            motion_type, attrs, params, len(self._axis_list.listed), self._host.config.io_words,
+            self._host.config.motors, len(self._host.axes), sample_rate=self._host.rate,
+            append_to=append_to, frame_buffer_size=self._axis_list.frame_buffer_size)
+
+    def _command_no_wait(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
+                         modify: bool) -> Outcome:
+        """MPI 001 NO_WAIT: the MPI "does NOT wait for the controller to acknowledge the commanded
+        move, does NOT wait for the controller to return an error code". What the library checks
+        itself (type, attributes, values) is still answered; whatever the controller would
+        refuse (its state, a profile it cannot load) is not: the call answers OK and a refused
+        move shows only as a missing MOTION_START, as MPI 001 warns."""
+        if not self.valid or not self._axis_list.listed:
+            return self._command(motion_type, attrs, params, modify)
+        params = self.stored_params if params is None else params
+        verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21,
+                                      append=MotionAttr.APPEND in attrs)
+        if verdict.ok:
+            append_to = (MotionAttr.APPEND in attrs and self._state.own_state is MPIState.MOVING
+                         and self._moves.open_path() is not None)
+            verdict = self._check_request(motion_type, attrs, params, modify, append_to)
+        if not verdict.ok:
+            return verdict
+        if self._command(motion_type, attrs, params, modify).ok:
+            self._state.unacknowledged = self._host.sample  # status reads IDLE until the next sample
+        return Outcome(OK, "NO_WAIT: sent without waiting for the controller; MOTION_START shows whether the "
+                           "move began")
+
+    def _starts(self, queued: bool, state: MPIState, moving: bool) -> list[AxisStart]:
+        """Where the new profile of each axis starts."""
+        starts = []
+        last = self._moves.queue[-1] if self._moves.queue else self._moves.current
+        for n in self._axis_list.listed:
+            axis = self._axis(n)
+            plan = last.plan_for(n) if queued and last is not None else None
+            if plan is not None:
+                starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.turn_origin(plan.target)))
+            elif moving:
+                f = self._state.clock.feedrate(self._host.time)
+                velocity = axis.cmd_v / f if f > 0.0 else 0.0
+                acceleration = axis.cmd_a / (f * f) if f > 0.0 else 0.0
+                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.turn_origin(axis.cmd_p), acceleration))
+            else:
+                # A start runs at the normal feedrate from now on. The axis may still move (STOPPED
+                # at a non-zero pauseFeedrate, or past a FINAL_VEL move): start from that velocity.
+                f = self._state.config.normal_feedrate
+                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.turn_origin(axis.cmd_p),
+                                        axis.cmd_a / (f * f)))
+        return starts
+
+    def _cam_masters(self) -> list[tuple[AxisMaster, float]]:
+        """Each slave axis' master (MPIAxisConfig.master) and the master's position now, for a
+        cam on the axis list. Raises Refused if the masters would form a loop."""
+        masters = [self._axis(n).master for n in self._axis_list.listed]
+        running = {axis.number: axis.cam_reads() for axis in self._host.axes if axis.camming}
+        loop = cams.master_loop(self._axis_list.listed, masters, running)
+        if loop:
+            raise Refused(Message.MPIMessagePARAM_INVALID, f"{loop} (MPIAxisConfig.master): a slave cannot follow "
+                                                             "itself, directly or through other cams")
+        now = self._host.master_sources()
+        return [(master, float(now.position(master)[0])) for master in masters]
+
+    def _check_frames(self, moves: list[Move]) -> Message:
+        """Do the moves fit the frame buffer? A path's points need not: the library holds
+        what does not fit and loads it as the buffer drains (MPI 001, LOW_COUNT)."""
+        size = self._host.config.frame_buffer_size_of
+        loaded = [move for move in moves if move.stream is None]
+        for n in self._axis_list.listed:
+            if frames_needed(loaded, n) > size(n):
+                return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
+        return OK
+
+    def _low_count(self, attrs: MotionAttr, params: MotionParams) -> int:
+        """MPI 001 LOW_COUNT: the given count, else a quarter of the frame buffer (32 of 128)."""
+        if MotionAttr.LOW_COUNT in attrs:
+            return params.low_count
+        return self._axis_list.frame_buffer_size // 4
+
+    def _append_points(self, move: Move, motion_type: MPIMotionType, attrs: MotionAttr,
+                       params: MotionParams) -> Outcome:
+        """APPEND to an open path: the points follow its last point (or start now, if it ran
+        out of points), planned like a path of their own from there (docs/paths.md). The
+        append is recorded as a chunk of the path: a command whose outcome comes when its last
+        point is reached."""
+        stream = move.stream
+        plans = {plan.axis: plan for plan in move.plans}
+        if attrs & HOLD_ATTRS:
+            # A hold waits before a move begins; appended points continue one in progress.
+            return Outcome(Message.MPIMotionMessageATTRIBUTE_INVALID,
+                           "points appended to a path in motion cannot be held")
+        if stream is None or sorted(plans) != sorted(self._axis_list.listed):
+            return Outcome(Message.MPIMessagePARAM_INVALID, "the points' axes are not the axes of the open path")
+        t = self._host.time
+        tau = self._state.clock.tau_at(t)
+        # Profile time into the path per axis (an axis still held has run none of it).
+        listed = self._axis_list.listed
+        nows = {n: -math.inf if n in self._moves.holds else tau - self._axis(n).tau_start for n in listed}
+        if paths.point_count(motion_type, params, len(self._axis_list.listed)) == 0:
+            # No points: it only closes (or keeps open) the path, and is done with its last point.
+            stream.append(None, open_=not params.final)
+            stream.chunks.append((self._host.next_serial(),
+                                  {n: paths.last_point_time(plans[n]) for n in self._axis_list.listed}))
+            return Outcome(OK)
+        starts = [AxisStart(n, *paths.end_state(plans[n], nows[n]), self._axis(n).origin) for n in listed]
+        try:
+            chunk, notes = compile_move(self.number, motion_type, attrs, params, starts, self._host.rate)
+        except Refused as exc:
+            return exc.outcome
+        for kind, detail in notes.events:
+            self._moves.emit(kind, detail=detail, move=move)
+        self._moves.rebase(t)
+        ends = {new.axis: self._extend_plan(move, plans[new.axis], new, nows[new.axis], t) for new in chunk.plans}
+        stream.append(chunk.stream, open_=not params.final)
+        if MotionAttr.LOW_COUNT in attrs:
+            stream.low_count = params.low_count
+        stream.chunks.append((self._host.next_serial(), ends))
+        return Outcome(OK)
+
+    def _extend_plan(self, move: Move, old: AxisPlan, new: AxisPlan, now: float, t: float) -> float:
+        """Put ``new``'s points after ``old``'s on its axis; returns when its last one is reached."""
+        outputs = [(0.0, out) for out in new.outputs] + new.timed_outputs
+        axis = self._axis(new.axis)
+        values = new.feedforward[1][1:] if new.feedforward is not None else None
+        assert new.point_times is not None  # the plan of a path (paths.compile_path)
+        extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target,
+                                values, axis.feedforward)
+        move.plans[move.plans.index(old)] = extended
+        wait = self._moves.holds.get(new.axis)
+        if wait is not None:
+            wait.plan = extended  # still held: the path begins, whole, when the hold releases
+        else:
+            axis.extend(extended, t, self._state.clock)
+        return paths.last_point_time(extended)
+
+    # ================================================================= status ====
+    def snapshot(self, axis_snapshots: Sequence[AxisSnapshot] | None = None) -> MotionSnapshot:
+        """mpiMotionStatus; ``axis_snapshots``: every axis' at this sample, when already taken
+        (Controller.motion_snapshots), else its axes' are taken here."""
+        mapped = self._axis_list.mapped
+        if axis_snapshots is None:
+            axes = tuple(self._host.axis_snapshots(mapped))
+        else:
+            axes = tuple(axis_snapshots[n] for n in mapped)
+        move = self._moves.current or self._moves.last_move
+        done = all(a.done for a in axes) if axes else True
+        return MotionSnapshot(
+            sample=self._host.sample,
+            number=self.number,
+            state=self._reported_state(),
+            axis_numbers=tuple(self._axis_list.mapped),
+            axes=axes,
+            done=done and self._state.own_state is not MPIState.MOVING,
+            at_target=all(a.at_target for a in axes) if axes else True,
+            settled=all(a.settled for a in axes) if axes else True,
+            move_id=move.id if move else 0,
+            element_id=self._moves.element_id(move),
+            feedrate=self._state.clock.feedrate(self._host.time),
+            last_action=self._state.last_action,
+            action_source=self._state.action_source.value,
+            moves_pending=len(self._moves.queue),
+            motion_type=move.type.name if move else "",
+            progress=self.progress(),
+            latched_events=tuple(self.latched.names()),
+        )
+
+    def _reported_state(self) -> MPIState:
+        """The state status reports: IDLE at the sample of a start given NO_HANDSHAKE or
+        NO_WAIT (MPI 001 remarks: "the state is reported as MPIStateIDLE until the controller
+        begins the profile execution"), the state otherwise."""
+        state = self.state
+        if self._state.unacknowledged == self._host.sample and state is MPIState.MOVING:
+            return MPIState.IDLE
+        return state
+
+
+
+def _or_idle(state: MPIState | None) -> MPIState:
+    """An axis is in the state of the supervisor commanding it, IDLE without one."""
+    return MPIState.IDLE if state is None else state
