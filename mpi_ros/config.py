@@ -20,6 +20,7 @@ from typing import Any
 
 import yaml
 
+from mpi_ros.joints import AxisJoint, Joint, axis_joints
 from mpi_ros.mpi.axes.plant import Plant
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
@@ -129,10 +130,17 @@ class SuiteConfig:
     # feedback input of the axis' motor (docs/cams.md); empty: the defaults
     masters: list[AxisMaster] = field(default_factory=list)
     secondary: list[SecondaryFeedback] = field(default_factory=list)
+    # per axis: the machine's joint (docs/joints.md); None: ``axis<k>`` in counts
+    joints: list[Joint | None] = field(default_factory=list)
 
     @property
     def axis_count(self) -> int:
         return self.controller.axis_count
+
+    def axis_joints(self) -> list[AxisJoint]:
+        """Every axis as /joint_states and the robot description name it."""
+        joints = self.joints or [None] * self.axis_count
+        return axis_joints(joints, self.ros.joint_prefix)
 
     def build_controller(self) -> Controller:
         """A controller with the configured axes and supervisors (axis lists mapped). Every
@@ -266,6 +274,7 @@ class _AxesConfig:
     masters: list[AxisMaster]
     secondary: list[SecondaryFeedback]
     faults: list[Any]  # as given (read by _faults once the motors are known)
+    joints: list[Joint | None] = field(default_factory=list)
     frame_buffer_sizes: dict[int, int] = field(default_factory=dict)  # axes[n].frame_buffer_size, where given
 
 
@@ -300,10 +309,9 @@ def _axes(raw: dict | None) -> _AxesConfig:
     out = _AxesConfig(count, [], [], [], [], [])
     for n in range(count):
         merged = _merge(defaults, overrides.get(n, overrides.get(str(n), {})))
-        extra = set(merged) - {"in_position", "plant", "master", "secondary_feedback", "faults", "frame_buffer_size"}
+        extra = set(merged) - set(_AXIS_KEYS)
         if extra:
-            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: faults, frame_buffer_size, "
-                              "in_position, master, plant, secondary_feedback)")
+            raise ConfigError(f"axes[{n}].{sorted(extra)[0]}: unknown key (known: {', '.join(_AXIS_KEYS)})")
         if "frame_buffer_size" in merged:
             size = merged["frame_buffer_size"]
             _require(check_frame_buffer_size("frame_buffer_size", size), f"axes[{n}].")
@@ -320,7 +328,35 @@ def _axes(raw: dict | None) -> _AxesConfig:
         out.plant.append(plant)
         out.masters.append(_axis_master(merged.get("master"), f"axes[{n}].master"))
         out.secondary.append(secondary)
+        out.joints.append(_joint(merged.get("joint"), f"axes[{n}].joint"))
+    _unique_joint_names(out.joints)
     return out
+
+
+_AXIS_KEYS = ("faults", "frame_buffer_size", "in_position", "joint", "master", "plant", "secondary_feedback")
+
+
+def _joint(raw: Any, where: str) -> Joint | None:
+    """axes[n].joint: {name, type, counts_per_unit, offset, max_velocity}; absent: none."""
+    if raw is None:
+        return None
+    data = dict(raw) if isinstance(raw, dict) else raw
+    if isinstance(data, dict) and "name" not in data:
+        raise ConfigError(f"{where}.name: a joint needs a name")
+    joint = _dataclass(Joint, data, where)
+    _require(joint.validate(), f"{where}.")
+    return joint
+
+
+def _unique_joint_names(joints: list[Joint | None]) -> None:
+    """Joint names are unique in the suite, and none is another axis' default name."""
+    named = {f"axis{k}": k for k, joint in enumerate(joints) if joint is None}
+    for k, joint in enumerate(joints):
+        if joint is None:
+            continue
+        if joint.name in named:
+            raise ConfigError(f"axes[{k}].joint.name: {joint.name!r} is already the name of axis {named[joint.name]}")
+        named[joint.name] = k
 
 
 def _faults(raw: Any, number: int, motors: int) -> AxisFaultConfig:
@@ -454,7 +490,8 @@ def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
         _check_frame_sizes(controller, spec.axes, f"supervisors[{i}].axes")
     faults = [_faults(raw, n, controller.motors) for n, raw in enumerate(axes.faults)]
     return SuiteConfig(controller, axes.in_position, axes.plant, supervisors, _ros(data.get("ros")), source,
-                       copy.deepcopy(data), faults, masters=axes.masters, secondary=axes.secondary)
+                       copy.deepcopy(data), faults, masters=axes.masters, secondary=axes.secondary,
+                       joints=axes.joints)
 
 
 def load(path: str | Path | None = None, overrides: dict | None = None) -> SuiteConfig:

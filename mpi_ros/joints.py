@@ -1,0 +1,112 @@
+"""An axis as a joint of the machine: its name, its kind, and counts <-> SI units.
+
+The controller speaks counts (MPI 002: every position, velocity and acceleration of an axis is
+in counts and counts/s). The ROS robot stack speaks radians and metres under the machine's
+own joint names (REP 103; sensor_msgs/JointState, URDF, trajectory_msgs). A ``Joint`` is the
+bridge, configured per axis as ``axes.defaults|overrides.<n>.joint`` (docs/joints.md):
+
+    joint: {name: x, type: prismatic, counts_per_unit: 1.0e6, offset: 0.0, max_velocity: 0.5}
+
+``counts_per_unit`` is counts per metre (prismatic) or per radian (revolute, continuous);
+negative flips the direction. ``offset`` is the joint position (units) at count 0, so
+``units = offset + counts / counts_per_unit``. ``max_velocity`` (units/s, 0 = none given)
+is the URDF's velocity limit and the fastest a JointTrajectory may ask. An axis without a
+joint block keeps the name ``axis<k>`` and reports counts, as before joints existed.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from mpi_ros.mpi.base.outcome import VALID, Outcome
+from mpi_ros.mpi.base.params import check_magnitude, first_refusal, refuse, shown
+
+JOINT_TYPES = ("revolute", "prismatic", "continuous")
+# A URDF joint name and a ROS name token: letters, digits and underscores, not starting with
+# a digit (the namespace prefix rule of docs/cell.md adds "<ns>/" in front).
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+# Beyond this a unit conversion loses the count (2^53 counts over 1e-9 units).
+_COUNTS_PER_UNIT_MAX = 1e15
+
+
+@dataclass(slots=True)
+class Joint:
+    """One axis as a joint; the defaults are what an axis without a joint block reports."""
+
+    name: str = ""
+    type: str = "prismatic"
+    counts_per_unit: float = 1.0
+    offset: float = 0.0
+    max_velocity: float = 0.0  # units/s; 0: none given
+
+    def validate(self) -> Outcome:
+        return first_refusal((
+            self._name(),
+            self._type(),
+            self._counts_per_unit(),
+            check_magnitude("offset", self.offset, _COUNTS_PER_UNIT_MAX),
+            self._max_velocity(),
+        ))
+
+    def _name(self) -> Outcome:
+        if not isinstance(self.name, str) or not _NAME.fullmatch(self.name):
+            return refuse(f"name: expected letters, digits and underscores, not starting with a digit, got "
+                          f"{shown(self.name)}")
+        return VALID
+
+    def _type(self) -> Outcome:
+        if self.type not in JOINT_TYPES:
+            return refuse(f"type: expected one of {', '.join(JOINT_TYPES)}, got {shown(self.type)}")
+        return VALID
+
+    def _counts_per_unit(self) -> Outcome:
+        value = self.counts_per_unit
+        if not isinstance(value, float) or not math.isfinite(value) or value == 0.0 \
+                or abs(value) > _COUNTS_PER_UNIT_MAX:
+            return refuse(f"counts_per_unit: expected a finite, non-zero number of magnitude at most "
+                          f"{_COUNTS_PER_UNIT_MAX:g}, got {shown(value)}")
+        return VALID
+
+    def _max_velocity(self) -> Outcome:
+        value = self.max_velocity
+        if not isinstance(value, float) or not math.isfinite(value) or value < 0.0:
+            return refuse(f"max_velocity: expected a finite number >= 0 (0: none), got {shown(value)}")
+        return VALID
+
+    # -- conversions (the joint's units are metres or radians, its rates per second)
+    def position(self, counts: float) -> float:
+        return self.offset + counts / self.counts_per_unit
+
+    def rate(self, counts_per_second: float) -> float:
+        """A velocity, acceleration or effort in counts/s^n as units/s^n."""
+        return counts_per_second / self.counts_per_unit
+
+    def counts(self, position: float) -> float:
+        return (position - self.offset) * self.counts_per_unit
+
+    def counts_rate(self, units_per_second: float) -> float:
+        return units_per_second * self.counts_per_unit
+
+
+@dataclass(frozen=True, slots=True)
+class AxisJoint:
+    """The joint of axis ``axis`` as the ROS graph names it (``name`` with its namespace
+    prefix), or an axis without one (``joint`` None: ``axis<k>`` in counts)."""
+
+    axis: int
+    name: str
+    joint: Joint | None
+
+    def position(self, counts: float) -> float:
+        return counts if self.joint is None else self.joint.position(counts)
+
+    def rate(self, counts_per_second: float) -> float:
+        return counts_per_second if self.joint is None else self.joint.rate(counts_per_second)
+
+
+def axis_joints(joints: list[Joint | None], prefix: str) -> list[AxisJoint]:
+    """Every axis as the graph names it: its joint's name, or ``axis<k>``, after ``prefix``."""
+    return [AxisJoint(k, prefix + (joint.name if joint is not None else f"axis{k}"), joint)
+            for k, joint in enumerate(joints)]
