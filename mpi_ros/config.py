@@ -79,6 +79,7 @@ DEFAULT_NAMESPACE = "/mpi"
 # ros.discovery: how far DDS discovery reaches (ROS_AUTOMATIC_DISCOVERY_RANGE); the suite's
 # default keeps it on this host (docs/cell.md, "Exposure").
 DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")
+ACTION_SERVERS = ("batched", "rclpy")
 
 
 @dataclass(slots=True)
@@ -102,6 +103,10 @@ class RosSettings:
     # taking and answering goal requests then costs the suite's interpreter a few microseconds
     # instead of about 0.2 ms a goal. For goal rates of hundreds a second (docs/reliability.md).
     goal_process: bool = False
+    # Who speaks the action protocol (docs/reliability.md, "The goal path"): "batched", the
+    # suite's own server on rclpy's private bindings (ros/rcl.py), or "rclpy", rclpy's stock
+    # ActionServer (a goal costs more; for an rclpy other than Jazzy's).
+    action_server: str = "batched"
 
     @property
     def joint_states_topic(self) -> str:
@@ -447,6 +452,11 @@ def _ros(raw: dict | None) -> RosSettings:
         raise ConfigError(f"ros.discovery: one of {', '.join(DISCOVERY_RANGES)}, got {ros.discovery!r}")
     if ros.executor_threads < 4:
         raise ConfigError("ros.executor_threads: must be >= 4")
+    if ros.action_server not in ACTION_SERVERS:
+        raise ConfigError(f"ros.action_server: one of {', '.join(ACTION_SERVERS)}, got {ros.action_server!r}")
+    if ros.goal_process and ros.action_server != "batched":
+        raise ConfigError("ros.goal_process: the goal front serves the batched action server only "
+                          "(ros.action_server: batched)")
     return ros
 
 

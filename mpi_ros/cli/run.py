@@ -126,6 +126,7 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
     from rclpy.signals import SignalHandlerOptions
 
     from mpi_ros.ros import parameters
+    from mpi_ros.ros.rcl import UnsupportedRclpy
     from mpi_ros.ros.suite import Suite
 
     rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])], signal_handler_options=SignalHandlerOptions.NO)
@@ -135,7 +136,12 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         rclpy.try_shutdown()
         return 2
-    suite = Suite(cfg, time_scale=time_scale)
+    try:
+        suite = Suite(cfg, time_scale=time_scale)
+    except UnsupportedRclpy as exc:
+        print(f"{prog}: {exc}", file=sys.stderr)
+        rclpy.try_shutdown()
+        return 2
     parameters.show(suite.controller_node, cfg, time_scale)
     recorder = None
     if getattr(args, "record", None):

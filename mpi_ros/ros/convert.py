@@ -23,13 +23,14 @@ from typing import Any
 
 import numpy as np
 from builtin_interfaces.msg import Time
-from rclpy._rclpy_pybind11 import RCLError
 from sensor_msgs.msg import JointState
 
 from mpi_ros.mpi.base.events import Event
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 from mpi_ros.msg import Command as CommandMsg
+
+from . import rcl
 
 
 def to_dict(msg) -> dict[str, Any]:
@@ -359,6 +360,6 @@ def publish_all(node, sends: Iterable[tuple[Any, Any]]) -> None:
     try:
         for publisher, msg in sends:
             publisher.publish(msg)
-    except RCLError:
+    except rcl.RCLError:
         if node.context.ok():
             raise

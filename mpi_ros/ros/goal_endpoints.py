@@ -30,11 +30,10 @@ import threading
 from typing import Any, Protocol
 
 from action_msgs.msg import GoalInfo
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.type_support import check_for_type_support
 
-from . import convert
+from . import convert, rcl
 
 KINDS = ("goal", "cancel", "result")  # the action's services, in the order each round serves them
 SERVICE_NAMES = {"goal": "send_goal", "cancel": "cancel_goal", "result": "get_result"}
@@ -102,8 +101,7 @@ def create_services(node_handle, action_type, name: str, qos) -> dict[str, Any]:
     with node_handle:
         for kind in KINDS:
             check_for_type_support(types[kind])  # loads the C type support the service needs
-            services[kind] = _rclpy.Service(node_handle, types[kind], f"{name}/_action/{SERVICE_NAMES[kind]}",
-                                            qos.get_c_qos_profile())
+            services[kind] = rcl.service(node_handle, types[kind], f"{name}/_action/{SERVICE_NAMES[kind]}", qos)
     return services
 
 
@@ -158,7 +156,7 @@ class LocalEndpoints:
         try:
             with self._lock:
                 self.services[kind].service_send_response(response, header)
-        except _rclpy.RCLError:  # the client went away; its goal (if accepted) runs without it
+        except rcl.RCLError:  # the client went away; its goal (if accepted) runs without it
             self._node.get_logger().warning(f"a {kind} response could not be sent (the client may have gone away)")
 
     def flush(self) -> None:

@@ -36,6 +36,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
+from . import rcl
 from .goal_endpoints import ACTION_SERVICE_QOS, KINDS, LocalEndpoints, Outbox, RelayedEndpoints, take_ready
 from .goal_server import GoalServer
 
@@ -154,7 +155,6 @@ def run_front(connection, namespace: str) -> None:
     """The front's process: its node, the servers' services, a loop taking requests (this
     thread) and one sending the suite's responses."""
     import rclpy
-    from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
     from rclpy.node import Node
     from rclpy.signals import SignalHandlerOptions
 
@@ -174,7 +174,7 @@ def run_front(connection, namespace: str) -> None:
         connection.send(f"{type(exc).__name__}: {exc}")
         return
     headers: dict[int, Any] = {}
-    stop = _rclpy.GuardCondition(node.context.handle)
+    stop = rcl.guard_condition(node.context.handle)
     responder = threading.Thread(target=_respond, args=(connection, endpoints, headers, stop), daemon=True)
     responder.start()
     connection.send("ready")
@@ -194,11 +194,9 @@ def _action_type(path: str):
 def _take(connection, node, endpoints: list[LocalEndpoints], headers: dict[int, Any], stop) -> None:
     """Until the responder says the pipe closed: wait on every service, take what is waiting,
     send it to the suite as one batch."""
-    from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-
     tokens = itertools.count()
     with node.context.handle:
-        wait_set = _rclpy.WaitSet(0, 1, 0, 0, len(KINDS) * len(endpoints), 0, node.context.handle)
+        wait_set = rcl.wait_set(len(KINDS) * len(endpoints), node.context.handle)
         while True:
             taken = take_ready(wait_set, stop, endpoints, -1)
             if taken is None:

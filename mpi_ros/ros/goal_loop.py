@@ -21,8 +21,8 @@ from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack
 
 from rclpy.context import Context
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
+from . import rcl
 from .goal_endpoints import KINDS, LocalEndpoints, take_ready
 from .goal_server import GoalServer
 
@@ -43,7 +43,7 @@ class GoalLoop:
         self._context = context
         self._servers: list[GoalServer] = []
         with self._handle:
-            self._wake = _rclpy.GuardCondition(self._handle)
+            self._wake = rcl.guard_condition(self._handle)
         self._pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="mpi-ros-goals")
         self._stopping = False
         self._thread: threading.Thread | None = None
@@ -80,10 +80,10 @@ class GoalLoop:
                     for kind in KINDS:
                         held.enter_context(endpoints.services[kind])
                 held.enter_context(self._handle)
-                wait_set = _rclpy.WaitSet(0, 1, 0, 0, len(KINDS) * len(waited), 0, self._handle)
+                wait_set = rcl.wait_set(len(KINDS) * len(waited), self._handle)
                 while not self._stopping:
                     self._round(wait_set, waited)
-        except _rclpy.RCLError:
+        except rcl.RCLError:
             # The context shut down (Ctrl-C) before the loop was stopped: nothing can be
             # waited on any more. Anything else is a real error.
             if self._context.ok():

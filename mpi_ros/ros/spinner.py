@@ -19,8 +19,9 @@ import traceback
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import Executor
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+
+from . import rcl
 
 
 class Spinner:
@@ -63,7 +64,7 @@ class Spinner:
         try:
             while not self._stopping and self.executor.context.ok():
                 self.executor.spin_once()
-        except _rclpy.RCLError as exc:
+        except rcl.RCLError as exc:
             # The context shut down between the executor's check and its wait: it cannot make
             # the wait set any more. Anything else is a real error.
             if self.executor.context.ok():

@@ -20,7 +20,7 @@ from rclpy.executors import MultiThreadedExecutor
 
 from ..config import SuiteConfig
 from ..runner import ControllerRunner
-from . import convert
+from . import convert, rcl
 from .controller_node import ControllerNode
 from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
@@ -42,6 +42,8 @@ class Suite:
 
     def __init__(self, config: SuiteConfig, time_scale: float | None = 1.0, context: Context | None = None,
                  epoch_ns: int | None = None):
+        if config.ros.action_server == "batched":
+            rcl.check_version()  # before any node: the batched server needs rclpy's private bindings
         self.config = config
         self.controller = config.build_controller()
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)

@@ -65,6 +65,7 @@ from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
 from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
 from .goal_tracker import GoalBook, TrackedGoal
+from .stock_goal_server import StockGoalServer
 from .watchdog import LostClientWatchdog
 
 # The status writers keep 1000 samples for their readers: a suite catching up after a stall
@@ -85,7 +86,7 @@ _NOT_YET_CANCELING = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING)
 class _RosGoal:
     """What finishing a goal needs from ROS (the payload of its TrackedGoal)."""
 
-    server: GoalServer
+    server: GoalServer | StockGoalServer
     action_type: type
 
 
@@ -110,7 +111,8 @@ class SupervisorNode(Node):
         self._servers = {action_type: self._action_server(action_type, name, operation)
                          for action_type, name, operation in actions}
         for server in self._servers.values():
-            goal_loop.add(server)
+            if isinstance(server, GoalServer):
+                goal_loop.add(server)
         # Feedback goes out pre-serialized on the actions' own feedback topics (see _collect_feedback).
         self._feedback_pubs = {action_type: self.create_publisher(action_type.Impl.FeedbackMessage,
                                                                   f"~/{name}/_action/feedback", FEEDBACK_QOS)
@@ -145,10 +147,13 @@ class SupervisorNode(Node):
         return {"goals_tracked": len(self._book), "goals_kept": sum(s.kept() for s in self._servers.values()),
                 "requests_unfiled": sum(s.unfiled() for s in self._servers.values())}
 
-    def _action_server(self, action_type, name: str, operation: str) -> GoalServer:
+    def _action_server(self, action_type, name: str, operation: str) -> GoalServer | StockGoalServer:
         callbacks = Callbacks(accepting=lambda: not self._shutting_down,
                               apply=partial(self._on_goals, action_type, operation), cancel=self._on_cancel,
                               cancelled=lambda: self.runner.update(self._review))
+        if self.settings.action_server == "rclpy":
+            return StockGoalServer(self, action_type, f"~/{name}", callbacks, ACTION_SERVICE_QOS,
+                                   result_timeout=self.settings.result_timeout)
         endpoints = self._goal_loop.endpoints(self, action_type, f"~/{name}", ACTION_SERVICE_QOS)
         return GoalServer(self, action_type, f"~/{name}", callbacks, endpoints,
                           result_timeout=self.settings.result_timeout)
