@@ -57,6 +57,29 @@ import threading  # noqa: E402
 
 import pytest  # noqa: E402
 
+# Markers by directory (pyproject.toml declares them): `scripts/test.sh --fast` leaves out the
+# tests that need ROS or start processes, for the edit loop; CI runs everything.
+_DIRECTORY_MARKS = {"ros": "ros", "interfaces": "ros", "bag": "ros", "cli": "process"}
+_ROS_FIXTURES = {"ros_context", "module_context", "probe", "suite"}
+# Modules outside test/cli that start processes (suites, peers, examples, network namespaces).
+_PROCESS_MODULES = {"test_examples.py", "test_client.py", "test_robustness.py", "test_suite_process.py",
+                    "test_goal_front.py", "test_watchdog.py", "test_cell.py", "test_cell_netns.py",
+                    "test_interleavings.py", "test_cross_process.py", "test_killed_recording.py",
+                    "test_graph_recording.py", "test_bag.py", "test_lint.py"}
+
+
+def pytest_collection_modifyitems(config, items):
+    tests = os.path.dirname(os.path.abspath(__file__))
+    for item in items:
+        parts = os.path.relpath(str(item.path), tests).split(os.sep)
+        mark = _DIRECTORY_MARKS.get(parts[0]) if len(parts) > 1 else None
+        if mark is not None:
+            item.add_marker(mark)
+        if mark != "ros" and _ROS_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker("ros")
+        if mark != "process" and parts[-1] in _PROCESS_MODULES:
+            item.add_marker("process")
+
 
 def pytest_report_header(config):
     return (f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']} "
