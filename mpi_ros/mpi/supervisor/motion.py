@@ -486,6 +486,15 @@ class MotionSupervisor:
         if open_path is not None and motion_type not in paths.STREAMED_TYPES:
             return Outcome(Message.MPIMotionMessagePATH_ERROR, "the path in progress is open (final false): append "
                                                                "its points, or close it with final true, first")
+        # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
+        # (docs/state-machine.md), and behind a move already cruising at its final velocity there
+        # is nothing to wait for: the new move starts from where the axes are (a modify).
+        queued = append and state is MPIState.MOVING and (bool(self._moves.queue) or not self._moves.cruising())
+        running = self._moves.current
+        if modify and not auto_start and not queued and open_path is None and running is not None:
+            verdict = validate.check_running_type(running.type)
+            if not verdict.ok:
+                return verdict
         verdict = self._check_request(motion_type, attrs, params, modify, append_to=open_path is not None)
         if not verdict.ok:
             return verdict
@@ -495,10 +504,6 @@ class MotionSupervisor:
             # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
             return Outcome(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
-        # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
-        # (docs/state-machine.md), and behind a move already cruising at its final velocity there
-        # is nothing to wait for: the new move starts from where the axes are (a modify).
-        queued = append and state is MPIState.MOVING and (bool(self._moves.queue) or not self._moves.cruising())
         starts = self._starts(queued, state, modify and not auto_start)
         try:
             # (a cam also needs each slave's master; other moves are planned from the starts alone)

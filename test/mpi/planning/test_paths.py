@@ -832,6 +832,40 @@ def test_a_time_slice_of_one_sample_is_accepted():
     assert raw(ctl) == pytest.approx(P3[-1], abs=TOL)
 
 
+def _running(kind):
+    """A long closed path of ``kind`` (or FRAME moves) in progress: 40 points, 2 s."""
+    def setup(ctl, ms):
+        if kind is T.FRAME:
+            frames = [UserFrame(0.0, 100.0, 0.0, 0.0, 2.0), UserFrame(0.0, -50.0, 0.0, 0.0, 2.0)]
+            assert ms.start(T.FRAME, A.NONE, MotionParams(frames=frames)).ok
+        else:
+            t = np.arange(1.0, 41.0)
+            points = np.stack([10.0 * t + 5.0 * np.sin(t), -7.0 * t], axis=1)
+            assert ms.start(kind, A.RELATIVE, path_params(kind, points, [0.05] * 40, np.ones((40, 2)))).ok
+        ctl.step(200)
+        assert ms.state is MPIState.MOVING
+    return setup
+
+
+UNMODIFIABLE = [T.SPLINE, T.BSPLINE, T.BSPLINE2, T.BESSEL, T.PTF, T.PVTF, T.FRAME]
+MODIFYING = [(T.TRAPEZOIDAL, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)], position=[0.0, 0.0])),
+             (T.VELOCITY, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)])),
+             (T.PT, path_params(T.PT, P3, T3))]
+
+
+@pytest.mark.parametrize("running", UNMODIFIABLE, ids=[k.name for k in UNMODIFIABLE])
+@pytest.mark.parametrize("kind,params", MODIFYING, ids=[k.name for k, _ in MODIFYING])
+def test_the_running_motions_type_decides_whether_it_can_be_modified(running, kind, params):
+    # MPI 000, mpiMotionModify: "The types of motion whose parameters can be modified while moving are
+    # MPIMotionTypeTRAPEZOIDAL, MPIMotionTypeS_CURVE, MPIMotionTypeVELOCITY, MPIMotionTypePT and
+    # MPIMotionTypePVT": a modify of a modifiable type does not replace a motion that cannot be modified
+    (ctl_a, ms_a), (ctl_b, ms_b) = _twins(_running(running))
+    outcome, _ = ms_b.command(kind, A.NONE, params, True)
+    assert outcome.message is M.MPIMessageUNSUPPORTED
+    assert running.name in outcome.detail
+    assert _observe(ctl_a, ms_a) == _observe(ctl_b, ms_b)
+
+
 APPENDABLE = [T.PT, T.PTF, T.PVT, T.PVTF, T.BESSEL, T.BSPLINE, T.BSPLINE2]
 
 
