@@ -971,6 +971,53 @@ def test_stop_decelerates_along_the_path_and_resume_continues_it():
     assert [(e.serial, e.message) for e in ctl.move_log.recent(ms.number)] == [(serial, M.MPIMessageOK)]
 
 
+def _open_pvt_stopped_then_resumed(append_when_stopped: bool):
+    """An open PVT path (200 counts/s on axis 0), STOP at sample 101, RESUME 100 samples after it
+    is STOPPED; more points appended at sample 100 (MOVING) or once STOPPED. The command per sample."""
+    ctl, ms = new_supervisor(notify=None)
+    t = np.arange(1.0, 11.0)
+    first = np.stack([10.0 * t, -5.0 * t], axis=1)
+    more = np.stack([100.0 + 10.0 * t, -50.0 - 5.0 * t], axis=1)
+    velocity = np.tile([200.0, -100.0], (10, 1))
+    assert ms.start(T.PVT, A.NONE, path_params(T.PVT, first, [0.05] * 10, velocity, final=False,
+                                                empty_count=0)).ok
+    ctl.step(100)
+    appended = path_params(T.PVT, more, [0.05] * 10, velocity, final=True)
+    if not append_when_stopped:
+        assert ms.command(T.PVT, A.APPEND, appended, False)[0].ok
+    ctl.step(1)
+    assert ms.action(MPIAction.STOP).ok
+    assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 10_000)
+    if append_when_stopped:
+        assert ms.command(T.PVT, A.APPEND, appended, False)[0].ok
+        assert ms.state is MPIState.STOPPED
+    trace = []
+    for _ in range(100):
+        ctl.step(1)
+        trace.append(raw(ctl))
+    assert ms.action(MPIAction.RESUME).ok
+    while ms.state is not MPIState.IDLE and len(trace) < 20_000:
+        ctl.step(1)
+        trace.append(raw(ctl))
+    return np.array(trace)
+
+
+def test_points_appended_while_stopped_follow_the_stopped_path_and_resume_runs_them():
+    # MPI 000, MPIMotionPoint, final: "If final=0, more points can be loaded using mpiMotionModify(...) with the
+    # MPIMotionAttrMaskAPPEND attribute"; MPIMotionAttrMaskAPPEND adds "to the end of a previous motion
+    # profile": a STOP leaves the rest of the path pending, so the points follow it, as if appended in motion
+    stopped = _open_pvt_stopped_then_resumed(append_when_stopped=True)
+    moving = _open_pvt_stopped_then_resumed(append_when_stopped=False)
+    # the end time is the same sum of point times taken from another base: it may round to the next
+    # sample (both then rest on the last point), so the shorter run is padded with its last position
+    assert abs(len(stopped) - len(moving)) <= 1
+    length = max(len(stopped), len(moving))
+    stopped, moving = (np.concatenate([x, np.repeat(x[-1:], length - len(x), axis=0)]) for x in (stopped, moving))
+    assert np.allclose(stopped, moving, rtol=0.0, atol=TOL)
+    assert stopped[-1] == pytest.approx([200.0, -100.0], abs=TOL)
+    assert np.max(np.abs(np.diff(stopped[:, 0]))) * RATE <= 200.0 * (1 + 1e-6)
+
+
 def test_e_stop_decelerates_along_the_path_and_ends_its_goals_with_error():
     # MPI 000, mpiMotionStart: "The axis will E-stop along the path of the last frames in the buffer";
     # MPI 000, MPIMotionMessageERROR: the motion (and every append to it) ends in error
