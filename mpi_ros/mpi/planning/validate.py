@@ -112,6 +112,16 @@ def check_type(
     return OK
 
 
+def check_running_type(running: MPIMotionType) -> Outcome:
+    """May a modify replace the motion in progress? MPI 000, mpiMotionModify: "The types of
+    motion whose parameters can be modified while moving are ..." -- the running motion's
+    type decides, whatever type the modify itself carries (a TRAPEZOIDAL modify may not
+    replace a SPLINE or a cam)."""
+    if running not in MODIFIABLE_TYPES:
+        return _bad(Message.MPIMessageUNSUPPORTED, f"the {running.name} motion in progress cannot be modified")
+    return OK
+
+
 def check_attributes(
     motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool
 ) -> Outcome:

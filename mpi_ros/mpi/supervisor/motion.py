@@ -482,10 +482,24 @@ class MotionSupervisor:
                 return Outcome(STATE_MESSAGES[state.name], f"supervisor is {state.name}")
         elif state not in (MPIState.IDLE, MPIState.STOPPED) and not (append and state is MPIState.MOVING):
             return Outcome(STATE_MESSAGES[state.name], f"supervisor is {state.name}")
-        open_path = self._moves.open_path() if append and state is MPIState.MOVING else None
+        # MPI 000, MPIMotionAttrAPPEND: the profile is "added to the end of a previous motion
+        # profile"; STOPPED keeps the rest of its profile pending (RESUME continues it), so an
+        # APPEND given while STOPPED queues behind it like one given while MOVING.
+        behind = append and (state is MPIState.MOVING
+                             or (state is MPIState.STOPPED and self._moves.current is not None))
+        open_path = self._moves.open_path() if behind else None
         if open_path is not None and motion_type not in paths.STREAMED_TYPES:
             return Outcome(Message.MPIMotionMessagePATH_ERROR, "the path in progress is open (final false): append "
                                                                "its points, or close it with final true, first")
+        # APPEND queues behind the move in progress or pending; from STOPPED a start without it
+        # drops what is pending (docs/state-machine.md), and behind a move already cruising at its
+        # final velocity there is nothing to wait for: the new move starts from where the axes are.
+        queued = behind and (bool(self._moves.queue) or not self._moves.cruising())
+        running = self._moves.current
+        if modify and not auto_start and not queued and open_path is None and running is not None:
+            verdict = validate.check_running_type(running.type)
+            if not verdict.ok:
+                return verdict
         verdict = self._check_request(motion_type, attrs, params, modify, append_to=open_path is not None)
         if not verdict.ok:
             return verdict
@@ -495,10 +509,6 @@ class MotionSupervisor:
             # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
             return Outcome(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
-        # APPEND queues behind the move in progress; from STOPPED a start drops what is pending
-        # (docs/state-machine.md), and behind a move already cruising at its final velocity there
-        # is nothing to wait for: the new move starts from where the axes are (a modify).
-        queued = append and state is MPIState.MOVING and (bool(self._moves.queue) or not self._moves.cruising())
         starts = self._starts(queued, state, modify and not auto_start)
         try:
             # (a cam also needs each slave's master; other moves are planned from the starts alone)
@@ -560,7 +570,7 @@ class MotionSupervisor:
         verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21,
                                       append=MotionAttr.APPEND in attrs)
         if verdict.ok:
-            append_to = (MotionAttr.APPEND in attrs and self._state.own_state is MPIState.MOVING
+            append_to = (MotionAttr.APPEND in attrs and self._state.own_state in (MPIState.MOVING, MPIState.STOPPED)
                          and self._moves.open_path() is not None)
             verdict = self._check_request(motion_type, attrs, params, modify, append_to)
         if not verdict.ok:

@@ -429,6 +429,30 @@ def test_cams_cannot_be_modified():
     assert ms1.modify(T.CAM_LINEAR, A.NONE, p()) is M.MPIMessageUNSUPPORTED
 
 
+@pytest.mark.parametrize("kind,params", [
+    (T.TRAPEZOIDAL, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)], position=[0.0, 0.0])),
+    (T.VELOCITY, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)])),
+], ids=["TRAPEZOIDAL", "VELOCITY"])
+def test_a_modifiable_type_does_not_replace_a_running_cam(kind, params):
+    # MPI 000, mpiMotionModify: the types "whose parameters can be modified while moving" do not name the
+    # cams; the running motion's type decides, not the modify's: the slaves go on following the master
+    ctl = controller()
+    follow(ctl, AxisMaster(S.AXIS_COMMANDED_POSITION, 0))
+    master_velocity(ctl, 1000.0)
+    ms1 = ctl.supervisor(1)
+    assert ms1.start(T.CAM_LINEAR, A.NONE, cam([10_000.0], [5000.0, 2000.0])).ok
+    ctl.step(100)
+    outcome, _ = ms1.command(kind, A.NONE, params, True)
+    assert outcome.message is M.MPIMessageUNSUPPORTED and "CAM_LINEAR" in outcome.detail
+    origin = 0.0
+    for _ in range(200):
+        ctl.step(1)
+        travel = command(ctl, 0) - origin
+        assert command(ctl, 1) == pytest.approx(0.5 * travel, abs=1e-9)
+        assert command(ctl, 2) == pytest.approx(0.2 * travel, abs=1e-9)
+    assert ms1.state is MPIState.MOVING and ms1.current.type is T.CAM_LINEAR
+
+
 def test_a_cam_that_does_not_fit_the_frame_buffer():
     # MEIMotionMessageFRAME_BUFFER_TOO_SMALL: "When trying to start a cam, an insufficient amount of space was
     # found on the controller ... reduce the number of points within the cam ... or increase the number of

@@ -832,6 +832,40 @@ def test_a_time_slice_of_one_sample_is_accepted():
     assert raw(ctl) == pytest.approx(P3[-1], abs=TOL)
 
 
+def _running(kind):
+    """A long closed path of ``kind`` (or FRAME moves) in progress: 40 points, 2 s."""
+    def setup(ctl, ms):
+        if kind is T.FRAME:
+            frames = [UserFrame(0.0, 100.0, 0.0, 0.0, 2.0), UserFrame(0.0, -50.0, 0.0, 0.0, 2.0)]
+            assert ms.start(T.FRAME, A.NONE, MotionParams(frames=frames)).ok
+        else:
+            t = np.arange(1.0, 41.0)
+            points = np.stack([10.0 * t + 5.0 * np.sin(t), -7.0 * t], axis=1)
+            assert ms.start(kind, A.RELATIVE, path_params(kind, points, [0.05] * 40, np.ones((40, 2)))).ok
+        ctl.step(200)
+        assert ms.state is MPIState.MOVING
+    return setup
+
+
+UNMODIFIABLE = [T.SPLINE, T.BSPLINE, T.BSPLINE2, T.BESSEL, T.PTF, T.PVTF, T.FRAME]
+MODIFYING = [(T.TRAPEZOIDAL, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)], position=[0.0, 0.0])),
+             (T.VELOCITY, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)])),
+             (T.PT, path_params(T.PT, P3, T3))]
+
+
+@pytest.mark.parametrize("running", UNMODIFIABLE, ids=[k.name for k in UNMODIFIABLE])
+@pytest.mark.parametrize("kind,params", MODIFYING, ids=[k.name for k, _ in MODIFYING])
+def test_the_running_motions_type_decides_whether_it_can_be_modified(running, kind, params):
+    # MPI 000, mpiMotionModify: "The types of motion whose parameters can be modified while moving are
+    # MPIMotionTypeTRAPEZOIDAL, MPIMotionTypeS_CURVE, MPIMotionTypeVELOCITY, MPIMotionTypePT and
+    # MPIMotionTypePVT": a modify of a modifiable type does not replace a motion that cannot be modified
+    (ctl_a, ms_a), (ctl_b, ms_b) = _twins(_running(running))
+    outcome, _ = ms_b.command(kind, A.NONE, params, True)
+    assert outcome.message is M.MPIMessageUNSUPPORTED
+    assert running.name in outcome.detail
+    assert _observe(ctl_a, ms_a) == _observe(ctl_b, ms_b)
+
+
 APPENDABLE = [T.PT, T.PTF, T.PVT, T.PVTF, T.BESSEL, T.BSPLINE, T.BSPLINE2]
 
 
@@ -935,6 +969,53 @@ def test_stop_decelerates_along_the_path_and_resume_continues_it():
     run_idle(ctl, ms)
     assert raw(ctl) == pytest.approx(points[-1], abs=TOL)
     assert [(e.serial, e.message) for e in ctl.move_log.recent(ms.number)] == [(serial, M.MPIMessageOK)]
+
+
+def _open_pvt_stopped_then_resumed(append_when_stopped: bool):
+    """An open PVT path (200 counts/s on axis 0), STOP at sample 101, RESUME 100 samples after it
+    is STOPPED; more points appended at sample 100 (MOVING) or once STOPPED. The command per sample."""
+    ctl, ms = new_supervisor(notify=None)
+    t = np.arange(1.0, 11.0)
+    first = np.stack([10.0 * t, -5.0 * t], axis=1)
+    more = np.stack([100.0 + 10.0 * t, -50.0 - 5.0 * t], axis=1)
+    velocity = np.tile([200.0, -100.0], (10, 1))
+    assert ms.start(T.PVT, A.NONE, path_params(T.PVT, first, [0.05] * 10, velocity, final=False,
+                                                empty_count=0)).ok
+    ctl.step(100)
+    appended = path_params(T.PVT, more, [0.05] * 10, velocity, final=True)
+    if not append_when_stopped:
+        assert ms.command(T.PVT, A.APPEND, appended, False)[0].ok
+    ctl.step(1)
+    assert ms.action(MPIAction.STOP).ok
+    assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 10_000)
+    if append_when_stopped:
+        assert ms.command(T.PVT, A.APPEND, appended, False)[0].ok
+        assert ms.state is MPIState.STOPPED
+    trace = []
+    for _ in range(100):
+        ctl.step(1)
+        trace.append(raw(ctl))
+    assert ms.action(MPIAction.RESUME).ok
+    while ms.state is not MPIState.IDLE and len(trace) < 20_000:
+        ctl.step(1)
+        trace.append(raw(ctl))
+    return np.array(trace)
+
+
+def test_points_appended_while_stopped_follow_the_stopped_path_and_resume_runs_them():
+    # MPI 000, MPIMotionPoint, final: "If final=0, more points can be loaded using mpiMotionModify(...) with the
+    # MPIMotionAttrMaskAPPEND attribute"; MPIMotionAttrMaskAPPEND adds "to the end of a previous motion
+    # profile": a STOP leaves the rest of the path pending, so the points follow it, as if appended in motion
+    stopped = _open_pvt_stopped_then_resumed(append_when_stopped=True)
+    moving = _open_pvt_stopped_then_resumed(append_when_stopped=False)
+    # the end time is the same sum of point times taken from another base: it may round to the next
+    # sample (both then rest on the last point), so the shorter run is padded with its last position
+    assert abs(len(stopped) - len(moving)) <= 1
+    length = max(len(stopped), len(moving))
+    stopped, moving = (np.concatenate([x, np.repeat(x[-1:], length - len(x), axis=0)]) for x in (stopped, moving))
+    assert np.allclose(stopped, moving, rtol=0.0, atol=TOL)
+    assert stopped[-1] == pytest.approx([200.0, -100.0], abs=TOL)
+    assert np.max(np.abs(np.diff(stopped[:, 0]))) * RATE <= 200.0 * (1 + 1e-6)
 
 
 def test_e_stop_decelerates_along_the_path_and_ends_its_goals_with_error():

@@ -278,9 +278,10 @@ def test_stop_while_holding_then_resume(params):
     assert ctl.axes[0].command_position == 300.0
 
 
-def test_append_in_stopped_follows_the_table(params):
-    # docs/state-machine.md: start in STOPPED is "OK, pending profile dropped" and modify in STOPPED
-    # answers MPIMotionMessageSTOPPED; APPEND does not change either.
+def test_append_in_stopped_queues_behind_the_pending_profile(params):
+    # docs/state-machine.md: modify in STOPPED answers MPIMotionMessageSTOPPED, with APPEND too; a start
+    # with APPEND is "added to the end of a previous motion profile" (MPI 000, MPIMotionAttrAPPEND): it
+    # queues behind the stopped profile, nothing moves until RESUME, which runs both in turn
     ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, params=params((5000.0, 0.0)))
     ctl.step(400)
@@ -288,9 +289,13 @@ def test_append_in_stopped_follows_the_table(params):
     assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 5000)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.APPEND, params((0.0, 0.0))) is Message.MPIMotionMessageSTOPPED
     assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((100.0, 0.0))).ok
-    assert not ms.queue and ms.state is MPIState.MOVING
-    assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000, chunk=50)
-    assert ctl.axes[0].command_position == 100.0  # the stopped 5000-count profile was dropped
+    stopped_at = ctl.axes[0].cmd_p
+    ctl.step(200)
+    assert len(ms.queue) == 1 and ms.state is MPIState.STOPPED and ctl.axes[0].cmd_p == stopped_at
+    assert ms.action(MPIAction.RESUME).ok
+    assert ctl.run_until(lambda c: c.axes[0].cmd_p == 5000.0, 20_000)
+    assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 40_000, chunk=50)
+    assert ctl.axes[0].command_position == 100.0
 
 
 def test_command_position_can_be_set_in_error_after_abort():

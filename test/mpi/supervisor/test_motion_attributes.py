@@ -12,6 +12,7 @@ from mpi_ros.mpi import (
     IoSpace,
     MotionAttr,
     MotionParams,
+    MPIAction,
     MPIMotionType,
     MPIState,
     Output,
@@ -58,6 +59,46 @@ def test_append_on_an_idle_supervisor_is_a_start(ctl, ms, params):
     # MPI 000, MPIMotionAttrAPPEND APPEND adds to "a previous motion profile": with none, the move starts
     assert ms.start(T.TRAPEZOIDAL, A.APPEND, params((300.0, 0.0))).ok
     assert ms.state is MPIState.MOVING and not ms.queue
+
+
+def _stopped_then_resumed(append_when_stopped: bool):
+    """A move to 1000, a STOP at sample 301, RESUME 100 samples after it is STOPPED; the APPEND of
+    a move to 2000 is given at sample 300 (MOVING) or once STOPPED. The command, per sample."""
+    ctl = Controller()
+    _, ms = ctl.create_motion(0)
+    ms.axis_list_set([0, 1])
+    params = (MotionParams(trajectory=[Trajectory(1000.0, 10_000.0, 10_000.0)], position=[x, 0.0])
+              for x in (1000.0, 2000.0))
+    assert ms.start(T.TRAPEZOIDAL, A.NONE, next(params)).ok
+    ctl.step(300)
+    if not append_when_stopped:
+        assert ms.start(T.TRAPEZOIDAL, A.APPEND, next(params)).ok
+    ctl.step(1)
+    assert ms.action(MPIAction.STOP).ok
+    assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 10_000)
+    if append_when_stopped:
+        assert ms.start(T.TRAPEZOIDAL, A.APPEND, next(params)).ok
+        assert ms.state is MPIState.STOPPED and ms.snapshot().moves_pending == 1
+    positions = []
+    for _ in range(100):
+        ctl.step(1)
+        positions.append(ctl.axes[0].cmd_p)
+    assert ms.action(MPIAction.RESUME).ok
+    while ms.state is not MPIState.IDLE:
+        ctl.step(1)
+        positions.append(ctl.axes[0].cmd_p)
+    return positions, len(events_of(ctl, E.MOTION_DONE))
+
+
+def test_append_while_stopped_queues_behind_the_pending_move_and_resume_runs_both():
+    # MPI 000, MPIMotionAttrAPPEND: "This bit enables the motion profile to be added to the end of a previous
+    # motion profile ... The APPENDED profile will begin execution after the previous profile has completed":
+    # a STOPPED supervisor's previous profile is still pending (RESUME continues it), so the appended move
+    # queues behind it exactly as if it had been appended before the STOP
+    stopped, done_stopped = _stopped_then_resumed(append_when_stopped=True)
+    moving, done_moving = _stopped_then_resumed(append_when_stopped=False)
+    assert stopped == moving
+    assert stopped[-1] == 2000.0 and done_stopped == done_moving == 2
 
 
 def test_append_with_modify(ctl, ms, params):
