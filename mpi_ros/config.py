@@ -102,6 +102,10 @@ class RosSettings:
     # taking and answering goal requests then costs the suite's interpreter a few microseconds
     # instead of about 0.2 ms a goal. For goal rates of hundreds a second (docs/reliability.md).
     goal_process: bool = False
+    # A URDF file (relative: to the configuration file's folder) published on
+    # <ns>/robot_description instead of the generated one; checked against the joints
+    # (mpi_ros/description.py, docs/joints.md). Empty: generated.
+    robot_description: str = ""
 
     @property
     def joint_states_topic(self) -> str:
