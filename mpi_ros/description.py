@@ -31,6 +31,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from pathlib import Path
 
+from mpi_ros import config as suite_config
 from mpi_ros.config import ConfigError, SuiteConfig
 from mpi_ros.joints import JOINT_AXES, AxisJoint, Joint
 from mpi_ros.mpi.base.params import AxisFaultConfig
@@ -42,6 +43,16 @@ _AXIS_VECTORS = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
 def _number(x: float) -> str:
     """Shortest text that reads back as the same double (repr), without a spurious "-0"."""
     return repr(float(x) + 0.0)
+
+
+def load(path: str | Path | None = None, namespace: str | None = None) -> SuiteConfig:
+    """The configuration a suite started with ``--config path --namespace namespace`` runs
+    (what ``mpi-ros urdf`` and launch/machine.launch.py describe). ConfigError if bad."""
+    config = suite_config.load(path)
+    if namespace:
+        suite_config.check_namespace(namespace, "--namespace")
+        config = suite_config.parse(suite_config.merge(config.raw, {"ros": {"namespace": namespace}}), config.source)
+    return config
 
 
 def base_link(config: SuiteConfig) -> str:

@@ -223,3 +223,18 @@ def test_the_urdf_command_exits_2_on_a_mismatched_user_urdf(tmp_path, capsys):
     assert capsys.readouterr().err.startswith("mpi-ros urdf: invalid configuration: ros.robot_description: ")
     assert main(["urdf", "--config", config.source, "--generated"]) == 0
     assert capsys.readouterr().out == description.generate(config)
+
+
+def test_the_suite_refuses_to_start_on_a_mismatched_user_urdf_and_exits_2_naming_the_joints(tmp_path):
+    import subprocess
+    import sys
+
+    _user_urdf(tmp_path, {"x": "prismatic", "y": "revolute"})
+    config = _gantry_with(tmp_path, "machine.urdf")
+    proc = subprocess.run([sys.executable, "-P", "-m", "mpi_ros.cli", "run", "--config", config.source],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip().endswith(
+        f"mpi-ros run: invalid configuration: ros.robot_description: {tmp_path / 'machine.urdf'}: joints of the "
+        "configuration not in it: z, c; joints of another type: y (prismatic in the configuration, revolute in "
+        "the file)")

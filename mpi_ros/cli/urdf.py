@@ -28,10 +28,7 @@ def run(args: argparse.Namespace) -> int:
     from mpi_ros import description
 
     try:
-        cfg = suite_config.load(args.config)
-        if args.namespace is not None:
-            suite_config.check_namespace(args.namespace, "--namespace")
-            cfg = suite_config.parse(suite_config.merge(cfg.raw, {"ros": {"namespace": args.namespace}}), cfg.source)
+        cfg = description.load(args.config, args.namespace)
         text = description.generate(cfg) if args.generated else description.robot_description(cfg)
     except suite_config.ConfigError as exc:
         print(f"mpi-ros urdf: invalid configuration: {exc}", file=sys.stderr)
