@@ -128,8 +128,9 @@ class JointStates:
 
     Built once (the scales and offsets precomputed as tuples); :meth:`convert` is on the
     path of every JointState (100 Hz and more). Plain Python over the tuples: for 4 to 32
-    axes it measured faster than numpy (3.5 us against 5.0 us at 4 axes, 13 us against
-    15 us at 32: the arrays' creation and tolist() cost more than the arithmetic).
+    axes as fast as numpy within the noise (the arrays' creation and tolist() cost as much as
+    the arithmetic) and about 1.6x faster than a method call per axis and value at 32 axes
+    (bench/bench_joints.py, bench/RESULTS.md "Joint states in SI units").
     """
 
     __slots__ = ("names", "_scale", "_offset", "_identity")
