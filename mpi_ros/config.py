@@ -107,6 +107,10 @@ class RosSettings:
     # suite's own server on rclpy's private bindings (ros/rcl.py), or "rclpy", rclpy's stock
     # ActionServer (a goal costs more; for an rclpy other than Jazzy's).
     action_server: str = "batched"
+    # A URDF file (relative: to the configuration file's folder) published on
+    # <ns>/robot_description instead of the generated one; checked against the joints
+    # (mpi_ros/description.py, docs/joints.md). Empty: generated.
+    robot_description: str = ""
 
     @property
     def joint_states_topic(self) -> str:

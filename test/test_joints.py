@@ -68,3 +68,24 @@ def test_conversions_are_inverse_and_a_negative_scale_flips_the_direction():
         assert joint.counts(joint.position(counts)) == pytest.approx(counts, rel=1e-12, abs=1e-9)
     assert joint.position(2000.0) == pytest.approx(-0.5)
     assert joint.counts_rate(joint.rate(123.0)) == pytest.approx(123.0)
+
+
+def test_joint_states_convert_every_axis_as_its_joint_and_leave_the_others_bit_for_bit():
+    from mpi_ros.joints import JointStates
+
+    config = load(overrides={"axes": {"overrides": {1: {"joint": {"name": "q", "type": "revolute",
+                                                                   "counts_per_unit": -2000.0, "offset": 0.5}}}}})
+    joints = config.axis_joints()
+    states = JointStates(joints)
+    assert states.names == ("axis0", "q", "axis2", "axis3")
+    position, velocity, effort = [-0.0, 1000.0, 3.25, -7.5], [0.0, -400.0, -0.0, 1e300], [-0.0, 8000.0, 2.0, -1.0]
+    out = states.convert(position, velocity, effort)
+    for k in (0, 2, 3):  # counts as they were, the sign of a zero included
+        for converted, given in zip(out, (position, velocity, effort), strict=True):
+            assert converted[k] == given[k] and math.copysign(1.0, converted[k]) == math.copysign(1.0, given[k])
+    joint = joints[1]
+    assert (out[0][1], out[1][1], out[2][1]) == (joint.position(1000.0), joint.rate(-400.0), joint.rate(8000.0))
+    assert (out[0][1], out[1][1], out[2][1]) == (0.0, 0.2, -4.0)
+    # a suite without joints: the lists themselves, untouched
+    plain = JointStates(load().axis_joints())
+    assert plain.convert(position, velocity, effort) == (position, velocity, effort)

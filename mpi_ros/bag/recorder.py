@@ -29,6 +29,7 @@ from .. import __version__
 from ..commands import Command as ControllerCommand
 from ..commands import Reply
 from ..config import SuiteConfig
+from ..joints import JointStates
 from ..ros import convert
 from ..runner import ControllerRunner, Output
 from .writer import BagWriter, TopicQos
@@ -72,7 +73,7 @@ class Recorder:
             self.writer.add_topic(f"{ns}/ms{spec.number}/status", "mpi_ros/msg/MotionStatus", status)
         for axis in ctl.axes:
             self.writer.add_topic(f"{ns}/axis{axis.number}/status", "mpi_ros/msg/AxisStatus", status)
-        self.joint_states_topic, self.joint_prefix = config.ros.joint_states_topic, config.ros.joint_prefix
+        self.joint_states_topic, self.joints = config.ros.joint_states_topic, JointStates(config.axis_joints())
         self.writer.add_topic(self.joint_states_topic, "sensor_msgs/msg/JointState", status)
         self.writer.add_metadata(METADATA_NAME, {
             "config": yaml.safe_dump(config.raw, sort_keys=False),
@@ -111,7 +112,7 @@ class Recorder:
         return write
 
     def _collect_joints(self, ctl):
-        msg = convert.joint_state(ctl, self.epoch, self.joint_prefix)
+        msg = convert.joint_state(ctl, self.epoch, self.joints)
         t = self.log_time(ctl.sample)
         return lambda: self.writer.write(self.joint_states_topic, msg, t)
 

@@ -45,6 +45,7 @@ COMMANDS: dict[str, str] = {
     "play": "mpi_ros.cli.play",
     "crosscheck": "mpi_ros.cli.crosscheck",
     "plot": "mpi_ros.cli.plot",
+    "urdf": "mpi_ros.cli.urdf",
     "version": "mpi_ros.cli.version",
 }
 

@@ -125,6 +125,7 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
+    from mpi_ros import description
     from mpi_ros.ros import parameters
     from mpi_ros.ros.rcl import UnsupportedRclpy
     from mpi_ros.ros.suite import Suite
@@ -132,12 +133,13 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
     rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])], signal_handler_options=SignalHandlerOptions.NO)
     try:
         cfg, time_scale = parameters.resolve(None, args.config, args.time_scale, getattr(args, "namespace", None))
+        robot_description = description.robot_description(cfg)  # the user's URDF checked against the joints
     except suite_config.ConfigError as exc:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         rclpy.try_shutdown()
         return 2
     try:
-        suite = Suite(cfg, time_scale=time_scale)
+        suite = Suite(cfg, time_scale=time_scale, robot_description=robot_description)
     except UnsupportedRclpy as exc:
         print(f"{prog}: {exc}", file=sys.stderr)
         rclpy.try_shutdown()

@@ -1,14 +1,17 @@
 """The node that serves the controller as a whole: /<ns>/controller.
 
 Publishes /<ns>/axis<k>/status, /<ns>/events, /joint_states, /diagnostics and /clock
-(controller time, for use_sim_time consumers; ros.clock: false leaves it to another suite
-of a cell). In a namespace other than /mpi, joint states go to <ns>/joint_states with names
-prefixed by the namespace (RosSettings.joint_states_topic, joint_prefix; docs/cell.md);
-/diagnostics is shared by design, its statuses named by namespace. Serves the axis services
-(/<ns>/axis<k>/config_get|config_set|position_set, and fault_config_get|fault_config_set|fault_inject:
-docs/faults.md) and the control's gates and I/O
-(/<ns>/gate_set|gate_get|io_get|io_set), and the motors' secondary feedback inputs that cams can
-follow (/<ns>/motor_feedback_secondary_set).
+(controller time, for use_sim_time consumers; ros.clock: false leaves it to another suite of
+a cell). Joint states are in SI units under the configured joint names (axes without a joint
+block: ``axis<k>`` in counts; docs/joints.md), and the robot description (generated from the
+joints, or the user's checked URDF) is latched on /<ns>/robot_description. In a namespace
+other than /mpi, joint states go to <ns>/joint_states with names prefixed by the namespace
+(RosSettings.joint_states_topic, joint_prefix; docs/cell.md); /diagnostics is shared by
+design, its statuses named by namespace. Serves the axis services
+(/<ns>/axis<k>/config_get|config_set|position_set, and
+fault_config_get|fault_config_set|fault_inject: docs/faults.md) and the control's gates and
+I/O (/<ns>/gate_set|gate_get|io_get|io_set), and the motors' secondary feedback inputs that
+cams can follow (/<ns>/motor_feedback_secondary_set).
 
 For recordings any tool can make: every command the controller applied goes out on
 /<ns>/commands (mpi_ros/msg/Command, with the sample at which it took effect) and the
@@ -23,12 +26,15 @@ Stamps (and /clock) are controller time anchored to the wall clock: epoch + samp
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Refused
@@ -52,6 +58,7 @@ from mpi_ros.srv import (
 from .. import requests as rq
 from ..commands import Command, Reply, io_space
 from ..config import RosSettings
+from ..joints import AxisJoint, JointStates
 from ..runner import ControllerRunner
 from . import convert, snapshots, wire
 from .supervisor_node import STATUS_QOS
@@ -81,12 +88,18 @@ def _level(value: int) -> bytes:
 
 
 class ControllerNode(Node):
-    def __init__(self, runner: ControllerRunner, settings: RosSettings, **kwargs):
+    """``joints``: every axis as /joint_states names it (SuiteConfig.axis_joints(); default:
+    ``axis<k>`` in counts). ``robot_description``: the URDF published latched on
+    <ns>/robot_description (none: not published)."""
+
+    def __init__(self, runner: ControllerRunner, settings: RosSettings, joints: Sequence[AxisJoint] | None = None,
+                 robot_description: str | None = None, **kwargs):
         super().__init__("controller", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.settings = settings
         self._snapshots = snapshots.shared(runner)
-        self._joint_names: list[str] | None = None  # /joint_states' names, one per axis (fixed)
+        self.joints = (convert.default_joints(runner.ctl, settings.joint_prefix) if joints is None
+                       else JointStates(joints))
         if not wire.AVAILABLE:  # correct, only slower: say so, or a benchmark would not know why
             self.get_logger().warning("the installed interfaces differ from the layouts mpi_ros/ros/wire.py packs: "
                                       "status topics are built as messages (about 3x the CPU)")
@@ -118,6 +131,9 @@ class ControllerNode(Node):
         self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._pub_commands = self.create_publisher(CommandMsg, "commands", COMMANDS_QOS)
         self._pub_configuration = self.create_publisher(SuiteConfiguration, "configuration", LATCHED_QOS)
+        if robot_description is not None:  # once, latched: robot_state_publisher's own topic and QoS
+            self._pub_description = self.create_publisher(String, "robot_description", LATCHED_QOS)
+            self._pub_description.publish(String(data=robot_description))
         self._applied: list = []  # commands applied since the last change hook, to publish after the lock
         runner.on_command(self._on_command)
         runner.on_change(self._collect_commands)
@@ -168,12 +184,10 @@ class ControllerNode(Node):
 
     def _collect_joints(self, ctl):
         if not wire.AVAILABLE:
-            msg = convert.joint_state(ctl, self.epoch_ns, self.settings.joint_prefix)
+            msg = convert.joint_state(ctl, self.epoch_ns, self.joints)
         else:  # packed straight into CDR, from the axis topics' snapshots when they were taken now
-            if self._joint_names is None:
-                self._joint_names = convert.joint_names(ctl, self.settings.joint_prefix)
-            values = convert.joint_values(ctl, self._snapshots.taken_axes(ctl))
-            msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, self._joint_names, *values)
+            values = self.joints.convert(*convert.joint_values(ctl, self._snapshots.taken_axes(ctl)))
+            msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, self.joints.names, *values)
         return lambda: convert.publish(self, self._pub_joints, msg)
 
     def _collect_clock(self, ctl):

@@ -25,6 +25,7 @@ import numpy as np
 from builtin_interfaces.msg import Time
 from sensor_msgs.msg import JointState
 
+from mpi_ros.joints import AxisJoint, JointStates
 from mpi_ros.mpi.base.events import Event
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
@@ -286,18 +287,27 @@ def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
 
 
 def joint_names(ctl, prefix: str = "") -> list[str]:
-    """``<prefix>axis<k>``: the prefix is RosSettings.joint_prefix (the namespace of a suite
-    in a cell, none for the default one)."""
+    """``<prefix>axis<k>``: the names of axes without a joint block; the prefix is
+    RosSettings.joint_prefix (the namespace of a suite in a cell, none for the default one)."""
     return [f"{prefix}axis{a.number}" for a in ctl.axes]
 
 
-def joint_state(ctl, epoch_ns: int | None = None, prefix: str = "") -> JointState:
-    """Every axis as a joint: actual position (counts), actual velocity (counts/s) and the
-    servo's control effort (counts/s^2, see :func:`servo_effort`)."""
+def default_joints(ctl, prefix: str = "") -> JointStates:
+    """Every axis as ``<prefix>axis<k>`` in counts: a suite whose axes have no joint block."""
+    return JointStates([AxisJoint(a.number, name, None) for a, name in zip(ctl.axes, joint_names(ctl, prefix),
+                                                                           strict=True)])
+
+
+def joint_state(ctl, epoch_ns: int | None = None, joints: JointStates | None = None) -> JointState:
+    """Every axis as a joint (``joints``: SuiteConfig.axis_joints() as JointStates; default:
+    ``axis<k>`` in counts): actual position (m or rad; counts without a joint), actual velocity
+    (per s) and the servo's control effort (per s^2: the acceleration the servo demands, see
+    plant.servo_effort)."""
+    joints = default_joints(ctl) if joints is None else joints
     msg = JointState()
     msg.header.stamp = stamp(ctl.sample, ctl.rate, epoch_ns)
-    msg.name = joint_names(ctl, prefix)
-    msg.position, msg.velocity, msg.effort = joint_values(ctl)
+    msg.name = list(joints.names)
+    msg.position, msg.velocity, msg.effort = joints.convert(*joint_values(ctl))
     return msg
 
 

@@ -18,6 +18,7 @@ from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
 
+from .. import description
 from ..config import SuiteConfig
 from ..runner import ControllerRunner
 from . import convert, rcl
@@ -34,6 +35,10 @@ class Suite:
     ``time_scale``: 1 real time, >1 faster, 0 as fast as possible, None manual (the
     caller steps ``suite.runner``; tests do this).
 
+    ``robot_description``: the URDF latched on <ns>/robot_description; default: what
+    description.robot_description(config) gives (ConfigError, before any node exists, if the
+    user's URDF does not match the joints).
+
     ``epoch_ns``: the wall-clock time of sample 0 (ns since the Unix epoch); every stamp and
     /clock is ``epoch + sample / rate``. Default: now, when the suite is built (the controller
     starts counting when ``start`` is called, a few milliseconds later). It is published with
@@ -41,14 +46,17 @@ class Suite:
     """
 
     def __init__(self, config: SuiteConfig, time_scale: float | None = 1.0, context: Context | None = None,
-                 epoch_ns: int | None = None):
+                 epoch_ns: int | None = None, robot_description: str | None = None):
         if config.ros.action_server == "batched":
             rcl.check_version()  # before any node: the batched server needs rclpy's private bindings
         self.config = config
+        self.robot_description = (description.robot_description(config) if robot_description is None
+                                  else robot_description)
         self.controller = config.build_controller()
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)
         self.runner = ControllerRunner(self.controller, time_scale)
-        self.controller_node = ControllerNode(self.runner, config.ros, context=context)
+        self.controller_node = ControllerNode(self.runner, config.ros, config.axis_joints(), self.robot_description,
+                                              context=context)
         self.goal_loop: GoalLoop | GoalRelay = (
             GoalRelay(config.ros.namespace, config.ros.executor_threads) if config.ros.goal_process
             else GoalLoop(self.controller_node.context, config.ros.executor_threads))
