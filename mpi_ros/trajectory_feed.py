@@ -64,10 +64,17 @@ class TrajectoryFeed:
 
     def receive(self, joint_names: Sequence[str], points: Sequence[tuple[Sequence[float], Sequence[float], float]],
                 stamp_ns: int) -> Outcome | None:
-        """A trajectory as it arrived: refused (its outcome, logged and counted), or scheduled (None)."""
+        """A trajectory as it arrived: refused (its outcome, logged and counted), or scheduled
+        (None). It counts as received once it is one or the other."""
+        try:
+            return self._receive(joint_names, points, stamp_ns)
+        finally:
+            with self._lock:
+                self.counts.received += 1
+
+    def _receive(self, joint_names: Sequence[str],
+                 points: Sequence[tuple[Sequence[float], Sequence[float], float]], stamp_ns: int) -> Outcome | None:
         now, listed, rate = self.runner.read(self._now)
-        with self._lock:
-            self.counts.received += 1
         joints = [self.joints[n] for n in listed]
         try:
             traj = trajectory.read(joint_names, points, joints)
