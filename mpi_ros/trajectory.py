@@ -172,25 +172,20 @@ def read(joint_names: Sequence[str], points: Sequence[tuple[Sequence[float], Seq
     order. Raises Refused (MPIMessagePARAM_INVALID) for names that are not exactly the
     supervisor's joints, or points of the wrong size."""
     order = _order(list(joint_names), joints)
+    columns = np.argsort(order)  # the message's column of each supervisor axis
     width = len(joints)
-    positions = np.empty((len(points), width))
     with_velocities = bool(points) and len(points[0][1]) > 0
-    velocities = np.empty((len(points), width)) if with_velocities else None
     for i, (p, v, _) in enumerate(points):
         if len(p) != width:
             raise Refused(Message.MPIMessagePARAM_INVALID,
                           f"points[{i}].positions: {len(p)} values for {width} joints")
-        positions[i, order] = p
-        if velocities is not None:
-            if len(v) != width:
-                raise Refused(Message.MPIMessagePARAM_INVALID,
-                              f"points[{i}].velocities: {len(v)} values for {width} joints (all points give "
-                              "velocities, or none does)")
-            velocities[i, order] = v
-        elif len(v):
+        if len(v) != (width if with_velocities else 0):
             raise Refused(Message.MPIMessagePARAM_INVALID,
-                          f"points[{i}].velocities: given, but not for points[0] (all points give velocities, "
-                          "or none does)")
+                          f"points[{i}].velocities: {len(v)} values for {width} joints (all points give "
+                          "velocities, or none does)")
+    positions = np.array([p for p, _, _ in points], dtype=float).reshape(len(points), width)[:, columns]
+    velocities = (np.array([v for _, v, _ in points], dtype=float).reshape(len(points), width)[:, columns]
+                  if with_velocities else None)
     times = np.array([float(t) for _, _, t in points])
     return Trajectory(tuple(joints), positions, velocities, times)
 
