@@ -57,9 +57,9 @@ class Suite:
         ]
         self.configuration = self.controller_node.publish_configuration(config)
         self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
-        self.controller_node.add_diagnostic(lambda ctl: [self._suite_status()])
         for node in self.supervisor_nodes:
             self.controller_node.add_diagnostic(node.trajectory_diagnostic)
+        self.controller_node.add_diagnostic(lambda ctl: [self._suite_status()])
         self.executors = [_executor(node, config.ros.executor_threads, context) for node in self.nodes]
         self.spinners: list[Spinner] = []
 
