@@ -33,11 +33,13 @@ from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
 from mpi_ros.mpi.control import Controller
 
 from . import requests as rq
+from . import trajectory
 
 MOTION_START = "motion_start"
 MOTION_MODIFY = "motion_modify"
 ACTION = "action"
 CLIENT_LOST = "client_lost"
+JOINT_TRAJECTORY = "joint_trajectory"
 # The reference has no "internal error" message; of its generic messages, NO_MEMORY ("not
 # enough memory was available") is the one that says the library failed, not the call.
 # Nothing else in the controller answers it, so it tells a bug apart from every refusal.
@@ -107,6 +109,37 @@ def _supervisor(ctl: Controller, command: Command):
 def _motion(ctl: Controller, command: Command, modify: bool) -> Reply:
     ms = _supervisor(ctl, command)
     request = rq.motion_request(command.request)
+    outcome, serial = ms.command(request.type, request.attributes, request.params, modify)
+    reply = Reply(outcome, serial, ms.state)
+    return reply if reply.accepted else replace(reply, serial=0)
+
+
+def _joint_trajectory(ctl: Controller, command: Command) -> Reply:
+    """A chunk of a JointTrajectory (trajectory.py, docs/trajectories.md): checked against the
+    supervisor now (its axes, and the speed from where the path starts), then the MPI path.
+    The first chunk replaces a PT or PVT path in progress from now (mpiMotionModify, MPI 000:
+    PT and PVT may be modified) or starts one (mpiMotionStart: refused while another motion
+    runs, or in ERROR, with the controller's message); later chunks APPEND to it. No points:
+    STOP."""
+    ms = _supervisor(ctl, command)
+    if not command.request.get("time_from_start"):
+        return Reply(ms.action_detail(MPIAction.STOP), state=ms.state)
+    chunk = trajectory.Chunk.from_request(command.request)
+    axes = [j.axis for j in chunk.joints]
+    if axes != list(ms.axis_list):
+        return Reply.of(Message.MPIMessagePARAM_INVALID, f"the trajectory's axes {axes} are not supervisor "
+                        f"{ms.number}'s axes {list(ms.axis_list)}", state=ms.state)
+    start = None
+    if not chunk.append:
+        snaps = [ctl.axis_snapshot(n) for n in axes]
+        start = [(s.command_position, s.command_velocity) for s in snaps]
+    verdict = chunk.check(start)
+    if not verdict.ok:
+        return Reply(verdict, state=ms.state)
+    running = ms.current
+    modify = chunk.append or (ms.state is MPIState.MOVING and running is not None
+                              and running.type.name in ("PT", "PVT"))
+    request = rq.motion_request(chunk.motion_request())
     outcome, serial = ms.command(request.type, request.attributes, request.params, modify)
     reply = Reply(outcome, serial, ms.state)
     return reply if reply.accepted else replace(reply, serial=0)
@@ -293,6 +326,7 @@ OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
     MOTION_MODIFY: lambda ctl, c: _motion(ctl, c, modify=True),
     ACTION: _action,
     CLIENT_LOST: _client_lost,
+    JOINT_TRAJECTORY: _joint_trajectory,
     "config_set": _config_set,
     "params_set": _params_set,
     "axis_list_set": _axis_list_set,

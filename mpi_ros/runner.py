@@ -17,11 +17,13 @@ Modes: ``time_scale`` 1 = real time, >1 faster, 0 = as fast as possible, None = 
 
 from __future__ import annotations
 
+import heapq
+import itertools
 import logging
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 
 from mpi_ros.mpi.base.events import Event
@@ -61,6 +63,17 @@ class _Periodic:
     next_sample: int
 
 
+@dataclass(order=True, slots=True)
+class _Scheduled:
+    """A command to apply when the controller reaches ``sample`` (schedule)."""
+
+    sample: int
+    seq: int
+    command: Command = field(compare=False)
+    tag: Hashable = field(compare=False)
+    answered: Callable[[Answer], Output | None] | None = field(compare=False, default=None)
+
+
 class ControllerRunner:
     def __init__(self, controller: Controller, time_scale: float | None = 1.0, wake_period: float = 0.01):
         if time_scale is not None and time_scale < 0:
@@ -82,6 +95,8 @@ class ControllerRunner:
         self._running = threading.Event()
         self._anchor_wall = 0.0
         self._anchor_sample = 0
+        self._scheduled: list[_Scheduled] = []  # a heap: commands waiting for their sample
+        self._seq = itertools.count()
         controller.listeners.append(self._on_event)
 
     # -- configuration ---------------------------------------------------------------
@@ -218,7 +233,9 @@ class ControllerRunner:
         if ctl.sample >= target:
             return
         while ctl.sample < target:
-            stop = min([target] + [p.next_sample for p in self._periodic])
+            self._apply_scheduled()
+            stop = min([target] + [p.next_sample for p in self._periodic]
+                       + [entry.sample for entry in self._scheduled[:1]])
             if stop > ctl.sample:
                 ctl.step(stop - ctl.sample)
             for periodic in self._periodic:
@@ -228,7 +245,44 @@ class ControllerRunner:
                     output = periodic.callback(ctl)
                     if output is not None:
                         self._outputs.append(output)
+        self._apply_scheduled()
         self._changed()
+
+    # -- commands at a given sample ----------------------------------------------------------
+    def schedule(self, sample: int, command: Command, tag: Hashable = None,
+                 answered: Callable[[Answer], Output | None] | None = None) -> None:
+        """Apply ``command`` when the controller is at ``sample`` (it takes effect from that
+        sample's time on and is recorded with the next, as every command); one already due is
+        applied as the controller next steps. ``answered(answer)`` is called under the lock
+        with its reply and sample; what it returns runs after the lock. Stepping stops at the
+        sample however the samples are batched, so a scheduled command is never late, and a
+        recording of it replays exactly."""
+        with self.lock:
+            heapq.heappush(self._scheduled, _Scheduled(sample, next(self._seq), command, tag, answered))
+        self._wake.set()
+
+    def unschedule(self, drop: Callable[[int, Hashable], bool]) -> int:
+        """Drop the scheduled commands for which ``drop(sample, tag)`` holds; how many."""
+        with self.lock:
+            kept = [entry for entry in self._scheduled if not drop(entry.sample, entry.tag)]
+            dropped = len(self._scheduled) - len(kept)
+            heapq.heapify(kept)
+            self._scheduled = kept
+        return dropped
+
+    def scheduled(self) -> int:
+        """Commands waiting for their sample."""
+        return len(self._scheduled)
+
+    def _apply_scheduled(self) -> None:
+        """Lock held: the scheduled commands due at the controller's sample, in order."""
+        while self._scheduled and self._scheduled[0].sample <= self.ctl.sample:
+            entry = heapq.heappop(self._scheduled)
+            answer = self._apply_one(entry.command, self.ctl.effective_sample)
+            if entry.answered is not None:
+                output = entry.answered(answer)
+                if output is not None:
+                    self._outputs.append(output)
 
     def _changed(self) -> None:
         """After a step batch or a command (under the lock): hooks, waiters."""

@@ -62,11 +62,13 @@ class Suite:
             else GoalLoop(self.controller_node.context, config.ros.executor_threads))
         self.supervisor_nodes = [
             SupervisorNode(self.runner, spec.number, config.ros, self.goal_loop, spec.lost_client_timeout,
-                           context=context)
+                           joints=config.axis_joints(), context=context)
             for spec in config.supervisors
         ]
         self.configuration = self.controller_node.publish_configuration(config)
         self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
+        for node in self.supervisor_nodes:
+            self.controller_node.add_diagnostic(node.trajectory_diagnostic)
         self.controller_node.add_diagnostic(lambda ctl: [self._suite_status()])
         self.executors = [_executor(node, config.ros.executor_threads, context) for node in self.nodes]
         self.spinners: list[Spinner] = []

@@ -24,11 +24,13 @@ from dataclasses import dataclass
 from functools import partial
 
 from action_msgs.msg import GoalStatus
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import serialize_message
 from std_srvs.srv import Trigger
+from trajectory_msgs.msg import JointTrajectory
 
 from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.mpi.base.messages import Message
@@ -58,7 +60,9 @@ from mpi_ros.srv import (
 from .. import requests as rq
 from ..commands import ACTION, CLIENT_LOST, MOTION_MODIFY, MOTION_START, Command, Reply
 from ..config import RosSettings
+from ..joints import AxisJoint
 from ..runner import ControllerRunner, Output
+from ..trajectory_feed import TrajectoryFeed
 from . import convert, snapshots, wire
 from .goal_endpoints import ACTION_SERVICE_QOS
 from .goal_front import GoalRelay
@@ -76,6 +80,8 @@ from .watchdog import LostClientWatchdog
 # they ask for.
 STATUS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feedback publisher
+# As joint_trajectory_controller's ~/joint_trajectory subscription: reliable, depth 10.
+TRAJECTORY_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 TRIGGER_ACTIONS = {"stop": "STOP", "e_stop": "E_STOP", "abort": "ABORT", "reset": "RESET", "resume": "RESUME"}
 # A goal whose cancel was accepted is still in one of these until its GoalServer has moved it
 # to CANCELING (right after our cancel callback returns); only then may it end CANCELED.
@@ -92,7 +98,7 @@ class _RosGoal:
 
 class SupervisorNode(Node):
     def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings, goal_loop: GoalLoop | GoalRelay,
-                 lost_client_timeout: float = 0.0, **kwargs):
+                 lost_client_timeout: float = 0.0, joints: list[AxisJoint] | None = None, **kwargs):
         super().__init__(f"ms{number}", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.number = number
@@ -137,6 +143,11 @@ class SupervisorNode(Node):
         runner.add_periodic(settings.status_rate, self._collect_status)
         runner.add_periodic(settings.feedback_rate, self._collect_feedback)
         runner.on_change(self._review)
+        # JointTrajectory commands in SI units (trajectory_feed.py, docs/trajectories.md)
+        self.trajectories = TrajectoryFeed(runner, number, joints or [], convert.epoch_of(runner.ctl) or 0,
+                                           self.get_logger().warning)
+        self.create_subscription(JointTrajectory, "~/joint_trajectory", self._on_trajectory, TRAJECTORY_QOS,
+                                 callback_group=self._service_group)
         self.watchdog = (LostClientWatchdog(self, lost_client_timeout, self._running, self._client_lost,
                                             self._service_group) if lost_client_timeout > 0 else None)
 
@@ -187,6 +198,30 @@ class SupervisorNode(Node):
         encode = wire.motion_status if wire.AVAILABLE else convert.motion_status
         msg = encode(snap, ctl.rate, convert.epoch_of(ctl))
         return lambda: convert.publish(self, self._pub_status, msg)
+
+    # -- JointTrajectory commands -----------------------------------------------------
+    def _on_trajectory(self, msg: JointTrajectory) -> None:
+        points = [(list(p.positions), list(p.velocities), p.time_from_start.sec + p.time_from_start.nanosec * 1e-9)
+                  for p in msg.points]
+        stamp_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        self.trajectories.receive(list(msg.joint_names), points, stamp_ns)
+
+    def trajectory_diagnostic(self, _ctl=None) -> list[DiagnosticStatus]:
+        """/diagnostics "<ns>/ms<n>/joint_trajectory": trajectories received, accepted, refused
+        (per MPI message) and interrupted, and the last refusal with its reason."""
+        counts = self.trajectories.snapshot()
+        status = DiagnosticStatus()
+        status.name = f"{self.settings.namespace.strip('/')}/ms{self.number}/joint_trajectory"
+        status.hardware_id = "mpi_ros simulated controller"
+        level = DiagnosticStatus.WARN if counts.refused_total or counts.interrupted else DiagnosticStatus.OK
+        status.level = bytes([level]) if isinstance(level, int) else level
+        status.message = (f"{counts.accepted} accepted, {counts.refused_total} refused, {counts.interrupted} "
+                          "interrupted" + (f"; last: {counts.last_refusal}" if counts.last_refusal else ""))
+        values = [("received", counts.received), ("accepted", counts.accepted), ("refused", counts.refused_total),
+                  ("interrupted", counts.interrupted), ("last_refusal", counts.last_refusal)]
+        values += [(f"refused_{name}", n) for name, n in sorted(counts.refused.items())]
+        status.values = [KeyValue(key=k, value=str(v)) for k, v in values]
+        return [status]
 
     # -- goals: acceptance and cancel (executor threads) -------------------------------
     def _on_goals(self, action_type, operation: str, goals: list[tuple[bytes, dict | Exception]]) -> None:

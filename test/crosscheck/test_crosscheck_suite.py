@@ -118,9 +118,9 @@ def test_crosscheck_is_off_by_default(ros_context):
     suite = Suite(config.load(), time_scale=None, context=ros_context)
     try:
         assert suite.crosscheck is None
-        # only the suite's own entry (mpi/suite), no crosscheck entry
+        # the supervisors' trajectory counts and the suite's own entry (mpi/suite), no crosscheck entry
         names = [status.name for provide in suite.controller_node.diagnostic_providers
                  for status in provide(suite.controller)]
-        assert names == ["mpi/suite"]
+        assert names == ["mpi/ms0/joint_trajectory", "mpi/ms1/joint_trajectory", "mpi/suite"]
     finally:
         suite.shutdown()

@@ -77,7 +77,8 @@ def test_diagnostics_go_to_error_on_e_stop(suite, client, probe, applied, drive)
     diagnostics = Collector(probe, DiagnosticArray, "/diagnostics")
     drive(lambda: bool(diagnostics.messages), chunk=500)
     names = [s.name for s in diagnostics.messages[0].status]
-    assert names == ["mpi/ms0", "mpi/ms1", "mpi/axis0", "mpi/axis1", "mpi/axis2", "mpi/axis3", "mpi/suite"]
+    assert names == ["mpi/ms0", "mpi/ms1", "mpi/axis0", "mpi/axis1", "mpi/axis2", "mpi/axis3",
+                     "mpi/ms0/joint_trajectory", "mpi/ms1/joint_trajectory", "mpi/suite"]
     assert {s.level for s in diagnostics.messages[0].status} == {DiagnosticStatus.OK}
     # what the suite holds, for long runs: no goals at rest; manual clock: never behind; the
     # publications of the batch being stepped (500 samples) queued until it ends, fewer than one a sample
