@@ -35,6 +35,7 @@ import re
 import threading
 import time
 import uuid
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -545,6 +546,14 @@ class _Endpoint:
         namespace = self.namespace if namespace is None else namespace
         return sorted(int(match.group(1)) for name, ns in self.node.get_node_names_and_namespaces()
                       if ns == namespace and (match := _SUPERVISOR_NODE.fullmatch(name)))
+
+    def twins_on_graph(self, namespace: str | None = None) -> list[str]:
+        """The nodes under ``namespace`` that are on the graph more than once: two suites
+        under one namespace (``mpi-ros run`` refuses a second one it can see; one that
+        discovery did not show in time, or started at the same moment, shows here)."""
+        namespace = self.namespace if namespace is None else namespace
+        seen = Counter(name for name, ns in self.node.get_node_names_and_namespaces() if ns == namespace)
+        return [f"{namespace.rstrip('/')}/{name}" for name, count in sorted(seen.items()) if count > 1]
 
     def wait_for_suite(self, timeout: float | None = None, supervisor: int | None = None) -> list[int]:
         """Wait until the suite (and ``supervisor``, if given) is on the graph.
