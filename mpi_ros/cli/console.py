@@ -72,7 +72,10 @@ class Session:
         except RuntimeError as exc:  # rclpy's RCLError: the ROS arguments did not parse
             raise UsageError(f"invalid ROS arguments {' '.join(args.ros_args)!r}: "
                              f"{str(exc).split(', at ')[0]}") from exc
-        self.node_name = f"mpi_ros_cli_{os.getpid()}"
+        # --no-wait leaves its goal running on purpose: a name the lost-client watchdog
+        # (mpi_ros/ros/watchdog.py, DETACHED) knows not to STOP it by when the verb exits
+        detached = "_detached" if getattr(args, "no_wait", False) else ""
+        self.node_name = f"mpi_ros_cli_{os.getpid()}{detached}"
         self._endpoints: list[Any] = []
 
     def client(self, supervisor: int):

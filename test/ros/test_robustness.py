@@ -124,7 +124,8 @@ def test_a_client_killed_mid_goal_leaves_the_suite_working(suite, client, applie
     finally:
         doomed.kill()
         doomed.wait(timeout=10)
-    # the orphaned goal keeps its move; the suite still serves others
+    # the orphaned goal keeps its move (until the lost-client watchdog: the client's 20 s DDS
+    # lease + lost_client_timeout, test_watchdog.py); the suite still serves others
     assert client.stop().message == "MPIMessageOK"
     drive(lambda: suite.runner.read(lambda ctl: ctl.supervisor(0).state is MPIState.STOPPED))
     client.reset()
