@@ -2,7 +2,7 @@
 
     from mpi_ros.client import MotionClient, MotionType, Outcome
     with MotionClient(supervisor=0) as ms0:
-        result = ms0.move([1000.0, 0.0], velocity=500.0, acceleration=5000.0, jerk_percent=50.0)
+        result = ms0.move([1000.0, 0.0], velocity=500.0, acceleration=5000.0, deceleration=5000.0, jerk_percent=50.0)
         print(result.outcome, result.message, result.actual_position)   # waits until DONE
         goal = ms0.start({"type": "VELOCITY", "trajectory": [{"velocity": 200.0, "acceleration": 1000.0}]})
         ms0.stop()
@@ -817,11 +817,14 @@ class MotionClient(_Endpoint):
             goal.feedback = early[-1]
         return goal
 
-    def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float | None = None,
+    def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float,
              jerk_percent: float = 0.0, motion_type: MotionType | str = MotionType.S_CURVE,
              attributes: Iterable[Attribute | str] = (), wait: bool = True, timeout: float | None = None,
              **fields: Any) -> MotionResult | Goal:
         """A point-to-point move (one position per axis); waits for the result (or returns the Goal).
+
+        ``deceleration`` is required, as MPITrajectory requires it of TRAPEZOIDAL, S_CURVE and
+        S_CURVE_JERK (MPI 000, MPIMotionTrapezoidal, MPIMotionSCurve): none is made up here.
 
         ``timeout``: seconds to wait for the result (None: the client's timeout; give a long
         move a longer one). Refused or ended early: raises the message's exception.
@@ -831,7 +834,7 @@ class MotionClient(_Endpoint):
             "attributes": [_name(a) for a in attributes],
             "position": [float(p) for p in position],
             "trajectory": [{"velocity": velocity, "acceleration": acceleration,
-                            "deceleration": acceleration if deceleration is None else deceleration,
+                            "deceleration": deceleration,
                             "jerk_percent": jerk_percent}],
             **fields,
         }

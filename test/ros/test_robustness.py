@@ -129,7 +129,7 @@ def test_a_client_killed_mid_goal_leaves_the_suite_working(suite, client, applie
     assert client.stop().message == "MPIMessageOK"
     drive(lambda: suite.runner.read(lambda ctl: ctl.supervisor(0).state is MPIState.STOPPED))
     client.reset()
-    result = client.move([0.0, 0.0], velocity=5000.0, acceleration=50000.0, wait=False)
+    result = client.move([0.0, 0.0], velocity=5000.0, acceleration=50000.0, deceleration=50000.0, wait=False)
     applied.wait(4)
     drive(lambda: result.done)
     assert result.wait().message == "MPIMessageOK"
