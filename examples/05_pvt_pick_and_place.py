@@ -30,7 +30,7 @@ with MotionClient(supervisor=0) as ms0:
     if not ms0.wait_for_server(10.0):
         raise SystemExit("no suite on the graph: start it with scripts/run.sh")
     # 1. to the pick point (a path starts wherever the axes are)
-    ms0.move([PICK, 0.0], velocity=2000.0, acceleration=20000.0, jerk_percent=50.0, timeout=30.0)
+    ms0.move([PICK, 0.0], velocity=2000.0, acceleration=20000.0, deceleration=20000.0, jerk_percent=50.0, timeout=30.0)
     # 2. the whole cycle as one PVT path, an element id per point
     points, velocities, times = zip(*PATH, strict=True)
     result = ms0.path(MotionType.PVT, points, times, velocities=velocities, element_ids=range(1, len(PATH) + 1))

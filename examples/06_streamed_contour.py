@@ -53,7 +53,8 @@ with MotionClient(supervisor=0) as ms0:
     if not ms0.wait_for_server(10.0):
         raise SystemExit("no suite on the graph: start it with scripts/run.sh")
     # 1. to the crossing of the figure eight, where the contour starts (a path starts where the axes are)
-    ms0.move(lemniscate(0.0), velocity=2000.0, acceleration=20000.0, jerk_percent=50.0, timeout=30.0)
+    ms0.move(lemniscate(0.0), velocity=2000.0, acceleration=20000.0, deceleration=20000.0,
+             jerk_percent=50.0, timeout=30.0)
     # 2. the points and their velocities (zero at the last point: the contour ends at rest)
     times = [DT * k for k in range(1, COUNT + 1)]
     points = [lemniscate(t) for t in times]

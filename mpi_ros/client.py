@@ -2,7 +2,7 @@
 
     from mpi_ros.client import MotionClient, MotionType, Outcome
     with MotionClient(supervisor=0) as ms0:
-        result = ms0.move([1000.0, 0.0], velocity=500.0, acceleration=5000.0, jerk_percent=50.0)
+        result = ms0.move([1000.0, 0.0], velocity=500.0, acceleration=5000.0, deceleration=5000.0, jerk_percent=50.0)
         print(result.outcome, result.message, result.actual_position)   # waits until DONE
         goal = ms0.start({"type": "VELOCITY", "trajectory": [{"velocity": 200.0, "acceleration": 1000.0}]})
         ms0.stop()
@@ -35,6 +35,7 @@ import re
 import threading
 import time
 import uuid
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -546,6 +547,14 @@ class _Endpoint:
         return sorted(int(match.group(1)) for name, ns in self.node.get_node_names_and_namespaces()
                       if ns == namespace and (match := _SUPERVISOR_NODE.fullmatch(name)))
 
+    def twins_on_graph(self, namespace: str | None = None) -> list[str]:
+        """The nodes under ``namespace`` that are on the graph more than once: two suites
+        under one namespace (``mpi-ros run`` refuses a second one it can see; one that
+        discovery did not show in time, or started at the same moment, shows here)."""
+        namespace = self.namespace if namespace is None else namespace
+        seen = Counter(name for name, ns in self.node.get_node_names_and_namespaces() if ns == namespace)
+        return [f"{namespace.rstrip('/')}/{name}" for name, count in sorted(seen.items()) if count > 1]
+
     def wait_for_suite(self, timeout: float | None = None, supervisor: int | None = None) -> list[int]:
         """Wait until the suite (and ``supervisor``, if given) is on the graph.
 
@@ -808,11 +817,14 @@ class MotionClient(_Endpoint):
             goal.feedback = early[-1]
         return goal
 
-    def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float | None = None,
+    def move(self, position: Iterable[float], velocity: float, acceleration: float, deceleration: float,
              jerk_percent: float = 0.0, motion_type: MotionType | str = MotionType.S_CURVE,
              attributes: Iterable[Attribute | str] = (), wait: bool = True, timeout: float | None = None,
              **fields: Any) -> MotionResult | Goal:
         """A point-to-point move (one position per axis); waits for the result (or returns the Goal).
+
+        ``deceleration`` is required, as MPITrajectory requires it of TRAPEZOIDAL, S_CURVE and
+        S_CURVE_JERK (MPI 000, MPIMotionTrapezoidal, MPIMotionSCurve): none is made up here.
 
         ``timeout``: seconds to wait for the result (None: the client's timeout; give a long
         move a longer one). Refused or ended early: raises the message's exception.
@@ -822,7 +834,7 @@ class MotionClient(_Endpoint):
             "attributes": [_name(a) for a in attributes],
             "position": [float(p) for p in position],
             "trajectory": [{"velocity": velocity, "acceleration": acceleration,
-                            "deceleration": acceleration if deceleration is None else deceleration,
+                            "deceleration": deceleration,
                             "jerk_percent": jerk_percent}],
             **fields,
         }

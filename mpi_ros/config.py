@@ -64,6 +64,9 @@ class ConfigError(ValueError):
     """The configuration is invalid; the message names the key."""
 
 
+LOST_CLIENT_TIMEOUT = 2.0  # s: the lost-client watchdog's default
+
+
 @dataclass(slots=True)
 class SupervisorSpec:
     number: int
@@ -71,8 +74,9 @@ class SupervisorSpec:
     config: MotionConfig
     event_notify: MPIEventType
     # The lost-client watchdog (docs/cell.md): STOP this supervisor's motion when the client
-    # of a running goal has been gone from the graph this long (s); 0 = off (the default).
-    lost_client_timeout: float = 0.0
+    # of a running goal has been gone from the graph this long (s); 0 = off. On by default
+    # (docs/decisions.md): Jazzy's `ros2 action send_goal` does not cancel its goal on Ctrl-C.
+    lost_client_timeout: float = LOST_CLIENT_TIMEOUT
 
 
 DEFAULT_NAMESPACE = "/mpi"
@@ -427,8 +431,9 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         mask = MPIEventType.parse(notify_names) if isinstance(notify_names, list) else None
         if mask is None:
             raise ConfigError(f"{where}.event_notify: expected a list of event type names, got {notify_names!r}")
-        timeout = _lost_client_timeout(entry.get("lost_client_timeout", defaults.get("lost_client_timeout", 0.0)),
-                                       f"{where}.lost_client_timeout")
+        timeout = _lost_client_timeout(
+            entry.get("lost_client_timeout", defaults.get("lost_client_timeout", LOST_CLIENT_TIMEOUT)),
+            f"{where}.lost_client_timeout")
         specs.append(SupervisorSpec(number, list(axes), config, mask, timeout))
     return specs
 

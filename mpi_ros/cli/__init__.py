@@ -54,7 +54,7 @@ EPILOG = """\
 start here:
   mpi-ros run                      the suite (leave it running), then from another shell:
   mpi-ros status                   a live table of the supervisors and axes
-  mpi-ros move --position 1000 0 --velocity 500 --acceleration 5000 --jerk-percent 50
+  mpi-ros move --position 1000 0 --velocity 500 --acceleration 5000 --deceleration 5000 --jerk-percent 50
   mpi-ros demo                     or instead: a narrated, recorded tour on a suite of its own
 
 The console verbs (move ... echo) take --namespace (default /mpi) and --supervisor N

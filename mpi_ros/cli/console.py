@@ -72,7 +72,10 @@ class Session:
         except RuntimeError as exc:  # rclpy's RCLError: the ROS arguments did not parse
             raise UsageError(f"invalid ROS arguments {' '.join(args.ros_args)!r}: "
                              f"{str(exc).split(', at ')[0]}") from exc
-        self.node_name = f"mpi_ros_cli_{os.getpid()}"
+        # --no-wait leaves its goal running on purpose: a name the lost-client watchdog
+        # (mpi_ros/ros/watchdog.py, DETACHED) knows not to STOP it by when the verb exits
+        detached = "_detached" if getattr(args, "no_wait", False) else ""
+        self.node_name = f"mpi_ros_cli_{os.getpid()}{detached}"
         self._endpoints: list[Any] = []
 
     def client(self, supervisor: int):
@@ -82,6 +85,7 @@ class Session:
         client = self._keep(MotionClient(supervisor, self.args.namespace, context=self.context,
                                          timeout=self.args.timeout, node_name=self.node_name))
         client.wait_for_suite(self.args.timeout, supervisor)
+        warn_twins(self.args, client)
         if not client.wait_for_server(self.args.timeout):
             raise UsageError(f"{client.prefix} is on the graph but its actions and services did not answer "
                              f"within {self.args.timeout:g} s: is the suite shutting down?")
@@ -94,6 +98,7 @@ class Session:
         watcher = self._keep(Watcher(self.args.namespace, context=self.context, timeout=self.args.timeout,
                                      node_name=f"{self.node_name}_watch"))
         watcher.wait_for_suite(self.args.timeout, self.args.supervisor)
+        warn_twins(self.args, watcher)
         return watcher
 
     def _keep(self, endpoint):
@@ -110,6 +115,22 @@ class Session:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def twins_warning(endpoint) -> str | None:
+    """The warning for nodes of the suite's namespace seen twice on the graph, if any."""
+    twins = endpoint.twins_on_graph()
+    if not twins:
+        return None
+    return (f"warning: {len(twins)} node name(s) of {endpoint.namespace} are on ROS_DOMAIN_ID {endpoint.domain_id} "
+            f"twice ({', '.join(twins)}): two suites run under one namespace, and both take every command; "
+            f"stop one of them")
+
+
+def warn_twins(args: argparse.Namespace, endpoint) -> None:
+    warning = twins_warning(endpoint)
+    if warning is not None:
+        print(f"{prog(args)}: {warning}", file=sys.stderr)
 
 
 def run_verb(args: argparse.Namespace, body) -> int:

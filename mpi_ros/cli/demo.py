@@ -342,6 +342,7 @@ def s_curve_move(t: Tour) -> None:
     p, v, a, j = S_CURVE["position"], S_CURVE["velocity"], S_CURVE["acceleration"], S_CURVE["jerk_percent"]
     t.step("An S-curve move of ms0's two axes (0 and 1) with 50 % jerk: the axes arrive together",
            f"mpi-ros move --type S_CURVE --position {p[0]:g} {p[1]:g} --velocity {v:g} --acceleration {a:g} "
+           f"--deceleration {a:g} "
            f"--jerk-percent {j:g}")
     t.follow(t.client.start(_goal(p, v, a, j)))
 
@@ -358,7 +359,7 @@ def _jog(velocity: float) -> dict[str, Any]:
 def modify_in_flight(t: Tour) -> None:
     t.step("A jog, modified in flight into an S-curve move to a target",
            "mpi-ros move --type VELOCITY -v -1000 -a 5000      # returns once at velocity\n"
-           "   $ mpi-ros modify --type S_CURVE --position 1000 -1000 -v 2000 -a 10000 -j 50")
+           "   $ mpi-ros modify --type S_CURVE --position 1000 -1000 -v 2000 -a 10000 -d 10000 -j 50")
     t.follow(t.client.start(_jog(-1000.0)))
     t.follow(t.client.modify(_goal([1000.0, -1000.0], 2000.0, 10000.0)))
 
@@ -383,7 +384,7 @@ def stop_resume_e_stop_reset(t: Tour) -> None:
     status = t.client.wait_for_state("ERROR", WAIT, newer_than=reply.sample)
     t.say(f"ERROR at {positions(a.actual_position for a in status.axes)}: every move is refused until a RESET")
 
-    t.step("A move in ERROR is refused, with the spec's message", "mpi-ros move --position 0 0 -v 1000 -a 5000")
+    t.step("A move in ERROR is refused, with the spec's message", "mpi-ros move --position 0 0 -v 1000 -a 5000 -d 5000")
     refused = t.client.start(_goal([0.0, 0.0], 1000.0, 5000.0)).wait(WAIT, raise_on_error=False)
     t.say(f"{refused.message} (code {refused.code}) {refused.outcome}: {refused.detail}")
 
@@ -404,5 +405,5 @@ def path_move(t: Tour) -> None:
 
 
 def home(t: Tour) -> None:
-    t.step("Back home", "mpi-ros move --position 0 0 -v 4000 -a 20000 -j 50")
+    t.step("Back home", "mpi-ros move --position 0 0 -v 4000 -a 20000 -d 20000 -j 50")
     t.follow(t.client.start(_goal([0.0, 0.0], 4000.0, 20000.0)))

@@ -28,7 +28,8 @@ def add_goal_arguments(parser: argparse.ArgumentParser) -> None:
                       help="target of each axis of the supervisor, in counts")
     goal.add_argument("--velocity", "-v", type=float, metavar="V", help="counts/s")
     goal.add_argument("--acceleration", "-a", type=float, metavar="A", help="counts/s²")
-    goal.add_argument("--deceleration", "-d", type=float, metavar="D", help="counts/s² (default: the acceleration)")
+    goal.add_argument("--deceleration", "-d", type=float, metavar="D",
+                      help="counts/s² (TRAPEZOIDAL, S_CURVE and S_CURVE_JERK need it; VELOCITY ignores it)")
     goal.add_argument("--jerk-percent", "-j", type=float, metavar="J",
                       help="0..100: share of each ramp with non-zero jerk (S_CURVE, VELOCITY; default 0)")
     goal.add_argument("--attribute", action="append", default=[], metavar="NAME",
@@ -71,12 +72,9 @@ def goal_from_args(args: argparse.Namespace) -> dict[str, Any]:
         trajectory = goal.get("trajectory") or [{}]
         if not isinstance(trajectory, list) or not all(isinstance(t, dict) for t in trajectory):
             raise UsageError("--goal: trajectory must be a list of mappings")
-        # every axis' limits, if SYNC_START/SYNC_END gives one per axis; --deceleration
-        # defaults to --acceleration where the goal has none
+        # every axis' limits, if SYNC_START/SYNC_END gives one per axis; no deceleration is
+        # made up: a point-to-point profile needs one (docs/decisions.md, "Deceleration")
         goal["trajectory"] = [{**t, **limits} for t in trajectory]
-        if "acceleration" in limits:
-            for t in goal["trajectory"]:
-                t.setdefault("deceleration", limits["acceleration"])
     attributes = [str(a).upper() for a in goal.get("attributes") or []] + [a.upper() for a in args.attribute]
     for flag, field, attribute in (("id", "id", "ID"), ("delay", "delay", "DELAY"),
                                    ("final_velocity", "final_velocity", "FINAL_VEL")):
@@ -92,10 +90,12 @@ def goal_from_args(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _check_complete(goal: dict[str, Any]) -> None:
-    """Flags alone must make a whole move: say which is missing rather than let it be refused."""
+    """Flags alone must make a whole move: say which is missing rather than let it be refused.
+    A point-to-point move needs its deceleration (MPI 000, MPIMotionTrapezoidal, MPIMotionSCurve:
+    the profile is specified by velocity, acceleration and deceleration); VELOCITY ignores it."""
     needed = ["velocity", "acceleration"]
     if goal["type"] not in ("VELOCITY", "VELOCITY_JERK"):
-        needed.insert(0, "position")
+        needed = ["position", *needed, "deceleration"]
     have = set(goal) | set((goal.get("trajectory") or [{}])[0])
     missing = [f"--{name.replace('_', '-')}" for name in needed if name not in have]
     if missing:

@@ -1,6 +1,6 @@
 """Modify the running move (MotionModify): a new target or new limits, in flight.
 
-  mpi-ros modify --position 500 0 --velocity 1000 --acceleration 10000
+  mpi-ros modify --position 500 0 --velocity 1000 --acceleration 10000 --deceleration 10000
   mpi-ros modify --type VELOCITY --velocity -200 --acceleration 5000
   mpi-ros modify --goal "{type: S_CURVE, position: [500.0, 0.0],
                           trajectory: [{velocity: 1000.0, acceleration: 10000.0}]}"

@@ -1,7 +1,7 @@
 """Start a move (MotionStart) on a supervisor and follow it to its end.
 
-  mpi-ros move --type S_CURVE --position 1000 0 --velocity 500 --acceleration 5000 --jerk-percent 50
-  mpi-ros move --position -200 0 -v 500 -a 5000 --attribute RELATIVE --supervisor 1
+  mpi-ros move --type S_CURVE --position 1000 0 --velocity 500 --acceleration 5000 --deceleration 5000 --jerk-percent 50
+  mpi-ros move --position -200 0 -v 500 -a 5000 -d 5000 --attribute RELATIVE --supervisor 1
   mpi-ros move --type VELOCITY --velocity 300 --acceleration 2000 --no-wait
   mpi-ros move --goal "{type: S_CURVE, position: [1000.0, 0.0], trajectory: [{velocity: 500.0, acceleration: 5000.0,
                         deceleration: 5000.0, jerk_percent: 50.0}]}"

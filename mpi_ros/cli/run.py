@@ -18,6 +18,10 @@ with Ctrl-C (SIGINT) or SIGTERM: goals end with their results, the nodes are des
 the controller stops; a second Ctrl-C ends the process at once. Then, from
 another shell: `mpi-ros status`, `mpi-ros move ...` (see `mpi-ros --help`); or, instead
 of run, `mpi-ros demo` for a narrated, recorded tour.
+
+One suite per namespace: before it creates its nodes, the suite looks for the namespace's
+controller node on the graph for up to 3.5 s (mpi_ros/ros/twin.py); if another suite is there
+it says where (namespace, domain, the other process where it can) and exits with status 2.
 """
 
 from __future__ import annotations
@@ -126,7 +130,7 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
     from rclpy.signals import SignalHandlerOptions
 
     from mpi_ros import description
-    from mpi_ros.ros import parameters
+    from mpi_ros.ros import parameters, twin
     from mpi_ros.ros.rcl import UnsupportedRclpy
     from mpi_ros.ros.suite import Suite
 
@@ -136,6 +140,13 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
         robot_description = description.robot_description(cfg)  # the user's URDF checked against the joints
     except suite_config.ConfigError as exc:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
+        rclpy.try_shutdown()
+        return 2
+    other = twin.find_suite(rclpy.get_default_context(), cfg.ros.namespace)
+    if other is not None and other.origin.gone:  # a killed suite's nodes, until its lease ends
+        print(f"{prog}: {other.ghost()}", file=sys.stderr)
+    elif other is not None:  # one suite per namespace (docs/cell.md)
+        print(f"{prog}: {other.refusal()}", file=sys.stderr)
         rclpy.try_shutdown()
         return 2
     try:

@@ -20,7 +20,7 @@ import threading
 import time
 from typing import Any, TextIO
 
-from .console import OK, add_target_options, run_verb
+from .console import OK, add_target_options, run_verb, twins_warning
 
 STALE_AFTER = 2.0  # s without a newer sample before the header says so
 FLAGS = (("DONE", "done"), ("AT_TARGET", "at_target"), ("IN_FINE_POSITION", "in_fine_position"),
@@ -51,7 +51,7 @@ def _status(session, args: argparse.Namespace) -> int:
         watcher.wait_for_status(supervisors, extra, args.timeout)
     if args.once:
         supervisor_statuses, axis_statuses = watcher.latest()
-        print("\n".join(render(supervisor_statuses, axis_statuses, watcher.namespace)))
+        print("\n".join(render(supervisor_statuses, axis_statuses, watcher.namespace, None, twins_warning(watcher))))
         return OK
     tty = sys.stdout.isatty()
     interval = args.interval if args.interval is not None else (0.1 if tty else 1.0)
@@ -73,7 +73,8 @@ def _live(watcher, out: TextIO, tty: bool, interval: float) -> None:
             if sample != last_sample:
                 last_sample, changed_at = sample, time.monotonic()
             stale = time.monotonic() - changed_at
-            lines = render(supervisors, axes, watcher.namespace, stale if stale > STALE_AFTER else None)
+            lines = render(supervisors, axes, watcher.namespace, stale if stale > STALE_AFTER else None,
+                           twins_warning(watcher))
             if tty:
                 up = f"\x1b[{drawn}F" if drawn else ""
                 out.write(up + "".join(f"{line}\x1b[K\n" for line in lines) + "\x1b[J")
@@ -89,14 +90,14 @@ def _live(watcher, out: TextIO, tty: bool, interval: float) -> None:
 
 
 def render(supervisors: dict[int, Any], axes: dict[int, Any], namespace: str,
-           stale: float | None = None) -> list[str]:
-    """The table's lines: a header, one row per supervisor, one per axis."""
+           stale: float | None = None, warning: str | None = None) -> list[str]:
+    """The table's lines: a header (and ``warning`` under it), one row per supervisor, one per axis."""
     sample = max((s.sample for s in [*supervisors.values(), *axes.values()]), default=0)
     header = f"{namespace}  sample {sample}"
     if stale is not None:
         header += f"  (no newer status for {stale:.0f} s: is the suite still running?)"
-    lines = [header, (f"{'supervisor':<11} {'state':<15} {'axes':<10} {'move':>5}  {'type':<14} "
-                      f"{'pending':>7}  last action")]
+    lines = [header, *([warning] if warning else []),
+             f"{'supervisor':<11} {'state':<15} {'axes':<10} {'move':>5}  {'type':<14} {'pending':>7}  last action"]
     rows: list[Any] = []
     for number in sorted(supervisors):
         ms = supervisors[number]

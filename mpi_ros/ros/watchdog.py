@@ -2,9 +2,15 @@
 
 A client that holds a running goal and vanishes (process killed, link cut) can no longer
 cancel it: the move would run to its end with nobody watching. With
-``lost_client_timeout: T`` (seconds, per supervisor; 0, the default, is off) the suite
+``lost_client_timeout: T`` (seconds, per supervisor; 2 by default, 0 is off) the suite
 STOPs that supervisor's motion once the goal's client has been gone from the graph for T
-seconds, with a CLIENT_LOST event saying which goal and why.
+seconds, with a CLIENT_LOST event saying which goal and why. It is on by default because
+Jazzy's ``ros2 action send_goal`` does not cancel its goal on Ctrl-C (an upstream bug,
+fixed in later releases): without it an interrupted send_goal left the axis moving.
+
+A client may leave a goal running on purpose (``mpi-ros move --no-wait``): a node whose
+name ends in DETACHED says so, and a goal whose candidate clients are all such nodes is
+not watched.
 
 How "the goal's client" is found on the graph: rclpy does not tell an action server who
 sent a goal, but every ROS action client (rclpy, rclcpp, the ros2 tool) subscribes to the
@@ -37,6 +43,7 @@ from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
 
 PERIOD = 0.1  # s between looks at the graph (shorter for a shorter timeout)
+DETACHED = "_detached"  # the end of a client node's name whose goals are left running on purpose
 DISCOVERY_GRACE = 1.0  # s a goal's client may take to appear on the graph after its goal
 
 
@@ -49,8 +56,16 @@ class _Watched:
     gone_since: float | None = None  # monotonic time the last of them left the graph
 
 
-def _gids(node: Node, topic: str) -> frozenset:
-    return frozenset(bytes(info.endpoint_gid) for info in node.get_subscriptions_info_by_topic(topic))
+@dataclass(frozen=True, slots=True)
+class _Subscribers:
+    gids: frozenset  # every subscriber of a feedback topic
+    detached: bool  # there are some, and every one is a DETACHED client
+
+
+def _subscribers(node: Node, topic: str) -> _Subscribers:
+    infos = node.get_subscriptions_info_by_topic(topic)
+    return _Subscribers(frozenset(bytes(info.endpoint_gid) for info in infos),
+                        bool(infos) and all(info.node_name.endswith(DETACHED) for info in infos))
 
 
 def describe(keys: Iterable[bytes]) -> str:
@@ -76,7 +91,10 @@ class LostClientWatchdog:
         self.timer = node.create_timer(min(PERIOD, max(timeout / 4.0, 0.01)), self.check, callback_group=group)
 
     def watch(self, key: bytes, topic: str) -> None:
-        watched = _Watched(key, topic, _gids(self.node, topic), self._clock())
+        subscribers = _subscribers(self.node, topic)
+        if subscribers.detached:
+            return  # sent by a client that leaves it running on purpose (only such were there)
+        watched = _Watched(key, topic, subscribers.gids, self._clock())
         with self._lock:
             self._goals[key] = watched
 
@@ -87,7 +105,7 @@ class LostClientWatchdog:
         if not goals:
             return
         still = self._running([w.key for w in goals])
-        present: dict[str, frozenset] = {}
+        present: dict[str, _Subscribers] = {}
         now = self._clock()
         lost = []
         for watched in goals:
@@ -95,8 +113,11 @@ class LostClientWatchdog:
                 self._forget(watched.key)
                 continue
             if watched.topic not in present:
-                present[watched.topic] = _gids(self.node, watched.topic)
-            if self._gone(watched, present[watched.topic], now):
+                present[watched.topic] = _subscribers(self.node, watched.topic)
+            if not watched.clients and present[watched.topic].detached:  # its client, seen late, is detached
+                self._forget(watched.key)
+                continue
+            if self._gone(watched, present[watched.topic].gids, now):
                 lost.append(watched)
                 self._forget(watched.key)
         if lost:

@@ -221,7 +221,8 @@ def test_live_run_recorded_with_mpi_ros_run_replays_exactly(tmp_path, ros_contex
     try:
         with MotionClient(0, context=ros_context, timeout=20.0) as ms0:
             assert ms0.wait_for_server(20.0)
-            ms0.move([2000.0, 500.0], velocity=4000.0, acceleration=40000.0, jerk_percent=50.0, timeout=20.0)
+            ms0.move([2000.0, 500.0], velocity=4000.0, acceleration=40000.0, deceleration=40000.0,
+                     jerk_percent=50.0, timeout=20.0)
             goal = ms0.start({"type": "S_CURVE", "position": [-30000.0, 0.0],
                               "trajectory": [{"velocity": 3000.0, "acceleration": 30000.0, "deceleration": 30000.0}]})
             ms0.wait_for_state("MOVING", 20.0)

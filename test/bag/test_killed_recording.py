@@ -57,7 +57,8 @@ def test_a_killed_recording_replays_as_truncated_and_the_suite_restarts(tmp_path
     try:
         with MotionClient(0, namespace="/killed", context=ros_context, timeout=WAIT) as ms0:
             assert ms0.wait_for_server(WAIT)
-            assert ms0.move([20000.0, -5000.0], velocity=50000.0, acceleration=500000.0).message == "MPIMessageOK"
+            assert ms0.move([20000.0, -5000.0], velocity=50000.0, acceleration=500000.0,
+                            deceleration=500000.0).message == "MPIMessageOK"
         wait_for_record(bag, "/killed/commands", suite)  # its chunk is written; more may follow
     finally:
         suite.send_signal(signal.SIGKILL)
@@ -87,7 +88,8 @@ def test_a_killed_recording_replays_as_truncated_and_the_suite_restarts(tmp_path
             assert arrived.wait(WAIT), "no configuration from the restarted suite"
             running = yaml.safe_load(got[0].config)
             assert running["ros"]["feedback_rate"] == 25.0 and got[0].ros_namespace == "/killed"
-            assert ms0.move([0.0, 0.0], velocity=50000.0, acceleration=500000.0).message == "MPIMessageOK"
+            assert ms0.move([0.0, 0.0], velocity=50000.0, acceleration=500000.0,
+                            deceleration=500000.0).message == "MPIMessageOK"
     finally:
         restarted.send_signal(signal.SIGINT)
         _, err = restarted.communicate(timeout=WAIT)

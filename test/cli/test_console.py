@@ -31,7 +31,7 @@ def _table_row(table: str, first: str) -> list[str]:
 # -- move ----------------------------------------------------------------------------------------
 def test_move_prints_the_final_message_code_and_positions_and_exits_0(ms0):
     proc = mpi_ros("move", "--type", "S_CURVE", "--position", "1000", "-500", "--velocity", "5000",
-                   "--acceleration", "50000", "--jerk-percent", "50")
+                   "--acceleration", "50000", "--deceleration", "50000", "--jerk-percent", "50")
     assert proc.returncode == 0, proc.stderr
     assert "MPIMessageOK (code 0) DONE, state IDLE: motion done" in proc.stdout
     assert "command position [1000.0, -500.0]" in proc.stdout
@@ -51,7 +51,8 @@ def test_move_from_goal_yaml_with_a_flag_overriding_it_on_ms1(ms1, capsys):
 
 def test_a_move_with_a_wrong_number_of_positions_is_refused_with_exit_1(ms0):
     before = [a.command_position for a in ms0.status(WAIT).axes]
-    proc = mpi_ros("move", "--position", "1000", "--velocity", "500", "--acceleration", "5000")
+    proc = mpi_ros("move", "--position", "1000", "--velocity", "500", "--acceleration", "5000",
+                   "--deceleration", "5000")
     assert proc.returncode == 1, proc.stderr
     first = proc.stdout.splitlines()[0]
     assert first.startswith("MPIMessagePARAM_INVALID (code 2) REFUSED, state IDLE: position needs 2 value(s)")
@@ -60,7 +61,10 @@ def test_a_move_with_a_wrong_number_of_positions_is_refused_with_exit_1(ms0):
 
 def test_move_usage_errors_exit_2_and_say_what_is_missing(capsys):
     assert console("move", "--position", "1000", "0") == 2
-    assert "--velocity and --acceleration needed for a S_CURVE move" in capsys.readouterr().err
+    assert "--velocity and --acceleration and --deceleration needed for a S_CURVE move" in capsys.readouterr().err
+    # a point-to-point move's deceleration is never made up (docs/decisions.md, "Deceleration")
+    assert console("move", "--position", "1000", "0", "-v", "500", "-a", "5000") == 2
+    assert "--deceleration needed for a S_CURVE move" in capsys.readouterr().err
     assert console("move", "--goal", "[1, 2]") == 2
     assert "--goal: expected a mapping of goal fields" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exc:
@@ -81,7 +85,7 @@ def test_an_unknown_supervisor_exits_2_naming_those_the_suite_runs():
 
 
 def test_no_suite_exits_2_saying_where_it_looked_and_what_to_do():
-    proc = mpi_ros("move", "--position", "0", "0", "-v", "1", "-a", "1", "--namespace", "/nosuch",
+    proc = mpi_ros("move", "--position", "0", "0", "-v", "1", "-a", "1", "-d", "1", "--namespace", "/nosuch",
                    "--timeout", "0.5")
     assert proc.returncode == 2
     message = proc.stderr.strip()
@@ -124,7 +128,7 @@ def test_stop_resume_e_stop_reset_change_the_state_as_status_shows(ms0, capsys):
     assert _table_row(table, "ms0")[1] == "ERROR" and _table_row(table, "ms1")[1] == "IDLE"
     assert "E_STOP (USER)" in table
 
-    assert console("move", "--position", "0", "0", "-v", "100", "-a", "1000") == 1
+    assert console("move", "--position", "0", "0", "-v", "100", "-a", "1000", "-d", "1000") == 1
     captured = capsys.readouterr()
     assert captured.out.startswith("MPIMotionMessageERROR (code 2315) REFUSED, state ERROR")
     assert "`mpi-ros reset` leaves it" in captured.err
@@ -191,7 +195,8 @@ def test_modify_in_flight_retargets_the_move(ms0):
                       "trajectory": [{"velocity": 2000.0, "acceleration": 20000.0, "deceleration": 20000.0,
                                       "jerk_percent": 50.0}]})
     ms0.wait_for(lambda s: s.state_name == "MOVING", WAIT, "MOVING")
-    proc = mpi_ros("modify", "--position", "-300", "250", "--velocity", "8000", "--acceleration", "80000")
+    proc = mpi_ros("modify", "--position", "-300", "250", "--velocity", "8000", "--acceleration", "80000",
+                   "--deceleration", "80000")
     assert proc.returncode == 0, proc.stdout + proc.stderr
     final = [line for line in proc.stdout.splitlines() if not line.startswith("progress")]
     assert final[0].startswith("MPIMessageOK (code 0) DONE")
@@ -200,13 +205,13 @@ def test_modify_in_flight_retargets_the_move(ms0):
 
 
 def test_modify_while_idle_is_refused(ms0, capsys):
-    assert console("modify", "--position", "0", "0", "-v", "100", "-a", "1000") == 1
+    assert console("modify", "--position", "0", "0", "-v", "100", "-a", "1000", "-d", "1000") == 1
     assert capsys.readouterr().out.startswith("MPIMotionMessageIDLE (code 2310) REFUSED")
 
 
 # -- Ctrl-C ------------------------------------------------------------------------------------------
 def test_ctrl_c_during_a_move_cancels_it_which_is_a_stop(ms0, running):
-    move = running("move", "--position", "100000", "0", "-v", "1000", "-a", "10000")
+    move = running("move", "--position", "100000", "0", "-v", "1000", "-a", "10000", "-d", "10000")
     move.expect("progress")  # it runs
     move.process.send_signal(signal.SIGINT)
     status, out, err = move.finish()
@@ -221,8 +226,9 @@ def test_events_prints_motion_done_after_a_move_filtered_by_type_and_supervisor(
     events = running("events", "--supervisor", "0", "--type", "MOTION_DONE", "--type", "motion_start",
                      "--count", "2")
     events.expect("listening on /mpi/events", stream="stderr")
-    ms1.move([10.0, 0.0], velocity=5000.0, acceleration=50000.0, timeout=WAIT)  # another supervisor: not shown
-    ms0.move([300.0, 300.0], velocity=5000.0, acceleration=50000.0, timeout=WAIT)
+    # another supervisor: not shown
+    ms1.move([10.0, 0.0], velocity=5000.0, acceleration=50000.0, deceleration=50000.0, timeout=WAIT)
+    ms0.move([300.0, 300.0], velocity=5000.0, acceleration=50000.0, deceleration=50000.0, timeout=WAIT)
     status, out, err = events.finish()
     assert status == 0, err
     lines = out.splitlines()

@@ -25,7 +25,7 @@ from mpi_ros.client import EVENTS_QOS, MotionClient
 from mpi_ros.msg import Command, MotionEvent, MotionStatus
 
 WAIT = 20.0
-FAST = {"velocity": 200000.0, "acceleration": 2000000.0, "jerk_percent": 0.0}
+FAST = {"velocity": 200000.0, "acceleration": 2000000.0, "deceleration": 2000000.0, "jerk_percent": 0.0}
 
 
 def say(**fields) -> None:
@@ -94,7 +94,7 @@ def phase1(clients: dict[str, MotionClient]) -> dict:
 
 def cut(clients: dict[str, MotionClient], ns_a: str, ns_b: str) -> dict:
     a = clients[ns_a]
-    goal = a.move([500000.0, 0.0], velocity=2000.0, acceleration=20000.0, wait=False)
+    goal = a.move([500000.0, 0.0], velocity=2000.0, acceleration=20000.0, deceleration=20000.0, wait=False)
     if not goal.wait_started(WAIT):
         raise SystemExit("the long move did not start")
     moving = a.wait_for_state("MOVING", WAIT)

@@ -85,7 +85,8 @@ def test_two_namespaced_suites_share_a_graph_without_colliding(cell, probe, ros_
     try:
         for client in clients:
             assert client.wait_for_server(WAIT)
-        goals = [client.move([1000.0 * (i + 1), 0.0], velocity=20000.0, acceleration=200000.0, wait=False)
+        goals = [client.move([1000.0 * (i + 1), 0.0], velocity=20000.0, acceleration=200000.0,
+                              deceleration=200000.0, wait=False)
                  for i, client in enumerate(clients)]
         step_all(cell, lambda: all(goal.done for goal in goals))
         results = [goal.wait(WAIT) for goal in goals]
@@ -143,7 +144,8 @@ def test_mpi_ros_run_takes_the_namespace(how, ros_context, tmp_path):
     try:
         with MotionClient(0, namespace="/cell_a", context=ros_context, timeout=PROCESS_WAIT) as ms0:
             assert ms0.wait_for_server(PROCESS_WAIT), "the suite did not come up in /cell_a"
-            result = ms0.move([500.0, 0.0], velocity=5000.0, acceleration=50000.0, timeout=PROCESS_WAIT)
+            result = ms0.move([500.0, 0.0], velocity=5000.0, acceleration=50000.0, deceleration=50000.0,
+                              timeout=PROCESS_WAIT)
             assert result.message == "MPIMessageOK"
             configuration = ms0.node.get_topic_names_and_types()
             assert "/cell_a/joint_states" in dict(configuration)

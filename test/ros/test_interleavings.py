@@ -140,7 +140,7 @@ def test_random_interleavings_from_several_clients_on_shared_axes(shared_suite, 
             with MotionClient(n, context=probe.context, timeout=WAIT, node_name=f"interleavings_after_{n}") as ms:
                 assert ms.wait_for_server(WAIT)
                 ms.reset()
-        result = ms0.move([100.0, -100.0], velocity=5000.0, acceleration=50000.0, timeout=WAIT)
+        result = ms0.move([100.0, -100.0], velocity=5000.0, acceleration=50000.0, deceleration=50000.0, timeout=WAIT)
         assert (result.message, result.state_name) == ("MPIMessageOK", "IDLE")
 
     process.send_signal(signal.SIGINT)

@@ -124,11 +124,12 @@ def test_a_client_killed_mid_goal_leaves_the_suite_working(suite, client, applie
     finally:
         doomed.kill()
         doomed.wait(timeout=10)
-    # the orphaned goal keeps its move; the suite still serves others
+    # the orphaned goal keeps its move (until the lost-client watchdog: the client's 20 s DDS
+    # lease + lost_client_timeout, test_watchdog.py); the suite still serves others
     assert client.stop().message == "MPIMessageOK"
     drive(lambda: suite.runner.read(lambda ctl: ctl.supervisor(0).state is MPIState.STOPPED))
     client.reset()
-    result = client.move([0.0, 0.0], velocity=5000.0, acceleration=50000.0, wait=False)
+    result = client.move([0.0, 0.0], velocity=5000.0, acceleration=50000.0, deceleration=50000.0, wait=False)
     applied.wait(4)
     drive(lambda: result.done)
     assert result.wait().message == "MPIMessageOK"

@@ -32,7 +32,8 @@ def test_move_e_stop_reset_across_processes_and_clean_ctrl_c(suite_process, ros_
 
     with MotionClient(0, context=ros_context, timeout=WAIT) as ms0:
         assert ms0.wait_for_server(WAIT), "the suite did not come up"
-        result = ms0.move([1500.0, -500.0], velocity=5000.0, acceleration=50000.0, jerk_percent=50.0,
+        result = ms0.move([1500.0, -500.0], velocity=5000.0, acceleration=50000.0, deceleration=50000.0,
+                          jerk_percent=50.0,
                           timeout=WAIT)
         assert (result.message, result.state_name) == ("MPIMessageOK", "IDLE")
         assert list(result.command_position) == [1500.0, -500.0]
@@ -44,7 +45,7 @@ def test_move_e_stop_reset_across_processes_and_clean_ctrl_c(suite_process, ros_
         status = ms0.wait_for_state("ERROR", WAIT)
         assert (status.last_action, status.action_source) == ("E_STOP", "USER")
         with pytest.raises(errors.MPIMotionMessageERROR):
-            ms0.move([0.0, 0.0], velocity=100.0, acceleration=1000.0)
+            ms0.move([0.0, 0.0], velocity=100.0, acceleration=1000.0, deceleration=1000.0)
         assert ms0.reset().state_name == "IDLE"
 
     suite_process.send_signal(signal.SIGINT)

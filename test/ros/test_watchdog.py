@@ -1,10 +1,12 @@
-"""The lost-client watchdog (docs/cell.md, "Lost clients"; mpi_ros/ros/watchdog.py): off by
-default; with lost_client_timeout on a supervisor, a goal whose client leaves the graph has its
-motion STOPped, with a CLIENT_LOST event, through a recorded command."""
+"""The lost-client watchdog (docs/cell.md, "Lost clients"; mpi_ros/ros/watchdog.py): on by
+default (2 s; docs/decisions.md: Jazzy's `ros2 action send_goal` does not cancel its goal on
+Ctrl-C), 0 turns it off; a goal whose client leaves the graph has its motion STOPped, with a
+CLIENT_LOST event, through a recorded command."""
 
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -22,7 +24,9 @@ from mpi_ros.mpi.base.types import MPIState
 from .conftest import WAIT
 
 LEASE_PROFILE = Path(__file__).resolve().parents[2] / "config" / "fastdds_short_lease.xml"
-TIMEOUT = 0.5  # s: ms1's lost_client_timeout here
+# this tree's default configuration (an installed copy, which config.load() prefers, may be older)
+DEFAULTS = Path(__file__).resolve().parents[2] / "config" / "default.yaml"
+TIMEOUT = config.LOST_CLIENT_TIMEOUT  # s: ms1's lost_client_timeout here, the default
 LEASE = 2.0  # s: the killed client's DDS lease (config/fastdds_short_lease.xml)
 # s more a loaded machine may take to see the killed client leave the graph (the middleware's
 # lease check and graph update; 2.5 s in all here, over 12 s seen once in a loaded full run)
@@ -34,18 +38,29 @@ FEEDBACK = "/mpi/ms1/motion_start/_action/feedback"  # where the doomed client s
 
 @pytest.fixture
 def suite_config():
-    return config.load(overrides={"supervisors": [{"number": 0, "axes": [0, 1]},
-                                                  {"number": 1, "axes": [2, 3], "lost_client_timeout": TIMEOUT}]})
+    # ms1 keeps the default; ms0 turns the watchdog off
+    return config.load(DEFAULTS, overrides={"supervisors": [{"number": 0, "axes": [0, 1], "lost_client_timeout": 0},
+                                                            {"number": 1, "axes": [2, 3]}]})
 
 
-def test_the_watchdog_is_off_by_default_and_validated():
-    cfg = config.load()
-    assert [spec.lost_client_timeout for spec in cfg.supervisors] == [0.0, 0.0]
-    on = config.load(overrides={"supervisor_defaults": {"lost_client_timeout": 2}})
-    assert [spec.lost_client_timeout for spec in on.supervisors] == [2.0, 2.0]
+def test_the_watchdog_is_on_at_2_s_by_default_and_validated(tmp_path):
+    assert TIMEOUT == 2.0
+    cfg = config.load(DEFAULTS)
+    assert [spec.lost_client_timeout for spec in cfg.supervisors] == [2.0, 2.0]
+    unsaid = tmp_path / "unsaid.yaml"  # a configuration that does not name it
+    unsaid.write_text("".join(line for line in DEFAULTS.read_text().splitlines(keepends=True)
+                              if "lost_client_timeout" not in line))
+    assert [spec.lost_client_timeout for spec in config.load(unsaid).supervisors] == [2.0, 2.0]
+    off = config.load(DEFAULTS, overrides={"supervisor_defaults": {"lost_client_timeout": 0}})
+    assert [spec.lost_client_timeout for spec in off.supervisors] == [0.0, 0.0]
     for bad in (-1.0, "soon", float("inf"), True):
         with pytest.raises(config.ConfigError, match=r"supervisors\[0\]\.lost_client_timeout"):
             config.load(overrides={"supervisors": [{"number": 0, "axes": [0], "lost_client_timeout": bad}]})
+
+
+def _no_inherited_sigint() -> None:
+    # a process started from a background job inherits an ignored SIGINT: the client must die of it
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 class Events:
@@ -72,13 +87,19 @@ class Events:
             return next(entry for entry in self.commands if entry[1].operation == operation)
 
 
-def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_path):
+@pytest.mark.parametrize("kill", [signal.SIGINT, signal.SIGKILL], ids=["SIGINT", "SIGKILL"])
+def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_path, kill):
+    """SIGINT is Ctrl-C on a client that does not cancel its goal then, as Jazzy's ros2
+    action send_goal; SIGKILL leaves nothing the client could do. Either way the motion is
+    STOPPED lost_client_timeout after the client has left the graph (at once for SIGINT, its
+    DDS lease for SIGKILL)."""
     seen = Events(suite.runner)
     env = dict(os.environ, FASTRTPS_DEFAULT_PROFILES_FILE=str(LEASE_PROFILE))
     doomed = subprocess.Popen([sys.executable, "-P", str(DOOMED), "1", "500000.0"], stdin=subprocess.PIPE,
-                              stdout=subprocess.PIPE, text=True, cwd=tmp_path, env=env)
+                              stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=tmp_path, env=env,
+                              preexec_fn=_no_inherited_sigint)  # noqa: PLW1509 - signal() only
     watchdog = suite.supervisor_nodes[1].watchdog
-    assert suite.supervisor_nodes[0].watchdog is None  # off where not configured
+    assert suite.supervisor_nodes[0].watchdog is None  # lost_client_timeout: 0 is off
     try:
         assert doomed.stdout.readline().strip() == "sent"
         seen.wait_command("motion_start", WAIT)
@@ -86,8 +107,11 @@ def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_
         assert watchdog.watched == 1
     finally:
         killed_at = time.monotonic()
-        doomed.kill()
-        doomed.wait(timeout=10)
+        doomed.send_signal(kill)
+        ended = doomed.wait(timeout=10)
+    # SIGINT: rclpy's handler shuts the client's context down and KeyboardInterrupt ends it
+    # (an exit status 1, or an abort in the middleware's teardown, -6, seen here)
+    assert ended == -signal.SIGKILL if kill is signal.SIGKILL else ended != 0
     sample, command, reply = seen.wait_command(
         CLIENT_LOST, LEASE + TIMEOUT + LOADED,
         lambda: f"watched: {watchdog.describe_watched()}; subscribers of the feedback topic: "
@@ -95,6 +119,8 @@ def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_
                             for info in suite.supervisor_nodes[1].get_subscriptions_info_by_topic(FEEDBACK)))
     took = time.monotonic() - killed_at
     assert TIMEOUT <= took < LEASE + TIMEOUT + LOADED
+    # the client did not cancel (no STOP action of its own): the watchdog stopped the motion
+    assert [c.operation for _, c, _ in seen.commands] == ["motion_start", CLIENT_LOST]
     assert command.supervisor == 1 and reply.message.name == "MPIMessageOK" and reply.state is MPIState.STOPPING
     lost = [e for e in seen.events if e.type_name == "CLIENT_LOST"]
     assert len(lost) == 1 and lost[0].supervisor == 1 and "left the graph" in lost[0].detail
@@ -130,9 +156,11 @@ class FakeGraph:
 
     def __init__(self):
         self.subscribers: dict[str, list[bytes]] = {}
+        self.names: dict[bytes, str] = {}  # node names by GID ("client" when not given)
 
     def get_subscriptions_info_by_topic(self, topic):
-        return [SimpleNamespace(endpoint_gid=list(gid)) for gid in self.subscribers.get(topic, [])]
+        return [SimpleNamespace(endpoint_gid=list(gid), node_name=self.names.get(gid, "client"))
+                for gid in self.subscribers.get(topic, [])]
 
     def create_timer(self, period, callback, callback_group=None):
         return SimpleNamespace(period=period, callback=callback)
@@ -197,3 +225,31 @@ def test_a_goal_whose_client_was_never_seen_is_stopped_after_the_discovery_grace
     now[0] = 30.0
     watchdog.check()
     assert len(lost) == 1 and watchdog.watched == 1
+
+
+def test_a_goal_whose_clients_are_all_detached_is_not_watched():
+    """`mpi-ros move --no-wait` leaves its goal running on purpose: its node's name ends in
+    DETACHED, and a goal whose candidate clients are all such nodes is never stopped; with
+    any other candidate among them it is watched as usual."""
+    from mpi_ros.ros.watchdog import DETACHED, LostClientWatchdog
+
+    graph, now, lost = FakeGraph(), [0.0], []
+    topic = "/mpi/ms0/motion_start/_action/feedback"
+    graph.subscribers[topic] = [b"D" * 16]
+    graph.names[b"D" * 16] = f"mpi_ros_cli_123{DETACHED}"
+    watchdog = LostClientWatchdog(graph, 0.5, lambda keys: set(keys), lost.append, None, clock=lambda: now[0])
+    watchdog.watch(b"g" * 16, topic)
+    assert watchdog.watched == 0
+    graph.subscribers[topic] = [b"D" * 16, b"A" * 16]  # a ros2 tool beside it: which one sent it?
+    watchdog.watch(b"h" * 16, topic)
+    assert watchdog.watched == 1
+    graph.subscribers[topic] = []
+    watchdog.check()
+    now[0] = 0.5
+    watchdog.check()
+    assert len(lost) == 1 and "68686868" in lost[0]
+    graph.subscribers[topic] = []  # a detached client seen only after its goal: forgotten then
+    watchdog.watch(b"i" * 16, topic)
+    graph.subscribers[topic] = [b"D" * 16]
+    watchdog.check()
+    assert watchdog.watched == 0 and len(lost) == 1
