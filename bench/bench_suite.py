@@ -76,7 +76,7 @@ os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
 WAIT = 30.0
 BASELINE = "ca83577"  # the suite before issue 10's ROS-layer changes (wire.py, snapshots.py, the clock's stops)
 SETTLE = 2.0  # s between the last axis at velocity and the window (discovery, queues drained)
-_STAMP = struct.Struct("<iI")  # builtin_interfaces/Time, the first field of every topic counted
+_STAMP = struct.Struct("<iI")  # builtin_interfaces/Time: every topic counted starts with its header's stamp
 
 
 @dataclass(frozen=True)

@@ -55,8 +55,18 @@ from bench_suite import (  # noqa: E402
 )
 
 SUPERVISORS = 8
-_SAMPLE = struct.Struct("<Q")  # MotionStatus/AxisStatus: stamp (8 bytes), then uint64 sample, after the CDR header
-_SAMPLE_AT = 4 + 8
+_SAMPLE = struct.Struct("<Q")
+_LENGTH = struct.Struct("<I")
+CDR_HEADER = 4
+
+
+def sample_of(data: bytes) -> int:
+    """The sample of a MotionStatus/AxisStatus in CDR: after the 4-byte CDR header, the
+    std_msgs/Header (stamp: 8 bytes; frame_id: uint32 length, then that many bytes), then the
+    uint64 sample, aligned to 8 from the start of the data."""
+    (length,) = _LENGTH.unpack_from(data, CDR_HEADER + 8)
+    at = 8 + 4 + length
+    return _SAMPLE.unpack_from(data, CDR_HEADER + at + -at % 8)[0]
 
 
 def suite_yaml(directory: Path, status_rate: float, result_timeout: float, goal_process: bool) -> Path:
@@ -84,7 +94,7 @@ class SampleOrder:
     lock: threading.Lock = field(default_factory=threading.Lock)
 
     def on_message(self, data: bytes, _info: dict) -> None:
-        (sample,) = _SAMPLE.unpack_from(data, _SAMPLE_AT)
+        sample = sample_of(data)
         with self.lock:
             self.count += 1
             if self.last >= 0:

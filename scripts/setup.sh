@@ -19,6 +19,28 @@ req="$repo/requirements"
 say() { printf '[setup] %s\n' "$*"; }
 die() { printf '[setup] ERROR: %s\n' "$*" >&2; exit 1; }
 
+# Progress of the long steps, one line at a time (a CI log shows them as they come): the whole
+# output goes to a log under build/, the lines that show progress to the terminal, and on a
+# failure the log's last lines follow.
+logged() {  # logged NAME FILTER COMMAND...: run COMMAND, its output to build/setup-NAME.log
+    local name="$1" filter="$2"; shift 2
+    local log="$repo/build/setup-$name.log"
+    if ! "$@" 2>&1 | tee "$log" | "$filter"; then
+        printf '[setup] %s failed; the end of %s:\n' "$name" "$log" >&2
+        tail -n 40 "$log" >&2
+        exit 1
+    fi
+}
+pip_progress() {  # pip's lines, condensed: a line every 25 packages resolved, then the install
+    awk '/^Collecting / { n++; if (n % 25 == 1) { printf "[setup]   %d packages resolved\n", n; fflush() } next }
+         /^Installing collected packages/ { printf "[setup]   installing %d packages\n", n; fflush() }'
+}
+build_progress() {  # setup.py's own lines and CMake's percentage, every 10 %
+    awk '/^\[mpi_ros setup.py\]/ { sub(/^\[mpi_ros setup.py\] /, ""); if (length($0) < 100) printf "[setup]   %s\n", $0; fflush(); next }
+         /^\[ *[0-9]+%\]/ { p = substr($0, 2, index($0, "%") - 2) + 0
+                             if (p >= last + 10) { printf "[setup]   building the interfaces: %d%%\n", p; fflush(); last = p } }'
+}
+
 mkdir -p "$repo/build"
 exec 9>"$repo/build/.setup.lock"
 flock 9
@@ -87,9 +109,12 @@ deps_stamp="$venv/.mpi_ros-deps.stamp"
 if [[ "$(cat "$deps_stamp" 2>/dev/null || true)" != "$deps_hash" ]]; then
     say "installing pinned requirements (requirements/runtime.txt, requirements/test.txt)"
     rm -f "$deps_stamp" "$venv/.mpi_ros-package.stamp"
-    "$vpy" -m pip install --quiet -r "$req/runtime.txt" -r "$req/test.txt"
+    start=$SECONDS
+    logged requirements pip_progress \
+        "$vpy" -m pip install --progress-bar off -r "$req/runtime.txt" -r "$req/test.txt"
     "$vpy" "$repo/scripts/fix-ros-wheel-paths.py" --prefix "$venv"
     printf '%s' "$deps_hash" > "$deps_stamp"
+    say "requirements installed in $((SECONDS - start)) s"
 fi
 
 # --- 3. the package ------------------------------------------------------------------------
@@ -110,7 +135,7 @@ if [[ "$(cat "$pkg_stamp" 2>/dev/null || true)" != "$pkg_hash" \
     say "building and installing mpi_ros (pip install .; CMake build dir build/cmake)"
     rm -f "$pkg_stamp"
     start=$SECONDS
-    (cd "$repo" && "$vpy" -m pip install --quiet --no-deps --no-build-isolation .)
+    (cd "$repo" && logged build build_progress "$vpy" -m pip install -v --no-deps --no-build-isolation .)
     printf '%s' "$pkg_hash" > "$pkg_stamp"
     say "mpi_ros installed in $((SECONDS - start)) s"
 elif [[ "${MPI_ROS_SETUP_QUIET:-0}" != 1 ]]; then

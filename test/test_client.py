@@ -117,8 +117,9 @@ def test_message_to_dict_and_message_class():
     status = MotionStatus(number=1, state_name="IDLE", axis_numbers=[2, 3], axes=[AxisStatus(number=2)])
     plain = message_to_dict(status)
     assert plain["number"] == 1 and plain["axis_numbers"] == [2, 3]
-    assert plain["axes"][0]["number"] == 2 and plain["stamp"] == {"sec": 0, "nanosec": 0}
-    assert list(plain)[:3] == ["stamp", "sample", "number"]  # in field order
+    assert plain["axes"][0]["number"] == 2
+    assert plain["header"] == {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}  # nested messages as dicts
+    assert list(plain)[:3] == ["header", "sample", "number"]  # in field order
     assert message_class("mpi_ros/msg/MotionStatus") is MotionStatus
     assert message_class("mpi_ros/MotionStatus") is MotionStatus
     with pytest.raises(ValueError):

@@ -47,6 +47,7 @@ def play(node: Node, path: str | Path, rate: float = 1.0, topics: Iterable[str] 
             break
         if stop.is_set():
             break
-        publishers[item.topic].publish(item.data)
+        # a message recorded before its type changed is sent in the installed type (reader.upgrade)
+        publishers[item.topic].publish(item.installed_data())
         count += 1
     return count

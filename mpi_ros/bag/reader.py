@@ -33,15 +33,59 @@ class Recorded:
     sequence: int = 0  # the writer's count on the topic: the order messages were written in
     schema_text: str = ""  # the ros2msg definition the bag stores for the type ("": unknown)
 
+    @property
+    def older(self) -> bool:
+        """Whether the bag stores a definition of the type other than the installed one (a bag
+        recorded before the type changed, docs/recording.md "Older recordings")."""
+        return bool(self.schema_text) and self.schema_text != schema.ros2msg(self.type)
+
     def decode(self):
         """The message: as its generated Python class (the package must be installed) when the
         bag's definition of the type is the installed one; else read by the definition the bag
         stores (a bag recorded before the type changed), with the fields it had."""
-        if self.schema_text and self.schema_text != schema.ros2msg(self.type):
+        if self.older:
             return _recorded_decoder(self.type, self.schema_text)(self.data)
         from rclpy.serialization import deserialize_message
 
         return deserialize_message(self.data, schema.message_class(self.type))
+
+    def installed_data(self) -> bytes:
+        """The CDR of the message in the installed type: the recorded bytes, or, recorded by an
+        older definition, the message rebuilt in the installed type (:func:`upgrade`)."""
+        if not self.older:
+            return self.data
+        from rclpy.serialization import serialize_message
+
+        return serialize_message(upgrade(self.decode(), schema.message_class(self.type)))
+
+
+def upgrade(old: Any, cls: Any) -> Any:
+    """A message of the installed ``cls`` from ``old``, read by an older definition: the fields
+    both have, by name (nested messages alike); a field ``old`` lacks keeps its default, except
+    a header, which takes a bare ``stamp`` (the layout before the headers)."""
+    msg = cls()
+    for name, kind in cls.get_fields_and_field_types().items():
+        if name == "header" and not hasattr(old, "header") and hasattr(old, "stamp"):
+            msg.header.stamp.sec, msg.header.stamp.nanosec = old.stamp.sec, old.stamp.nanosec
+            continue
+        if not hasattr(old, name):
+            continue
+        value = getattr(old, name)
+        nested = _nested_class(kind)
+        if nested is None:
+            setattr(msg, name, value)
+        elif kind.startswith("sequence<") or kind.endswith("]"):
+            setattr(msg, name, [upgrade(item, nested) for item in value])
+        else:
+            setattr(msg, name, upgrade(value, nested))
+    return msg
+
+
+def _nested_class(kind: str) -> Any:
+    """The message class of a field type ('pkg/Type', 'sequence<pkg/Type>', 'pkg/Type[3]'), or None
+    for a primitive or a sequence of primitives."""
+    base = kind.removeprefix("sequence<").split(">")[0].split(",")[0].split("[")[0]
+    return schema.message_class(base) if "/" in base else None
 
 
 @lru_cache(maxsize=64)

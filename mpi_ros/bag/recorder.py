@@ -58,6 +58,7 @@ class Recorder:
         self.rate = ctl.rate
         ns = config.ros.namespace.rstrip("/")
         self.ns = ns
+        self.namespace = config.ros.namespace  # the headers' frame ids name their sources in it
         if epoch_ns is None:  # the suite's epoch when recording a suite (its stamps on the graph)
             epoch_ns = convert.epoch_of(ctl)
         if epoch_ns is None:
@@ -99,11 +100,13 @@ class Recorder:
         t = self.log_time(ctl.sample)
         motions, axes = ctl.motion_snapshots()  # every axis read once for both kinds of topic
         messages: list[tuple[str, object]] = [
-            (f"{self.ns}/ms{number}/status", convert.motion_status(snap, ctl.rate, self.epoch))
+            (f"{self.ns}/ms{number}/status", convert.motion_status(snap, ctl.rate, self.epoch, self.namespace))
             for number, snap in motions.items()
         ]
-        messages += [(f"{self.ns}/axis{snap.number}/status", convert.axis_status(snap, ctl.rate, self.epoch))
-                     for snap in axes]
+        messages += [
+            (f"{self.ns}/axis{snap.number}/status", convert.axis_status(snap, ctl.rate, self.epoch, self.namespace))
+            for snap in axes
+        ]
 
         def write() -> None:
             for topic, msg in messages:
@@ -117,11 +120,11 @@ class Recorder:
         return lambda: self.writer.write(self.joint_states_topic, msg, t)
 
     def _on_event(self, event) -> None:
-        self.writer.write(f"{self.ns}/events", convert.motion_event(event, self.rate, self.epoch),
+        self.writer.write(f"{self.ns}/events", convert.motion_event(event, self.rate, self.epoch, self.namespace),
                           self.log_time(event.sample))
 
     def _on_command(self, sample: int, command: ControllerCommand, reply: Reply) -> None:
-        msg = convert.command(sample, command, reply, self.rate, self.epoch)
+        msg = convert.command(sample, command, reply, self.rate, self.epoch, self.namespace)
         self.writer.write(self.commands_topic, msg, self.log_time(sample))
 
     def close(self) -> None:

@@ -6,7 +6,9 @@ overrides, to see what a changed parameter does): the MCAP metadata ``mpi_ros`` 
 ``mpi-ros record`` writes, or else the suite's latched <ns>/configuration message, which
 any recorder of the graph (``ros2 bag record -a``) captures along with the commands on
 <ns>/commands. A bag without one of them is refused with what it lacks (MissingInput).
-Stamps are compared too when the bag knows the epoch they count from. Statuses recorded at sample k are
+Stamps are compared too when the bag knows the epoch they count from, and so are the headers'
+frame ids (a bag recorded before the messages had a header holds a bare ``stamp``: it is
+compared with the header's, and the frame id is not). Statuses recorded at sample k are
 compared once the new controller is at k; commands recorded with effective sample k are
 applied when it is at k-1 (docs/decisions.md, "Samples, commands and replay": a command is
 applied at the first sample after the controller's current one). Identical runs report zero
@@ -29,6 +31,7 @@ from .reader import BagReader
 from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED, commands_topic
 
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
+_OLDER_STAMP = "header.stamp"  # where a bag recorded before the headers has its bare `stamp` compared
 STATUS_TYPES = ("mpi_ros/msg/MotionStatus", "mpi_ros/msg/AxisStatus")
 
 
@@ -91,10 +94,13 @@ class ReplayReport:
 
 def _flatten(data, prefix: str = "", skipped=_SKIPPED_FIELDS):
     if isinstance(data, dict):
+        # a status or event recorded before the header (docs/recording.md, "Older recordings")
+        older = "stamp" in data and "sample" in data
         for key, value in data.items():
             if key in skipped:
                 continue
-            yield from _flatten(value, f"{prefix}.{key}" if prefix else key, skipped)
+            name = _OLDER_STAMP if older and key == "stamp" else key
+            yield from _flatten(value, f"{prefix}.{name}" if prefix else name, skipped)
     elif isinstance(data, list) and data and isinstance(data[0], dict):
         for i, value in enumerate(data):
             yield from _flatten(value, f"{prefix}[{i}]", skipped)
@@ -256,14 +262,16 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
                 report.record(Divergence(msg.sample, topic, f"{msg.operation}.message", msg.message,
                                          reply.message.name))
         else:
-            _compare(report, sample, topic, msg, _replayed_status(ctl, msg_type, msg.number, epoch), tolerance, skipped)
+            replayed = _replayed_status(ctl, msg_type, msg.number, epoch, recording.namespace)
+            _compare(report, sample, topic, msg, replayed, tolerance, skipped)
             report.statuses += 1
         if stop_at_first and report.first is not None:
             break
     report.last_sample = ctl.sample
     # a recording of the graph holds the events from when it started; mpi-ros record has them all
     since = (first_recorded if first_recorded is not None else report.last_sample + 1) if recording.graph else 0
-    _compare_events(report, recorded_events, replayed_events, ctl.rate, tolerance, epoch, skipped, since)
+    _compare_events(report, recorded_events, replayed_events, ctl.rate, tolerance, epoch, skipped, since,
+                    recording.namespace)
     return report
 
 
@@ -272,21 +280,22 @@ def _step_to(ctl, sample: int) -> None:
         ctl.step(sample - ctl.sample)
 
 
-def _replayed_status(ctl, msg_type: str, number: int, epoch: int | None):
+def _replayed_status(ctl, msg_type: str, number: int, epoch: int | None, namespace: str):
     if msg_type == "mpi_ros/msg/MotionStatus":
-        return convert.motion_status(ctl.supervisor(number).snapshot(), ctl.rate, epoch or 0)
-    return convert.axis_status(ctl.axis_snapshot(number), ctl.rate, epoch or 0)
+        return convert.motion_status(ctl.supervisor(number).snapshot(), ctl.rate, epoch or 0, namespace)
+    return convert.axis_status(ctl.axis_snapshot(number), ctl.rate, epoch or 0, namespace)
 
 
 def _compare_events(report: ReplayReport, recorded, replayed, rate: float, tolerance: float,
-                    epoch: int | None = None, skipped=_SKIPPED_FIELDS, since: int = 0) -> None:
+                    epoch: int | None = None, skipped=_SKIPPED_FIELDS, since: int = 0,
+                    namespace: str = suite_config.DEFAULT_NAMESPACE) -> None:
     """Events from ``since`` up to the last compared sample, in order."""
     horizon = report.last_sample
     if report.truncated:
         # the cut may fall among the writes of the last sample: events are written as they
         # happen, before the statuses of any later sample, so those before it are all there
         horizon -= 1
-    replayed = [convert.motion_event(e, rate, epoch or 0) for e in replayed if since <= e.sample <= horizon]
+    replayed = [convert.motion_event(e, rate, epoch or 0, namespace) for e in replayed if since <= e.sample <= horizon]
     recorded = [e for e in recorded if e.sample <= horizon]
     # pairs up to the shorter list: a difference in count is a divergence of its own (below)
     for i, (old, new) in enumerate(zip(recorded, replayed, strict=False)):

@@ -1,9 +1,9 @@
 """Message definitions as rosbag2 stores them in MCAP (schema encoding ``ros2msg``).
 
-A schema is the type's .msg text, then for each nested type (depth first, each once) a
-line of 80 ``=``, ``MSG: pkg/Type`` and that type's .msg text (docs/recording.md, "The MCAP
-file"). The .msg files and the RIHS01 type hashes come from the packages'
-installed share/ folders.
+A schema is the type's .msg text, then for each nested type (depth first, each once, the
+types of one text in sorted order, as rosbag2 orders them) a newline, a line of 80 ``=``,
+``MSG: pkg/Type`` and that type's .msg text (docs/recording.md, "The MCAP file"). The .msg
+files and the RIHS01 type hashes come from the packages' installed share/ folders.
 """
 
 from __future__ import annotations
@@ -73,25 +73,23 @@ def _field_types(text: str, package: str) -> list[str]:
 
 @cache
 def ros2msg(type_name: str) -> str:
-    """The ros2msg schema text of a type ('pkg/msg/Type')."""
+    """The ros2msg schema text of a type ('pkg/msg/Type'), as rosbag2 writes it (rosbag2_cpp's
+    local message definition source): the type's .msg file as it stands; after it, for each
+    type that text uses, in sorted order, and not written already: a newline, the line of 80
+    ``=``, ``MSG: pkg/Type`` and that type's text, followed in the same way by the types it uses."""
     package, name = split(type_name)
-    root = msg_text(type_name)
-    parts = [root.rstrip("\n")]
     seen: set[str] = set()
 
-    def visit(text: str, pkg: str) -> None:
-        for dep in _field_types(text, pkg):
-            dep_pkg, dep_name = split(dep)
-            key = f"{dep_pkg}/{dep_name}"
-            if key in seen:
+    def text_of(key: str, pkg: str) -> str:
+        text = msg_text(key)
+        for dep in sorted(set(_field_types(text, pkg))):
+            if dep in seen:
                 continue
-            seen.add(key)
-            dep_text = msg_text(key)
-            parts.append(f"{_SEPARATOR}\nMSG: {key}\n{dep_text.rstrip(chr(10))}")
-            visit(dep_text, dep_pkg)
+            seen.add(dep)
+            text += f"\n{_SEPARATOR}\nMSG: {dep}\n" + text_of(dep, split(dep)[0])
+        return text
 
-    visit(root, package)
-    return "\n".join(parts) + "\n"
+    return text_of(f"{package}/{name}", package)
 
 
 @cache

@@ -21,9 +21,10 @@ def _series(reader: BagReader):
     events: list[tuple[float, str, int]] = []
     t0: int | None = None  # stamps are wall-clock anchored: plot the time since the first one
     for item, msg in reader.decoded():
-        if not hasattr(msg, "stamp"):
+        stamp = _stamp(msg)
+        if stamp is None:
             continue
-        ns = msg.stamp.sec * 1_000_000_000 + msg.stamp.nanosec
+        ns = stamp.sec * 1_000_000_000 + stamp.nanosec
         t0 = ns if t0 is None else t0
         t = (ns - t0) * 1e-9
         if item.type == "mpi_ros/msg/AxisStatus":
@@ -37,6 +38,13 @@ def _series(reader: BagReader):
         elif item.type == "mpi_ros/msg/MotionEvent" and msg.type in MARKED_EVENTS:
             events.append((t, msg.type, msg.supervisor))
     return axes, states, events
+
+
+def _stamp(msg):
+    """A recorded message's stamp: its header's, or the bare `stamp` of a bag recorded before
+    the messages had a header (docs/recording.md); None for messages without one."""
+    header = getattr(msg, "header", None)
+    return header.stamp if header is not None else getattr(msg, "stamp", None)
 
 
 def _state_bands(ax, states: list[tuple[float, str]]) -> None:

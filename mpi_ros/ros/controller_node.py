@@ -145,7 +145,7 @@ class ControllerNode(Node):
             self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
             runner.add_periodic(settings.clock_rate, self._collect_clock)
         runner.on_event(lambda event: convert.publish(
-            self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns)))
+            self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns, settings.namespace)))
 
     def _service(self, srv_type, name, callback):
         self.create_service(srv_type, name, callback, callback_group=self._service_group)
@@ -161,7 +161,8 @@ class ControllerNode(Node):
     # -- applied commands -------------------------------------------------------------------
     def _on_command(self, sample, command, reply) -> None:
         # under the runner lock: keep it; it is published once the lock is released
-        self._applied.append(convert.command(sample, command, reply, self.runner.ctl.rate, self.epoch_ns))
+        self._applied.append(convert.command(sample, command, reply, self.runner.ctl.rate, self.epoch_ns,
+                                             self.settings.namespace))
 
     def _collect_commands(self, ctl):
         if not self._applied:
@@ -179,7 +180,8 @@ class ControllerNode(Node):
         # packed straight into CDR and published raw where the interfaces allow (wire.py: the
         # same bytes, a third of the work); the snapshots are the supervisors' (snapshots.py)
         encode = wire.axis_status if wire.AVAILABLE else convert.axis_status
-        messages = [encode(self._snapshots.axis(ctl, a.number), ctl.rate, self.epoch_ns) for a in ctl.axes]
+        messages = [encode(self._snapshots.axis(ctl, a.number), ctl.rate, self.epoch_ns, self.settings.namespace)
+                    for a in ctl.axes]
         return lambda: convert.publish_all(self, zip(self._pub_axis_status, messages, strict=True))
 
     def _collect_joints(self, ctl):

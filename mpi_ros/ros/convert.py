@@ -8,6 +8,11 @@ epoch is published (latched, <ns>/configuration) and recorded in bags so replay 
 every stamp. Functions that stamp take ``epoch_ns``; left out, they use the epoch of the
 suite anchored last in this process (one suite per process is the rule; pass it explicitly
 where two may coexist).
+
+Headers: the statuses, events and commands carry a std_msgs/Header, its stamp as above and its
+frame_id naming the message's source within the suite, the namespace first without its
+leading slash, as /diagnostics names them (:func:`frame_id`: ``mpi/axis0``, ``mpi/ms1``,
+``mpi/controller``; ``cell_a/axis0`` in /cell_a). They are names, not tf frames.
 """
 
 from __future__ import annotations
@@ -24,7 +29,9 @@ from typing import Any
 import numpy as np
 from builtin_interfaces.msg import Time
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Header
 
+from mpi_ros.config import DEFAULT_NAMESPACE
 from mpi_ros.joints import AxisJoint, JointStates
 from mpi_ros.mpi.base.events import Event
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
@@ -213,13 +220,32 @@ def time_ns(value: Time) -> int:
     return int(value.sec) * 1_000_000_000 + int(value.nanosec)
 
 
+def frame_id(namespace: str, supervisor: int = -1, axis: int = -1) -> str:
+    """The source a message's header names: the most specific object given, the axis
+    (``mpi/axis<k>``) if ``axis`` >= 0, else the supervisor (``mpi/ms<n>``) if ``supervisor``
+    >= 0, else the controller (``mpi/controller``); ``mpi`` being the namespace without its
+    leading slash (``plant/cell_a/axis0`` in /plant/cell_a), as /diagnostics names them."""
+    prefix = namespace.strip("/")
+    if axis >= 0:
+        return f"{prefix}/axis{axis}"
+    if supervisor >= 0:
+        return f"{prefix}/ms{supervisor}"
+    return f"{prefix}/controller"
+
+
+def header(sample: int, rate: float, epoch_ns: int | None, frame: str) -> Header:
+    """A std_msgs/Header: the stamp of ``sample`` and the source ``frame`` (:func:`frame_id`)."""
+    return Header(stamp=stamp(sample, rate, epoch_ns), frame_id=frame)
+
+
 def _finite(x: float) -> float:
     return float(x) if math.isfinite(x) else 0.0
 
 
-def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) -> AxisStatus:
+def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None,
+                namespace: str = DEFAULT_NAMESPACE) -> AxisStatus:
     msg = AxisStatus()
-    msg.stamp = stamp(snap.sample, rate, epoch_ns)
+    msg.header = header(snap.sample, rate, epoch_ns, frame_id(namespace, axis=snap.number))
     msg.sample = snap.sample
     msg.number = snap.number
     msg.state = int(snap.state)
@@ -249,15 +275,16 @@ def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) ->
     return msg
 
 
-def motion_status(snap: MotionSnapshot, rate: float, epoch_ns: int | None = None) -> MotionStatus:
+def motion_status(snap: MotionSnapshot, rate: float, epoch_ns: int | None = None,
+                  namespace: str = DEFAULT_NAMESPACE) -> MotionStatus:
     msg = MotionStatus()
-    msg.stamp = stamp(snap.sample, rate, epoch_ns)
+    msg.header = header(snap.sample, rate, epoch_ns, frame_id(namespace, supervisor=snap.number))
     msg.sample = snap.sample
     msg.number = snap.number
     msg.state = int(snap.state)
     msg.state_name = snap.state.name
     msg.axis_numbers = list(snap.axis_numbers)
-    msg.axes = [axis_status(a, rate, epoch_ns) for a in snap.axes]
+    msg.axes = [axis_status(a, rate, epoch_ns, namespace) for a in snap.axes]
     msg.done = snap.done
     msg.at_target = snap.at_target
     msg.settled = snap.settled
@@ -311,11 +338,13 @@ def joint_state(ctl, epoch_ns: int | None = None, joints: JointStates | None = N
     return msg
 
 
-def command(sample: int, command, reply, rate: float, epoch_ns: int | None = None) -> CommandMsg:
+def command(sample: int, command, reply, rate: float, epoch_ns: int | None = None,
+            namespace: str = DEFAULT_NAMESPACE) -> CommandMsg:
     """An applied command (mpi_ros.commands.Command) and the controller's reply, with the
-    sample at which it took effect, as published on <ns>/commands and recorded for replay."""
+    sample at which it took effect, as published on <ns>/commands and recorded for replay;
+    its frame_id names the object it addressed (:func:`frame_id`)."""
     msg = CommandMsg()
-    msg.stamp = stamp(sample, rate, epoch_ns)
+    msg.header = header(sample, rate, epoch_ns, frame_id(namespace, command.supervisor, command.axis))
     msg.sample = int(sample)
     msg.operation = command.operation
     msg.supervisor = int(command.supervisor)
@@ -344,9 +373,11 @@ def configuration(config, rate: float, start_sample: int, epoch_ns: int):
     return msg
 
 
-def motion_event(event: Event, rate: float, epoch_ns: int | None = None) -> MotionEvent:
+def motion_event(event: Event, rate: float, epoch_ns: int | None = None,
+                 namespace: str = DEFAULT_NAMESPACE) -> MotionEvent:
+    """An event; its frame_id names its source, the most specific object it names (:func:`frame_id`)."""
     msg = MotionEvent()
-    msg.stamp = stamp(event.sample, rate, epoch_ns)
+    msg.header = header(event.sample, rate, epoch_ns, frame_id(namespace, event.supervisor, event.axis))
     msg.sample = event.sample
     msg.type = event.type_name
     msg.supervisor = event.supervisor

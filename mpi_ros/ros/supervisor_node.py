@@ -196,7 +196,7 @@ class SupervisorNode(Node):
             return None
         # packed straight into CDR and published raw where the interfaces allow (wire.py)
         encode = wire.motion_status if wire.AVAILABLE else convert.motion_status
-        msg = encode(snap, ctl.rate, convert.epoch_of(ctl))
+        msg = encode(snap, ctl.rate, convert.epoch_of(ctl), self.settings.namespace)
         return lambda: convert.publish(self, self._pub_status, msg)
 
     # -- JointTrajectory commands -----------------------------------------------------

@@ -17,10 +17,11 @@ data after the header; a string is a uint32 length (with the NUL), its UTF-8 byt
 NUL; a sequence is a uint32 count and its elements; nested messages are inline and have
 no alignment of their own (an AxisStatus inside a MotionStatus is laid out by where it
 starts). The layout of a run of fields depends only on where it starts (mod 8) and on the
-lengths of its strings, so each is one struct.Struct, built once per case and cached.
-AxisStatus is packed with or without the trailing feedforward of later interfaces (issue
-11). If the installed interfaces differ from these layouts, :data:`AVAILABLE` is False, the
-nodes publish messages as before and the controller node says so in its log.
+lengths of its strings, so each is one struct.Struct, built once per case and cached. A
+std_msgs/Header is its stamp (int32 sec, uint32 nanosec) and its frame_id (a string). If the
+installed interfaces differ from these layouts (built from older .msg files), :data:`AVAILABLE`
+is False, the nodes build messages with convert.py instead and the controller node says so in
+its log.
 """
 
 from __future__ import annotations
@@ -29,10 +30,10 @@ import math
 import struct
 from collections.abc import Sequence
 from functools import cache, lru_cache
-from typing import Any
 
 from sensor_msgs.msg import JointState
 
+from mpi_ros.config import DEFAULT_NAMESPACE
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.msg import AxisStatus, MotionStatus
 
@@ -43,16 +44,17 @@ _NS = 1_000_000_000
 
 # The layouts packed below, as the generated classes describe them.
 _AXIS_FIELDS = {
-    "stamp": "builtin_interfaces/Time", "sample": "uint64", "number": "int32", "state": "uint8",
+    "header": "std_msgs/Header", "sample": "uint64", "number": "int32", "state": "uint8",
     "state_name": "string", "command_position": "double", "actual_position": "double",
     "position_error": "double", "target_position": "double", "origin": "double", "command_velocity": "double",
     "actual_velocity": "double", "command_acceleration": "double", "done": "boolean", "at_target": "boolean",
     "in_fine_position": "boolean", "in_coarse_position": "boolean", "settled": "boolean",
     "at_velocity": "boolean", "trajectory_complete": "boolean", "amp_enabled": "boolean", "move_id": "int32",
-    "element_id": "int32", "frame_count": "int32", "supervisor": "int32",
+    "element_id": "int32", "frame_count": "int32", "supervisor": "int32", "feedforward": "double",
+    "faults": "sequence<string>",
 }
 _MOTION_FIELDS = {
-    "stamp": "builtin_interfaces/Time", "sample": "uint64", "number": "int32", "state": "uint8",
+    "header": "std_msgs/Header", "sample": "uint64", "number": "int32", "state": "uint8",
     "state_name": "string", "axis_numbers": "sequence<int32>", "axes": "sequence<mpi_ros/AxisStatus>",
     "done": "boolean", "at_target": "boolean", "settled": "boolean", "move_id": "int32", "element_id": "int32",
     "feedrate": "double", "last_action": "string", "action_source": "string", "moves_pending": "int32",
@@ -60,14 +62,7 @@ _MOTION_FIELDS = {
 }
 _JOINT_FIELDS = {"header": "std_msgs/Header", "name": "sequence<string>", "position": "sequence<double>",
                  "velocity": "sequence<double>", "effort": "sequence<double>"}
-# Interfaces built from a later msg/AxisStatus.msg end with the PTF/PVTF feedforward (issue 11):
-# the snapshot's, finite, as convert.axis_status sets it there (0.0 where the snapshot has none).
-_FEEDFORWARD = {**_AXIS_FIELDS, "feedforward": "double"}
-# ... and then the faults latched on the axis (issue 14, docs/faults.md).
-_FAULTS = {**_FEEDFORWARD, "faults": "sequence<string>"}
-FAULTS = AxisStatus.get_fields_and_field_types() == _FAULTS
-FEEDFORWARD = FAULTS or AxisStatus.get_fields_and_field_types() == _FEEDFORWARD
-AVAILABLE = (AxisStatus.get_fields_and_field_types() in (_AXIS_FIELDS, _FEEDFORWARD, _FAULTS)
+AVAILABLE = (AxisStatus.get_fields_and_field_types() == _AXIS_FIELDS
              and MotionStatus.get_fields_and_field_types() == _MOTION_FIELDS
              and JointState.get_fields_and_field_types() == _JOINT_FIELDS)
 
@@ -96,19 +91,29 @@ class _Layout:
         return struct.Struct(self.fmt)
 
 
-@cache
-def _axis_layout(start: int, name_length: int) -> struct.Struct:
-    """A whole AxisStatus starting at ``start`` (mod 8) with a state name of that length."""
-    layout = _Layout(start).add("i", 4).add("I", 4).add("Q", 8).add("i", 4).add("B", 1).string(name_length)
-    layout.add("d", 8, 8).add("?", 1, 8).add("i", 4, 4)
-    return (layout.add("d", 8) if FEEDFORWARD else layout).struct()
+def _head(start: int, frame_length: int, name_length: int) -> _Layout:
+    """A status from its header (stamp, frame_id) to its state name, from ``start`` (mod 8)."""
+    layout = _Layout(start).add("i", 4).add("I", 4).string(frame_length)
+    return layout.add("Q", 8).add("i", 4).add("B", 1).string(name_length)
 
 
 @cache
-def _motion_head(name_length: int, axes: int) -> struct.Struct:
-    """A MotionStatus from its stamp to the count of its axes (it starts the data: at 0)."""
-    layout = _Layout(0).add("i", 4).add("I", 4).add("Q", 8).add("i", 4).add("B", 1).string(name_length)
-    return layout.add("I", 4).add("i", 4, axes).add("I", 4).struct()
+def _axis_layout(start: int, frame_length: int, name_length: int) -> struct.Struct:
+    """An AxisStatus up to its faults, starting at ``start`` (mod 8), with a frame_id and a
+    state name of those lengths."""
+    return _head(start, frame_length, name_length).add("d", 8, 8).add("?", 1, 8).add("i", 4, 4).add("d", 8).struct()
+
+
+@cache
+def _motion_head(frame_length: int, name_length: int, axes: int) -> struct.Struct:
+    """A MotionStatus from its header to the count of its axes (it starts the data: at 0)."""
+    return _head(0, frame_length, name_length).add("I", 4).add("i", 4, axes).add("I", 4).struct()
+
+
+@lru_cache(maxsize=1024)
+def _frame(namespace: str, supervisor: int, axis: int) -> bytes:
+    """A header's frame_id, encoded (convert.frame_id): constant per source, encoded once."""
+    return convert.frame_id(namespace, supervisor, axis).encode("utf-8")
 
 
 @cache
@@ -146,22 +151,20 @@ def _finite(x: float) -> float:
     return float(x) if math.isfinite(x) else 0.0  # as convert.axis_status sets the field
 
 
-def _axis(out: bytearray, snap: AxisSnapshot, rate: float, epoch_ns: int | None) -> None:
+def _axis(out: bytearray, snap: AxisSnapshot, rate: float, epoch_ns: int | None, namespace: str) -> None:
     name = snap.state.name.encode("utf-8")
-    layout = _axis_layout((len(out) - len(HEADER)) % 8, len(name))
-    values: tuple[Any, ...] = (
-        *_time(snap.sample, rate, epoch_ns), snap.sample, snap.number, int(snap.state), len(name) + 1, name,
+    frame = _frame(namespace, -1, snap.number)
+    layout = _axis_layout((len(out) - len(HEADER)) % 8, len(frame), len(name))
+    out += layout.pack(
+        *_time(snap.sample, rate, epoch_ns), len(frame) + 1, frame,
+        snap.sample, snap.number, int(snap.state), len(name) + 1, name,
         _finite(snap.command_position), _finite(snap.actual_position), _finite(snap.position_error),
         float(snap.target_position), _finite(snap.origin), _finite(snap.command_velocity),
         _finite(snap.actual_velocity), _finite(snap.command_acceleration),
         snap.done, snap.at_target, snap.in_fine_position, snap.in_coarse_position, snap.settled,
         snap.at_velocity, snap.trajectory_complete, snap.amp_enabled,
-        snap.move_id, snap.element_id, snap.frame_count, snap.supervisor)
-    if FEEDFORWARD:
-        values += (_finite(getattr(snap, "feedforward", 0.0)),)
-    out += layout.pack(*values)
-    if FAULTS:
-        _strings(out, snap.faults)
+        snap.move_id, snap.element_id, snap.frame_count, snap.supervisor, _finite(snap.feedforward))
+    _strings(out, snap.faults)
 
 
 def _strings(out: bytearray, texts: Sequence[str]) -> None:
@@ -173,22 +176,26 @@ def _strings(out: bytearray, texts: Sequence[str]) -> None:
     out += layout.struct().pack(len(encoded), *(x for text in encoded for x in (len(text) + 1, text)))
 
 
-def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None) -> bytes:
-    """The CDR of ``convert.axis_status(snap, rate, epoch_ns)``."""
+def axis_status(snap: AxisSnapshot, rate: float, epoch_ns: int | None = None,
+                namespace: str = DEFAULT_NAMESPACE) -> bytes:
+    """The CDR of ``convert.axis_status(snap, rate, epoch_ns, namespace)``."""
     out = bytearray(HEADER)
-    _axis(out, snap, rate, epoch_ns)
+    _axis(out, snap, rate, epoch_ns, namespace)
     return bytes(out)
 
 
-def motion_status(snap: MotionSnapshot, rate: float, epoch_ns: int | None = None) -> bytes:
-    """The CDR of ``convert.motion_status(snap, rate, epoch_ns)``."""
+def motion_status(snap: MotionSnapshot, rate: float, epoch_ns: int | None = None,
+                  namespace: str = DEFAULT_NAMESPACE) -> bytes:
+    """The CDR of ``convert.motion_status(snap, rate, epoch_ns, namespace)``."""
     name = snap.state.name.encode("utf-8")
+    frame = _frame(namespace, snap.number, -1)
     out = bytearray(HEADER)
-    out += _motion_head(len(name), len(snap.axis_numbers)).pack(
-        *_time(snap.sample, rate, epoch_ns), snap.sample, snap.number, int(snap.state), len(name) + 1, name,
+    out += _motion_head(len(frame), len(name), len(snap.axis_numbers)).pack(
+        *_time(snap.sample, rate, epoch_ns), len(frame) + 1, frame,
+        snap.sample, snap.number, int(snap.state), len(name) + 1, name,
         len(snap.axis_numbers), *snap.axis_numbers, len(snap.axes))
     for axis in snap.axes:
-        _axis(out, axis, rate, epoch_ns)
+        _axis(out, axis, rate, epoch_ns, namespace)
     strings = [text.encode("utf-8") for text in (snap.last_action, snap.action_source, snap.motion_type)]
     last_action, action_source, motion_type = strings
     out += _motion_tail((len(out) - len(HEADER)) % 8, *map(len, strings)).pack(

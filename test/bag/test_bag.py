@@ -38,6 +38,71 @@ def test_a_bag_recorded_before_a_type_changed_replays_by_its_own_definitions():
     assert report.commands == 2 and report.statuses > 100
 
 
+def test_a_bag_recorded_before_the_headers_replays_with_its_stamps_compared():
+    # Recorded when statuses, events and commands had a bare `stamp` (docs/recording.md,
+    # "Older recordings"): read by the bag's own definitions; the bare stamp is compared with
+    # the replayed header's stamp (so a wrong epoch would show), the frame id is not.
+    bag = FIXTURES / "older" / "p2p_modify_before_headers"
+    reader = BagReader(bag)
+    status = next(msg for item, msg in reader.decoded() if item.type == "mpi_ros/msg/AxisStatus")
+    assert hasattr(status, "stamp") and not hasattr(status, "header")
+    report = replay(bag)
+    assert report.identical, report.summary()
+    assert report.commands == 2 and report.statuses > 100 and report.events > 0
+    moved = replay(bag, overrides={"controller": {"sample_rate": 1000.0}})  # other stamps at the same samples
+    assert not moved.identical and "stamp" in moved.first.field
+
+
+def test_schemas_are_written_as_rosbag2_writes_them():
+    """rosbag2 (rosbag2_cpp's local message definition source): the .msg file as installed,
+    then per nested type, depth first, the types one text uses in sorted order, each once:
+    a newline, 80 '=', 'MSG: pkg/Type' and that file."""
+    from mpi_ros.bag import schema
+
+    separator = "\n" + "=" * 80 + "\n"
+    for type_name, nested in {
+        "mpi_ros/msg/MotionStatus": ["mpi_ros/AxisStatus", "std_msgs/Header", "builtin_interfaces/Time"],
+        "mpi_ros/msg/AxisStatus": ["std_msgs/Header", "builtin_interfaces/Time"],
+        "mpi_ros/msg/MotionEvent": ["std_msgs/Header", "builtin_interfaces/Time"],
+        "mpi_ros/msg/Command": ["std_msgs/Header", "builtin_interfaces/Time"],
+        "sensor_msgs/msg/JointState": ["std_msgs/Header", "builtin_interfaces/Time"],
+    }.items():
+        first, *sections = schema.ros2msg(type_name).split(separator)
+        assert first == schema.msg_text(type_name)  # the file as it is, its last newline included
+        assert [s.split("\n", 1)[0] for s in sections] == [f"MSG: {name}" for name in nested]
+        assert [s.split("\n", 1)[1] for s in sections] == [schema.msg_text(name) for name in nested]
+
+
+def test_a_recording_names_each_source_in_its_headers(tmp_path):
+    """Statuses, events and commands of a recording carry the header the suite publishes:
+    the stamp of their sample and the frame id of their source, in the recorded namespace."""
+    from mpi_ros.bag import scenario
+    from mpi_ros.ros import convert
+
+    plan = scenario.load(FIXTURES / "scenarios" / "two_supervisors.yaml")
+    plan.config = {**plan.config, "ros": {**plan.config["ros"], "namespace": "/cell_a"}}
+    bag = scenario.record(plan, tmp_path / "run")
+    epoch = int(BagReader(bag).metadata("mpi_ros")["stamp_epoch_ns"])
+    seen = set()
+    for item, msg in BagReader(bag).decoded():
+        if not hasattr(msg, "sample"):
+            continue
+        rate = 2000.0
+        assert convert.time_ns(msg.header.stamp) == epoch + round(msg.sample * 1e9 / rate) == item.log_time
+        frame = msg.header.frame_id
+        if item.type == "mpi_ros/msg/AxisStatus":
+            assert frame == f"cell_a/axis{msg.number}"
+        elif item.type == "mpi_ros/msg/MotionStatus":
+            assert frame == f"cell_a/ms{msg.number}"
+            assert [a.header.frame_id for a in msg.axes] == [f"cell_a/axis{n}" for n in msg.axis_numbers]
+        else:
+            assert frame == convert.frame_id("/cell_a", msg.supervisor, msg.axis)
+        seen.add((item.type, frame.split("/")[1].rstrip("0123456789")))
+    assert {("mpi_ros/msg/MotionEvent", "axis"), ("mpi_ros/msg/MotionEvent", "ms"),
+            ("mpi_ros/msg/Command", "ms"), ("mpi_ros/msg/Command", "controller")} <= seen  # gate_set: the controller
+    assert replay(bag).identical
+
+
 @pytest.mark.parametrize("bag", BAGS, ids=[b.name for b in BAGS])
 def test_fixture_replays_with_zero_differences(bag):
     report = replay(bag)
@@ -271,8 +336,53 @@ def test_playback_publishes_every_recorded_event(ros_context, probe):
     assert [m.type for m in received] == recorded
 
 
+def test_playback_of_a_bag_from_before_the_headers_sends_the_installed_types(ros_context, probe):
+    """Its bytes are in the older layout: sent as recorded, subscribers of the installed type
+    would misread them. Each is rebuilt in the installed type, the bare stamp in the header."""
+    from rclpy.node import Node
+
+    from mpi_ros.bag.playback import play
+    from mpi_ros.msg import MotionStatus
+
+    bag = FIXTURES / "older" / "p2p_modify_before_headers"
+    recorded = [msg for _, msg in BagReader(bag).decoded(["/mpi/ms0/status"])]
+    received = []
+    done = threading.Event()
+
+    def on_status(msg):
+        received.append(msg)
+        if len(received) == len(recorded):
+            done.set()
+
+    probe.create_subscription(MotionStatus, "/mpi/ms0/status", on_status, 1000)
+    player = Node("test_older_player", context=ros_context)
+    try:
+        assert play(player, bag, rate=50.0, topics=["/mpi/ms0/status"], wait_for_subscribers=1) == len(recorded)
+    finally:
+        player.destroy_node()
+    assert done.wait(10.0), f"received {len(received)} of {len(recorded)}"
+    for old, new in zip(recorded, received, strict=True):
+        assert (new.header.stamp.sec, new.header.stamp.nanosec) == (old.stamp.sec, old.stamp.nanosec)
+        assert new.header.frame_id == "" and new.sample == old.sample and new.state_name == old.state_name
+        assert [a.command_position for a in new.axes] == [a.command_position for a in old.axes]
+        assert [convert_ns(a.header.stamp) for a in new.axes] == [convert_ns(a.stamp) for a in old.axes]
+
+
+def convert_ns(stamp) -> int:
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
 def test_plot_of_a_bag_writes_a_png(tmp_path):
     from mpi_ros.plot.bag import plot_bag
 
     out = plot_bag(FIXTURES / "bags" / "two_supervisors", tmp_path / "two.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 20_000
+
+
+def test_plot_reads_the_stamps_of_a_bag_from_before_the_headers():
+    from mpi_ros.plot.bag import _series
+
+    axes, states, events = _series(BagReader(FIXTURES / "older" / "p2p_modify_before_headers"))
+    assert sorted(axes) == [0, 1, 2, 3] and states and events
+    times = axes[0]["t"]
+    assert 0.0 <= times[0] < 0.1 and times == sorted(times) and times[-1] > 1.0  # s since the first stamp

@@ -16,6 +16,8 @@ from sensor_msgs.msg import JointState
 
 from mpi_ros import config
 from mpi_ros.cli import run as run_cli
+from mpi_ros.msg import Command as CommandMsg
+from mpi_ros.msg import MotionEvent, MotionStatus
 
 from .conftest import WAIT
 
@@ -80,6 +82,9 @@ def test_two_namespaced_suites_share_a_graph_without_colliding(cell, probe, ros_
     joints_a = Latest(probe, JointState, "/cell_a/joint_states")
     joints_b = Latest(probe, JointState, "/cell_b/joint_states")
     diagnostics = Latest(probe, DiagnosticArray, "/diagnostics")
+    statuses = {ns: Latest(probe, MotionStatus, f"/{ns}/ms0/status") for ns in ("cell_a", "cell_b")}
+    events = {ns: Latest(probe, MotionEvent, f"/{ns}/events") for ns in ("cell_a", "cell_b")}
+    commands = {ns: Latest(probe, CommandMsg, f"/{ns}/commands") for ns in ("cell_a", "cell_b")}
     clients = [MotionClient(0, namespace=ns, context=ros_context, timeout=WAIT, node_name=f"cell_client_{ns[1:]}")
                for ns in ("/cell_a", "/cell_b")]
     try:
@@ -102,6 +107,14 @@ def test_two_namespaced_suites_share_a_graph_without_colliding(cell, probe, ros_
             names = [s.name for s in array.status]
             assert all(name.startswith(f"{ns}/") for name in names)
             assert {f"{ns}/ms0", f"{ns}/ms1", *(f"{ns}/axis{k}" for k in range(4))} <= set(names)
+        for ns in ("cell_a", "cell_b"):  # the headers name their sources in the suite's namespace
+            status = statuses[ns].wait(lambda m: True)
+            assert status.header.frame_id == f"{ns}/ms0"
+            assert [a.header.frame_id for a in status.axes] == [f"{ns}/axis0", f"{ns}/axis1"]
+            assert events[ns].wait(lambda m: m.type == "MOTION_DONE").header.frame_id == f"{ns}/ms0"
+            settled = events[ns].wait(lambda m: m.type == "SETTLED")  # an axis' event: the axis
+            assert settled.axis >= 0 and settled.header.frame_id == f"{ns}/axis{settled.axis}"
+            assert commands[ns].wait(lambda m: m.operation == "motion_start").header.frame_id == f"{ns}/ms0"
         topics = dict(probe.get_topic_names_and_types())
         assert "/joint_states" not in topics  # the default topic is left to a suite in /mpi
         assert probe.count_publishers("/clock") == 1  # ros.clock: one clock source for the cell
@@ -149,6 +162,9 @@ def test_mpi_ros_run_takes_the_namespace(how, ros_context, tmp_path):
             assert result.message == "MPIMessageOK"
             configuration = ms0.node.get_topic_names_and_types()
             assert "/cell_a/joint_states" in dict(configuration)
+            status = ms0.status(timeout=PROCESS_WAIT)  # the headers name the sources in the namespace in effect
+            assert status.header.frame_id == "cell_a/ms0"
+            assert [a.header.frame_id for a in status.axes] == ["cell_a/axis0", "cell_a/axis1"]
     finally:
         process.send_signal(signal.SIGINT)
         _, err = process.communicate(timeout=PROCESS_WAIT)

@@ -40,7 +40,9 @@ def test_axis_status_is_stamped_with_anchored_controller_time_at_the_status_rate
     for msg in messages:
         assert msg.number == 2 and msg.state_name == "IDLE" and msg.state == AxisStatus.STATE_IDLE
         # controller time anchored to the wall clock: epoch + sample / rate
-        assert msg.stamp.sec * 1_000_000_000 + msg.stamp.nanosec == suite.epoch_ns + round(msg.sample * 1e9 / rate)
+        stamp = msg.header.stamp
+        assert stamp.sec * 1_000_000_000 + stamp.nanosec == suite.epoch_ns + round(msg.sample * 1e9 / rate)
+        assert msg.header.frame_id == "mpi/axis2"  # the source, named as /diagnostics names it
         assert msg.done and msg.in_fine_position and msg.settled and msg.amp_enabled
         assert msg.supervisor in (-1, 1)
 
@@ -56,6 +58,11 @@ def test_events_arrive_in_order_with_move_ids_and_none_is_lost_in_a_burst(suite,
     # MPI 000, MPIMotionAttrAPPEND APPEND: "Each successful call ... will generate an MPIEventTypeMOTION_DONE"
     assert [m.move_id for m in done] == list(range(1, 11))
     assert [m.sample for m in seen] == sorted(m.sample for m in seen)
+    # each header names the event's source: its axis if it names one, else its supervisor
+    assert all(m.header.frame_id == (f"mpi/axis{m.axis}" if m.axis >= 0 else f"mpi/ms{m.supervisor}") for m in seen)
+    assert {m.header.frame_id for m in done} == {"mpi/ms0"} and any(m.axis >= 0 for m in seen)
+    assert all(m.header.stamp.sec * 1_000_000_000 + m.header.stamp.nanosec
+               == suite.epoch_ns + round(m.sample * 1e9 / suite.controller.rate) for m in seen)
     controller_events = suite.runner.read(lambda ctl: len(ctl.events))
     assert len(seen) == controller_events  # every event the controller notified reached ROS
 

@@ -114,3 +114,15 @@ def test_a_class_that_is_not_generated_is_read_by_its_slots():
             self._hidden = 1
 
     assert convert.to_dict(Stored()) == {"type": "S_CURVE", "position": [1.0]}
+
+
+def test_a_header_names_the_most_specific_source_in_the_namespace():
+    """frame_id: the axis if one is named, else the supervisor, else the controller, after the
+    namespace without its leading slash (as /diagnostics names them; docs/recording.md, "Headers")."""
+    assert convert.frame_id("/mpi", axis=0) == "mpi/axis0"
+    assert convert.frame_id("/mpi", supervisor=1) == "mpi/ms1"
+    assert convert.frame_id("/mpi", supervisor=1, axis=3) == "mpi/axis3"
+    assert convert.frame_id("/mpi") == "mpi/controller"
+    assert convert.frame_id("/plant/cell_a", 0) == "plant/cell_a/ms0"
+    header = convert.header(4001, 2000.0, 7 * 10**9, "mpi/ms0")
+    assert (header.stamp.sec, header.stamp.nanosec, header.frame_id) == (9, 500_000, "mpi/ms0")

@@ -63,12 +63,14 @@ def test_every_applied_command_is_published_with_its_effective_sample(suite, cli
     (msg,) = inbox.wait_for(1)
     assert (msg.sample, msg.operation, msg.supervisor, msg.axis) == (sample, "motion_start", 0, -1)
     assert json.loads(msg.request)["position"] == MOVE["position"] and msg.message == reply.message.name
-    assert _ns(msg.stamp) == suite.epoch_ns + round(sample * 1e9 / suite.controller.rate)
+    assert _ns(msg.header.stamp) == suite.epoch_ns + round(sample * 1e9 / suite.controller.rate)
+    assert msg.header.frame_id == "mpi/ms0"  # the object it addressed (convert.frame_id)
     drive(lambda: goal.done)
     assert client.action("STOP", raise_on_error=False).message == "MPIMotionMessageIDLE"  # refused: still published
     (_, stop) = inbox.wait_for(2)
     assert stop.operation == "action" and json.loads(stop.request) == {"action": "STOP"}
     assert stop.message == "MPIMotionMessageIDLE" and stop.sample > msg.sample
+    assert stop.header.frame_id == "mpi/ms0"
 
 
 def test_stamps_of_every_topic_are_the_wall_anchored_controller_time(suite, probe, drive):
@@ -84,13 +86,16 @@ def test_stamps_of_every_topic_are_the_wall_anchored_controller_time(suite, prob
     clock = Inbox(probe, Clock, "/clock", QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
     drive(lambda: status.messages and axis.messages and joints.messages and clock.messages, chunk=20)
     for msg in (status.messages[0], axis.messages[0], *status.messages[0].axes):
-        assert _ns(msg.stamp) == suite.epoch_ns + round(msg.sample * 1e9 / rate)
+        assert _ns(msg.header.stamp) == suite.epoch_ns + round(msg.sample * 1e9 / rate)
+    # the headers name their sources (convert.frame_id), the nested axes included
+    assert status.messages[0].header.frame_id == "mpi/ms1" and axis.messages[0].header.frame_id == "mpi/axis3"
+    assert [a.header.frame_id for a in status.messages[0].axes] == ["mpi/axis2", "mpi/axis3"]
     # no sample field: a whole number of samples after the epoch, no later than the controller
     for t in (_ns(joints.messages[0].header.stamp), _ns(clock.messages[0].clock)):
         samples = (t - suite.epoch_ns) * rate / 1e9
         assert samples == int(samples) and 0 < samples <= suite.controller.sample
     # wall-clock time, not "seconds since the suite started": tools without sim time take it as now
-    assert abs(_ns(axis.messages[0].stamp) - time.time_ns()) < 120 * 10**9
+    assert abs(_ns(axis.messages[0].header.stamp) - time.time_ns()) < 120 * 10**9
 
 
 def test_joint_effort_is_the_servo_loop_output():

@@ -57,29 +57,32 @@ def test_the_installed_interfaces_have_the_layout_the_encoder_packs():
     assert wire.AVAILABLE
 
 
-@pytest.mark.parametrize("epoch", [EPOCH, 0])
-def test_axis_and_motion_status_bytes_equal_the_canonical_cdr_of_convert(epoch):
+# the headers' frame ids: their lengths move everything after them (every alignment, mod 8)
+@pytest.mark.parametrize(("epoch", "namespace"), [(EPOCH, "/mpi"), (0, "/mpi"), (EPOCH, "/plant/cell_a"),
+                                                  (EPOCH, "/c"), (EPOCH, "/cell_b7")])
+def test_axis_and_motion_status_bytes_equal_the_canonical_cdr_of_convert(epoch, namespace):
     seen_states = set()
     for ctl in _moving_states(_controller()):
         for axis in ctl.axes:
             snap = ctl.axis_snapshot(axis.number)
-            msg = convert.axis_status(snap, ctl.rate, epoch)
-            assert wire.axis_status(snap, ctl.rate, epoch) == cdr.serialize(msg)
+            msg = convert.axis_status(snap, ctl.rate, epoch, namespace)
+            assert wire.axis_status(snap, ctl.rate, epoch, namespace) == cdr.serialize(msg)
+            assert msg.header.frame_id == f"{namespace[1:]}/axis{axis.number}"
             seen_states.add(snap.state)
         for ms in ctl.supervisors:
             snap = ms.snapshot()
-            msg = convert.motion_status(snap, ctl.rate, epoch)
-            data = wire.motion_status(snap, ctl.rate, epoch)
+            msg = convert.motion_status(snap, ctl.rate, epoch, namespace)
+            data = wire.motion_status(snap, ctl.rate, epoch, namespace)
             assert data == cdr.serialize(msg)
             _same_message(data, msg)
+            assert msg.header.frame_id == f"{namespace[1:]}/ms{ms.number}"
     assert {MPIState.MOVING, MPIState.IDLE, MPIState.STOPPING_ERROR} <= seen_states
 
 
 def test_edge_values_are_packed_as_convert_sets_them():
     ctl = _controller()
     snap = ctl.axis_snapshot(0)
-    if wire.FEEDFORWARD and hasattr(snap, "feedforward"):  # interfaces and core of issue 11
-        snap = dataclasses.replace(snap, feedforward=math.inf)  # a finite value is sent: 0.0
+    snap = dataclasses.replace(snap, feedforward=math.inf)  # a finite value is sent: 0.0
     odd = dataclasses.replace(snap, sample=2**33 + 3, number=31, state=MPIState.STOPPING_ERROR,
                               command_position=math.inf, actual_position=-math.inf, position_error=math.nan,
                               target_position=math.nan, origin=-1e300, command_velocity=-0.0,
