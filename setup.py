@@ -3,7 +3,8 @@
 It drives the same CMakeLists.txt as colcon (rosidl_generate_interfaces + the hand-written
 Python package), so both routes install the same files:
 
-1. configure (once) and build in ``build/cmake`` (persistent, so a re-install after a
+1. configure (once) and build in ``build/cmake`` (Python users' generators only:
+   MPI_ROS_PYTHON_ONLY in CMakeLists.txt) (persistent, so a re-install after a
    Python-only change rebuilds nothing; wiped when the venv, the source directory or the set
    of interface files changes),
    with CMAKE_INSTALL_PREFIX = the venv (sys.prefix), Python3_EXECUTABLE = the venv's python;
@@ -110,6 +111,7 @@ def cmake_build_and_stage() -> str:
         for name in os.listdir(os.path.join(ROOT, sub)) if name.endswith(suffix))
     fingerprint = {
         "interfaces": interfaces,
+        "python_only": True,  # -DMPI_ROS_PYTHON_ONLY=ON below (CMakeLists.txt)
         "source": ROOT,
         "prefix": prefix,
         "python": os.path.realpath(sys.executable),
@@ -133,7 +135,8 @@ def cmake_build_and_stage() -> str:
               f"-DPython3_EXECUTABLE={sys.executable}",
               "-DPython3_FIND_VIRTUALENV=ONLY",
               "-DCMAKE_BUILD_TYPE=Release",
-              "-DBUILD_TESTING=OFF"], env)
+              "-DBUILD_TESTING=OFF",
+              "-DMPI_ROS_PYTHON_ONLY=ON"], env)
         with open(FINGERPRINT, "w", encoding="utf-8") as f:
             json.dump(fingerprint, f, indent=1)
     jobs = str(os.cpu_count() or 1)
