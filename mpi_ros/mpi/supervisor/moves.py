@@ -272,7 +272,10 @@ class Moves:
             if plan.hold is not None:
                 axis.unload(t, self.clock_of(axis))
                 axis.holding = True
-                axis.target = axis.rest
+                # The move is loaded and waits (MPI 000, MEIMotionAttrHOLD): its target is the
+                # target, as while a DELAY waits (MPI 002 status table: IN_COARSE_POSITION is
+                # the distance to it).
+                axis.target = plan.target
                 self.holds[plan.axis] = HoldWait.begin(
                     plan, move.attributes, sample, host.rate,
                     self.position_of(plan.hold) if HoldWait.watches(plan.hold) else 0.0)
