@@ -242,6 +242,40 @@ def test_each_master_source(source):
     assert command(ctl, 1) > 0.0
 
 
+ORIGIN_MASTERS = [
+    ("commanded", AxisMaster(S.AXIS_COMMANDED_POSITION, 0), 0),
+    ("actual", AxisMaster(S.AXIS_ACTUAL_POSITION, 0), 0),
+    ("correction", AxisMaster(S.AXIS_COMMANDED_POSITION, 0, correction=3), 3),
+]
+
+
+@pytest.mark.parametrize("name,master,moved", ORIGIN_MASTERS, ids=[m[0] for m in ORIGIN_MASTERS])
+def test_an_origin_change_does_not_move_a_cam_slave(name, master, moved):
+    # MPI 002, mpiAxisOriginSet and MPIAxisMasterType AXIS_COMMANDED/ACTUAL_POSITION: the origin only changes
+    # how positions are reported; the master axis (or the masterCorrection axis) does not move, so neither
+    # may the slave: it goes on exactly as a twin whose origin stays put
+    twins = []
+    for change in (True, False):
+        ctl = controller()
+        follow(ctl, master, axes=(1,))
+        master_velocity(ctl, 1000.0)
+        ms1 = ctl.supervisor(1)
+        ms1.axis_list_set([1])
+        ctl.step(20)
+        assert ms1.start(T.CAM_LINEAR, A.NONE, cam([10_000.0], [5000.0])).ok  # gear ratio 0.5
+        ctl.step(100)
+        slave = [command(ctl, 1)]
+        if change:
+            assert ctl.axis_origin_set(moved, -1000.0) is M.MPIMessageOK
+        for _ in range(300):
+            ctl.step(1)
+            slave.append(command(ctl, 1))
+        twins.append(np.array(slave))
+    changed, kept = twins
+    assert np.max(np.abs(np.diff(changed))) * RATE < 600.0  # 0.5 x the master's 1000 counts/s, plus the loop
+    assert np.array_equal(changed, kept)
+
+
 def test_a_master_axis_of_another_supervisor_and_a_chain_of_cams():
     # axis 1 (supervisor 1) follows axis 0 (supervisor 0); axis 3 (supervisor 2) follows axis 1's command:
     # the slave of a slave, computed in the same sample after its master
