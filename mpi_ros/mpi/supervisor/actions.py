@@ -78,13 +78,18 @@ class Actions:
         others = self._sharing()
         if not others:
             return handler(source)
-        forwarded = [self._host.act_on(other, action, source).ok for other in others]
+        forwarded = {other: self._host.act_on(other, action, source) for other in others}
         allowed = _OWN_STATES.get(action)
         if allowed is None or (self._state.own_state in allowed and self._state.own_state is not MPIState.IDLE):
             return handler(source)
-        if any(forwarded):
+        if any(outcome.ok for outcome in forwarded.values()):
             return Outcome(OK, "acted on the motion of the supervisor sharing its axes")
-        return self._refusal(self._moves.shown_state())
+        # Refused everywhere: the shown state's message, with why each sharing supervisor refused
+        # (a RESET refused by a persisting fault names the fault: docs/faults.md).
+        refusal = self._refusal(self._moves.shown_state())
+        why = "; ".join(f"supervisor {other}: {outcome.detail}" for other, outcome in forwarded.items()
+                        if outcome.detail)
+        return Outcome(refusal.message, f"{refusal.detail}; {why}" if why else refusal.detail)
 
     def _refuse(self, allowed: tuple[MPIState, ...], own: bool = False) -> Outcome | None:
         """None if the action may go on, else the message of the state that refuses it.
