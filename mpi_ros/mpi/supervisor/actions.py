@@ -140,7 +140,7 @@ class Actions:
         t = self._host.time
         if self._state.own_state is MPIState.ERROR:
             if then_abort and not self._state.aborted:
-                self.disable_amps(t)
+                self.generated_abort(t)
             return Outcome(OK, "already in ERROR")
         if self._state.own_state is MPIState.STOPPING_ERROR:
             self._state.abort_after_stop |= then_abort
@@ -173,6 +173,13 @@ class Actions:
             self._state.error_at = self._host.sample + 1
         self._moves.emit(MPIEventType.ABORT)
         return DONE
+
+    def generated_abort(self, t: float) -> None:
+        """The ABORT that E_STOP_ABORT generates once its E_STOP is done (MPI 000,
+        MPIActionE_STOP_ABORT: "Next, MotionAction will generate an MPIActionABORT"): the
+        amplifiers go off and, as for any ABORT, an ABORT event says so."""
+        self.disable_amps(t)
+        self._moves.emit(MPIEventType.ABORT)
 
     def disable_amps(self, t: float) -> None:
         self._state.aborted = True

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from mpi_ros.mpi import Controller, ControllerConfig, Hold, HoldType, MotionAttr, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
 
 T = MPIMotionType
@@ -186,6 +187,40 @@ def test_e_stop_abort_decelerates_then_disables(params):
     assert ms.state is MPIState.ERROR
     ms.action(MPIAction.RESET)
     assert ctl.axes[0].cmd_p == ctl.axes[0].act_p  # it was aborted: command = actual
+
+
+def _safety_events(ctl):
+    kinds = (MPIEventType.E_STOP, MPIEventType.ABORT)
+    return [(e.type, e.sample) for e in ctl.drain_events() if e.type in kinds and e.supervisor == 0]
+
+
+def test_e_stop_abort_emits_the_abort_it_generates(params):
+    # MPI 000, MPIActionE_STOP_ABORT: "The E_STOP_ABORT first performs an E_STOP, and then performs an ABORT"
+    # ("Next, MotionAction will generate an MPIActionABORT"): the E_STOP event at the action, the ABORT event
+    # at the sample the amplifiers go off, as a plain ABORT emits it
+    ctl, ms = two_axes()
+    ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
+    ctl.step(1000)
+    ctl.drain_events()
+    ms.action(MPIAction.E_STOP_ABORT)
+    began = ctl.sample
+    assert ctl.run_until(lambda c: not ms.axes[0].amp_enabled, 1000)
+    ctl.step(10)
+    assert _safety_events(ctl) == [(MPIEventType.E_STOP, began), (MPIEventType.ABORT, ctl.sample - 10)]
+
+
+def test_e_stop_abort_in_error_after_an_e_stop_emits_abort(params):
+    # docs/state-machine.md: E_STOP_ABORT in ERROR "OK, stays ERROR" and still disables the amplifiers: the
+    # ABORT it performs (MPI 000, MPIActionE_STOP_ABORT) is an ABORT event
+    ctl, ms = two_axes()
+    ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
+    ctl.step(500)
+    ms.action(MPIAction.E_STOP)
+    assert ctl.run_until(lambda c: ms.state is MPIState.ERROR, 200)
+    ctl.drain_events()
+    assert ms.action(MPIAction.E_STOP_ABORT).ok
+    assert _safety_events(ctl) == [(MPIEventType.ABORT, ctl.sample)]
+    assert not ms.axes[0].amp_enabled
 
 
 def test_abort_in_error_after_e_stop_disables(params):
