@@ -212,6 +212,9 @@ class Actions:
         refused = self._refuse((MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR))
         if refused:
             return refused
+        creeping = self._moves.still_creeping([axis.number for axis in self._own_axes()])
+        if not creeping.ok:
+            return creeping
         persisting = faults.persisting(self._axis_list.mapped)
         if persisting:  # docs/faults.md: a fault is cleared by RESET once its condition is gone
             return Outcome(Message.MPIMotionMessageERROR, f"RESET refused: {'; '.join(persisting)}: clear it first")
@@ -244,10 +247,8 @@ class Actions:
             return refused
         if not self._axis_list.listed:
             return Outcome(Message.MEIMotionMessageNO_AXES_MAPPED, "the axis list is empty")
-        message = self._moves.remap()
-        if not message.ok:
-            return Outcome(message, "an axis that leaves the mapping still moves (pauseFeedrate); RESET first")
-        return DONE
+        remapped = self._moves.remap()
+        return remapped if not remapped.ok else DONE
 
     def _map_if_unmapped(self) -> None:
         if not self._axis_list.mapped:

@@ -368,9 +368,9 @@ class MotionSupervisor:
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
         if self._state.own_state in (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR):
-            message = self._moves.remap()
-            if not message.ok:
-                return message
+            remapped = self._moves.remap()
+            if not remapped.ok:
+                return remapped.message
         self.notify_mask = MPIEventType(mask)
         return OK
 
@@ -526,9 +526,9 @@ class MotionSupervisor:
             message = self._check_frames([move])
         if not message.ok:
             return Outcome(message, "the move does not fit in the frame buffer")
-        message = self._moves.remap()
-        if not message.ok:
-            return Outcome(message, "an axis that leaves the mapping still moves (pauseFeedrate); RESET first")
+        remapped = self._moves.remap()
+        if not remapped.ok:
+            return remapped
         for kind, detail in notes.events:
             self._moves.emit(kind, detail=detail, move=move)
         if queued:

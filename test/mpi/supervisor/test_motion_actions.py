@@ -279,6 +279,43 @@ def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
     assert ctl.axes[0].command_position == 0.0
 
 
+def _creeping(params):
+    """Supervisor 0 STOPPED at pauseFeedrate 0.5: its axis 0 still moves at 500 counts/s."""
+    ctl, ms = two_axes()
+    config = ms.config_get()[1]
+    config.pause_feedrate = 0.5
+    assert ms.config_set(config).ok
+    assert ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0))).ok
+    ctl.step(1000)
+    assert ms.action(MPIAction.STOP).ok
+    assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 2000)
+    assert ctl.axes[0].cmd_v == pytest.approx(500.0)
+    return ctl, ms
+
+
+def test_reset_and_remap_follow_one_rule_while_stopped_axes_creep(params):
+    # MPI 000, MPIMotionConfig, pauseFeedrate: "the feed speed rate for the Stop action": above 0 the STOPPED
+    # axes still move. A RESET (to IDLE, pending profile dropped: docs/state-machine.md) or a remap that drops
+    # the profile would stop them dead in one sample: both are refused with MPIMotionMessageSTOPPED, say why,
+    # and change nothing; an E_STOP decelerates them (decelTime.eStop), and RESET is then OK
+    ctl, ms = _creeping(params)
+    twin, twin_ms = _creeping(params)
+    reset = ms.action_detail(MPIAction.RESET)
+    assert reset.message is Message.MPIMotionMessageSTOPPED and "pauseFeedrate" in reset.detail
+    assert ms.axis_list_set([1]).ok
+    remap = ms.action_detail(MPIAction.MAP)
+    assert (remap.message, remap.detail) == (reset.message, reset.detail)
+    assert twin_ms.axis_list_set([1]).ok
+    for _ in range(20):
+        ctl.step(10)
+        twin.step(10)
+        assert ms.state is twin_ms.state is MPIState.STOPPED
+        assert (ctl.axes[0].cmd_p, ctl.axes[0].cmd_v) == (twin.axes[0].cmd_p, twin.axes[0].cmd_v)
+    assert ms.action(MPIAction.E_STOP).ok
+    assert ctl.run_until(lambda c: ms.state is MPIState.ERROR, 2000)
+    assert ms.action(MPIAction.RESET).ok and ms.state is MPIState.IDLE
+
+
 def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(params):
     # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL "a non-zero target velocity": the axis leaves the move at that
     # velocity, so the supervisor stays MOVING (docs/decisions.md: never DONE, never IDLE while
