@@ -1,7 +1,7 @@
 """Cams on the controller: CAM_LINEAR and CAM_CUBIC slaves following a master position.
 
 MPI 000: MPIMotionCam, MPIMotionType CAM_LINEAR / CAM_CUBIC, the attributes REPEAT, MASTER_START,
-NO_BACKTRACK and NO_BACKTRACK_HOLD, MEIMotionMessageFRAME_BUFFER_TOO_SMALL; MPI 002: MPIAxisConfig.master,
+NO_BACKTRACK and NO_BACKTRACK_HOLD, MPIMotionMessageFRAME_BUFFER_TOO_SMALL; MPI 002: MPIAxisConfig.master,
 MPIAxisMaster, MPIAxisMasterType, masterCorrection. Decisions: docs/cams.md. Everything steps the
 controller by samples.
 """
@@ -488,7 +488,7 @@ def test_a_modifiable_type_does_not_replace_a_running_cam(kind, params):
 
 
 def test_a_cam_that_does_not_fit_the_frame_buffer():
-    # MEIMotionMessageFRAME_BUFFER_TOO_SMALL: "When trying to start a cam, an insufficient amount of space was
+    # MPIMotionMessageFRAME_BUFFER_TOO_SMALL: "When trying to start a cam, an insufficient amount of space was
     # found on the controller ... reduce the number of points within the cam ... or increase the number of
     # points in the frame buffer": a segment per frame, and the final frame (docs/cams.md)
     ctl = controller(frame_buffer_size=16)
