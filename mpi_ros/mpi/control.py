@@ -342,7 +342,7 @@ class Controller:
         feedrate, _ = owner.clock.feedrates(stretch.t)
         if self._sources is None or self._sources[0] is not stretch:  # one per stretch, for all its slaves
             self._sources = (stretch, self.master_sources(stretch))
-        return self._sources[1].position(plan.cam.master), feedrate / owner.config.normal_feedrate
+        return self._sources[1].position(plan.cam.master, plan.cam.frame), feedrate / owner.config.normal_feedrate
     def axis_fault_config_set(self, number: int, config: AxisFaultConfig) -> Outcome:
         """The fault limits and actions of an axis (docs/faults.md), checked by the one
         AxisFaultConfig validator (the YAML loader and the service use it too)."""

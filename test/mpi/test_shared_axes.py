@@ -233,6 +233,21 @@ def test_reset_from_the_sharing_supervisor_clears_the_other_s_error(ctl):
     assert b.start(T.TRAPEZOIDAL, params=make_params((10.0, 10.0))).ok
 
 
+def test_a_reset_refused_by_a_fault_on_a_shared_axis_names_the_fault(ctl):
+    # docs/faults.md: RESET is refused with MPIMotionMessageERROR while a latched fault persists, saying
+    # which; given to the supervisor that shares the axis, it is passed on to the motion in ERROR
+    # (docs/decisions.md, "Actions on shared axes") and its refusal must name the fault as well
+    a, b = sharing_axis_1(ctl)
+    assert b.start(T.TRAPEZOIDAL, params=make_params((5000.0, 5000.0))).ok
+    ctl.step(100)
+    assert ctl.axis_fault_inject(1, "AMP_FAULT", True).message.ok
+    run_to_state(ctl, b, MPIState.ERROR)
+    outcome = a.action_detail(A.RESET)
+    assert outcome.message is Message.MPIMotionMessageERROR
+    assert "axis 1 AMP_FAULT persists" in outcome.detail and "supervisor 1" in outcome.detail
+    assert b.state is MPIState.ERROR
+
+
 @pytest.mark.parametrize("action,column", [(A.STOP, "stop"), (A.E_STOP, "stop"), (A.ABORT, "abort")])
 def test_status_bits_after_an_action_from_the_sharing_supervisor(ctl, action, column):
     # MPI 002, the status-bit tables with settleOnStop/settleOnEstop FALSE: "After STOP (E-STOP)":

@@ -6,7 +6,8 @@ A slave axis follows one of:
 - MOTOR_FEEDBACK_SECONDARY: the motor's second encoder input (:class:`SecondaryInputs`), which
   configuration or a service drives, e.g. at the constant speed of a line shaft;
 - AXIS_COMMANDED_POSITION / AXIS_ACTUAL_POSITION: axis ``number``'s command or actual position
-  (user units: raw minus its origin), of any supervisor;
+  (user units: raw minus its origin), of any supervisor; a cam keeps the origins of its start
+  (an origin change later is bookkeeping and moves no slave: docs/cams.md);
 - ADDRESS: the value of the I/O word ``address`` of the simulated I/O image (io.py).
 With masterCorrection >= 0 the command position of that axis is added (docs/cams.md).
 
@@ -27,6 +28,7 @@ from mpi_ros.mpi.base.types import AxisMasterType, IoSpace
 
 M = AxisMasterType
 _AXIS_SOURCES = (M.AXIS_COMMANDED_POSITION, M.AXIS_ACTUAL_POSITION, M.MOTOR_FEEDBACK_PRIMARY)
+_USER_SOURCES = (M.AXIS_COMMANDED_POSITION, M.AXIS_ACTUAL_POSITION)  # read in user units: less the origin
 
 
 def reads(master: AxisMaster) -> set[int]:
@@ -81,19 +83,27 @@ class Sources:
     secondary: SecondaryInputs
     rate: float
 
-    def position(self, master: AxisMaster) -> np.ndarray:
-        """The master position at each sample."""
+    def frame(self, master: AxisMaster) -> float:
+        """The origins a user's reading of ``master`` subtracts now: the master axis' (AXIS_*
+        sources) and the masterCorrection axis'."""
+        frame = self.origin(master.number) if master.type in _USER_SOURCES else 0.0
+        if master.correction >= 0:
+            frame += self.origin(master.correction)
+        return frame
+
+    def position(self, master: AxisMaster, frame: float | None = None) -> np.ndarray:
+        """The master position at each sample: the raw reading less ``frame`` (by default the
+        origins now, :meth:`frame`). A cam reads its master with the frame of its start, so
+        that a later mpiAxisOriginSet, bookkeeping only, moves no slave."""
         n, kind = master.number, master.type
         if kind is M.AXIS_COMMANDED_POSITION:
-            value = self.cmd_p[n] - self.origin(n)
-        elif kind is M.AXIS_ACTUAL_POSITION:
-            value = self.act_p[n] - self.origin(n)
-        elif kind is M.MOTOR_FEEDBACK_PRIMARY:
-            value = self.act_p[n] + 0.0  # (a copy)
+            value = self.cmd_p[n] + 0.0  # (a copy)
+        elif kind in (M.AXIS_ACTUAL_POSITION, M.MOTOR_FEEDBACK_PRIMARY):
+            value = self.act_p[n] + 0.0
         elif kind is M.MOTOR_FEEDBACK_SECONDARY:
             value = self.secondary.at(n, self.samples, self.rate)
         else:
             value = np.full(self.samples.shape, float(self.io.words[IoSpace.IO][master.address]))
         if master.correction >= 0:
-            value = value + (self.cmd_p[master.correction] - self.origin(master.correction))
-        return value
+            value = value + self.cmd_p[master.correction]
+        return value - (self.frame(master) if frame is None else frame)

@@ -140,7 +140,8 @@ class CamFollow:
     """One slave axis' part of a cam move: its table, its master (MPIAxisConfig.master as it
     was when the cam started), the table's direction along the master (+1 or -1), the master
     position at travel 0, the backtrack rule, the slave's raw command at the start, and its
-    progress at the last committed sample."""
+    progress at the last committed sample. ``frame``: the origins the master was read less at
+    the start (masters.Sources.frame); it is read so for the whole cam."""
 
     table: CamTable
     master: AxisMaster
@@ -149,6 +150,7 @@ class CamFollow:
     mode: Backtrack
     start: float
     state: CamState
+    frame: float = 0.0
     pending: tuple[np.ndarray, Progress] | None = None  # the last stretch traced: (times, progress)
 
     def travel(self, master: np.ndarray) -> np.ndarray:

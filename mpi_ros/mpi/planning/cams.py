@@ -37,23 +37,24 @@ from mpi_ros.mpi.planning.start import AxisStart
 
 
 def cam_plans(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, starts: list[AxisStart],
-              masters: list[tuple[AxisMaster, float]]) -> list[AxisPlan]:
+              masters: list[tuple[AxisMaster, float, float]]) -> list[AxisPlan]:
     """The plans of a validated cam (validate._check_cam) for the slave axes ``starts``, each
-    with its master and the master's position now. Travel 0 is the master's position now, or
-    ``masterStart`` with MASTER_START; the table's direction is the sign of the master
-    distances, and a gear ratio (dS/d master position) becomes dS/d travel in it."""
+    with its master, the master's position now and the origins it is read less (its frame).
+    Travel 0 is the master's position now, or ``masterStart`` with MASTER_START; the table's
+    direction is the sign of the master distances, and a gear ratio (dS/d master position)
+    becomes dS/d travel in it."""
     count = len(starts)
     direction = 1.0 if params.master_distance[0] > 0.0 else -1.0
     distances = [abs(float(d)) for d in params.master_distance]
     repeat_from = int(params.repeat_from) if MotionAttr.REPEAT in attrs else None
     cubic = motion_type is MPIMotionType.CAM_CUBIC
     plans = []
-    for j, (start, (master, now)) in enumerate(zip(starts, masters, strict=True)):
+    for j, (start, (master, now, frame)) in enumerate(zip(starts, masters, strict=True)):
         ratios = [direction * float(g) for g in params.gear_ratio[j::count]] if cubic else None
         table = CamTable.build(distances, [float(s) for s in params.slave_position[j::count]], ratios, repeat_from)
         origin = float(params.master_start) if MotionAttr.MASTER_START in attrs else now
         follow = CamFollow(table, master.copy(), direction, origin, Backtrack.of(attrs), start.position,
-                           CamState.at_start((now - origin) * direction))
+                           CamState.at_start((now - origin) * direction), frame)
         plans.append(AxisPlan(axis=start.axis, segments=[], start_position=start.position, target=follow.target,
                               cam=follow))
     return plans

@@ -450,7 +450,7 @@ def compile_move(
     params: MotionParams,
     starts: list[AxisStart],
     sample_rate: float,
-    cam_masters: list[tuple[AxisMaster, float]] | None = None,
+    cam_masters: list[tuple[AxisMaster, float, float]] | None = None,
 ) -> tuple[Move, PlanNotes]:
     """The frames of a request for the axes ``starts`` (in the supervisor's order).
 
@@ -458,8 +458,8 @@ def compile_move(
     that starts while its axes move cannot wait first: a non-zero DELAY is
     MPIMotionMessageILLEGAL_DELAY (MPI 000, for a modify in motion) and a HOLD
     MPIMotionMessageATTRIBUTE_INVALID (MPI 000: HOLD is not permitted in modifies); either
-    would stop the axes dead. A cam (``cam_masters``: each slave's master and its position
-    now) is planned by cams.py.
+    would stop the axes dead. A cam (``cam_masters``: each slave's master, its position
+    now and the origins it is read less) is planned by cams.py.
     """
     notes = PlanNotes([])  # (its list given: the dataclass' default factory is a call more)
     bits = int(attrs)

@@ -78,13 +78,18 @@ class Actions:
         others = self._sharing()
         if not others:
             return handler(source)
-        forwarded = [self._host.act_on(other, action, source).ok for other in others]
+        forwarded = {other: self._host.act_on(other, action, source) for other in others}
         allowed = _OWN_STATES.get(action)
         if allowed is None or (self._state.own_state in allowed and self._state.own_state is not MPIState.IDLE):
             return handler(source)
-        if any(forwarded):
+        if any(outcome.ok for outcome in forwarded.values()):
             return Outcome(OK, "acted on the motion of the supervisor sharing its axes")
-        return self._refusal(self._moves.shown_state())
+        # Refused everywhere: the shown state's message, with why each sharing supervisor refused
+        # (a RESET refused by a persisting fault names the fault: docs/faults.md).
+        refusal = self._refusal(self._moves.shown_state())
+        why = "; ".join(f"supervisor {other}: {outcome.detail}" for other, outcome in forwarded.items()
+                        if outcome.detail)
+        return Outcome(refusal.message, f"{refusal.detail}; {why}" if why else refusal.detail)
 
     def _refuse(self, allowed: tuple[MPIState, ...], own: bool = False) -> Outcome | None:
         """None if the action may go on, else the message of the state that refuses it.
@@ -135,7 +140,7 @@ class Actions:
         t = self._host.time
         if self._state.own_state is MPIState.ERROR:
             if then_abort and not self._state.aborted:
-                self.disable_amps(t)
+                self.generated_abort(t)
             return Outcome(OK, "already in ERROR")
         if self._state.own_state is MPIState.STOPPING_ERROR:
             self._state.abort_after_stop |= then_abort
@@ -169,6 +174,13 @@ class Actions:
         self._moves.emit(MPIEventType.ABORT)
         return DONE
 
+    def generated_abort(self, t: float) -> None:
+        """The ABORT that E_STOP_ABORT generates once its E_STOP is done (MPI 000,
+        MPIActionE_STOP_ABORT: "Next, MotionAction will generate an MPIActionABORT"): the
+        amplifiers go off and, as for any ABORT, an ABORT event says so."""
+        self.disable_amps(t)
+        self._moves.emit(MPIEventType.ABORT)
+
     def disable_amps(self, t: float) -> None:
         self._state.aborted = True
         for axis in self._own_axes():
@@ -200,6 +212,9 @@ class Actions:
         refused = self._refuse((MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR))
         if refused:
             return refused
+        creeping = self._moves.still_creeping([axis.number for axis in self._own_axes()])
+        if not creeping.ok:
+            return creeping
         persisting = faults.persisting(self._axis_list.mapped)
         if persisting:  # docs/faults.md: a fault is cleared by RESET once its condition is gone
             return Outcome(Message.MPIMotionMessageERROR, f"RESET refused: {'; '.join(persisting)}: clear it first")
@@ -232,10 +247,8 @@ class Actions:
             return refused
         if not self._axis_list.listed:
             return Outcome(Message.MEIMotionMessageNO_AXES_MAPPED, "the axis list is empty")
-        message = self._moves.remap()
-        if not message.ok:
-            return Outcome(message, "an axis that leaves the mapping still moves (pauseFeedrate); RESET first")
-        return DONE
+        remapped = self._moves.remap()
+        return remapped if not remapped.ok else DONE
 
     def _map_if_unmapped(self) -> None:
         if not self._axis_list.mapped:

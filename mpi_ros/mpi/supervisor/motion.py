@@ -368,9 +368,9 @@ class MotionSupervisor:
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
         if self._state.own_state in (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR):
-            message = self._moves.remap()
-            if not message.ok:
-                return message
+            remapped = self._moves.remap()
+            if not remapped.ok:
+                return remapped.message
         self.notify_mask = MPIEventType(mask)
         return OK
 
@@ -526,9 +526,9 @@ class MotionSupervisor:
             message = self._check_frames([move])
         if not message.ok:
             return Outcome(message, "the move does not fit in the frame buffer")
-        message = self._moves.remap()
-        if not message.ok:
-            return Outcome(message, "an axis that leaves the mapping still moves (pauseFeedrate); RESET first")
+        remapped = self._moves.remap()
+        if not remapped.ok:
+            return remapped
         for kind, detail in notes.events:
             self._moves.emit(kind, detail=detail, move=move)
         if queued:
@@ -602,9 +602,10 @@ class MotionSupervisor:
                                         axis.cmd_a / (f * f)))
         return starts
 
-    def _cam_masters(self) -> list[tuple[AxisMaster, float]]:
-        """Each slave axis' master (MPIAxisConfig.master) and the master's position now, for a
-        cam on the axis list. Raises Refused if the masters would form a loop."""
+    def _cam_masters(self) -> list[tuple[AxisMaster, float, float]]:
+        """Each slave axis' master (MPIAxisConfig.master), the master's position now and the
+        origins it is read less (the cam keeps them: masters.Sources.frame), for a cam on the
+        axis list. Raises Refused if the masters would form a loop."""
         masters = [self._axis(n).master for n in self._axis_list.listed]
         running = {axis.number: axis.cam_reads() for axis in self._host.axes if axis.camming}
         loop = cams.master_loop(self._axis_list.listed, masters, running)
@@ -612,7 +613,7 @@ class MotionSupervisor:
             raise Refused(Message.MPIMessagePARAM_INVALID, f"{loop} (MPIAxisConfig.master): a slave cannot follow "
                                                              "itself, directly or through other cams")
         now = self._host.master_sources()
-        return [(master, float(now.position(master)[0])) for master in masters]
+        return [(master, float(now.position(master)[0]), now.frame(master)) for master in masters]
 
     def _check_frames(self, moves: list[Move]) -> Message:
         """Do the moves fit the frame buffer? A path's points need not: the library holds

@@ -272,7 +272,10 @@ class Moves:
             if plan.hold is not None:
                 axis.unload(t, self.clock_of(axis))
                 axis.holding = True
-                axis.target = axis.rest
+                # The move is loaded and waits (MPI 000, MEIMotionAttrHOLD): its target is the
+                # target, as while a DELAY waits (MPI 002 status table: IN_COARSE_POSITION is
+                # the distance to it).
+                axis.target = plan.target
                 self.holds[plan.axis] = HoldWait.begin(
                     plan, move.attributes, sample, host.rate,
                     self.position_of(plan.hold) if HoldWait.watches(plan.hold) else 0.0)
@@ -324,21 +327,33 @@ class Moves:
         kind = MPIEventType.HOLD_TIMEOUT if timed_out else MPIEventType.HOLD_RELEASED
         self.emit(kind, axis=axis_number, move=self.current, detail=wait.hold.type.name)
 
-    def remap(self) -> Message:
+    def still_creeping(self, numbers: list[int]) -> Outcome:
+        """The one rule for ending a STOPPED motion (RESET; a remap that drops it): refused
+        while one of axes ``numbers`` still moves, as it does at a non-zero pauseFeedrate
+        (MPI 000, MPIMotionConfig): dropping its plan would stop it dead in one sample."""
+        moving = [n for n in numbers if self.axis(n).cmd_v != 0.0]
+        if self._state.own_state is not MPIState.STOPPED or not moving:
+            return Outcome(OK)
+        return Outcome(Message.MPIMotionMessageSTOPPED,
+                       f"axis {moving[0]} still moves at pauseFeedrate {self._state.config.pause_feedrate:g}: "
+                       "ending the stopped motion would stop it dead; RESUME, or E_STOP (it decelerates) and RESET")
+
+    def remap(self) -> Outcome:
         """Write the axis list to the controller (MEIActionMAP).
 
         A stopped motion's pending profile belongs to the axes it was started on. Mapping a
         list that leaves out one of them drops that profile (the supervisor goes IDLE, as a
         RESET would take it): RESUME could not continue it, and the axes it leaves must not
         keep a plan no supervisor runs. Refused while such an axis still moves (a non-zero
-        pauseFeedrate): it would stop dead."""
+        pauseFeedrate), by the rule RESET follows too (:meth:`still_creeping`)."""
         move, state = self.current, self._state
         leaving = self._axis_list.leaving([p.axis for p in move.plans]) if move is not None else []
         if leaving and state.own_state is MPIState.STOPPED:
-            if any(self.axis(n).cmd_v != 0.0 for n in leaving):
-                return Message.MPIMotionMessageSTOPPED
+            creeping = self.still_creeping(leaving)
+            if not creeping.ok:
+                return creeping
             self.rebase(self._host.time)
             self.drop_pending(Message.MPIMotionMessageSTOPPED, "dropped: its axes were remapped")
             state.enter(MPIState.IDLE, "MAP", state.action_source)
         state.config.axis_numbers = list(self._axis_list.commit_mapping())
-        return OK
+        return Outcome(OK)

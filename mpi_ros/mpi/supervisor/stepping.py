@@ -219,7 +219,7 @@ class Transitions:
         t = self._host.time
         if self._state.error_at is None:
             if self._state.abort_after_stop:
-                self._actions.disable_amps(t)
+                self._actions.generated_abort(t)
             for axis in self._moves.axes:
                 if axis.mode is CommandMode.FOLLOW_ACTUAL:
                     # settleOnEstopCmdEqAct: "After the Estop time elapses, the axis'

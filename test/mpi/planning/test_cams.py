@@ -1,7 +1,7 @@
 """Cams on the controller: CAM_LINEAR and CAM_CUBIC slaves following a master position.
 
 MPI 000: MPIMotionCam, MPIMotionType CAM_LINEAR / CAM_CUBIC, the attributes REPEAT, MASTER_START,
-NO_BACKTRACK and NO_BACKTRACK_HOLD, MEIMotionMessageFRAME_BUFFER_TOO_SMALL; MPI 002: MPIAxisConfig.master,
+NO_BACKTRACK and NO_BACKTRACK_HOLD, MPIMotionMessageFRAME_BUFFER_TOO_SMALL; MPI 002: MPIAxisConfig.master,
 MPIAxisMaster, MPIAxisMasterType, masterCorrection. Decisions: docs/cams.md. Everything steps the
 controller by samples.
 """
@@ -242,6 +242,40 @@ def test_each_master_source(source):
     assert command(ctl, 1) > 0.0
 
 
+ORIGIN_MASTERS = [
+    ("commanded", AxisMaster(S.AXIS_COMMANDED_POSITION, 0), 0),
+    ("actual", AxisMaster(S.AXIS_ACTUAL_POSITION, 0), 0),
+    ("correction", AxisMaster(S.AXIS_COMMANDED_POSITION, 0, correction=3), 3),
+]
+
+
+@pytest.mark.parametrize("name,master,moved", ORIGIN_MASTERS, ids=[m[0] for m in ORIGIN_MASTERS])
+def test_an_origin_change_does_not_move_a_cam_slave(name, master, moved):
+    # MPI 002, mpiAxisOriginSet and MPIAxisMasterType AXIS_COMMANDED/ACTUAL_POSITION: the origin only changes
+    # how positions are reported; the master axis (or the masterCorrection axis) does not move, so neither
+    # may the slave: it goes on exactly as a twin whose origin stays put
+    twins = []
+    for change in (True, False):
+        ctl = controller()
+        follow(ctl, master, axes=(1,))
+        master_velocity(ctl, 1000.0)
+        ms1 = ctl.supervisor(1)
+        ms1.axis_list_set([1])
+        ctl.step(20)
+        assert ms1.start(T.CAM_LINEAR, A.NONE, cam([10_000.0], [5000.0])).ok  # gear ratio 0.5
+        ctl.step(100)
+        slave = [command(ctl, 1)]
+        if change:
+            assert ctl.axis_origin_set(moved, -1000.0) is M.MPIMessageOK
+        for _ in range(300):
+            ctl.step(1)
+            slave.append(command(ctl, 1))
+        twins.append(np.array(slave))
+    changed, kept = twins
+    assert np.max(np.abs(np.diff(changed))) * RATE < 600.0  # 0.5 x the master's 1000 counts/s, plus the loop
+    assert np.array_equal(changed, kept)
+
+
 def test_a_master_axis_of_another_supervisor_and_a_chain_of_cams():
     # axis 1 (supervisor 1) follows axis 0 (supervisor 0); axis 3 (supervisor 2) follows axis 1's command:
     # the slave of a slave, computed in the same sample after its master
@@ -454,7 +488,7 @@ def test_a_modifiable_type_does_not_replace_a_running_cam(kind, params):
 
 
 def test_a_cam_that_does_not_fit_the_frame_buffer():
-    # MEIMotionMessageFRAME_BUFFER_TOO_SMALL: "When trying to start a cam, an insufficient amount of space was
+    # MPIMotionMessageFRAME_BUFFER_TOO_SMALL: "When trying to start a cam, an insufficient amount of space was
     # found on the controller ... reduce the number of points within the cam ... or increase the number of
     # points in the frame buffer": a segment per frame, and the final frame (docs/cams.md)
     ctl = controller(frame_buffer_size=16)

@@ -5,7 +5,18 @@ from __future__ import annotations
 
 import pytest
 
-from mpi_ros.mpi import Hold, HoldType, IoSpace, MotionAttr, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi import (
+    Controller,
+    Hold,
+    HoldType,
+    IoSpace,
+    MotionAttr,
+    MotionParams,
+    MPIAction,
+    MPIMotionType,
+    MPIState,
+    Trajectory,
+)
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
 
@@ -41,6 +52,33 @@ def test_gate_holds_until_opened(ctl, ms, params, run_to):
     assert ctl.axes[0].cmd_p > 0.0
     run_to(ctl, ms, MPIState.IDLE, 20_000, chunk=100)
     assert ctl.axes[0].command_position == 500.0
+
+
+STATUS = ("target_position", "command_position", "done", "at_target", "in_fine_position", "in_coarse_position",
+          "settled", "trajectory_complete", "state")
+
+
+def _waiting_status(attrs, **fields):
+    """The status of axis 0 while a move to 5000 waits 0.1 s into a HOLD or a DELAY."""
+    ctl = Controller()
+    _, ms = ctl.create_motion(0)
+    assert ms.axis_list_set([0, 1]).ok
+    ctl.gate_set(3, True)
+    params = MotionParams(trajectory=[Trajectory(1000.0, 10_000.0, 10_000.0)], position=[5000.0, 0.0], **fields)
+    assert ms.start(T.TRAPEZOIDAL, attrs, params).ok
+    ctl.step(200)
+    axis = ms.snapshot().axes[0]
+    return {name: getattr(axis, name) for name in STATUS}
+
+
+def test_a_held_move_reports_its_target_as_a_delayed_one_does():
+    # MPI 000, MEIMotionAttrHOLD: the hold "prevents a motion profile from executing until the specified trigger
+    # conditions are met": the move is loaded, its target is the target; MPI 002's status table, IN_COARSE_POSITION
+    # is the target distance (|target - actual| < coarse): 5000 counts away it is FALSE, as while a DELAY waits
+    held = _waiting_status(A.HOLD, hold=[Hold(type=HoldType.GATE, gate=3)] * 2)
+    delayed = _waiting_status(A.DELAY, delay=[10.0, 10.0])
+    assert held["target_position"] == 5000.0 and not held["in_coarse_position"]
+    assert held == delayed
 
 
 def test_open_gate_does_not_hold(ctl, ms, params):

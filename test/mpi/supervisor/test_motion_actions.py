@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from mpi_ros.mpi import Controller, ControllerConfig, Hold, HoldType, MotionAttr, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
 
 T = MPIMotionType
@@ -188,6 +189,40 @@ def test_e_stop_abort_decelerates_then_disables(params):
     assert ctl.axes[0].cmd_p == ctl.axes[0].act_p  # it was aborted: command = actual
 
 
+def _safety_events(ctl):
+    kinds = (MPIEventType.E_STOP, MPIEventType.ABORT)
+    return [(e.type, e.sample) for e in ctl.drain_events() if e.type in kinds and e.supervisor == 0]
+
+
+def test_e_stop_abort_emits_the_abort_it_generates(params):
+    # MPI 000, MPIActionE_STOP_ABORT: "The E_STOP_ABORT first performs an E_STOP, and then performs an ABORT"
+    # ("Next, MotionAction will generate an MPIActionABORT"): the E_STOP event at the action, the ABORT event
+    # at the sample the amplifiers go off, as a plain ABORT emits it
+    ctl, ms = two_axes()
+    ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
+    ctl.step(1000)
+    ctl.drain_events()
+    ms.action(MPIAction.E_STOP_ABORT)
+    began = ctl.sample
+    assert ctl.run_until(lambda c: not ms.axes[0].amp_enabled, 1000)
+    ctl.step(10)
+    assert _safety_events(ctl) == [(MPIEventType.E_STOP, began), (MPIEventType.ABORT, ctl.sample - 10)]
+
+
+def test_e_stop_abort_in_error_after_an_e_stop_emits_abort(params):
+    # docs/state-machine.md: E_STOP_ABORT in ERROR "OK, stays ERROR" and still disables the amplifiers: the
+    # ABORT it performs (MPI 000, MPIActionE_STOP_ABORT) is an ABORT event
+    ctl, ms = two_axes()
+    ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0)))
+    ctl.step(500)
+    ms.action(MPIAction.E_STOP)
+    assert ctl.run_until(lambda c: ms.state is MPIState.ERROR, 200)
+    ctl.drain_events()
+    assert ms.action(MPIAction.E_STOP_ABORT).ok
+    assert _safety_events(ctl) == [(MPIEventType.ABORT, ctl.sample)]
+    assert not ms.axes[0].amp_enabled
+
+
 def test_abort_in_error_after_e_stop_disables(params):
     # docs/state-machine.md: ABORT in ERROR "OK, stays ERROR" (and does abort)
     ctl, ms = two_axes()
@@ -242,6 +277,43 @@ def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
     assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))).ok
     run_smoothly_to_idle(ctl, ms)
     assert ctl.axes[0].command_position == 0.0
+
+
+def _creeping(params):
+    """Supervisor 0 STOPPED at pauseFeedrate 0.5: its axis 0 still moves at 500 counts/s."""
+    ctl, ms = two_axes()
+    config = ms.config_get()[1]
+    config.pause_feedrate = 0.5
+    assert ms.config_set(config).ok
+    assert ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0))).ok
+    ctl.step(1000)
+    assert ms.action(MPIAction.STOP).ok
+    assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 2000)
+    assert ctl.axes[0].cmd_v == pytest.approx(500.0)
+    return ctl, ms
+
+
+def test_reset_and_remap_follow_one_rule_while_stopped_axes_creep(params):
+    # MPI 000, MPIMotionConfig, pauseFeedrate: "the feed speed rate for the Stop action": above 0 the STOPPED
+    # axes still move. A RESET (to IDLE, pending profile dropped: docs/state-machine.md) or a remap that drops
+    # the profile would stop them dead in one sample: both are refused with MPIMotionMessageSTOPPED, say why,
+    # and change nothing; an E_STOP decelerates them (decelTime.eStop), and RESET is then OK
+    ctl, ms = _creeping(params)
+    twin, twin_ms = _creeping(params)
+    reset = ms.action_detail(MPIAction.RESET)
+    assert reset.message is Message.MPIMotionMessageSTOPPED and "pauseFeedrate" in reset.detail
+    assert ms.axis_list_set([1]).ok
+    remap = ms.action_detail(MPIAction.MAP)
+    assert (remap.message, remap.detail) == (reset.message, reset.detail)
+    assert twin_ms.axis_list_set([1]).ok
+    for _ in range(20):
+        ctl.step(10)
+        twin.step(10)
+        assert ms.state is twin_ms.state is MPIState.STOPPED
+        assert (ctl.axes[0].cmd_p, ctl.axes[0].cmd_v) == (twin.axes[0].cmd_p, twin.axes[0].cmd_v)
+    assert ms.action(MPIAction.E_STOP).ok
+    assert ctl.run_until(lambda c: ms.state is MPIState.ERROR, 2000)
+    assert ms.action(MPIAction.RESET).ok and ms.state is MPIState.IDLE
 
 
 def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(params):

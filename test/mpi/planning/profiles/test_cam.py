@@ -72,5 +72,5 @@ def test_repeat_from_zero_repeats_the_whole_table():
 
 
 def test_frames_are_one_per_segment_and_the_final_frame():
-    # MEIMotionMessageFRAME_BUFFER_TOO_SMALL: a cam's points must fit the frame buffer (see test_cams.py)
+    # MPIMotionMessageFRAME_BUFFER_TOO_SMALL: a cam's points must fit the frame buffer (see test_cams.py)
     assert CamTable.build([1.0] * 5, [0.0] * 5, None, None).frames == 6
