@@ -45,6 +45,8 @@ COMMANDS: dict[str, str] = {
     "play": "mpi_ros.cli.play",
     "crosscheck": "mpi_ros.cli.crosscheck",
     "plot": "mpi_ros.cli.plot",
+    "fit": "mpi_ros.cli.fit",
+    "compare": "mpi_ros.cli.compare",
     "version": "mpi_ros.cli.version",
 }
 

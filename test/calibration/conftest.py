@@ -1,6 +1,9 @@
 """Recordings for the calibration tests: the twin's own controller run in-process (ROS-free)
 with known plant parameters, and a plant the twin cannot represent (scipy.signal).
 
+Fixtures: ``made`` (the controller's run, once per session: stepping it takes seconds),
+``noisy`` and ``third_order`` (functions making an AxisRecording of it).
+
 The controller is stepped a few samples at a time and its axes read after each step, as a
 status recorder at ``rate / every`` would read them."""
 
@@ -9,12 +12,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pytest
 
 from mpi_ros import config as suite_config
 from mpi_ros.calibration.recording import AxisRecording
 from mpi_ros.mpi import MotionParams, MPIMotionType, Trajectory
 
 RATE = 2000.0
+EVERY = 4  # samples between readings: a 500 Hz recording of a 2 kHz controller
 # Per axis, far from the defaults (30 Hz, 0.7, 0.9, 0.0): what a fit must find again.
 TRUE_PLANTS = {
     0: {"bandwidth_hz": 45.0, "damping": 0.55, "velocity_feedforward": 0.8, "acceleration_feedforward": 0.3},
@@ -96,3 +101,39 @@ def third_order(made: Made, axis: int, extra_pole_hz: float, sigma: float, step:
     actual = np.interp(t, fine, out + command[0])
     clean = Made(made.time, {axis: made.command[axis]}, {axis: actual})
     return noisy(clean, axis, sigma, step)
+
+
+@pytest.fixture(scope="session")
+def made() -> Made:
+    return twin_run(every=EVERY)
+
+
+@pytest.fixture
+def make_noisy():
+    return noisy
+
+
+@pytest.fixture
+def make_third_order():
+    return third_order
+
+
+@pytest.fixture
+def true_plants() -> dict[int, dict[str, float]]:
+    return TRUE_PLANTS
+
+
+def write_csv(path, recordings: list[AxisRecording]) -> None:
+    """``recordings`` (same times) as a CSV of this suite's layout."""
+    columns = {"time": recordings[0].time}
+    for r in recordings:
+        columns[f"axis{r.number}_command_position"] = r.command
+        columns[f"axis{r.number}_actual_position"] = r.actual
+    rows = [",".join(columns)]
+    rows += [",".join(repr(float(c[i])) for c in columns.values()) for i in range(len(recordings[0].time))]
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+
+
+@pytest.fixture
+def csv_of():
+    return write_csv
