@@ -85,7 +85,8 @@ class AxisTwin:
         self.grid = np.arange(n) / rate
         spline = CubicSpline(t, recording.command, bc_type="natural")
         g = self.grid
-        self.pieces = np.column_stack((spline(g), spline(g, 1), spline(g, 2) / 2.0, spline(g, 3) / 6.0))
+        # (4, n), one row per coefficient: each a contiguous run for the products below
+        self.pieces = np.array([spline(g), spline(g, 1), spline(g, 2) / 2.0, spline(g, 3) / 6.0])
         position = t * rate
         index = np.rint(position).astype(np.int64)
         self._index = index if np.all(np.abs(position - index) < _ON_GRID) else None
@@ -93,18 +94,17 @@ class AxisTwin:
     def motor(self, config: PlantConfig) -> tuple[np.ndarray, np.ndarray]:
         """The motor's position and velocity at every grid point (not read by the encoder)."""
         a, b = step_map(config, self.rate)
-        inputs = self.pieces @ b.T  # (n, 2): what each sample's piece adds
-        y0, dy0 = steady_state(config, self.pieces[0])
-        # x[k] = A x[k-1] + w[k] with w[0] = x0 and w[k] = inputs[k-1]: x[0] = x0 exactly.
-        w = np.empty((len(self.grid), 2))
-        w[0] = (y0, dy0)
-        w[1:] = inputs[:-1]
+        y0, dy0 = steady_state(config, self.pieces[:, 0])
+        # x[k] = A x[k-1] + w[k] with w[0] = x0 and w[k] what piece k-1 adds: x[0] = x0 exactly.
+        w = np.empty((2, self.pieces.shape[1]))
+        w[:, 0] = (y0, dy0)
+        w[:, 1:] = b @ self.pieces[:, :-1]
         den = [1.0, -(a[0, 0] + a[1, 1]), a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]]
         # (I - A z^-1)^-1 = adj(I - A z^-1) / det(I - A z^-1), one row per state component.
-        y = lfilter([1.0], den, _mix(w[:, 0], -a[1, 1], w[:, 1], a[0, 1]))
+        y = lfilter([1.0], den, _mix(w[0], -a[1, 1], w[1], a[0, 1]))
         if self._index is not None:
             return y, np.empty(0)
-        dy = lfilter([1.0], den, _mix(w[:, 1], -a[0, 0], w[:, 0], a[1, 0]))
+        dy = lfilter([1.0], den, _mix(w[1], -a[0, 0], w[0], a[1, 0]))
         return y, dy
 
     def actual(self, config: PlantConfig, read: bool = True) -> np.ndarray:
