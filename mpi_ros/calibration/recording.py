@@ -160,14 +160,17 @@ def _column(path: Path, rows: list[list[str]], index: int, name: str) -> np.ndar
     end = len(cells)
     while end and not cells[end - 1]:
         end -= 1
-    values = np.empty(end)
+    try:
+        return np.array(cells[:end], dtype=float)
+    except ValueError:
+        pass  # (some cell is not a number: found below, by row)
     for i in range(end):
         try:
-            values[i] = float(cells[i])
+            float(cells[i])
         except ValueError:
             where = "empty" if not cells[i] else f"{cells[i]!r} is not a number"
             raise RecordingError(f"{path}: row {i + 2}, column {name}: {where}") from None
-    return values
+    raise AssertionError("unreachable: numpy refused a column whose every cell float() reads")
 
 
 # -- MCAP --------------------------------------------------------------------------------------
