@@ -234,6 +234,7 @@ setup(
         "numpy>=1.26",
         "PyYAML>=6",
         "matplotlib>=3.8",
+        "scipy>=1.11",
     ],
     entry_points={"console_scripts": ["mpi-ros = mpi_ros.cli:main"]},
     distclass=BinaryDistribution,

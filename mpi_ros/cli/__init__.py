@@ -46,6 +46,8 @@ COMMANDS: dict[str, str] = {
     "crosscheck": "mpi_ros.cli.crosscheck",
     "plot": "mpi_ros.cli.plot",
     "urdf": "mpi_ros.cli.urdf",
+    "fit": "mpi_ros.cli.fit",
+    "compare": "mpi_ros.cli.compare",
     "version": "mpi_ros.cli.version",
 }
 
