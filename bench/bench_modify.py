@@ -40,7 +40,7 @@ TRAJECTORY = [{"velocity": 5000.0, "acceleration": 100000.0, "deceleration": 100
 
 # -- the measuring process ------------------------------------------------------------------
 def _controller() -> Controller:
-    from mpi_ros.commands import MOTION_START, Command, apply
+    from mpi_ros.commands import Command, Operation, apply
     from mpi_ros.mpi import Controller, ControllerConfig, MPIAction
 
     ctl = Controller(ControllerConfig(axis_count=SUPERVISORS, supervisor_count=SUPERVISORS))
@@ -48,7 +48,7 @@ def _controller() -> Controller:
         _, ms = ctl.create_motion(n)
         ms.axis_list_set([n])
         ms.action(MPIAction.MAP)
-        apply(ctl, Command(MOTION_START, n, request={"type": "S_CURVE", "position": [2000.0],
+        apply(ctl, Command(Operation.MOTION_START, n, request={"type": "S_CURVE", "position": [2000.0],
                                                       "trajectory": TRAJECTORY}))
     ctl.step(100)
     return ctl
@@ -57,7 +57,7 @@ def _controller() -> Controller:
 def measure(batch: int, every: int, samples: int, modify: bool) -> dict:
     """CPU seconds stepping and applying over ``samples`` samples, the modifies applied, and a
     digest of every axis' values after every step."""
-    from mpi_ros.commands import MOTION_MODIFY, Command, apply
+    from mpi_ros.commands import Command, Operation, apply
 
     ctl = _controller()
     digest = hashlib.sha256()
@@ -76,7 +76,7 @@ def measure(batch: int, every: int, samples: int, modify: bool) -> dict:
                        "attributes": ["AUTO_START"], "trajectory": TRAJECTORY}
             t0 = time.process_time()
             for n in range(SUPERVISORS):
-                apply(ctl, Command(MOTION_MODIFY, n, request=request))
+                apply(ctl, Command(Operation.MOTION_MODIFY, n, request=request))
             applying += time.process_time() - t0
             mods += SUPERVISORS
     return {"stepping": stepping, "applying": applying, "mods": mods, "digest": digest.hexdigest()}

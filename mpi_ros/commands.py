@@ -23,6 +23,7 @@ import json
 import logging
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from enum import StrEnum
 from typing import Any
 
 from mpi_ros.mpi.base.events import MPIEventType
@@ -35,11 +36,32 @@ from mpi_ros.mpi.control import Controller
 from . import requests as rq
 from . import trajectory
 
-MOTION_START = "motion_start"
-MOTION_MODIFY = "motion_modify"
-ACTION = "action"
-CLIENT_LOST = "client_lost"
-JOINT_TRAJECTORY = "joint_trajectory"
+
+class Operation(StrEnum):
+    """What a command does: one per handler in OPERATIONS. The values are what a recording
+    stores (Command.operation), so they never change."""
+
+    MOTION_START = "motion_start"
+    MOTION_MODIFY = "motion_modify"
+    ACTION = "action"
+    CLIENT_LOST = "client_lost"
+    JOINT_TRAJECTORY = "joint_trajectory"
+    CONFIG_SET = "config_set"
+    PARAMS_SET = "params_set"
+    AXIS_LIST_SET = "axis_list_set"
+    AXIS_LIST_EDIT = "axis_list_edit"
+    POSITION_SET = "position_set"
+    EVENT_NOTIFY_SET = "event_notify_set"
+    EVENT_RESET = "event_reset"
+    GATE_SET = "gate_set"
+    IO_SET = "io_set"
+    AXIS_CONFIG_SET = "axis_config_set"
+    SECONDARY_FEEDBACK_SET = "secondary_feedback_set"
+    AXIS_POSITION_SET = "axis_position_set"
+    AXIS_FAULT_CONFIG_SET = "axis_fault_config_set"
+    AXIS_FAULT_INJECT = "axis_fault_inject"
+
+
 # The reference has no "internal error" message; of its generic messages, NO_MEMORY ("not
 # enough memory was available") is the one that says the library failed, not the call.
 # Nothing else in the controller answers it, so it tells a bug apart from every refusal.
@@ -321,26 +343,26 @@ def _axis_fault_inject(ctl: Controller, command: Command) -> Reply:
     return Reply(outcome, value=faults)
 
 
-OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {
-    MOTION_START: lambda ctl, c: _motion(ctl, c, modify=False),
-    MOTION_MODIFY: lambda ctl, c: _motion(ctl, c, modify=True),
-    ACTION: _action,
-    CLIENT_LOST: _client_lost,
-    JOINT_TRAJECTORY: _joint_trajectory,
-    "config_set": _config_set,
-    "params_set": _params_set,
-    "axis_list_set": _axis_list_set,
-    "axis_list_edit": _axis_list_edit,
-    "position_set": _position_set,
-    "event_notify_set": _event_notify_set,
-    "event_reset": _event_reset,
-    "gate_set": _gate_set,
-    "io_set": _io_set,
-    "axis_config_set": _axis_config_set,
-    "secondary_feedback_set": _secondary_feedback_set,
-    "axis_position_set": _axis_position_set,
-    "axis_fault_config_set": _axis_fault_config_set,
-    "axis_fault_inject": _axis_fault_inject,
+OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {  # by Operation
+    Operation.MOTION_START: lambda ctl, c: _motion(ctl, c, modify=False),
+    Operation.MOTION_MODIFY: lambda ctl, c: _motion(ctl, c, modify=True),
+    Operation.ACTION: _action,
+    Operation.CLIENT_LOST: _client_lost,
+    Operation.JOINT_TRAJECTORY: _joint_trajectory,
+    Operation.CONFIG_SET: _config_set,
+    Operation.PARAMS_SET: _params_set,
+    Operation.AXIS_LIST_SET: _axis_list_set,
+    Operation.AXIS_LIST_EDIT: _axis_list_edit,
+    Operation.POSITION_SET: _position_set,
+    Operation.EVENT_NOTIFY_SET: _event_notify_set,
+    Operation.EVENT_RESET: _event_reset,
+    Operation.GATE_SET: _gate_set,
+    Operation.IO_SET: _io_set,
+    Operation.AXIS_CONFIG_SET: _axis_config_set,
+    Operation.SECONDARY_FEEDBACK_SET: _secondary_feedback_set,
+    Operation.AXIS_POSITION_SET: _axis_position_set,
+    Operation.AXIS_FAULT_CONFIG_SET: _axis_fault_config_set,
+    Operation.AXIS_FAULT_INJECT: _axis_fault_inject,
 }
 
 

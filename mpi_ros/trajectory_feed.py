@@ -26,7 +26,7 @@ from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Outcome, Refused
 
 from . import trajectory
-from .commands import JOINT_TRAJECTORY, Command
+from .commands import Command, Operation
 from .runner import Answer, ControllerRunner, Output
 
 Log = Callable[[str], None]
@@ -87,15 +87,15 @@ class TrajectoryFeed:
         serial = next(self._ids)
         if traj.empty:  # JTC: an empty trajectory stops; here the supervisor STOPs now
             self.runner.unschedule(lambda _sample, tag: _is_of(tag, self.number))
-            self.runner.schedule(now, Command(JOINT_TRAJECTORY, self.number, request={}), (self.number, serial),
-                                 self._stopped)
+            stop = Command(Operation.JOINT_TRAJECTORY, self.number, request={})
+            self.runner.schedule(now, stop, (self.number, serial), self._stopped)
             return None
         start = trajectory.start_sample(stamp_ns, self.epoch_ns, rate, now)
         # replaces, from its start on, whatever earlier trajectories were still to feed
         self.runner.unschedule(lambda sample, tag: _is_of(tag, self.number) and sample >= start)
         chunks = traj.chunks(self.chunk_points)
         for k, (chunk, sample) in enumerate(zip(chunks, trajectory.feed_samples(start, chunks, rate), strict=True)):
-            self.runner.schedule(sample, Command(JOINT_TRAJECTORY, self.number, request=chunk.to_request()),
+            self.runner.schedule(sample, Command(Operation.JOINT_TRAJECTORY, self.number, request=chunk.to_request()),
                                  (self.number, serial), self._answered(serial, k))
         return None
 

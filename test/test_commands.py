@@ -10,7 +10,7 @@ import math
 import pytest
 
 from mpi_ros import config
-from mpi_ros.commands import INTERNAL_ERROR, Command, apply
+from mpi_ros.commands import INTERNAL_ERROR, OPERATIONS, Command, Operation, apply
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.types import MPIState
 
@@ -331,3 +331,9 @@ def test_no_refusal_answers_the_internal_error_message():
     controller = pathlib.Path(__file__).resolve().parent.parent / "mpi_ros" / "mpi"
     users = [p.name for p in controller.rglob("*.py") if "NO_MEMORY" in p.read_text(encoding="utf-8")]
     assert users == ["messages.py"]
+
+
+def test_every_operation_has_one_handler_and_keeps_its_recorded_name():
+    assert set(OPERATIONS) == set(Operation)
+    # a recording stores the value: a command read back from JSON finds its handler
+    assert Command.from_json("motion_start", 0, -1, "{}").operation == Operation.MOTION_START

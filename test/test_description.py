@@ -13,7 +13,7 @@ import pytest
 from urdf_parser_py.urdf import URDF
 
 from mpi_ros import description
-from mpi_ros.commands import MOTION_START, Command, apply
+from mpi_ros.commands import Command, Operation, apply
 from mpi_ros.config import ConfigError, load
 from mpi_ros.joints import JointStates
 from mpi_ros.mpi.base.wrap import HALF
@@ -132,7 +132,7 @@ def test_forward_kinematics_at_the_twins_joint_states_puts_each_link_where_the_c
     ctl = config.build_controller()
     # X to 250,000 counts, Y to 100,000; Z down 100,000 counts, C a quarter turn (2,500 counts)
     for number, position in ((0, [250_000.0, 100_000.0]), (1, [100_000.0, 2_500.0])):
-        reply = apply(ctl, Command(MOTION_START, number, request={"type": "S_CURVE", "position": position,
+        reply = apply(ctl, Command(Operation.MOTION_START, number, request={"type": "S_CURVE", "position": position,
                                                                   "trajectory": S_CURVE}))
         assert reply.accepted, reply
     for samples in (500, 4000):  # on the way, then at rest

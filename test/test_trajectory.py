@@ -12,7 +12,7 @@ import pytest
 from scipy.interpolate import CubicHermiteSpline
 
 from mpi_ros import config, trajectory
-from mpi_ros.commands import JOINT_TRAJECTORY, Command, apply
+from mpi_ros.commands import Command, Operation, apply
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Refused
 from mpi_ros.mpi.base.types import MPIAction, MPIState
@@ -148,7 +148,7 @@ def test_the_start_is_the_first_sample_at_or_after_the_stamp():
 
 # -- the command -----------------------------------------------------------------------
 def command(chunk, supervisor=0) -> Command:
-    return Command(JOINT_TRAJECTORY, supervisor, request=chunk.to_request())
+    return Command(Operation.JOINT_TRAJECTORY, supervisor, request=chunk.to_request())
 
 
 def si_positions(ctl, joints, axes):
@@ -206,7 +206,7 @@ def test_an_empty_trajectory_stops_and_error_refuses(gantry, joints):
     t = read(ms0(joints), ["x", "y"], [([0.4, 0.0], [], 1.0)])
     apply(ctl, command(t.chunks()[0]))
     ctl.step(100)
-    assert apply(ctl, Command(JOINT_TRAJECTORY, 0, request={})).message is Message.MPIMessageOK
+    assert apply(ctl, Command(Operation.JOINT_TRAJECTORY, 0, request={})).message is Message.MPIMessageOK
     assert ctl.supervisor(0).state is MPIState.STOPPING
     ctl.supervisor(0).action(MPIAction.E_STOP)
     ctl.step(200)

@@ -251,10 +251,6 @@ class Controller:
         return self.axes[number]
 
     # -- axis calls ---------------------------------------------------------------------
-    def _axis_moving(self, axis: Axis) -> bool:
-        owner = self.supervisor(axis.owner)
-        return owner is not None and owner.own_state not in (MPIState.IDLE, MPIState.ERROR)
-
     def axis_command_position_set(self, number: int, position: float) -> Message:
         """mpiAxisCommandPositionSet under the rule of MPI 002 (Axis.can_set_command, which
         mpiMotionPositionSet applies too): MPIAxisMessageCOMMAND_NOT_SET while it moves."""

@@ -56,7 +56,7 @@ from mpi_ros.srv import (
 )
 
 from .. import requests as rq
-from ..commands import Command, Reply, io_space
+from ..commands import Command, Operation, Reply, io_space
 from ..config import RosSettings
 from ..joints import AxisJoint, JointStates
 from ..runner import ControllerRunner
@@ -259,17 +259,17 @@ class ControllerNode(Node):
         return convert.answer(response, Reply.of(Message.MPIMessageOK))
 
     def _on_config_set(self, k: int, request, response):
-        reply, _ = self.runner.submit(Command("axis_config_set", axis=k, request={
+        reply, _ = self.runner.submit(Command(Operation.AXIS_CONFIG_SET, axis=k, request={
             "in_position": convert.to_dict(request.in_position), "master": convert.to_dict(request.master),
             "master_correction": request.master_correction}))
         return convert.answer(response, reply)
 
     def _on_secondary_set(self, request, response):
-        reply, _ = self.runner.submit(Command("secondary_feedback_set", request=convert.to_dict(request)))
+        reply, _ = self.runner.submit(Command(Operation.SECONDARY_FEEDBACK_SET, request=convert.to_dict(request)))
         return convert.answer(response, reply)
 
     def _on_position_set(self, k: int, request, response):
-        reply, _ = self.runner.submit(Command("axis_position_set", axis=k,
+        reply, _ = self.runner.submit(Command(Operation.AXIS_POSITION_SET, axis=k,
                                               request={"which": request.which, "value": request.value}))
         return convert.answer(response, reply)
 
@@ -279,20 +279,21 @@ class ControllerNode(Node):
         return convert.answer(response, Reply.of(message))
 
     def _on_fault_config_set(self, k: int, request, response):
-        reply, _ = self.runner.submit(Command("axis_fault_config_set", axis=k,
+        reply, _ = self.runner.submit(Command(Operation.AXIS_FAULT_CONFIG_SET, axis=k,
                                               request={"config": convert.to_dict(request.config)}))
         response.detail = reply.detail
         return convert.answer(response, reply)
 
     def _on_fault_inject(self, k: int, request, response):
-        reply, _ = self.runner.submit(Command("axis_fault_inject", axis=k,
+        reply, _ = self.runner.submit(Command(Operation.AXIS_FAULT_INJECT, axis=k,
                                               request={"fault": request.fault, "active": request.active}))
         response.detail = reply.detail
         response.faults = list(reply.value or [])
         return convert.answer(response, reply)
 
     def _on_gate_set(self, request, response):
-        reply, _ = self.runner.submit(Command("gate_set", request={"gate": request.gate, "closed": request.closed}))
+        request_data = {"gate": request.gate, "closed": request.closed}
+        reply, _ = self.runner.submit(Command(Operation.GATE_SET, request=request_data))
         return convert.answer(response, reply)
 
     def _on_gate_get(self, request, response):
@@ -301,7 +302,7 @@ class ControllerNode(Node):
         return convert.answer(response, Reply.of(message))
 
     def _on_io_set(self, request, response):
-        reply, _ = self.runner.submit(Command("io_set", request=convert.to_dict(request)))
+        reply, _ = self.runner.submit(Command(Operation.IO_SET, request=convert.to_dict(request)))
         return convert.answer(response, reply)
 
     def _on_io_get(self, request, response):

@@ -58,7 +58,7 @@ from mpi_ros.srv import (
 )
 
 from .. import requests as rq
-from ..commands import ACTION, CLIENT_LOST, MOTION_MODIFY, MOTION_START, Command, Reply
+from ..commands import Command, Operation, Reply
 from ..config import RosSettings
 from ..joints import AxisJoint
 from ..runner import ControllerRunner, Output
@@ -110,7 +110,8 @@ class SupervisorNode(Node):
         self._closing = threading.Condition()
         self._goal_loop = goal_loop
         self._unfinished = 0  # goals ended whose result has not been handed to their server yet
-        actions = ((MotionStart, "motion_start", MOTION_START), (MotionModify, "motion_modify", MOTION_MODIFY))
+        actions = ((MotionStart, "motion_start", Operation.MOTION_START),
+                   (MotionModify, "motion_modify", Operation.MOTION_MODIFY))
         # each action's feedback topic: its clients subscribe there (the watchdog looks for them)
         self._feedback_topics = {action_type: f"{self.get_fully_qualified_name()}/{name}/_action/feedback"
                                  for action_type, name, _ in actions}
@@ -277,7 +278,7 @@ class SupervisorNode(Node):
         return True
 
     def _stop(self) -> None:
-        self.runner.submit(Command(ACTION, self.number, request={"action": "STOP"}))
+        self.runner.submit(Command(Operation.ACTION, self.number, request={"action": "STOP"}))
 
     # -- the lost-client watchdog (watchdog.py; its timer, service group) ---------------
     def _running(self, keys: list[bytes]) -> set[bytes]:
@@ -287,7 +288,7 @@ class SupervisorNode(Node):
         return self.runner.read(read)
 
     def _client_lost(self, detail: str) -> None:
-        reply, sample = self.runner.submit(Command(CLIENT_LOST, self.number, request={"detail": detail}))
+        reply, sample = self.runner.submit(Command(Operation.CLIENT_LOST, self.number, request={"detail": detail}))
         self.get_logger().warning(f"lost-client watchdog at sample {sample}: {detail} "
                                   f"(STOP answered {reply.message.name})")
 
@@ -401,7 +402,7 @@ class SupervisorNode(Node):
         return reply
 
     def _on_action(self, request, response):
-        reply, sample = self.runner.submit(Command(ACTION, self.number, request={"action": request.action}))
+        reply, sample = self.runner.submit(Command(Operation.ACTION, self.number, request={"action": request.action}))
         convert.answer(response, reply)
         response.state = int(reply.state)
         response.state_name = reply.state.name
@@ -410,7 +411,7 @@ class SupervisorNode(Node):
         return response
 
     def _on_trigger(self, action: str, response):
-        reply, sample = self.runner.submit(Command(ACTION, self.number, request={"action": action}))
+        reply, sample = self.runner.submit(Command(Operation.ACTION, self.number, request={"action": action}))
         response.success = reply.message is Message.MPIMessageOK
         response.message = reply.message.name + (f": {reply.detail}" if reply.detail else "")
         return response

@@ -10,7 +10,7 @@ from mpi_ros import config
 from mpi_ros.bag.recorder import Recorder
 from mpi_ros.bag.replay import replay
 from mpi_ros.bag.scenario import FIXED_EPOCH_NS
-from mpi_ros.commands import JOINT_TRAJECTORY
+from mpi_ros.commands import Operation
 from mpi_ros.runner import ControllerRunner
 from mpi_ros.trajectory_feed import TrajectoryFeed
 
@@ -46,7 +46,7 @@ def test_a_streamed_and_replaced_trajectory_run_replays_with_zero_differences(tm
     # one before it begins (its predecessor's predecessor done: 10 + 0.32 s, 10 + 0.64 s); the
     # fifth (due at 10 + 0.96 s) was dropped by the replacement, which took effect at 1510.
     # Each is recorded with the sample after the one it was applied at.
-    assert applied == [(s, JOINT_TRAJECTORY, "MPIMessageOK") for s in (11, 11, 651, 1291, 1511)]
+    assert applied == [(s, Operation.JOINT_TRAJECTORY, "MPIMessageOK") for s in (11, 11, 651, 1291, 1511)]
     report = replay(tmp_path / "run")
     assert report.identical, report.summary()
     assert report.commands == len(applied) and report.statuses > 100

@@ -14,7 +14,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from scipy.interpolate import CubicHermiteSpline
 
 from mpi_ros.client import STATUS_QOS
-from mpi_ros.commands import ACTION, Command
+from mpi_ros.commands import Command, Operation
 
 from .conftest import WAIT
 from .test_paths_ros import Topic
@@ -126,7 +126,7 @@ def test_each_refusal_moves_nothing_and_is_counted_on_diagnostics(suite, probe, 
     publish(message(["x", "y"], [([float("nan"), 0.0], [], 0.5)]))  # NaN
     publish(message(["x", "y"], [([0.4, 0.0], [], 0.5)]))  # 0.8 m/s, over x's max_velocity 0.5 m/s
     suite.runner.step(100)
-    suite.runner.submit(Command(ACTION, 0, request={"action": "E_STOP"}))
+    suite.runner.submit(Command(Operation.ACTION, 0, request={"action": "E_STOP"}))
     suite.runner.step(100)
     publish(message(["x", "y"], ok))  # the supervisor is in ERROR
     suite.runner.step(400)

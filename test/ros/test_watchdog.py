@@ -1,7 +1,7 @@
 """The lost-client watchdog (docs/cell.md, "Lost clients"; mpi_ros/ros/watchdog.py): on by
 default (2 s; docs/decisions.md: Jazzy's `ros2 action send_goal` does not cancel its goal on
 Ctrl-C), 0 turns it off; a goal whose client leaves the graph has its motion STOPped, with a
-CLIENT_LOST event, through a recorded command."""
+Operation.CLIENT_LOST event, through a recorded command."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from types import SimpleNamespace
 import pytest
 
 from mpi_ros import config
-from mpi_ros.commands import CLIENT_LOST, Command, apply
+from mpi_ros.commands import Command, Operation, apply
 from mpi_ros.mpi.base.types import MPIState
 
 from .conftest import WAIT
@@ -113,14 +113,14 @@ def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_
     # (an exit status 1, or an abort in the middleware's teardown, -6, seen here)
     assert ended == -signal.SIGKILL if kill is signal.SIGKILL else ended != 0
     sample, command, reply = seen.wait_command(
-        CLIENT_LOST, LEASE + TIMEOUT + LOADED,
+        Operation.CLIENT_LOST, LEASE + TIMEOUT + LOADED,
         lambda: f"watched: {watchdog.describe_watched()}; subscribers of the feedback topic: "
                 + ", ".join(f"{info.node_namespace}/{info.node_name}"
                             for info in suite.supervisor_nodes[1].get_subscriptions_info_by_topic(FEEDBACK)))
     took = time.monotonic() - killed_at
     assert TIMEOUT <= took < LEASE + TIMEOUT + LOADED
     # the client did not cancel (no STOP action of its own): the watchdog stopped the motion
-    assert [c.operation for _, c, _ in seen.commands] == ["motion_start", CLIENT_LOST]
+    assert [c.operation for _, c, _ in seen.commands] == ["motion_start", Operation.CLIENT_LOST]
     assert command.supervisor == 1 and reply.message.name == "MPIMessageOK" and reply.state is MPIState.STOPPING
     lost = [e for e in seen.events if e.type_name == "CLIENT_LOST"]
     assert len(lost) == 1 and lost[0].supervisor == 1 and "left the graph" in lost[0].detail
@@ -143,11 +143,12 @@ def test_a_client_lost_command_replays_as_recorded():
             "type": "TRAPEZOIDAL", "position": [100000.0, 0.0],
             "trajectory": [{"velocity": 1000.0, "acceleration": 10000.0, "deceleration": 10000.0}]}))
         ctl.step(100)
-        reply = apply(ctl, Command(CLIENT_LOST, 0, request={"detail": "the client of goal 0123abcd left the graph"}))
+        lost = {"detail": "the client of goal 0123abcd left the graph"}
+        reply = apply(ctl, Command(Operation.CLIENT_LOST, 0, request=lost))
         answers.append((reply.message, reply.state, [(e.sample, e.type_name, e.detail) for e in events]))
     assert answers[0] == answers[1]
     assert answers[0][0].name == "MPIMessageOK" and answers[0][1] is MPIState.STOPPING
-    refused = apply(config.load().build_controller(), Command(CLIENT_LOST, 0, request={"detail": 5}))
+    refused = apply(config.load().build_controller(), Command(Operation.CLIENT_LOST, 0, request={"detail": 5}))
     assert refused.message.name == "MPIMessagePARAM_INVALID"
 
 

@@ -8,7 +8,8 @@ transition happens, stops there, and calls :meth:`Transitions.transition`.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from enum import IntEnum
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,6 +33,27 @@ if TYPE_CHECKING:
 OK = Message.MPIMessageOK
 
 
+class Condition(IntEnum):
+    """What a stretch may bring about for a supervisor. At one sample, :meth:`Transitions.transition`
+    applies them in this order (a HOLD or an OUTPUT per axis, in axis order)."""
+
+    HOLD = 0  # a held move's trigger (or timeout): released
+    OUTPUT = 1  # a path point's output is due
+    CHUNK = 2  # the points of the oldest streamed request are done
+    FRAMES_LOW = 3
+    FRAMES_EMPTY = 4
+    STARVING = 5  # fewer than emptyCount points left: E_STOP, before the underflow fault of that sample
+    UNDERFLOW = 6
+    MOVE_DONE = 7
+    AT_VELOCITY = 8
+    STOPPED = 9  # a STOP complete
+    ERROR = 10  # an E_STOP or ABORT complete
+
+
+Key = tuple[Condition, int]  # a condition and its axis (-1: the supervisor's)
+_BUFFER_EVENTS = (Condition.FRAMES_LOW, Condition.FRAMES_EMPTY, Condition.STARVING)
+
+
 class Transitions:
     """The transitions of one motion supervisor while the controller steps: on its ``state``
     and ``moves``; ``actions`` for the E_STOP a starving path gets."""
@@ -41,8 +63,8 @@ class Transitions:
         self._state = state
         self._moves = moves
         self._actions = actions
-        # what :meth:`scan` found for :meth:`transition`: by a name, or (a name, an axis number)
-        self._conditions: dict[Any, np.ndarray] = {}
+        # what :meth:`scan` found for :meth:`transition`, per sample of the stretch
+        self._conditions: dict[Key, np.ndarray] = {}
 
     def scan(self, stretch: Stretch, status: StretchStatus) -> int | None:
         """The first sample of a stretch (stretch.Stretch, status.StretchStatus) at which a
@@ -50,21 +72,23 @@ class Transitions:
 
         The conditions are kept until :meth:`transition` applies them.
         """
-        conditions: dict[Any, np.ndarray] = {}
+        conditions: dict[Key, np.ndarray] = {}
         self._conditions = conditions
         state = self._state.own_state
         if self._moves.holds and state in (MPIState.MOVING, MPIState.STOPPED):
             for axis_number, wait in self._moves.holds.items():
-                conditions[("hold", axis_number)] = self._hold_trigger(wait, stretch)
+                conditions[Condition.HOLD, axis_number] = self._hold_trigger(wait, stretch)
         if state is MPIState.MOVING and self._moves.current is not None and not self._moves.holds:
             self._scan_move(self._moves.current, stretch, status, conditions)
         if state is MPIState.STOPPING:
-            conditions["stopped"] = self._stop_complete(stretch.t, status, lambda a: a.in_position.settle_on_stop)
+            conditions[Condition.STOPPED, -1] = self._stop_complete(stretch.t, status,
+                                                                     lambda a: a.in_position.settle_on_stop)
         elif state is MPIState.STOPPING_ERROR:
             if self._state.error_at is not None:
-                conditions["error"] = stretch.samples >= self._state.error_at
+                conditions[Condition.ERROR, -1] = stretch.samples >= self._state.error_at
             else:
-                conditions["error"] = self._stop_complete(stretch.t, status, lambda a: a.in_position.settle_on_estop)
+                conditions[Condition.ERROR, -1] = self._stop_complete(stretch.t, status,
+                                                                      lambda a: a.in_position.settle_on_estop)
         firsts = [int(np.argmax(fired)) for fired in conditions.values() if fired.any()]
         return min(firsts) if firsts else None
 
@@ -80,13 +104,13 @@ class Transitions:
         # (MOVING) until a modify, an append or a stop.
         if move.ends_moving:
             if self._moves.queue:
-                conditions["move_done"] = np.logical_and.reduce(
+                conditions[Condition.MOVE_DONE, -1] = np.logical_and.reduce(
                     [stretch.rel[plan.axis] >= plan.duration for plan in move.plans])
         else:
-            self._all_axes(move, conditions, "move_done", status, DONE)
+            self._all_axes(move, conditions, Condition.MOVE_DONE, status, DONE)
         if move.is_velocity and not self._moves.at_velocity_sent:
             # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
-            self._all_axes(move, conditions, "at_velocity", status, AT_VELOCITY)
+            self._all_axes(move, conditions, Condition.AT_VELOCITY, status, AT_VELOCITY)
 
     def _scan_path(self, move: Move, stream: Stream, stretch: Stretch, conditions: dict) -> None:
         """Outputs due at a later point; while the path is open, the points left in the
@@ -101,32 +125,33 @@ class Transitions:
                 continue
             rel = np.nan_to_num(stretch.rel[plan.axis], nan=-np.inf)
             if plan.timed_outputs:
-                conditions[("output", plan.axis)] = reached(rel) >= min(when for when, _ in plan.timed_outputs)
+                conditions[Condition.OUTPUT, plan.axis] = reached(rel) >= min(when for when, _ in plan.timed_outputs)
             counts = plan.points_left(rel)
             left = counts if left is None else np.minimum(left, counts)
             if stream.chunks and plan.axis in stream.chunks[0][1]:
                 done = reached(rel) >= stream.chunks[0][1][plan.axis]
-                conditions["chunk"] = done & conditions.get("chunk", True)
+                conditions[Condition.CHUNK, -1] = done & conditions.get((Condition.CHUNK, -1), True)
         if left is None or not stream.open:
             return
         if not stream.low_sent:
-            conditions["frames_low"] = left < stream.low_count
+            conditions[Condition.FRAMES_LOW, -1] = left < stream.low_count
         if not stream.empty_sent:
-            conditions["frames_empty"] = left == 0
+            conditions[Condition.FRAMES_EMPTY, -1] = left == 0
         if stream.empty_count > 0:
-            conditions["starving"] = left < stream.empty_count
+            conditions[Condition.STARVING, -1] = left < stream.empty_count
         if self._state.own_state is MPIState.MOVING and self._host.faults.watches_underflow(move.plan_axes):
-            conditions["underflow"] = left == 0  # (after "starving": its E_STOP at that sample comes first)
+            conditions[Condition.UNDERFLOW, -1] = left == 0
 
-    def _all_axes(self, move: Move, conditions: dict, key: str, status: StretchStatus, bit: int) -> None:
-        """``conditions[key]``: per sample, is ``bit`` set on every axis of ``move`` (the current
+    def _all_axes(self, move: Move, conditions: dict[Key, np.ndarray], condition: Condition, status: StretchStatus,
+                  bit: int) -> None:
+        """``conditions[condition]``: per sample, is ``bit`` set on every axis of ``move`` (the current
         one)? (left out where it never is: an axis without it anywhere in the stretch)"""
         ever = status.ever(bit)
         axes = move.plan_axes
         for number in axes:
             if not ever[number]:
                 return
-        conditions[key] = np.logical_and.reduce(status.bits[bit, list(axes)], axis=0)
+        conditions[condition, -1] = np.logical_and.reduce(status.bits[bit, list(axes)], axis=0)
 
     def _stop_complete(self, t: np.ndarray, status: StretchStatus, settle: Callable[[Axis], bool]) -> np.ndarray:
         ready = t >= self._state.stop_end - 1e-12
@@ -147,29 +172,27 @@ class Transitions:
     def transition(self, index: int, samples: np.ndarray) -> None:
         """Apply what :meth:`scan` found at stretch sample ``index`` (the controller is there)."""
         conditions, self._conditions = self._conditions, {}
-        for key, fired in conditions.items():
-            if not fired[index]:
-                continue
-            if key[0] == "hold":
-                wait = self._moves.holds.get(key[1])
+        for condition, axis in sorted(key for key, fired in conditions.items() if fired[index]):
+            if condition is Condition.HOLD:
+                wait = self._moves.holds.get(axis)
                 if wait is not None:
                     timed_out = bool(wait.timed_out(samples[index:index + 1])[0])
-                    self._moves.release(key[1], wait, timed_out=timed_out)
-            elif key[0] == "output":
-                self._due_outputs(key[1])
-            elif key in ("frames_low", "frames_empty", "starving"):
-                self._buffer_event(key)
-            elif key == "underflow":
+                    self._moves.release(axis, wait, timed_out=timed_out)
+            elif condition is Condition.OUTPUT:
+                self._due_outputs(axis)
+            elif condition in _BUFFER_EVENTS:
+                self._buffer_event(condition)
+            elif condition is Condition.UNDERFLOW:
                 self._underflow()
-            elif key == "chunk":
+            elif condition is Condition.CHUNK:
                 self._chunk_done()
-            elif key == "move_done":
+            elif condition is Condition.MOVE_DONE:
                 self._move_done()
-            elif key == "at_velocity":
+            elif condition is Condition.AT_VELOCITY:
                 self._moves.at_velocity_reached()
-            elif key == "stopped":
+            elif condition is Condition.STOPPED:
                 self._state.enter(MPIState.STOPPED, self._state.last_action, self._state.action_source)
-            elif key == "error":
+            elif condition is Condition.ERROR:
                 self._stop_on_error_complete()
 
     def _due_outputs(self, axis_number: int) -> None:
@@ -193,17 +216,17 @@ class Transitions:
             serial, _ = chunks.pop(0)
             self._moves.end_serial(serial, OK, "points executed")
 
-    def _buffer_event(self, key: str) -> None:
+    def _buffer_event(self, condition: Condition) -> None:
         move = self._moves.current
         assert move is not None and move.stream is not None  # scan found it on the current path
         stream = move.stream
-        if key == "frames_low" and not stream.low_sent:
+        if condition is Condition.FRAMES_LOW and not stream.low_sent:
             stream.low_sent = True
             self._moves.emit(MPIEventType.FRAMES_LOW, detail=f"fewer than {stream.low_count} points left: append more")
-        elif key == "frames_empty" and not stream.empty_sent:
+        elif condition is Condition.FRAMES_EMPTY and not stream.empty_sent:
             stream.empty_sent = True
             self._moves.emit(MPIEventType.FRAMES_EMPTY, detail="no points left; the path rests on its last point")
-        elif key == "starving" and self._state.own_state is MPIState.MOVING:
+        elif condition is Condition.STARVING and self._state.own_state is MPIState.MOVING:
             self._actions.e_stop(ActionSource.CONTROLLER, reason=f"fewer than emptyCount = {stream.empty_count} "
                                                                  "points left while more are expected (final false)")
 
