@@ -24,6 +24,7 @@ from mpi_ros.mpi.planning.profiles.segment import Row, ScaledProfile, Segment, S
 
 if TYPE_CHECKING:
     from mpi_ros.mpi.planning.cam_follow import CamFollow
+    from mpi_ros.mpi.planning.profiles.path import SplineHistory
 
 # A point's time is a sum of its dts in floating point, off the sample grid by rounding: a
 # point counts as reached from the sample within this many seconds of its time (far below
@@ -68,6 +69,9 @@ class AxisPlan:
     # Cams (cams.py): the slave's table, master and progress; its "profile time" is the
     # progress along the table (status, progress and frames read it as they read time).
     cam: CamFollow | None = None
+    # BSPLINE/BSPLINE2 (paths.py): the control points and point times of the whole curve, so
+    # that points appended to an open path continue the one B-spline of all the points.
+    spline: SplineHistory | None = None
     duration: float = field(init=False)
     _table: SegmentTable | None = field(init=False, default=None, repr=False, compare=False)
 
@@ -113,6 +117,7 @@ class AxisPlan:
         plan.timed_outputs = []
         plan.feedforward = None
         plan.cam = None
+        plan.spline = None
         plan._table = None
         return plan
 
@@ -155,7 +160,13 @@ class AxisPlan:
         """Points of a path not reached by profile time ``rel`` (0 for other plans)."""
         if self.point_times is None:
             return 0 if np.ndim(rel) == 0 else np.zeros(np.shape(rel), dtype=np.int64)
-        return len(self.point_times) - np.searchsorted(self.point_times, reached(rel), side="right")
+        left = len(self.point_times) - np.searchsorted(self.point_times, reached(rel), side="right")
+        if self.spline is not None:
+            # an open B-spline has run out where its points settle the curve (docs/paths.md):
+            # the points beyond cannot run until more come
+            left = np.where(np.asarray(rel) >= self.duration, 0, left)
+            return int(left) if np.ndim(rel) == 0 else left
+        return left
 
     def element_at(self, rel: float) -> int | None:
         """The element id of the point a path runs toward at ``rel`` (its last one once

@@ -28,7 +28,7 @@ from mpi_ros.mpi.base.params import MotionParams, Output
 from mpi_ros.mpi.base.types import HOLD_ATTRS, MotionAttr, MPIMotionType
 from mpi_ros.mpi.base.wrap import WRAP
 from mpi_ros.mpi.planning.frames import AxisPlan, reached
-from mpi_ros.mpi.planning.profiles.path import PathKind, path_segments, peaks
+from mpi_ros.mpi.planning.profiles.path import PathKind, SplineHistory, path_segments, peaks
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 A = MotionAttr
@@ -88,6 +88,11 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
         # Every kind ends exactly on its last point (the segments reach it within rounding;
         # the command is put on it when the path is done, AxisPlan.evaluate).
         ends = [float(points[-1, k]) for k in range(axes)]
+        histories = [_history(motion_type, start, points[:, k], params.time) for k, start in enumerate(starts)]
+        if not params.final and histories[0] is not None:
+            # An open B-spline runs only as far as its points settle it (docs/paths.md).
+            per_axis = [history.pieces(0.0, final=False) for history in histories if history is not None]
+            ends = [_curve_end(segments, start.position) for segments, start in zip(per_axis, starts, strict=True)]
     element_ids = _element_ids(params, attrs, len(times[0]) if times else 0)
     feedforward = _feedforward(motion_type, params, axes)
     plans = []
@@ -101,8 +106,78 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
             timed_outputs=[(when, out) for when, out in timed if when > 0.0],
             hold=params.hold[k] if attrs & HOLD_ATTRS else None,
             feedforward=None if feedforward is None else _knots(0.0, math.nan, point_times, feedforward[:, k]),
+            spline=None if motion_type is MPIMotionType.FRAME else histories[k],
         ))
     return plans, [peaks(plan.segments) for plan in plans]
+
+
+def _history(motion_type: MPIMotionType, start: PathStart, points: np.ndarray,
+             dts: list[float]) -> SplineHistory | None:
+    """A B-spline's control points and dts (None for the other kinds)."""
+    kind = KINDS[motion_type]
+    if kind not in (PathKind.BSPLINE, PathKind.BSPLINE2):
+        return None
+    values = (float(start.position), *(float(x) for x in points))
+    return SplineHistory(kind, 0.0, values, tuple(float(dt) for dt in dts))
+
+
+def _curve_end(segments: list[Segment], start: float) -> float:
+    """Where the segments end (``start`` if there are none)."""
+    return float(segments[-1].end_state()[0]) if segments else start
+
+
+@dataclass(frozen=True, slots=True)
+class SplineContinuation:
+    """Points appended to a B-spline path: the curve's history with them (``history``), the
+    segments that follow the plan's end, the new points' times from there, where the plan now
+    ends, and the time shift of the plan's pending points beyond ``settled`` (its old end)."""
+
+    history: SplineHistory
+    segments: list[Segment]
+    point_times: np.ndarray
+    target: float
+    settled: float
+    shift: float
+
+
+def continued_spline(plan: AxisPlan, chunk: AxisPlan, now: float, final: bool) -> SplineContinuation | None:
+    """Points ``chunk`` appended to the path ``plan`` (profile time ``now`` into it); None
+    unless they are B-spline points.
+
+    An open B-spline plan ends where its points settle the curve; the new points continue the
+    one B-spline of all the points from there, so a streamed B-spline is the curve one request
+    of all its points makes (docs/paths.md). If the path ran out (``now`` past that end: it
+    rested there) the rest of the curve runs from now, later by the wait. Onto a path of
+    another kind, the points make a B-spline of their own from the path's end."""
+    old, new = plan.spline, chunk.spline
+    if new is None:
+        return None
+    begin = append_time(plan, now)
+    if old is None or old.kind is not new.kind:
+        history = SplineHistory(new.kind, begin, new.values, new.dts)
+        assert chunk.point_times is not None  # (the plan of a path)
+        return SplineContinuation(history, chunk.segments, chunk.point_times, chunk.target, math.inf, 0.0)
+    return _continued(plan, old, new.values[1:], new.dts, begin, final)
+
+
+def closed_spline(plan: AxisPlan, now: float) -> SplineContinuation | None:
+    """An open B-spline path closed without more points (final true): the rest of its curve,
+    to its last point (None for the other kinds: they end on their last point already)."""
+    if plan.spline is None:
+        return None
+    return _continued(plan, plan.spline, (), (), append_time(plan, now), True)
+
+
+def _continued(plan: AxisPlan, old: SplineHistory, values: tuple[float, ...], dts: tuple[float, ...], begin: float,
+               final: bool) -> SplineContinuation:
+    settled = plan.duration
+    shift = begin - settled
+    history = old.continued(shift, values, dts)
+    segments = history.pieces(begin, final)
+    last_old = old.end_time() + shift  # the old last point, after the wait
+    point_times = (last_old - begin) + np.cumsum(np.asarray(dts, dtype=float))
+    target = history.values[-1] if final else _curve_end(segments, plan.target)
+    return SplineContinuation(history, segments, point_times, target, settled, shift)
 
 
 def _feedforward(motion_type: MPIMotionType, params: MotionParams, axes: int) -> np.ndarray | None:
@@ -165,18 +240,25 @@ def timed_outputs(params: MotionParams, attrs: MotionAttr, point_times: np.ndarr
 
 def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.ndarray,
            element_ids: tuple[int, ...], outputs: list[tuple[float, Output]], target: float,
-           feedforward: np.ndarray | None = None, held: float = 0.0) -> AxisPlan:
+           feedforward: np.ndarray | None = None, held: float = 0.0,
+           spline: SplineContinuation | None = None) -> AxisPlan:
     """``plan`` with points appended (profile time ``now`` into it): the executed segments
     and points are flushed; the new ones follow the last point, or start now if the path
     has run out of points (it rests on its last point meanwhile). ``point_times``: when the
     new points are reached, from the time they begin; ``outputs``: (time from
     the first new point's interval, output); ``target``: where the new points end;
-    ``feedforward``: the new points' values (PTF/PVTF), ``held`` the axis' feedforward now."""
+    ``feedforward``: the new points' values (PTF/PVTF), ``held`` the axis' feedforward now;
+    ``spline``: B-spline points (:func:`continued_spline`): the old points and outputs beyond
+    the curve's settled end come later by the time the path waited there."""
     begin = append_time(plan, now)
     kept = [s for s, end in zip(plan.segments, plan.table.end, strict=True) if end > now]
     first = float(plan.table.start[len(plan.segments) - len(kept)]) if kept else begin
     old_times = plan.point_times
     assert old_times is not None  # the plan of a path (compile_path)
+    timed = plan.timed_outputs
+    if spline is not None and spline.shift > 0.0:
+        old_times = np.where(old_times > spline.settled, old_times + spline.shift, old_times)
+        timed = [(w + spline.shift if w > spline.settled else w, o) for w, o in timed]
     pending = old_times > reached(now)
     new_times = begin + point_times
     shifted = [*kept, *segments]
@@ -186,8 +268,9 @@ def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.
         start_velocity=plan.start_velocity, origin_time=first,
         point_times=np.concatenate([old_times[pending], new_times]),
         element_ids=ids,
-        timed_outputs=[(w, o) for w, o in plan.timed_outputs if w > now] + [(begin + w, o) for w, o in outputs],
+        timed_outputs=[(w, o) for w, o in timed if w > now] + [(begin + w, o) for w, o in outputs],
         feedforward=_extended_feedforward(plan, begin, point_times, feedforward, held),
+        spline=None if spline is None else spline.history,
     )
 
 
@@ -232,7 +315,10 @@ def last_point_time(plan: AxisPlan) -> float:
 
 def end_state(plan: AxisPlan, now: float) -> tuple[float, float]:
     """Position and velocity (profile time) the next appended points start from: the last
-    point's, or at rest on it once the path has run out."""
+    point's, or at rest on it once the path has run out. (A B-spline's points continue its
+    curve, continued_spline; its last point is where RELATIVE points are measured from.)"""
+    if plan.spline is not None:
+        return plan.spline.values[-1], 0.0
     if now >= plan.duration:
         return plan.target, 0.0
     _, v, _ = plan.segments[-1].end_state()

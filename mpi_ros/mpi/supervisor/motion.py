@@ -651,10 +651,15 @@ class MotionSupervisor:
         listed = self._axis_list.listed
         nows = {n: -math.inf if n in self._moves.holds else tau - self._axis(n).tau_start for n in listed}
         if paths.point_count(motion_type, params, len(self._axis_list.listed)) == 0:
-            # No points: it only closes (or keeps open) the path, and is done with its last point.
+            # No points: it only closes (or keeps open) the path, and is done with its last point
+            # (an open B-spline then runs the rest of its curve: docs/paths.md).
+            if params.final and all(plans[n].spline is not None for n in listed):
+                self._moves.rebase(t)
+                ends = {n: self._close_spline(move, plans[n], nows[n], t) for n in listed}
+            else:
+                ends = {n: paths.last_point_time(plans[n]) for n in listed}
             stream.append(None, open_=not params.final)
-            stream.chunks.append((self._host.next_serial(),
-                                  {n: paths.last_point_time(plans[n]) for n in self._axis_list.listed}))
+            stream.chunks.append((self._host.next_serial(), ends))
             return Outcome(OK)
         starts = [AxisStart(n, *paths.end_state(plans[n], nows[n]), self._axis(n).origin) for n in listed]
         try:
@@ -664,27 +669,46 @@ class MotionSupervisor:
         for kind, detail in notes.events:
             self._moves.emit(kind, detail=detail, move=move)
         self._moves.rebase(t)
-        ends = {new.axis: self._extend_plan(move, plans[new.axis], new, nows[new.axis], t) for new in chunk.plans}
+        ends = {new.axis: self._extend_plan(move, plans[new.axis], new, nows[new.axis], t, params.final)
+                for new in chunk.plans}
         stream.append(chunk.stream, open_=not params.final)
         if MotionAttr.LOW_COUNT in attrs:
             stream.low_count = params.low_count
         stream.chunks.append((self._host.next_serial(), ends))
         return Outcome(OK)
 
-    def _extend_plan(self, move: Move, old: AxisPlan, new: AxisPlan, now: float, t: float) -> float:
-        """Put ``new``'s points after ``old``'s on its axis; returns when its last one is reached."""
+    def _extend_plan(self, move: Move, old: AxisPlan, new: AxisPlan, now: float, t: float, final: bool) -> float:
+        """Put ``new``'s points after ``old``'s on its axis (B-spline points: on its curve, as
+        one request of all the points would make it); returns when its last one is reached."""
         outputs = [(0.0, out) for out in new.outputs] + new.timed_outputs
         axis = self._axis(new.axis)
         values = new.feedforward[1][1:] if new.feedforward is not None else None
         assert new.point_times is not None  # the plan of a path (paths.compile_path)
-        extended = paths.extend(old, now, new.segments, new.point_times, new.element_ids, outputs, new.target,
-                                values, axis.feedforward)
+        spline = paths.continued_spline(old, new, now, final)
+        segments, times, target = ((new.segments, new.point_times, new.target) if spline is None
+                                   else (spline.segments, spline.point_times, spline.target))
+        extended = paths.extend(old, now, segments, times, new.element_ids, outputs, target,
+                                values, axis.feedforward, spline)
+        return self._install(move, old, extended, t)
+
+    def _close_spline(self, move: Move, old: AxisPlan, now: float, t: float) -> float:
+        """An open B-spline path closed without points: the rest of its curve, to its last
+        point (paths.closed_spline); returns when that point is reached."""
+        spline = paths.closed_spline(old, now)
+        assert spline is not None  # (only for B-spline plans)
+        extended = paths.extend(old, now, spline.segments, spline.point_times, (), [], spline.target,
+                                None, self._axis(old.axis).feedforward, spline)
+        return self._install(move, old, extended, t)
+
+    def _install(self, move: Move, old: AxisPlan, extended: AxisPlan, t: float) -> float:
+        """``extended`` replaces ``old`` in the move and on its axis; returns when its last
+        point is reached."""
         move.plans[move.plans.index(old)] = extended
-        wait = self._moves.holds.get(new.axis)
+        wait = self._moves.holds.get(old.axis)
         if wait is not None:
             wait.plan = extended  # still held: the path begins, whole, when the hold releases
         else:
-            axis.extend(extended, t, self._state.clock)
+            self._axis(old.axis).extend(extended, t, self._state.clock)
         return paths.last_point_time(extended)
 
     # ================================================================= status ====

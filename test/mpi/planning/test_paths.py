@@ -867,35 +867,102 @@ def test_the_running_motions_type_decides_whether_it_can_be_modified(running, ki
 
 
 APPENDABLE = [T.PT, T.PTF, T.PVT, T.PVTF, T.BESSEL, T.BSPLINE, T.BSPLINE2]
+BSPLINES = [T.BSPLINE, T.BSPLINE2]
 
 
 @pytest.mark.parametrize("kind", APPENDABLE, ids=[k.name for k in APPENDABLE])
 def test_a_modify_with_append_adds_points_and_modifies_nothing(kind):
     # MPI 000, MPIMotionPoint, final: more points are loaded "using mpiMotionModify(...) with the
     # MPIMotionAttrMaskAPPEND attribute mask" (docs/paths.md: for every type that may carry APPEND; the
-    # points already given run unchanged)
+    # points already given run unchanged; a B-spline's run on the one curve of all the points, which its
+    # first points settle only in part: four settle none of a cubic's, so it starts when the rest come)
     ctl, ms = new_supervisor()
     first = np.array([[20.0, 10.0], [50.0, 30.0], [60.0, 70.0], [90.0, 80.0]])
     outcome, path_serial = ms.command(kind, A.NONE, path_params(kind, first, [EXACT_DT] * 4, final=False,
                                                                    empty_count=0), False)
     message = outcome.message
     assert message.ok
-    expected = Expected.of(kind, (0.0, 0.0), first, [EXACT_DT] * 4,
-                           np.zeros((4, 2)) if kind in WITH_VELOCITY else None)
-    ctl.step(10)
     more = np.array([[120.0, 60.0], [150.0, 40.0], [170.0, 20.0]])
+    late = 10 if kind is T.BSPLINE else 0
+    if kind in BSPLINES:
+        expected = Expected.of(kind, (0.0, 0.0), np.concatenate([first, more]), [EXACT_DT] * 7)
+    else:
+        expected = Expected.of(kind, (0.0, 0.0), first, [EXACT_DT] * 4,
+                               np.zeros((4, 2)) if kind in WITH_VELOCITY else None)
+    ctl.step(10)
     outcome, serial = ms.command(kind, A.APPEND, path_params(kind, more, [EXACT_DT] * 3, final=True), True)
     message = outcome.message
     assert message.ok and serial != path_serial
     n = int(round(EXACT_DT * RATE))
     for k in range(11, 4 * n + 1):
         ctl.step(1)
-        assert np.allclose(raw(ctl), expected.at(k / RATE), rtol=0.0, atol=TOL), k
+        assert np.allclose(raw(ctl), expected.at((k - late) / RATE), rtol=0.0, atol=1e-6 if late else TOL), k
     run_idle(ctl, ms)
     assert raw(ctl) == pytest.approx(more[-1], abs=TOL)
     (done,) = ends_of(ctl, serial)
-    assert (done.message, done.detail, done.sample) == (M.MPIMessageOK, "points executed", 7 * n)
+    assert (done.message, done.detail, done.sample) == (M.MPIMessageOK, "points executed", 7 * n + late)
     assert ends_of(ctl, path_serial)[0].message is M.MPIMessageOK
+
+
+@pytest.mark.parametrize("kind", BSPLINES, ids=[k.name for k in BSPLINES])
+@pytest.mark.parametrize("chunks", [(6, 5), (6, 1, 1, 3), (7, 2, 2, 0)], ids=["6+5", "6+1+1+3", "7+2+2+close"])
+def test_a_streamed_b_spline_is_the_one_request_b_spline(kind, chunks):
+    # MPI 000, MPIMotionPoint.final: "If final=0, more points can be loaded using mpiMotionModify(...) with the
+    # MPIMotionAttrMaskAPPEND attribute" (APPEND is among the BSPLINE, BSPLINE2 attributes); MPIMotionTypeBSPLINE
+    # fits one B spline "through a list of position and time points", and the reference warns of a velocity step
+    # at an appended seam for the cubic SPLINE only (Streaming Point Motion Type Calculations): points streamed in
+    # time make the same curve as the same points given in one request
+    ctl, ms = new_supervisor()
+    count = sum(chunks)
+    t = np.arange(1.0, count + 1.0)
+    points = np.stack([40.0 * t + 30.0 * np.sin(t), 25.0 * np.cos(0.7 * t) - 10.0 * t], axis=1)
+    times = [EXACT_DT * (1 + (i % 3)) for i in range(count)]
+    expected = Expected.of(kind, (0.0, 0.0), points, times)
+    n = int(round(EXACT_DT * RATE))
+    first = 0
+    trace = []
+    for index, size in enumerate(chunks):
+        final = index == len(chunks) - 1
+        params = path_params(kind, points[first:first + size], times[first:first + size], final=final,
+                             empty_count=0)
+        outcome, _ = ms.command(kind, A.APPEND if index else A.NONE, params, bool(index))
+        assert outcome.ok
+        first += size
+        for _ in range(n // 5):  # each chunk comes in good time, while the path runs well inside what it has
+            ctl.step(1)
+            trace.append(raw(ctl))
+    while ms.state is not MPIState.IDLE:
+        ctl.step(1)
+        trace.append(raw(ctl))
+    trace = np.array(trace)
+    wanted = np.array([expected.at(k / RATE) for k in range(1, len(trace) + 1)])
+    assert np.allclose(trace, wanted, rtol=0.0, atol=1e-6)
+    assert trace[-1] == pytest.approx(points[-1], abs=TOL)
+
+
+@pytest.mark.parametrize("kind", BSPLINES, ids=[k.name for k in BSPLINES])
+def test_a_b_spline_that_runs_out_waits_where_its_points_settle_it_then_runs_the_same_curve(kind):
+    # MPI 000, mpiMotionStart: a path whose points come too late underflows ("the axis jumps on a frame
+    # underflow"): an open B-spline runs only as far as its points settle the curve (docs/paths.md), two
+    # points of a BSPLINE2 (three of a BSPLINE) settle none of it; the points that come later run the rest of
+    # the same curve, later by the wait
+    ctl, ms = new_supervisor()
+    t = np.arange(1.0, 10.0)
+    points = np.stack([30.0 * t, 20.0 * np.sin(t)], axis=1)
+    times = [EXACT_DT] * 9
+    early = 2 if kind is T.BSPLINE2 else 3
+    assert ms.command(kind, A.NONE, path_params(kind, points[:early], times[:early], final=False, empty_count=0),
+                      False)[0].ok
+    ctl.drain_events()
+    ctl.step(40)
+    assert np.array_equal(raw(ctl), [0.0, 0.0])
+    assert [e.sample for e in ctl.drain_events() if e.type is E.FRAMES_EMPTY] == [1]  # it ran out at once
+    assert ms.command(kind, A.APPEND, path_params(kind, points[early:], times[early:]), True)[0].ok
+    expected = Expected.of(kind, (0.0, 0.0), points, times)
+    for k in range(1, int(round(9 * EXACT_DT * RATE)) + 10):
+        ctl.step(1)
+        assert np.allclose(raw(ctl), expected.at(k / RATE), rtol=0.0, atol=1e-6), k
+    run_idle(ctl, ms)
 
 
 @pytest.mark.parametrize("kind", [T.PT, T.PVT], ids=["PT", "PVT"])

@@ -15,7 +15,9 @@ dt > 0, every value finite, as many times as positions, at least one point).
 from __future__ import annotations
 
 import enum
+import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from mpi_ros.mpi.planning.profiles.segment import Segment
@@ -61,10 +63,8 @@ def path_segments(kind: PathKind, start_position: float, start_velocity: float,
         return _natural_spline(values, dts)
     if kind is PathKind.BESSEL:
         return _hermite(values, _bessel_tangents(values, dts), dts)
-    if kind is PathKind.BSPLINE:
-        return _bspline(values, dts, 3)
-    if kind is PathKind.BSPLINE2:
-        return _bspline(values, dts, 2)
+    if kind in _DEGREE:
+        return _bspline(values, dts, _DEGREE[kind])
     raise ValueError(f"not a path kind: {kind!r}")
 
 
@@ -198,6 +198,57 @@ def _natural_spline(values: list[float], dts: list[float]) -> list[Segment]:
 
 # --- BSPLINE and BSPLINE2: clamped B-splines with the start and the points as control points ---
 
+_DEGREE = {PathKind.BSPLINE: 3, PathKind.BSPLINE2: 2}  # docs/paths.md: "3rd order" read as the degree
+_KNOT_TOLERANCE = 1e-9  # seconds: knots computed by other sums of the same dts agree far closer
+
+
+@dataclass(frozen=True, slots=True)
+class SplineHistory:
+    """A B-spline path's control points (the start, then every point so far, raw) and the dts
+    of its points, and the profile time ``begin`` at which the curve starts: enough to plan the
+    one B-spline of these points and of any appended to them."""
+
+    kind: PathKind
+    begin: float
+    values: tuple[float, ...]
+    dts: tuple[float, ...]
+
+    def continued(self, shift: float, values: Sequence[float], dts: Sequence[float]) -> SplineHistory:
+        """With more points, the curve starting ``shift`` later (a path that ran out waited)."""
+        return SplineHistory(self.kind, self.begin + shift, self.values + tuple(values), self.dts + tuple(dts))
+
+    def pieces(self, after: float, final: bool) -> list[Segment]:
+        """The curve's segments from profile time ``after`` (one of its knots) to its end, or,
+        while more points may come (``final`` false), to where it is settled."""
+        until = math.inf if final else self.settled_until() - _KNOT_TOLERANCE
+        out, t = [], self.begin
+        for segment in path_segments(self.kind, self.values[0], 0.0, self.values[1:], self.dts):
+            if after - _KNOT_TOLERANCE <= t < until:
+                out.append(segment)
+            t += segment.duration
+        return out
+
+    def end_time(self) -> float:
+        """Profile time of the last point."""
+        return self.begin + math.fsum(self.dts)
+
+    def settled_until(self) -> float:
+        """The profile time up to which the curve stays what it is whatever points are appended.
+
+        The piece on knot interval i depends on the knots u_{i-k+1} .. u_{i+k} and the control
+        points c_{i-k} .. c_i (de Boor). Appended points leave the control points and the inner
+        knots u_{k+1} .. u_n of n points as they are and replace the end knots, so the pieces up
+        to interval n-k are final: the curve is settled up to u_{n-k+1}. With fewer points than
+        the degree needs, more points raise the degree and change all of it."""
+        degree, count = _DEGREE[self.kind], len(self.dts)
+        if count < degree:
+            return self.begin
+        knot_times = [0.0]
+        for dt in self.dts:
+            knot_times.append(knot_times[-1] + dt)
+        knots = _clamped_knots(knot_times, degree)
+        return self.begin + knots[count - degree + 1]
+
 
 def _clamped_knots(knot_times: list[float], degree: int) -> list[float]:
     """The knot vector: the first and last time repeated degree+1 times (so the path starts on the
@@ -270,4 +321,4 @@ def _bspline(values: list[float], dts: list[float], degree: int) -> list[Segment
     return segments
 
 
-__all__ = ["PathKind", "path_segments", "peaks", "feedforward_segments"]
+__all__ = ["PathKind", "SplineHistory", "path_segments", "peaks", "feedforward_segments"]
