@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,7 +42,7 @@ from mpi_ros.mpi.base.types import (
 from mpi_ros.mpi.host import SupervisorHost
 from mpi_ros.mpi.planning import cams, paths, validate
 from mpi_ros.mpi.planning.frames import AxisPlan, Move, frames_needed
-from mpi_ros.mpi.planning.planner import compile_move
+from mpi_ros.mpi.planning.planner import PlanNotes, compile_move
 from mpi_ros.mpi.planning.start import AxisStart
 from mpi_ros.mpi.supervisor.actions import Actions
 from mpi_ros.mpi.supervisor.axis_list import AxisList
@@ -60,6 +61,21 @@ _START_ONLY = (MotionAttr.APPEND | MotionAttr.AUTO_START | MotionAttr.DELAY | Mo
 # meiMotionActionFunction: called with (motion, motion type, action name) on every
 # start ("START"), modify ("MODIFY") and action ("STOP", "E_STOP", ...).
 ActionCallback = Callable[["MotionSupervisor", MPIMotionType, str], object]
+
+
+@dataclass(frozen=True, slots=True)
+class _Admitted:
+    """How a start or modify was admitted: the state it found, whether a modify from IDLE
+    starts (AUTO_START), whether it queues behind what runs or is pending (APPEND), and the
+    open path it adds points to, if any."""
+
+    state: MPIState
+    auto_start: bool
+    queued: bool
+    open_path: Move | None
+
+
+OUTCOME_OK = Outcome(Message.MPIMessageOK)
 
 
 class MotionSupervisor:
@@ -449,16 +465,39 @@ class MotionSupervisor:
         return outcome, serial
 
     def _command(self, motion_type, attrs, params, modify) -> Outcome:
+        """A start or modify, in five steps, each of which may refuse it (nothing changes then):
+        admit (handle, axes, type, state), check (the request against what runs), plan,
+        fit (the frame buffer, the mapping), commit."""
+        if params is None:
+            params = self.stored_params
+        admitted = self._admit(motion_type, attrs, modify)
+        if isinstance(admitted, Outcome):
+            return admitted
+        verdict = self._check(motion_type, attrs, params, modify, admitted)
+        if not verdict.ok:
+            return verdict
+        if admitted.open_path is not None:
+            return self._append_points(admitted.open_path, motion_type, attrs, params)
+        planned = self._plan(motion_type, attrs, params, modify, admitted)
+        if isinstance(planned, Outcome):
+            return planned
+        move, notes = planned
+        verdict = self._fit(move, admitted.queued)
+        if not verdict.ok:
+            return verdict
+        return self._commit(move, notes, params, modify, admitted)
+
+    def _admit(self, motion_type: MPIMotionType, attrs: MotionAttr, modify: bool) -> Outcome | _Admitted:
+        """May this supervisor take a start or modify of this type now, and how (behind what
+        runs, into an open path, as an AUTO_START)?"""
         if not self.valid:
             return Outcome(Message.MPIMessageHANDLE_INVALID, "invalid motion handle")
         self._notify_action(motion_type, "MODIFY" if modify else "START")
-        if params is None:
-            params = self.stored_params
         if not self._axis_list.listed:
             return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes")
         bits = int(attrs)
-        verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21,
-                                      append=bool(bits & _APPEND))
+        append = bool(bits & _APPEND)
+        verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21, append=append)
         if not verdict.ok:
             return verdict
         state = self._moves.state_for(self._axis_list.listed)
@@ -471,7 +510,6 @@ class MotionSupervisor:
             axis, other, other_state = held[0]
             return Outcome(STATE_MESSAGES[state.name], (f"axis {axis} is in the {other_state.name} motion of "
                                                         f"supervisor {other}: command it there, or RESET it"))
-        append = bool(bits & _APPEND)
         auto_start = False
         if modify:
             if state is MPIState.IDLE:
@@ -487,29 +525,38 @@ class MotionSupervisor:
         # APPEND given while STOPPED queues behind it like one given while MOVING.
         behind = append and (state is MPIState.MOVING
                              or (state is MPIState.STOPPED and self._moves.current is not None))
-        open_path = self._moves.open_path() if behind else None
-        if open_path is not None and motion_type not in paths.STREAMED_TYPES:
-            return Outcome(Message.MPIMotionMessagePATH_ERROR, "the path in progress is open (final false): append "
-                                                               "its points, or close it with final true, first")
         # APPEND queues behind the move in progress or pending; from STOPPED a start without it
         # drops what is pending (docs/state-machine.md), and behind a move already cruising at its
         # final velocity there is nothing to wait for: the new move starts from where the axes are.
         queued = behind and (bool(self._moves.queue) or not self._moves.cruising())
+        open_path = self._moves.open_path() if behind else None
+        return _Admitted(state, auto_start, queued, open_path)
+
+    def _check(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
+               admitted: _Admitted) -> Outcome:
+        """The request itself, and against the motion it would join or replace."""
+        if admitted.open_path is not None and motion_type not in paths.STREAMED_TYPES:
+            return Outcome(Message.MPIMotionMessagePATH_ERROR, "the path in progress is open (final false): append "
+                                                               "its points, or close it with final true, first")
+        replaces = modify and not admitted.auto_start
         running = self._moves.current
-        if modify and not auto_start and not queued and open_path is None and running is not None:
+        if replaces and not admitted.queued and admitted.open_path is None and running is not None:
             verdict = validate.check_running_type(running.type)
             if not verdict.ok:
                 return verdict
-        verdict = self._check_request(motion_type, attrs, params, modify, append_to=open_path is not None)
-        if not verdict.ok:
+        verdict = self._check_request(motion_type, attrs, params, modify, append_to=admitted.open_path is not None)
+        if not verdict.ok or admitted.open_path is not None:
             return verdict
-        if open_path is not None:
-            return self._append_points(open_path, motion_type, attrs, params)
-        if modify and not auto_start and bits & _DELAY and any(d != 0.0 for d in params.delay):
+        if replaces and int(attrs) & _DELAY and any(d != 0.0 for d in params.delay):
             # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
             return Outcome(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
-        starts = self._starts(queued, state, modify and not auto_start)
+        return OUTCOME_OK
+
+    def _plan(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
+              admitted: _Admitted) -> Outcome | tuple[Move, PlanNotes]:
+        """The move, from where each axis' new profile starts."""
+        starts = self._starts(admitted.queued, admitted.state, modify and not admitted.auto_start)
         try:
             # (a cam also needs each slave's master; other moves are planned from the starts alone)
             cams_of = (self._cam_masters(),) if motion_type in CAM_TYPES else ()
@@ -519,6 +566,11 @@ class MotionSupervisor:
         move.serial = self._host.next_serial()  # (a modify keeps the serial of the move it changes: Moves.replace)
         if move.stream is not None:
             move.stream.low_count = self._low_count(attrs, params)
+        return move, notes
+
+    def _fit(self, move: Move, queued: bool) -> Outcome:
+        """Does the move fit the frame buffer (with what it queues behind), and is the mapping
+        the axes need in place?"""
         if queued:
             current = [self._moves.current] if self._moves.current else []
             message = self._check_frames(list(self._moves.queue) + current + [move])
@@ -526,24 +578,26 @@ class MotionSupervisor:
             message = self._check_frames([move])
         if not message.ok:
             return Outcome(message, "the move does not fit in the frame buffer")
-        remapped = self._moves.remap()
-        if not remapped.ok:
-            return remapped
+        return self._moves.remap()
+
+    def _commit(self, move: Move, notes: PlanNotes, params: MotionParams, modify: bool,
+                admitted: _Admitted) -> Outcome:
+        """The move runs, replaces the one running, or queues; its notes are reported."""
         for kind, detail in notes.events:
             self._moves.emit(kind, detail=detail, move=move)
-        if queued:
+        if admitted.queued:
             self._moves.queue.append(move)
-        elif modify and not auto_start:
+        elif modify and not admitted.auto_start:
             self._moves.replace(move)
         else:
             self._moves.begin(move)
-        if auto_start or not modify:
+        if admitted.auto_start or not modify:
             # MPI 000, mpiMotionParamsGet: the parameters are set by mpiMotionParamsSet "or
             # mpiMotionStart", so a start's parameters are the ones a later get returns.
             self.stored_params = params.copy()
-        if auto_start:
+        if admitted.auto_start:
             return Outcome(Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)")
-        return Outcome(OK)
+        return OUTCOME_OK
 
     def _check_request(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
                        append_to: bool) -> Outcome:
