@@ -35,8 +35,10 @@ pip_progress() {  # pip's lines, condensed: a line every 25 packages resolved, t
     awk '/^Collecting / { n++; if (n % 25 == 1) { printf "[setup]   %d packages resolved\n", n; fflush() } next }
          /^Installing collected packages/ { printf "[setup]   installing %d packages\n", n; fflush() }'
 }
-build_progress() {  # setup.py's own lines and CMake's percentage, every 10 %
-    awk '/^\[mpi_ros setup.py\]/ { sub(/^\[mpi_ros setup.py\] /, ""); if (length($0) < 100) printf "[setup]   %s\n", $0; fflush(); next }
+build_progress() {  # setup.py's own lines and CMake's percentage, every 10 % (pip indents them)
+    awk '{ sub(/^ +/, "") }
+         /^\[mpi_ros setup.py\]/ { sub(/^\[mpi_ros setup.py\] /, ""); if (length($0) > 96) $0 = substr($0, 1, 93) "..."
+                                  printf "[setup]   %s\n", $0; fflush(); next }
          /^\[ *[0-9]+%\]/ { p = substr($0, 2, index($0, "%") - 2) + 0
                              if (p >= last + 10) { printf "[setup]   building the interfaces: %d%%\n", p; fflush(); last = p } }'
 }
