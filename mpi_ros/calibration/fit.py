@@ -122,11 +122,17 @@ def fit_axis(recording: AxisRecording, rate: float, configured: PlantConfig) -> 
     if resolution is not None:
         fitted = replace(fitted, encoder_resolution=resolution)
     after = residual(twin, fitted)
+    before = residual(twin, configured)
+    if _rms(before) <= _rms(after):
+        # The configured plant explains the recording at least as well: kept. (A recording whose
+        # following error is near the encoder's step leaves the plant undetermined, and the
+        # search on unrounded positions can land on any of many plants that round alike.)
+        fitted, after = configured, before
     t = recording.time
     noise, structured = split_noise(after)
     runs = search.evaluations + (scout.evaluations if scout is not None else 0)
     return AxisFit(recording.number, len(t), recording.duration, rate, configured, fitted,
-                   Residual.of(t, residual(twin, configured)), Residual.of(t, after),
+                   Residual.of(t, before), Residual.of(t, after),
                    Residual.of(t, recording.command - recording.actual), resolution,
                    noise, structured, (scout or search).started, runs)
 

@@ -23,6 +23,7 @@ class Inputs:
     rate: float
     plants: dict[int, PlantConfig]  # the configured plant of each axis
     config_source: str
+    skipped: list[int]  # axes left out because their command never moves (none named)
 
 
 def gather(path: str | Path, axes: list[int] | None, config_path: str | None, rate: float | None) -> Inputs:
@@ -41,4 +42,5 @@ def gather(path: str | Path, axes: list[int] | None, config_path: str | None, ra
     plants = {axis.number: config.plant[axis.number] if axis.number < len(config.plant) else PlantConfig()
               for axis in chosen}
     used = rate or recording.sample_rate or config.controller.sample_rate
-    return Inputs(chosen, float(used), plants, source)
+    skipped = [n for n in recording.still() if n not in {axis.number for axis in chosen}]
+    return Inputs(chosen, float(used), plants, source, skipped)

@@ -84,9 +84,16 @@ class Recording:
     sample_rate: float | None = None  # the controller's, when the recording says it
     config: dict | None = field(default=None)  # the configuration recorded with it (YAML mapping)
 
+    def still(self) -> list[int]:
+        """The axes whose command never moves (nothing to fit on them)."""
+        return [n for n, axis in sorted(self.axes.items()) if len(axis.command) and np.ptp(axis.command) == 0.0]
+
     def select(self, wanted: list[int] | None) -> list[AxisRecording]:
-        """The axes asked for (all if None), each validated."""
-        numbers = sorted(self.axes) if not wanted else list(dict.fromkeys(wanted))
+        """The axes asked for, each validated; if none are named, every axis whose command
+        moves (a recording of a machine with an axis at rest fits the others), or, when none
+        does, every axis (and the first one's error says so)."""
+        moving = [n for n in sorted(self.axes) if n not in self.still()]
+        numbers = (moving or sorted(self.axes)) if not wanted else list(dict.fromkeys(wanted))
         missing = [n for n in numbers if n not in self.axes]
         if missing:
             have = ", ".join(str(n) for n in sorted(self.axes)) or "none"

@@ -37,6 +37,8 @@ def fit_text(fit: AxisFit) -> str:
         f"    the fitted residual: white noise {fit.noise:.4f}, structured {fit.structured:.4f} RMS; "
         f"the twin reproduces {100.0 * fit.explained:.3f} % of the following error's power",
     ]
+    if f == c:
+        lines.append("    the configured plant fits this recording at least as well as any found: kept")
     if fit.matched:
         lines.append("    MATCH: what the fitted twin leaves is within the recording's noise")
     else:

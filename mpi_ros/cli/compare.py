@@ -17,7 +17,8 @@ import sys
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("recording", metavar="RECORDING", help="bag directory, .mcap file or .csv file")
     parser.add_argument("--config", metavar="FILE", required=True, help="the configuration to compare")
-    parser.add_argument("--axis", type=int, action="append", metavar="K", help="only these axes (repeatable)")
+    parser.add_argument("--axis", type=int, nargs="+", action="extend", metavar="K",
+                        help="only these axes (default: every axis whose command moves)")
     parser.add_argument("--rate", type=float, metavar="HZ", help="the controller's sample rate")
 
 
@@ -36,6 +37,8 @@ def run(args) -> int:
     from mpi_ros.calibration.fit import compare
 
     print(f"configured plants: {inputs.config_source}")
+    for number in inputs.skipped:
+        print(f"axis {number}: left out, its command never moves")
     for axis in inputs.axes:
         plant = inputs.plants[axis.number]
         print(report.compare_text(axis, inputs.rate, plant, *compare(axis, plant, inputs.rate)))

@@ -24,7 +24,8 @@ import sys
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("recording", metavar="RECORDING", help="bag directory, .mcap file or .csv file")
-    parser.add_argument("--axis", type=int, action="append", metavar="K", help="only these axes (repeatable)")
+    parser.add_argument("--axis", type=int, nargs="+", action="extend", metavar="K",
+                        help="only these axes (default: every axis whose command moves)")
     parser.add_argument("--output", metavar="FILE", help="also write the fitted YAML block to FILE")
     parser.add_argument("--plot", metavar="FILE", help="a PNG of recorded and twin actual position and error")
     parser.add_argument("--config", metavar="FILE", help="the configuration whose plants are compared")
@@ -46,6 +47,8 @@ def run(args) -> int:
     from mpi_ros.calibration.fit import fit_axis
 
     print(f"configured plants: {inputs.config_source}")
+    for number in inputs.skipped:
+        print(f"axis {number}: left out, its command never moves")
     fits = []
     for axis in inputs.axes:
         fit = fit_axis(axis, inputs.rate, inputs.plants[axis.number])
