@@ -105,11 +105,11 @@ def _args(*argv: str) -> argparse.Namespace:
 
 
 def test_goal_from_flags():
-    goal = goal_from_args(_args("-p", "1000", "-250.5", "-v", "500", "-a", "5000", "-j", "50",
+    goal = goal_from_args(_args("-p", "1000", "-250.5", "-v", "500", "-a", "5000", "-d", "5000", "-j", "50",
                                 "--attribute", "relative", "--id", "7"))
     assert goal == {"type": "S_CURVE", "position": [1000.0, -250.5],
-                    "trajectory": [{"velocity": 500.0, "acceleration": 5000.0, "jerk_percent": 50.0,
-                                    "deceleration": 5000.0}],
+                    "trajectory": [{"velocity": 500.0, "acceleration": 5000.0, "deceleration": 5000.0,
+                                    "jerk_percent": 50.0}],
                     "id": 7, "attributes": ["RELATIVE", "ID"]}
     velocity = goal_from_args(_args("--type", "velocity", "-v", "-300", "-a", "2000"))
     assert velocity["type"] == "VELOCITY" and "position" not in velocity
@@ -123,11 +123,13 @@ def test_goal_yaml_with_flags_overriding_its_fields():
     assert goal["attributes"] == ["APPEND", "DELAY"] and goal["delay"] == [0.5, 0.5]
     goal = goal_from_args(_args("--goal", "{position: [1, 2], trajectory: [{velocity: 1, deceleration: 9}, "
                                           "{velocity: 1}]}", "-a", "5000"))
-    assert [t["deceleration"] for t in goal["trajectory"]] == [9, 5000.0]  # --deceleration: the acceleration
+    # no deceleration is made up (docs/decisions.md, "Deceleration"): the goal is the controller's to refuse
+    assert [t.get("deceleration") for t in goal["trajectory"]] == [9, None]
 
 
 @pytest.mark.parametrize("argv, text", [
-    (["-p", "1", "2", "-a", "5"], "--velocity needed for a S_CURVE move"),
+    (["-p", "1", "2", "-a", "5"], "--velocity and --deceleration needed for a S_CURVE move"),
+    (["-p", "1", "2", "-v", "1", "-a", "5"], "--deceleration needed for a S_CURVE move"),
     (["--type", "VELOCITY"], "--velocity and --acceleration needed for a VELOCITY move"),
     (["--goal", "{type: [unclosed"], "--goal: not valid YAML"),
     (["--goal", "- 1"], "--goal: expected a mapping of goal fields"),
