@@ -39,7 +39,7 @@ from mpi_ros.mpi.base.types import (
     MPIState,
 )
 from mpi_ros.mpi.host import SupervisorHost
-from mpi_ros.mpi.planning import cams, paths, validate
+from mpi_ros.mpi.planning import blend, cams, paths, validate
 from mpi_ros.mpi.planning.frames import AxisPlan, Move, frames_needed
 from mpi_ros.mpi.planning.planner import compile_move
 from mpi_ros.mpi.planning.start import AxisStart
@@ -532,6 +532,9 @@ class MotionSupervisor:
         for kind, detail in notes.events:
             self._moves.emit(kind, detail=detail, move=move)
         if queued:
+            ahead = self._moves.queue[-1] if self._moves.queue else self._moves.current
+            if ahead is not None:
+                move.blend = blend.overlap(ahead, move, self._state.config.blend_limit)
             self._moves.queue.append(move)
         elif modify and not auto_start:
             self._moves.replace(move)

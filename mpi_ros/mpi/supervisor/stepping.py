@@ -82,6 +82,11 @@ class Transitions:
             if self._moves.queue:
                 conditions["move_done"] = np.logical_and.reduce(
                     [stretch.rel[plan.axis] >= plan.duration for plan in move.plans])
+        elif self._moves.queue and self._moves.queue[0].blend > 0.0:
+            # blendLimit (planning/blend.py): the next move starts while this one decelerates
+            overlap = self._moves.queue[0].blend
+            conditions["move_done"] = np.logical_and.reduce(
+                [stretch.rel[plan.axis] >= plan.duration - overlap for plan in move.plans])
         else:
             self._all_axes(move, conditions, "move_done", status, DONE)
         if move.is_velocity and not self._moves.at_velocity_sent:
