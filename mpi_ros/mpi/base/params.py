@@ -377,7 +377,7 @@ class MotionConfig:
     pause_feedrate: float = 0.0
     user_label: str = ""
     axis_numbers: list[int] = field(default_factory=list)
-    blend_limit: float = 0.0
+    blend_limit: float = -1.0
 
     @property
     def axis_count(self) -> int:

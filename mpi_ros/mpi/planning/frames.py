@@ -376,6 +376,7 @@ class Move:
     event_mask: MPIEventType = MPIEventType.NONE
     serial: int = 0  # given when a supervisor takes the move (SupervisorHost.next_serial)
     stream: Stream | None = None  # a path move: its streaming state
+    blend: float = 0.0  # seconds it starts before the move ahead of it ends (blend.py, blendLimit)
     # Facts the controller asks every stretch (a move's plans never change once compiled).
     is_velocity: bool = field(init=False)  # a VELOCITY move
     ends_moving: bool = field(init=False)  # FINAL_VEL: the axes go on at their final velocity
@@ -407,6 +408,7 @@ class Move:
         move.event_mask = event_mask
         move.serial = 0
         move.stream = stream
+        move.blend = 0.0
         move.__post_init__()
         return move
 

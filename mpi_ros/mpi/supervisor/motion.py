@@ -40,7 +40,7 @@ from mpi_ros.mpi.base.types import (
     MPIState,
 )
 from mpi_ros.mpi.host import SupervisorHost
-from mpi_ros.mpi.planning import cams, paths, validate
+from mpi_ros.mpi.planning import blend, cams, paths, validate
 from mpi_ros.mpi.planning.frames import AxisPlan, Move, frames_needed
 from mpi_ros.mpi.planning.planner import PlanNotes, compile_move
 from mpi_ros.mpi.planning.start import AxisStart
@@ -586,6 +586,9 @@ class MotionSupervisor:
         for kind, detail in notes.events:
             self._moves.emit(kind, detail=detail, move=move)
         if admitted.queued:
+            ahead = self._moves.queue[-1] if self._moves.queue else self._moves.current
+            if ahead is not None:
+                move.blend = blend.overlap(ahead, move, self._state.config.blend_limit)
             self._moves.queue.append(move)
         elif modify and not admitted.auto_start:
             self._moves.replace(move)

@@ -23,6 +23,7 @@ from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
 from mpi_ros.mpi.base.params import Hold, Output
 from mpi_ros.mpi.base.types import STATE_SEVERITY, ActionSource, HoldType, IoSpace, MotionAttr, MPIState, OutputType
 from mpi_ros.mpi.host import SupervisorHost
+from mpi_ros.mpi.planning import blend
 from mpi_ros.mpi.planning.frames import AxisPlan, Move
 from mpi_ros.mpi.supervisor.axis_list import AxisList
 from mpi_ros.mpi.supervisor.holds import HoldWait
@@ -291,8 +292,23 @@ class Moves:
         self.current = None
         if not self.queue:
             return False
-        self.load(self.queue.popleft())
+        move = self.queue.popleft()
+        if move.blend > 0.0:
+            self._blend(move)
+        self.load(move)
         return True
+
+    def _blend(self, move: Move) -> None:
+        """``move`` starts while the one before still decelerates (blendLimit): what is left of
+        that one's profile is added to its plans (planning/blend.py)."""
+        t = self._host.time
+        for k, plan in enumerate(move.plans):
+            axis = self.axis(plan.axis)
+            previous = axis.plan
+            if previous is None:
+                continue
+            axis.rebase(t, self.clock_of(axis))
+            move.plans[k] = blend.blended(plan, blend.tail(previous.segments, axis.rel), previous.target)
 
     def fire_outputs(self, plan: AxisPlan) -> None:
         for output in plan.outputs:

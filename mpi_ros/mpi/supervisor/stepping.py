@@ -92,7 +92,8 @@ class Transitions:
         firsts = [int(np.argmax(fired)) for fired in conditions.values() if fired.any()]
         return min(firsts) if firsts else None
 
-    def _scan_move(self, move: Move, stretch: Stretch, status: StretchStatus, conditions: dict) -> None:
+    def _scan_move(self, move: Move, stretch: Stretch, status: StretchStatus,
+                   conditions: dict[Key, np.ndarray]) -> None:
         """A move done; a velocity move at its velocity; a path's outputs and buffer (``move``:
         the current one)."""
         if move.stream is not None:
@@ -106,19 +107,24 @@ class Transitions:
             if self._moves.queue:
                 conditions[Condition.MOVE_DONE, -1] = np.logical_and.reduce(
                     [stretch.rel[plan.axis] >= plan.duration for plan in move.plans])
+        elif self._moves.queue and self._moves.queue[0].blend > 0.0:
+            # blendLimit (planning/blend.py): the next move starts while this one decelerates
+            overlap = self._moves.queue[0].blend
+            conditions[Condition.MOVE_DONE, -1] = np.logical_and.reduce(
+                [stretch.rel[plan.axis] >= plan.duration - overlap for plan in move.plans])
         else:
             self._all_axes(move, conditions, Condition.MOVE_DONE, status, DONE)
         if move.is_velocity and not self._moves.at_velocity_sent:
             # MPIEventTypeMOTION_AT_VELOCITY: every axis of the move at the commanded velocity.
             self._all_axes(move, conditions, Condition.AT_VELOCITY, status, AT_VELOCITY)
 
-    def _scan_path(self, move: Move, stream: Stream, stretch: Stretch, conditions: dict) -> None:
+    def _scan_path(self, move: Move, stream: Stream, stretch: Stretch, conditions: dict[Key, np.ndarray]) -> None:
         """Outputs due at a later point; while the path is open, the points left in the
         buffer: FRAMES_LOW below lowCount, FRAMES_EMPTY at none, and the E_STOP of MPI 000,
         MPIMotionPoint, emptyCount ("If the number of points in the buffer is below
         emptyCount, an E_STOP action will occur"; <= 0 disables, MotionParams.empty_count_disabled).
         ``move``: the current one, a path; ``stream``: its streaming state."""
-        left = None
+        left: np.ndarray | None = None
         for plan in move.plans:
             axis = self._moves.axis(plan.axis)
             if axis.plan is not plan:
@@ -126,7 +132,7 @@ class Transitions:
             rel = np.nan_to_num(stretch.rel[plan.axis], nan=-np.inf)
             if plan.timed_outputs:
                 conditions[Condition.OUTPUT, plan.axis] = reached(rel) >= min(when for when, _ in plan.timed_outputs)
-            counts = plan.points_left(rel)
+            counts = np.asarray(plan.points_left(rel))  # (rel is an array: so is the count)
             left = counts if left is None else np.minimum(left, counts)
             if stream.chunks and plan.axis in stream.chunks[0][1]:
                 done = reached(rel) >= stream.chunks[0][1][plan.axis]
