@@ -158,9 +158,9 @@ class RosSettings:
                                  "rclpy's stock ActionServer, for an rclpy other than Jazzy's (docs/reliability.md)",
                                  choices=ACTION_SERVERS)
     # checked against the joints (mpi_ros/description.py)
-    robot_description: str = setting("", "a URDF file published on robot_description (in the suite's namespace) instead of the generated "
-                                     "one (relative: to the configuration file's folder; docs/joints.md); "
-                                     "empty: generated")
+    robot_description: str = setting("", "a URDF file published on robot_description (in the suite's namespace) "
+                                     "instead of the generated one (relative: to the configuration file's folder; "
+                                     "docs/joints.md); empty: generated")
 
     @property
     def joint_states_topic(self) -> str:
