@@ -267,8 +267,8 @@ def _axes(raw: dict | None) -> _AxesConfig:
     unknown = set(raw) - {"count", "defaults", "overrides"}
     if unknown:
         raise ConfigError(f"axes.{sorted(unknown)[0]}: unknown key (known: count, defaults, overrides)")
-    count = raw.get("count", 4)
-    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_OBJECTS:
+    count = _READ.integer(raw.get("count", 4), "axes.count")
+    if not 1 <= count <= MAX_OBJECTS:
         raise ConfigError(f"axes.count: expected an integer from 1 to {MAX_OBJECTS}, got {count!r}")
     defaults = raw.get("defaults") or {}
     overrides = raw.get("overrides") or {}
@@ -365,8 +365,8 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         extra = set(entry) - set(_SUPERVISOR_KEYS)
         if extra:
             raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: {', '.join(sorted(_SUPERVISOR_KEYS))})")
-        number = entry.get("number", i)
-        if isinstance(number, bool) or not isinstance(number, int) or not 0 <= number < MAX_OBJECTS:
+        number = _READ.integer(entry.get("number", i), f"{where}.number")
+        if not 0 <= number < MAX_OBJECTS:
             raise ConfigError(f"{where}.number: expected an integer from 0 to {MAX_OBJECTS - 1}, got {number!r}")
         if number in seen:
             raise ConfigError(f"{where}.number: supervisor {number} is configured twice")
@@ -377,7 +377,7 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         if len(axes) > MAX_COORD_AXES:
             raise ConfigError(f"{where}.axes: at most {MAX_COORD_AXES} axes (MEIXmpMAX_COORD_AXES)")
         for j, axis in enumerate(axes):
-            if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < axis_count:
+            if not 0 <= _READ.integer(axis, f"{where}.axes[{j}]") < axis_count:
                 raise ConfigError(f"{where}.axes[{j}]: axis {axis!r} does not exist ({axis_count} axes)")
         if len(set(axes)) != len(axes):
             raise ConfigError(f"{where}.axes: an axis is listed twice")

@@ -202,6 +202,9 @@ def test_the_rule_holds_where_requests_and_files_are_read():
         "axes[0].in_position.position_coarse: expected an integer, got 100.0"
     assert _refusal({"axes": {"defaults": {"in_position": {"settle_on_stop": 0}}}}) == \
         "axes[0].in_position.settle_on_stop: expected true or false, got 0"
+    assert _refusal({"axes": {"count": 4.0}}) == "axes.count: expected an integer, got 4.0"
+    assert _refusal({"supervisors": [{"number": 0, "axes": [0, 1.0]}]}) == \
+        "supervisors[0].axes[1]: expected an integer, got 1.0"
     # a number may be written as an integer, or as a string PyYAML did not read as a number
     assert requests.motion_config({"normal_feedrate": 1}).normal_feedrate == 1.0
     assert config.load(overrides=_ros("status_rate", "1e2")).ros.status_rate == 100.0
