@@ -2,10 +2,13 @@
 
 Validated when loaded: every error names its key (``supervisors[1].axes[0]: axis 7
 does not exist (4 axes)``) so a wrong file never starts a half-configured suite. The
-ranges are the structs' own validators (mpi_ros/mpi/base/params.py), the ones the controller
-and the services use, and building the controller checks every call's answer: a value
-the controller refuses stops the suite with its key named, it is never dropped. The
-same configuration builds the controller for the ROS suite, the CLI tools and replay.
+``ros`` section and ``lost_client_timeout`` are checked by their declarations in the settings
+schema (mpi_ros/settings.py); the other ranges are the structs' own validators
+(mpi_ros/mpi/base/params.py), the ones the controller and the services use. Scalars are read
+by the requests' reader (mpi_ros/scalars.py: an integer is an int, true is true). Building
+the controller checks every call's answer: a value the controller refuses stops the suite
+with its key named, it is never dropped. The same configuration builds the controller for
+the ROS suite, the CLI tools and replay.
 """
 
 from __future__ import annotations
