@@ -2,15 +2,17 @@
 
 Validated when loaded: every error names its key (``supervisors[1].axes[0]: axis 7
 does not exist (4 axes)``) so a wrong file never starts a half-configured suite. The
-ranges are the structs' own validators (mpi_ros/mpi/base/params.py), the ones the controller
-and the services use, and building the controller checks every call's answer: a value
-the controller refuses stops the suite with its key named, it is never dropped. The
-same configuration builds the controller for the ROS suite, the CLI tools and replay.
+``ros`` section and ``lost_client_timeout`` are checked by their declarations in the settings
+schema (mpi_ros/settings.py); the other ranges are the structs' own validators
+(mpi_ros/mpi/base/params.py), the ones the controller and the services use. Scalars are read
+by the requests' reader (mpi_ros/scalars.py: an integer is an int, true is true). Building
+the controller checks every call's answer: a value the controller refuses stops the suite
+with its key named, it is never dropped. The same configuration builds the controller for
+the ROS suite, the CLI tools and replay.
 """
 
 from __future__ import annotations
 
-import contextlib
 import copy
 import math
 import sys
@@ -42,6 +44,20 @@ from mpi_ros.mpi.base.params import (
 )
 from mpi_ros.mpi.base.types import AxisMasterType, MPIAction
 from mpi_ros.mpi.control import Controller
+from mpi_ros.scalars import readers
+from mpi_ros.settings import (
+    ACTION_SERVERS,
+    DEFAULT_NAMESPACE,
+    DISCOVERY_RANGES,
+    LOST_CLIENT,
+    LOST_CLIENT_TIMEOUT,
+    ROS,
+    RosSettings,
+    namespace_refusal,
+)
+
+__all__ = ["ACTION_SERVERS", "DEFAULT_NAMESPACE", "DISCOVERY_RANGES", "LOST_CLIENT_TIMEOUT", "ConfigError",
+           "RosSettings", "SuiteConfig", "SupervisorSpec", "check_namespace", "load", "merge", "parse", "read_value"]
 
 
 def default_config_path() -> Path:
@@ -64,9 +80,6 @@ class ConfigError(ValueError):
     """The configuration is invalid; the message names the key."""
 
 
-LOST_CLIENT_TIMEOUT = 2.0  # s: the lost-client watchdog's default
-
-
 @dataclass(slots=True)
 class SupervisorSpec:
     number: int
@@ -77,56 +90,6 @@ class SupervisorSpec:
     # of a running goal has been gone from the graph this long (s); 0 = off. On by default
     # (docs/decisions.md): Jazzy's `ros2 action send_goal` does not cancel its goal on Ctrl-C.
     lost_client_timeout: float = LOST_CLIENT_TIMEOUT
-
-
-DEFAULT_NAMESPACE = "/mpi"
-# ros.discovery: how far DDS discovery reaches (ROS_AUTOMATIC_DISCOVERY_RANGE); the suite's
-# default keeps it on this host (docs/cell.md, "Exposure").
-DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")
-ACTION_SERVERS = ("batched", "rclpy")
-
-
-@dataclass(slots=True)
-class RosSettings:
-    namespace: str = DEFAULT_NAMESPACE
-    status_rate: float = 100.0
-    feedback_rate: float = 20.0
-    joint_states_rate: float = 100.0
-    diagnostics_rate: float = 1.0
-    clock_rate: float = 100.0
-    crosscheck: bool = False
-    executor_threads: int = 8  # threads of each node's executor and of the goal loop's pool (ros/suite.py)
-    clock: bool = True  # publish /clock; in a cell of several suites exactly one should (docs/cell.md)
-    discovery: str = "localhost"  # see DISCOVERY_RANGES
-    # s an ended goal's result stays available to a client that asks for it late (rclpy's
-    # ActionServer result_timeout; 900 s in rclpy). The action server keeps each goal and
-    # publishes the status of all it keeps at every goal's change, so at 100 goals a second
-    # rclpy's 900 s meant 90,000 goals kept and ever larger status messages.
-    result_timeout: float = 60.0
-    # The action servers' services in a process of their own, the goal front (ros/goal_front.py):
-    # taking and answering goal requests then costs the suite's interpreter a few microseconds
-    # instead of about 0.2 ms a goal. For goal rates of hundreds a second (docs/reliability.md).
-    goal_process: bool = False
-    # Who speaks the action protocol (docs/reliability.md, "The goal path"): "batched", the
-    # suite's own server on rclpy's private bindings (ros/rcl.py), or "rclpy", rclpy's stock
-    # ActionServer (a goal costs more; for an rclpy other than Jazzy's).
-    action_server: str = "batched"
-    # A URDF file (relative: to the configuration file's folder) published on
-    # <ns>/robot_description instead of the generated one; checked against the joints
-    # (mpi_ros/description.py, docs/joints.md). Empty: generated.
-    robot_description: str = ""
-
-    @property
-    def joint_states_topic(self) -> str:
-        """/joint_states for the default namespace (the contract); <namespace>/joint_states
-        for any other, so that suites of a cell neither collide nor interleave there."""
-        return "/joint_states" if self.namespace == DEFAULT_NAMESPACE else f"{self.namespace.rstrip('/')}/joint_states"
-
-    @property
-    def joint_prefix(self) -> str:
-        """Prefix of every joint name: none for the default namespace, else the namespace
-        ("cell_a/axis0"), so joint names stay unique in a cell (one robot description)."""
-        return "" if self.namespace == DEFAULT_NAMESPACE else self.namespace.strip("/") + "/"
 
 
 @dataclass(slots=True)
@@ -223,6 +186,16 @@ def _merge(base: dict, override: dict | None) -> dict:
     return out
 
 
+def _unreadable(where: str, expected: str, value: Any) -> ConfigError:
+    if expected == "a number":  # a file's number must also be finite (read_value)
+        expected = "a finite number"
+    return ConfigError(f"{where}: expected {expected}, got {value!r}")
+
+
+# The file's scalars are read by the rule the requests are read by (mpi_ros/scalars.py).
+_READ = readers(_unreadable)
+
+
 def _dataclass(cls, data: Any, where: str):
     """Build dataclass ``cls`` from a mapping, with clear errors for unknown or bad keys."""
     if data is None:
@@ -235,36 +208,21 @@ def _dataclass(cls, data: Any, where: str):
         if key not in known:
             raise ConfigError(f"{where}.{key}: unknown key (known: {', '.join(sorted(known))})")
         default = getattr(cls(), key)
-        kwargs[key] = _coerce(value, default, f"{where}.{key}")
+        kwargs[key] = read_value(value, default, f"{where}.{key}")
     return cls(**kwargs)
 
 
-def _coerce(value: Any, default: Any, where: str):
-    if isinstance(default, bool):
-        if not isinstance(value, bool):
-            raise ConfigError(f"{where}: expected true or false, got {value!r}")
+def read_value(value: Any, like: Any, where: str) -> Any:
+    """``value`` read as a value of ``like``'s type (one of another type: as given), or
+    ConfigError naming ``where``. A file's number must also be finite: no setting of the
+    suite means NaN or infinity."""
+    read = _READ.of(type(like))
+    if read is None:
         return value
-    if isinstance(default, int) and not isinstance(default, bool):
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{where}: expected an integer, got {value!r}")
-        return value
-    if isinstance(default, float):
-        if isinstance(value, str):  # PyYAML reads 1e9 (no exponent sign) as a string
-            with contextlib.suppress(ValueError):
-                value = float(value)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ConfigError(f"{where}: expected a finite number, got {value!r}")
-        return float(value)
-    if isinstance(default, str):
-        if not isinstance(value, str):
-            raise ConfigError(f"{where}: expected a string, got {value!r}")
-        return value
+    value = read(value, where)
+    if type(like) is float and not math.isfinite(value):
+        raise ConfigError(f"{where}: expected a finite number, got {value!r}")
     return value
-
-
-def _positive(value: float, where: str) -> None:
-    if not value > 0.0:
-        raise ConfigError(f"{where}: must be > 0, got {value!r}")
 
 
 def _controller(raw: dict | None, axis_count: int, supervisor_count: int,
@@ -312,8 +270,8 @@ def _axes(raw: dict | None) -> _AxesConfig:
     unknown = set(raw) - {"count", "defaults", "overrides"}
     if unknown:
         raise ConfigError(f"axes.{sorted(unknown)[0]}: unknown key (known: count, defaults, overrides)")
-    count = raw.get("count", 4)
-    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_OBJECTS:
+    count = _READ.integer(raw.get("count", 4), "axes.count")
+    if not 1 <= count <= MAX_OBJECTS:
         raise ConfigError(f"axes.count: expected an integer from 1 to {MAX_OBJECTS}, got {count!r}")
     defaults = raw.get("defaults") or {}
     overrides = raw.get("overrides") or {}
@@ -389,8 +347,8 @@ def _faults(raw: Any, number: int, motors: int) -> AxisFaultConfig:
 def _motion_config(raw: dict, where: str) -> MotionConfig:
     raw = dict(raw or {})
     decel = DecelTime(
-        stop=_coerce(raw.pop("decel_time_stop", 0.5), 0.5, f"{where}.decel_time_stop"),
-        e_stop=_coerce(raw.pop("decel_time_e_stop", 0.05), 0.05, f"{where}.decel_time_e_stop"),
+        stop=read_value(raw.pop("decel_time_stop", 0.5), 0.5, f"{where}.decel_time_stop"),
+        e_stop=read_value(raw.pop("decel_time_e_stop", 0.05), 0.05, f"{where}.decel_time_e_stop"),
     )
     cfg = _dataclass(MotionConfig, raw, where)
     cfg.decel_time = decel
@@ -410,8 +368,8 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         extra = set(entry) - set(_SUPERVISOR_KEYS)
         if extra:
             raise ConfigError(f"{where}.{sorted(extra)[0]}: unknown key (known: {', '.join(sorted(_SUPERVISOR_KEYS))})")
-        number = entry.get("number", i)
-        if isinstance(number, bool) or not isinstance(number, int) or not 0 <= number < MAX_OBJECTS:
+        number = _READ.integer(entry.get("number", i), f"{where}.number")
+        if not 0 <= number < MAX_OBJECTS:
             raise ConfigError(f"{where}.number: expected an integer from 0 to {MAX_OBJECTS - 1}, got {number!r}")
         if number in seen:
             raise ConfigError(f"{where}.number: supervisor {number} is configured twice")
@@ -422,7 +380,7 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         if len(axes) > MAX_COORD_AXES:
             raise ConfigError(f"{where}.axes: at most {MAX_COORD_AXES} axes (MEIXmpMAX_COORD_AXES)")
         for j, axis in enumerate(axes):
-            if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < axis_count:
+            if not 0 <= _READ.integer(axis, f"{where}.axes[{j}]") < axis_count:
                 raise ConfigError(f"{where}.axes[{j}]: axis {axis!r} does not exist ({axis_count} axes)")
         if len(set(axes)) != len(axes):
             raise ConfigError(f"{where}.axes: an axis is listed twice")
@@ -431,9 +389,8 @@ def _supervisors(raw: list, defaults: dict | None, axis_count: int) -> list[Supe
         mask = MPIEventType.parse(notify_names) if isinstance(notify_names, list) else None
         if mask is None:
             raise ConfigError(f"{where}.event_notify: expected a list of event type names, got {notify_names!r}")
-        timeout = _lost_client_timeout(
-            entry.get("lost_client_timeout", defaults.get("lost_client_timeout", LOST_CLIENT_TIMEOUT)),
-            f"{where}.lost_client_timeout")
+        timeout = _lost_client_timeout(entry.get("lost_client_timeout", defaults.get("lost_client_timeout",
+                                                                                     LOST_CLIENT.default)), where)
         specs.append(SupervisorSpec(number, list(axes), config, mask, timeout))
     return specs
 
@@ -443,26 +400,22 @@ _SUPERVISOR_KEYS = ("number", "axes", "config", "event_notify", "lost_client_tim
 
 def _lost_client_timeout(value: Any, where: str) -> float:
     """Seconds, >= 0 (0: the watchdog is off)."""
-    timeout = _coerce(value, 0.0, where)
-    if timeout < 0.0:
-        raise ConfigError(f"{where}: must be >= 0 (0 turns the watchdog off), got {value!r}")
+    where = f"{where}.{LOST_CLIENT.name}"
+    timeout = read_value(value, LOST_CLIENT.default, where)
+    _check(LOST_CLIENT.refusal(timeout), where)
     return timeout
 
 
+def _check(refusal: str | None, where: str) -> None:
+    if refusal is not None:
+        raise ConfigError(f"{where}: {refusal}")
+
+
 def _ros(raw: dict | None) -> RosSettings:
+    """The ros section, each key read and checked as its Setting says (mpi_ros/settings.py)."""
     ros = _dataclass(RosSettings, raw, "ros")
-    for key in ("status_rate", "feedback_rate", "joint_states_rate", "diagnostics_rate", "clock_rate",
-                "result_timeout"):
-        _positive(getattr(ros, key), f"ros.{key}")
-    if ros.status_rate > 1000.0:
-        raise ConfigError(f"ros.status_rate: at most 1000 Hz, got {ros.status_rate}")
-    check_namespace(ros.namespace, "ros.namespace")
-    if ros.discovery not in DISCOVERY_RANGES:
-        raise ConfigError(f"ros.discovery: one of {', '.join(DISCOVERY_RANGES)}, got {ros.discovery!r}")
-    if ros.executor_threads < 4:
-        raise ConfigError("ros.executor_threads: must be >= 4")
-    if ros.action_server not in ACTION_SERVERS:
-        raise ConfigError(f"ros.action_server: one of {', '.join(ACTION_SERVERS)}, got {ros.action_server!r}")
+    for key in ROS:
+        _check(key.refusal(getattr(ros, key.name)), key.key)
     if ros.goal_process and ros.action_server != "batched":
         raise ConfigError("ros.goal_process: the goal front serves the batched action server only "
                           "(ros.action_server: batched)")
@@ -480,15 +433,9 @@ def _check_frame_sizes(controller: ControllerConfig, axes: list[int], where: str
 
 
 def check_namespace(namespace: str, where: str = "namespace") -> str:
-    """``namespace`` if it is a ROS namespace (absolute, name parts of letters, digits and
-    underscores not starting with a digit: rcl's rules; no trailing slash), else ConfigError
+    """``namespace`` if it is a ROS namespace (settings.namespace_refusal), else ConfigError
     naming ``where``."""
-    parts = namespace.split("/")
-    if (not namespace.startswith("/") or namespace == "/" or namespace.endswith("/")
-            or not all(p and (p[0].isalpha() or p[0] == "_") and all(c.isalnum() or c == "_" for c in p)
-                       and p.isascii() for p in parts[1:])):
-        raise ConfigError(f"{where}: expected an absolute ROS namespace like /mpi or /cell_a "
-                          f"(letters, digits, underscores; parts not starting with a digit), got {namespace!r}")
+    _check(namespace_refusal(namespace), where)
     return namespace
 
 

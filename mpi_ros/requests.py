@@ -19,11 +19,11 @@ stays small and is refused again, with the same message, when it is replayed.
 from __future__ import annotations
 
 import functools
-import numbers as _numbers
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
+from mpi_ros import scalars
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Refused
@@ -195,50 +195,15 @@ def sequence(values: Any, what: str) -> list:
     return list(values)
 
 
-def number(value: Any, what: str) -> float:
-    """A number as a float (its range is the validators' business: nan passes here). A
-    string that spells a number reads as one, as in the YAML loader (PyYAML reads 1e9,
-    without an exponent sign, as a string)."""
-    if type(value) is float:  # what nearly every request holds
-        return value
-    if isinstance(value, bool) or not isinstance(value, (_numbers.Real, str)):
-        raise _unreadable(what, "a number", value)
-    try:
-        return float(value)
-    except (TypeError, ValueError, OverflowError) as exc:  # an int beyond every double, a word
-        raise _unreadable(what, "a number", value) from exc
-
-
-def integer(value: Any, what: str) -> int:
-    """An integer (an integral float such as 3.0 reads as 3; its range is the validators')."""
-    if type(value) is int:  # what nearly every request holds (bool is not int's type)
-        return value
-    if isinstance(value, bool) or not isinstance(value, _numbers.Real):
-        raise _unreadable(what, "an integer", value)
-    if isinstance(value, _numbers.Integral):
-        return int(value)
-    try:
-        if float(value).is_integer():  # nan and inf are not integers either
-            # typeshed's numbers.Real promises no __int__ (every Real has one: float, Fraction, numpy's)
-            return int(value)  # type: ignore[call-overload]
-    except (TypeError, ValueError, OverflowError):
-        pass
-    raise _unreadable(what, "an integer", value)
-
-
-def boolean(value: Any, what: str) -> bool:
-    """true or false (1 and 0 too, as C's long flags)."""
-    if isinstance(value, bool):
-        return value
-    if isinstance(value, _numbers.Integral) and value in (0, 1):
-        return bool(value)
-    raise _unreadable(what, "true or false", value)
-
-
-def text(value: Any, what: str) -> str:
-    if not isinstance(value, str):
-        raise _unreadable(what, "a string", value)
-    return value
+# The scalars of a request are read by the rule the configuration file is read by
+# (mpi_ros/scalars.py): a number is a real number or a string that spells one (nan passes:
+# its range is the validators' business); an integer is an int, never 3.0; true or false is a
+# bool, never 0 or 1 (docs/decisions.md, "One reader for plain data").
+_READ = scalars.readers(_unreadable)
+number = _READ.number
+integer = _READ.integer
+boolean = _READ.boolean
+text = _READ.text
 
 
 def numbers(values: Any, what: str) -> list[float]:
@@ -275,9 +240,6 @@ def event_mask(names: Any, what: str) -> MPIEventType:
     return mask
 
 
-_READERS = {bool: boolean, int: integer, float: number, str: text}
-
-
 def _struct(cls, data: Any, what: str, enum_fields: dict | None = None):
     """Dataclass ``cls`` from a mapping of its fields (each read as its default's type)."""
     enum_fields = enum_fields or {}
@@ -301,7 +263,7 @@ def _readers(cls) -> dict[str, Callable[[Any, str], Any] | None]:
     """The reader of each field of dataclass ``cls``, by its default's type (None for an
     enum's: read by name); made once per class, not per request."""
     defaults = cls()
-    return {f.name: _READERS.get(type(getattr(defaults, f.name))) for f in fields(cls)}
+    return {f.name: _READ.of(type(getattr(defaults, f.name))) for f in fields(cls)}
 
 
 def _structs(cls, values: Any, what: str, enum_fields: dict | None = None) -> list:

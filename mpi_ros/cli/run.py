@@ -47,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "else ros.discovery, localhost)")
 
 
-DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")  # mpi_ros.config.DISCOVERY_RANGES
+DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")  # mpi_ros.settings.DISCOVERY_RANGES
 RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
 
 
