@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from mpi_ros.mpi import (  # noqa: E402 - after the path
+from mpi_ros.mpi import (
     AxisMaster,
     AxisMasterType,
     Controller,

@@ -19,7 +19,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run with -P: the sibling bench_controller
-from bench_controller import REPO, baseline_tree  # noqa: E402 - after the path it is found on
+from bench_controller import REPO, baseline_tree
 
 CASES = [(32, 16, "velocity", 20, 20_000), (32, 16, "s-curves", 20, 20_000), (32, 16, "velocity", 4096, 200_000)]
 _MEASURE = """

@@ -27,9 +27,9 @@ from rclpy.qos import QoSProfile, qos_profile_action_status_default
 from rclpy.type_support import check_for_type_support
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # this tree's mpi_ros, before the installed one
-from mpi_ros.action import MotionModify  # noqa: E402
-from mpi_ros.ros import goal_table  # noqa: E402
-from mpi_ros.ros.goal_table import GoalTable  # noqa: E402
+from mpi_ros.action import MotionModify
+from mpi_ros.ros import goal_table
+from mpi_ros.ros.goal_table import GoalTable
 
 SIZES = (100, 1000, 2000, 8000)
 _EVENT = _rclpy.GoalEvent

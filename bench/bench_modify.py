@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_controller import REPO, baseline_tree, measure_in  # noqa: E402 - after the path it is found on
+from bench_controller import REPO, baseline_tree, measure_in
 
 if TYPE_CHECKING:
     from mpi_ros.mpi import Controller

@@ -23,10 +23,10 @@ import numpy as np
 # This source tree, not the copy scripts/setup.sh last installed into the venv (run with -P).
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState  # noqa: E402
-from mpi_ros.mpi.base.types import MotionAttr  # noqa: E402
-from mpi_ros.mpi.planning.planner import compile_move  # noqa: E402
-from mpi_ros.mpi.planning.start import AxisStart  # noqa: E402
+from mpi_ros.mpi import Controller, MotionParams, MPIAction, MPIMotionType, MPIState
+from mpi_ros.mpi.base.types import MotionAttr
+from mpi_ros.mpi.planning.planner import compile_move
+from mpi_ros.mpi.planning.start import AxisStart
 
 POINTS = 1000
 KINDS = (MPIMotionType.PT, MPIMotionType.PVT, MPIMotionType.SPLINE, MPIMotionType.BESSEL, MPIMotionType.BSPLINE,

@@ -46,12 +46,12 @@ from types import ModuleType
 # This source tree, not the copy scripts/setup.sh last installed into the venv (run with -P).
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from mpi_ros.crosscheck import check_plan  # noqa: E402
-from mpi_ros.crosscheck.result import RuckigLimits  # noqa: E402
-from mpi_ros.mpi.base.params import MotionParams, Trajectory  # noqa: E402
-from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType  # noqa: E402
-from mpi_ros.mpi.planning.planner import compile_move  # noqa: E402
-from mpi_ros.mpi.planning.start import AxisStart  # noqa: E402
+from mpi_ros.crosscheck import check_plan
+from mpi_ros.crosscheck.result import RuckigLimits
+from mpi_ros.mpi.base.params import MotionParams, Trajectory
+from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
+from mpi_ros.mpi.planning.planner import compile_move
+from mpi_ros.mpi.planning.start import AxisStart
 
 REPO = Path(__file__).resolve().parent.parent
 SAMPLE_RATE = 2000.0

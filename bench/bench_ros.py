@@ -20,14 +20,14 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
 # This source tree, not the copy scripts/setup.sh last installed into the venv (run with -P).
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-import rclpy  # noqa: E402
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
 
-from mpi_ros import config  # noqa: E402
-from mpi_ros.commands import Command  # noqa: E402
-from mpi_ros.msg import MotionStatus  # noqa: E402
-from mpi_ros.ros.suite import Suite  # noqa: E402
-from mpi_ros.srv import MotionAction  # noqa: E402
+from mpi_ros import config
+from mpi_ros.commands import Command
+from mpi_ros.msg import MotionStatus
+from mpi_ros.ros.suite import Suite
+from mpi_ros.srv import MotionAction
 
 VELOCITY = {"type": "VELOCITY", "trajectory": [{"velocity": 1000.0, "acceleration": 100000.0}]}
 

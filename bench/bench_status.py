@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_controller, beside this file
-from bench_controller import REPO, _controller, _restart_idle, _velocity, baseline_tree, measure_in  # noqa: E402
+from bench_controller import REPO, _controller, _restart_idle, _velocity, baseline_tree, measure_in
 
 if TYPE_CHECKING:
     from mpi_ros.mpi import Controller

@@ -43,7 +43,7 @@ from typing import Any
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_suite, beside this file (python -P adds nothing)
-from bench_suite import (  # noqa: E402
+from bench_suite import (
     REPO,
     WAIT,
     Probe,

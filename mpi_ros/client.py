@@ -316,7 +316,7 @@ def fill(msg: Any, data: Mapping[str, Any], where: str = "") -> Any:
     the edge, as the generated messages want.
     """
     if not isinstance(data, Mapping):
-        raise ValueError(f"{where or type(msg).__name__}: expected a mapping of fields, got {data!r}")  # noqa: TRY004 - bad user data, reported as such
+        raise ValueError(f"{where or type(msg).__name__}: expected a mapping of fields, got {data!r}")
     types = msg.get_fields_and_field_types()
     for name, value in data.items():
         path = f"{where}.{name}" if where else str(name)

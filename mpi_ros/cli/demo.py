@@ -139,7 +139,7 @@ class SuiteProcess:
         # itself, in order (the recording is finished when the process ends).
         self.process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=self._log,
                                         stderr=subprocess.STDOUT, env=env, start_new_session=True,
-                                        preexec_fn=_child_setup())  # noqa: PLW1509 - nothing it calls takes a lock
+                                        preexec_fn=_child_setup())
 
     def running(self) -> bool:
         return self.process.poll() is None

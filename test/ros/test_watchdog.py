@@ -97,7 +97,7 @@ def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_
     env = dict(os.environ, FASTRTPS_DEFAULT_PROFILES_FILE=str(LEASE_PROFILE))
     doomed = subprocess.Popen([sys.executable, "-P", str(DOOMED), "1", "500000.0"], stdin=subprocess.PIPE,
                               stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=tmp_path, env=env,
-                              preexec_fn=_no_inherited_sigint)  # noqa: PLW1509 - signal() only
+                              preexec_fn=_no_inherited_sigint)
     watchdog = suite.supervisor_nodes[1].watchdog
     assert suite.supervisor_nodes[0].watchdog is None  # lost_client_timeout: 0 is off
     try:
