@@ -77,15 +77,28 @@ class Session:
 
     def client(self, supervisor: int):
         """A MotionClient of ``supervisor``, once the suite and that supervisor are on the graph."""
+        from mpi_ros import graph
         from mpi_ros.client import MotionClient
 
         client = self._keep(MotionClient(supervisor, self.args.namespace, context=self.context,
                                          timeout=self.args.timeout, node_name=self.node_name))
-        client.wait_for_suite(self.args.timeout, supervisor)
+        # The supervisor's own endpoints, not the suite's nodes first: they are what a goal needs
+        graph.wait_for_endpoints(client.node, client.namespace, supervisor, client.servers_ready,
+                                 self.args.timeout, "its actions and services")
         if not client.wait_for_server(self.args.timeout):
             raise UsageError(f"{client.prefix} is on the graph but its actions and services did not answer "
                              f"within {self.args.timeout:g} s: is the suite shutting down?")
         return client
+
+    def action_call(self, supervisor: int):
+        """An ActionCall of ``supervisor``, once its action service is reachable: all a one-shot
+        action waits for (a MotionClient would wait for the suite's nodes and both actions)."""
+        from mpi_ros.action_call import ActionCall
+
+        call = self._keep(ActionCall(supervisor, self.args.namespace, context=self.context,
+                                     node_name=self.node_name))
+        call.wait_ready(self.args.timeout)
+        return call
 
     def watcher(self):
         """A Watcher of the suite, once the suite (and --supervisor, if given) is on the graph."""

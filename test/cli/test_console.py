@@ -91,6 +91,21 @@ def test_no_suite_exits_2_saying_where_it_looked_and_what_to_do():
     assert message.count("(supervisors found under /mpi)") <= 1
 
 
+def test_a_one_shot_action_waits_for_its_one_service_not_the_goal_client():
+    """`mpi-ros e-stop` and its kin build an ActionCall (the action service alone), not a
+    MotionClient (both actions, their round trips, rclpy.action and numpy to import first)."""
+    import subprocess
+    import sys
+
+    from .conftest import REPO, with_timeout
+
+    probe = ("import sys; from mpi_ros.cli import main; status = main(sys.argv[1:]); "
+             "print(status, 'mpi_ros.client' in sys.modules, 'rclpy.action' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", probe, *with_timeout(["reset"])], capture_output=True, text=True,
+                          timeout=WAIT * 2, cwd=REPO, check=False)
+    assert done.stdout.splitlines()[-1] == "0 False False", done.stdout + done.stderr
+
+
 def test_bad_ros_arguments_are_a_usage_error(capsys):
     assert console("status", "--once", "--ros-args", "-p", "nonsense") == 2
     assert "invalid ROS arguments" in capsys.readouterr().err
