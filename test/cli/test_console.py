@@ -178,16 +178,16 @@ def test_status_once_prints_every_supervisor_and_axis(ms0, capsys):
     assert console("status", "--once") == 0
     lines = capsys.readouterr().out.splitlines()
     assert re.match(r"/mpi  sample \d+$", lines[0])
-    assert lines[1].split() == ["supervisor", "state", "axes", "move", "type", "pending", "last", "action"]
-    header = next(line for line in lines if line.startswith("axis"))
-    assert header.split() == ["axis", "ms", "state", "command", "actual", "velocity", "DONE", "AT_TARGET",
-                              "IN_FINE_POSITION", "SETTLED"]
+    assert lines[1].split() == ["ms", "state", "axes", "move", "type", "pending", "last", "action"]
+    header = next(line for line in lines if line.startswith("axis"))  # off a terminal: every column
+    assert header.split() == ["axis", "ms", "state", "command", "actual", "error", "velocity", "actual", "vel",
+                              "DONE", "AT_TARGET", "IN_FINE_POSITION", "SETTLED", "faults"]
     rows = {line.split()[0]: line.split() for line in lines[lines.index(header) + 1:]}
     assert sorted(rows) == ["0", "1", "2", "3"]
     assert [rows[k][1] for k in "0123"] == ["0", "0", "1", "1"]  # owning supervisor
-    state, velocity, done, settled = rows["0"][2], rows["0"][5], rows["0"][6], rows["0"][9]
-    assert (state, velocity, done, settled) == ("IDLE", "0.0", "yes", "yes")
-    assert all(bit in ("yes", "-") for row in rows.values() for bit in row[6:])
+    state, velocity, done, settled, faults = rows["0"][2], rows["0"][6], rows["0"][8], rows["0"][11], rows["0"][12]
+    assert (state, velocity, done, settled, faults) == ("IDLE", "0.0", "yes", "yes", "-")
+    assert all(bit in ("yes", "-") for row in rows.values() for bit in row[8:12])
 
 
 def test_status_live_prints_tables_until_ctrl_c(running):
