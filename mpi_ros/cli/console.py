@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from typing import Any, Self, TextIO
 
@@ -159,8 +160,25 @@ def print_reply(action: str, reply, supervisor: int, out: TextIO | None = None) 
     refusal = f": {reply.detail}" if reply.detail and not reply.ok else ""  # e.g. which fault persists
     print(f"{action}: {reply.message} (code {reply.code}), state {reply.state_name}, sample {reply.sample}{refusal}",
           file=out)
-    _hint(reply.message, supervisor)
+    persisting = PERSISTS.findall(reply.detail) if not reply.ok else []
+    if persisting:  # a RESET refused: another RESET would be refused as well
+        print(f"hint: {persists_hint(persisting, supervisor)}", file=sys.stderr)
+    else:
+        _hint(reply.message, supervisor)
     return OK if reply.ok else REFUSED
+
+
+# How the fault monitor words a fault whose condition still holds at a RESET (docs/faults.md).
+PERSISTS = re.compile(r"axis (\d+) ([A-Z_]+) persists")
+CONDITIONS = ("AMP_FAULT", "ENCODER_FAULT")  # injected conditions: `mpi-ros fault NAME --clear` ends them
+
+
+def persists_hint(persisting: list[tuple[str, str]], supervisor: int) -> str:
+    """What to do when RESET was refused because faults persist: end their causes first."""
+    steps = [f"`mpi-ros fault {fault} --axis {axis} --clear`" if fault in CONDITIONS
+             else f"bring axis {axis} out of {fault}" for axis, fault in persisting]
+    return (f"ms{supervisor} stays in ERROR while the fault persists: first {' and '.join(steps)}, "
+            f"then `mpi-ros reset{'' if supervisor == 0 else f' --supervisor {supervisor}'}`")
 
 
 def _hint(message: str, supervisor: int) -> None:

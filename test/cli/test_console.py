@@ -307,9 +307,17 @@ def test_fault_injects_and_clears_and_reset_says_what_persists(ms1, capsys):
     assert "AMP_FAULT on axis 3: MPIMessageOK (code 0), faults [AMP_FAULT]" in capsys.readouterr().out
     ms1.wait_for_state("ERROR", WAIT)
     assert console("reset", "-s", "1") == 1
-    assert "RESET: MPIMotionMessageERROR" in (out := capsys.readouterr().out) and "axis 3 AMP_FAULT persists" in out
+    captured = capsys.readouterr()
+    assert "RESET: MPIMotionMessageERROR" in captured.out and "axis 3 AMP_FAULT persists" in captured.out
+    # not "`mpi-ros reset` leaves it": another RESET would be refused too
+    assert captured.err == ("hint: ms1 stays in ERROR while the fault persists: first "
+                            "`mpi-ros fault AMP_FAULT --axis 3 --clear`, then `mpi-ros reset --supervisor 1`\n")
     assert console("fault", "AMP_FAULT", "--axis", "3", "--clear", "-s", "1") == 0
-    capsys.readouterr()
+    captured = capsys.readouterr()
+    assert captured.out.startswith("AMP_FAULT on axis 3 cleared: MPIMessageOK (code 0), faults [AMP_FAULT]")
+    assert captured.err == ("hint: the condition is gone, but AMP_FAULT stays latched on axis 3 (and its "
+                            "supervisor in ERROR) until a RESET: `mpi-ros reset --supervisor 1`\n")
+    ms1.wait_for_state("ERROR", WAIT, newer_than=ms1.status(WAIT).sample)  # still
     assert console("fault", "OVERHEAT", "--axis", "3", "-s", "1") == 1
     assert "MPIMessagePARAM_INVALID" in (out := capsys.readouterr().out) and "unknown fault" in out
     assert console("reset", "-s", "1") == 0
