@@ -6,7 +6,9 @@ mpi_ros.cli VERB``, what the installed ``mpi-ros`` script runs); the effect is t
 which the controller applied the command, as the suite publishes it on ``/mpi/commands``
 (``stamp = epoch + sample / rate``, controller time anchored to the wall clock; the suite
 runs in real time). Also given: when that message reached this process, and when the verb's
-process had ended (it printed the answer).
+process had ended (it printed the answer), and the CPU time the process used (what it
+costs whatever the load: on a machine whose cores are taken by others, wall time is
+several times that).
 
 Each run is a cycle on ms0: ``move --no-wait`` (a 200-count S-curve), ``e-stop``, ``reset``.
 The suite of each source tree (this one and ``--baseline``, extracted with git archive) runs
@@ -54,6 +56,7 @@ class Run:
     arrival: float  # s from the process' start to /mpi/commands reaching this process
     exited: float  # s from the process' start to its end
     status: int
+    cpu: float  # s of CPU the process used (user + system), whatever the machine's load
 
 
 class Commands:
@@ -124,13 +127,17 @@ def _env(tree: Path) -> dict[str, str]:
 def one(tree: Path, commands: Commands, verb: str, argv: list[str], operation: str, word: str) -> Run:
     after = len(commands.seen)
     start = time.time()
-    done = subprocess.run([sys.executable, "-P", "-m", "mpi_ros.cli", *argv, "--timeout", "10"], cwd=tree,
-                          env=_env(tree), capture_output=True, text=True, check=False)
+    verb_process = subprocess.Popen([sys.executable, "-P", "-m", "mpi_ros.cli", *argv, "--timeout", "10"], cwd=tree,
+                                    env=_env(tree), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, wait_status, usage = os.wait4(verb_process.pid, 0)  # its CPU time too
     exited = time.time() - start
+    status = os.waitstatus_to_exitcode(wait_status)
+    verb_process.returncode = status
+    errors = verb_process.stderr.read().decode() if verb_process.stderr else ""
     effect = commands.wait_for(after, operation, word)
     if effect is None:
-        raise RuntimeError(f"{verb}: no command on /mpi/commands (exit {done.returncode}: {done.stderr.strip()})")
-    return Run(verb, effect[1] - start, effect[0] - start, exited, done.returncode)
+        raise RuntimeError(f"{verb}: no command on /mpi/commands (exit {status}: {errors.strip()})")
+    return Run(verb, effect[1] - start, effect[0] - start, exited, status, usage.ru_utime + usage.ru_stime)
 
 
 def measure(tree: Path, runs: int) -> list[Run]:
@@ -146,8 +153,9 @@ def measure(tree: Path, runs: int) -> list[Run]:
 
 
 def table(results: dict[str, list[Run]]) -> list[str]:
-    lines = ["| tree | verb | runs | effect median | effect max | answer received median | process ended median |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+    lines = ["| tree | verb | runs | effect median | effect max | command received median | process ended median | "
+             "CPU of the process median |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for tree, runs in results.items():
         for verb, *_ in CYCLE:
             mine = [run for run in runs if run.verb == verb]
@@ -156,7 +164,8 @@ def table(results: dict[str, list[Run]]) -> list[str]:
             lines.append(f"| {tree} | {verb} | {len(mine)}{f' ({failed} failed)' if failed else ''} | "
                          f"{statistics.median(effect):.2f} s | {max(effect):.2f} s | "
                          f"{statistics.median(run.arrival for run in mine):.2f} s | "
-                         f"{statistics.median(run.exited for run in mine):.2f} s |")
+                         f"{statistics.median(run.exited for run in mine):.2f} s | "
+                         f"{statistics.median(run.cpu for run in mine):.2f} s |")
     return lines
 
 
