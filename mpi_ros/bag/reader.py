@@ -153,14 +153,16 @@ class BagReader:
             return {}
         return {ch.topic: summary.schemas[ch.schema_id].name for ch in summary.channels.values()}
 
-    def messages(self, topics: Iterable[str] | None = None) -> Iterator[Recorded]:
-        """Messages in log-time order."""
+    def messages(self, topics: Iterable[str] | None = None, in_order: bool = True) -> Iterator[Recorded]:
+        """Messages in log-time order; ``in_order`` False: in the order they are stored (each
+        topic's still in log-time order as written, and several times faster to read)."""
         wanted = list(topics) if topics is not None else None
         if self._scan is not None:
             yield from self._scanned(wanted)
             return
         with open(self.path, "rb") as stream:
-            for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted, log_time_order=True):
+            for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted,
+                                                                                 log_time_order=in_order):
                 yield _recorded(schema_, channel, message)
 
     def _scanned(self, wanted: list[str] | None) -> Iterator[Recorded]:
