@@ -16,7 +16,7 @@ What the figure promises (issue 36; test/bag/test_plot.py checks each):
 
 Reading: status messages are read field by field from their CDR (mpi_ros.bag.fields), not
 built, when the bag's definition of the type is the installed one: a 3-minute recording of
-the default configuration (about 100,000 statuses) is plotted in about 3 s
+the default configuration (about 110,000 statuses) is plotted in about 4 s on a busy 2-core machine
 (bench/bench_plot.py).
 """
 
@@ -73,7 +73,7 @@ def _rows(reader: BagReader) -> Iterator[tuple[str, tuple]]:
     from the message built by the bag's definition."""
     topics = [topic for topic, type_name in reader.topics().items() if type_name in FIELDS]
     fast: dict[str, Any] = {}
-    for recorded in reader.messages(topics, in_order=False):  # each topic in order is enough
+    for recorded in reader.stored(topics):  # each topic in order is enough
         wanted = FIELDS[recorded.type]
         if recorded.topic not in fast:
             fast[recorded.topic] = _fast_reader(recorded, wanted)

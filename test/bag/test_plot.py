@@ -156,3 +156,11 @@ def _get(msg, dotted: str):
     for name in dotted.split("."):
         msg = getattr(msg, name)
     return msg
+
+
+@pytest.mark.parametrize("name", ["two_supervisors", "faults", "streamed_path"])
+def test_reading_in_stored_order_gives_what_mcap_gives(name):
+    reader = BagReader(BAGS / name)
+    topics = [topic for topic in reader.topics() if topic != "/mpi/configuration"]
+    fast = list(reader.stored(topics))
+    assert fast == list(reader.messages(topics, in_order=False)) and len(fast) > 100
