@@ -29,6 +29,7 @@ from pathlib import Path
 COMMANDS: dict[str, str] = {
     "run": "mpi_ros.cli.run",
     "demo": "mpi_ros.cli.demo",
+    "console": "mpi_ros.cli.tui",
     "move": "mpi_ros.cli.move",
     "modify": "mpi_ros.cli.modify",
     "stop": "mpi_ros.cli.stop",
@@ -52,6 +53,7 @@ PROG = "mpi-ros"
 EPILOG = """\
 start here:
   mpi-ros run                      the suite (leave it running), then from another shell:
+  mpi-ros console                  a full-screen console: live table, events, keys for STOP/E_STOP/...
   mpi-ros status                   a live table of the supervisors and axes
   mpi-ros move --position 1000 0 --velocity 500 --acceleration 5000 --jerk-percent 50
   mpi-ros demo                     or instead: a narrated, recorded tour on a suite of its own
