@@ -56,7 +56,8 @@ from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisFaultInject, MotionAction, MotorFeedbackSecondarySet
 
-from . import errors
+from . import errors, graph
+from .action_call import ActionReply, State, action_reply
 from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
 
 # The suite serves actions with deep service queues (an E_STOP can end many goals at once);
@@ -68,7 +69,6 @@ STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 # Events come in bursts (6-7 in one sample at the end of a move): deep and reliable.
 EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 
-_SUPERVISOR_NODE = re.compile(r"ms(\d+)")
 _POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
 RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting for its result
 RESULT_REASK = 2.0  # s without an answer after asking again (the server came back) before asking once more
@@ -150,18 +150,6 @@ class Action(StrEnum):
     MAP = "MAP"
 
 
-class State(StrEnum):
-    """A supervisor's or axis' state (``state_name``)."""
-
-    INVALID = "INVALID"
-    IDLE = "IDLE"
-    MOVING = "MOVING"
-    STOPPING = "STOPPING"
-    STOPPED = "STOPPED"
-    STOPPING_ERROR = "STOPPING_ERROR"
-    ERROR = "ERROR"
-
-
 class EventType(StrEnum):
     """MPIEventType names without the prefix (MotionEvent ``type``)."""
 
@@ -204,25 +192,6 @@ class Outcome(StrEnum):
     REFUSED = "REFUSED"    # the controller refused the command; nothing moved
     ENDED = "ENDED"        # it moved, then ended early: STOP, E_STOP, ABORT, a new start, RESET
     CANCELED = "CANCELED"  # the goal was cancelled (a cancel is a STOP)
-
-
-@dataclass(frozen=True)
-class ActionReply:
-    """The answer of mpiMotionAction (a MotionAction service call)."""
-
-    message: str
-    code: int
-    state_name: str
-    sample: int  # the sample at which the action took effect
-    detail: str = ""  # why it was refused (e.g. RESET while a fault persists)
-
-    @property
-    def ok(self) -> bool:
-        return self.message == errors.OK
-
-    @property
-    def state(self) -> State:
-        return State(self.state_name)
 
 
 @dataclass(frozen=True)
@@ -543,9 +512,7 @@ class _Endpoint:
 
     def supervisors_on_graph(self, namespace: str | None = None) -> list[int]:
         """Numbers of the supervisor nodes (``<namespace>/ms<n>``) on the graph now."""
-        namespace = self.namespace if namespace is None else namespace
-        return sorted(int(match.group(1)) for name, ns in self.node.get_node_names_and_namespaces()
-                      if ns == namespace and (match := _SUPERVISOR_NODE.fullmatch(name)))
+        return graph.supervisors_on_graph(self.node, self.namespace if namespace is None else namespace)
 
     def twins_on_graph(self, namespace: str | None = None) -> list[str]:
         """The nodes under ``namespace`` that are on the graph more than once: two suites
@@ -581,12 +548,7 @@ class _Endpoint:
         raise SuiteNotFound(self._not_found(timeout))
 
     def _not_found(self, timeout: float) -> str:
-        where = "" if self.namespace == "/mpi" else f" under {self.namespace}"
-        elsewhere = sorted({ns for name, ns in self.node.get_node_names_and_namespaces()
-                            if _SUPERVISOR_NODE.fullmatch(name) and ns != self.namespace})
-        hint = f" (supervisors found under {', '.join(elsewhere)})" if elsewhere else ""
-        return (f"no suite found{where} on ROS_DOMAIN_ID {self.domain_id} within {timeout:g} s{hint}: "
-                f"is `mpi-ros run` running, on the same domain?")
+        return graph.not_found(self.node, self.namespace, timeout)
 
 
 # -- goals and the motion client ---------------------------------------------------------------------------
@@ -746,10 +708,16 @@ class MotionClient(_Endpoint):
         """
         timeout = self.timeout if timeout is None else timeout
         deadline = time.monotonic() + timeout
-        return (all(wait(timeout_sec=timeout) for wait in (self._start.wait_for_server,
-                                                          self._modify.wait_for_server,
-                                                          self._action.wait_for_service))
-                and self._answered({self._start: MotionStart, self._modify: MotionModify}, deadline))
+        pause = threading.Event()  # never set: looked at every few ms (rclpy's own waits look every 0.25 s)
+        while not self.servers_ready():
+            if time.monotonic() >= deadline:
+                return False
+            pause.wait(graph.READY_POLL)
+        return self._answered({self._start: MotionStart, self._modify: MotionModify}, deadline)
+
+    def servers_ready(self) -> bool:
+        """Whether both actions' servers and the action service are matched (no round trip)."""
+        return self._start.server_is_ready() and self._modify.server_is_ready() and self._action.service_is_ready()
 
     def _answered(self, actions: dict[ActionClient, Any], deadline: float) -> bool:
         """Both actions at once: a result request for an unknown goal to each, sent again
@@ -1007,12 +975,7 @@ class MotionClient(_Endpoint):
             raise NoResponse(f"the supervisor's action service {self.prefix}/action is not available")
         response = self._wait_future(self._action.call_async(MotionAction.Request(action=name)), None,
                                      f"action {name}")
-        reply = ActionReply(response.message, response.code, response.state_name, response.sample,
-                            getattr(response, "detail", ""))
-        if raise_on_error:
-            raise_for(reply.message, f"{name} in {reply.state_name}" + (f": {reply.detail}" if reply.detail else ""),
-                      reply)
-        return reply
+        return action_reply(name, response, raise_on_error)
 
     def fault_inject(self, axis: int, fault: str, active: bool = True) -> FaultReply:
         """Inject a fault on an axis (AMP_FAULT, ENCODER_FAULT: a condition, cleared with

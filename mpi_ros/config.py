@@ -62,18 +62,23 @@ __all__ = ["ACTION_SERVERS", "DEFAULT_NAMESPACE", "DISCOVERY_RANGES", "LOST_CLIE
 
 def default_config_path() -> Path:
     """config/default.yaml: installed under share/mpi_ros/config, or in the source tree."""
-    candidates = [Path(sys.prefix) / "share" / "mpi_ros" / "config" / "default.yaml"]
+    return config_file("default.yaml")
+
+
+def config_file(name: str) -> Path:
+    """config/<name>: installed under share/mpi_ros/config, or in the source tree."""
+    candidates = [Path(sys.prefix) / "share" / "mpi_ros" / "config" / name]
     try:
         from ament_index_python.packages import get_package_share_directory
 
-        candidates.insert(0, Path(get_package_share_directory("mpi_ros")) / "config" / "default.yaml")
+        candidates.insert(0, Path(get_package_share_directory("mpi_ros")) / "config" / name)
     except Exception:  # noqa: BLE001 - no ament index (plain venv): fall back below
         pass
-    candidates.append(Path(__file__).resolve().parent.parent / "config" / "default.yaml")
+    candidates.append(Path(__file__).resolve().parent.parent / "config" / name)
     for candidate in candidates:
         if candidate.is_file():
             return candidate
-    raise ConfigError("config/default.yaml not found (looked in " + ", ".join(map(str, candidates)) + ")")
+    raise ConfigError(f"config/{name} not found (looked in " + ", ".join(map(str, candidates)) + ")")
 
 
 class ConfigError(ValueError):

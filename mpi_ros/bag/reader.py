@@ -16,9 +16,10 @@ from typing import Any
 
 import yaml
 from mcap.exceptions import EndOfFile, McapError
+from mcap.opcode import Opcode
 from mcap.reader import make_reader
-from mcap.records import Channel, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader
+from mcap.records import Channel, Chunk, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader, get_chunk_data_stream
 from mcap_ros2._dynamic import generate_dynamic
 
 from . import schema
@@ -197,14 +198,16 @@ class BagReader:
             return {}
         return {ch.topic: summary.schemas[ch.schema_id].name for ch in summary.channels.values()}
 
-    def messages(self, topics: Iterable[str] | None = None) -> Iterator[Recorded]:
-        """Messages in log-time order."""
+    def messages(self, topics: Iterable[str] | None = None, in_order: bool = True) -> Iterator[Recorded]:
+        """Messages in log-time order; ``in_order`` False: in the order they are stored (each
+        topic's still in log-time order as written, and several times faster to read)."""
         wanted = list(topics) if topics is not None else None
         if self._scan is not None:
             yield from self._scanned(wanted)
             return
         with open(self.path, "rb") as stream:
-            for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted, log_time_order=True):
+            for schema_, channel, message in self._reader(stream).iter_messages(topics=wanted,
+                                                                                 log_time_order=in_order):
                 yield _recorded(schema_, channel, message)
 
     def _scanned(self, wanted: list[str] | None) -> Iterator[Recorded]:
@@ -216,6 +219,29 @@ class BagReader:
                     wanted is not None and channel.topic not in wanted):
                 continue
             yield _recorded(scan.schemas[channel.schema_id], channel, message)
+
+    def stored(self, topics: Iterable[str]) -> Iterator[Recorded]:
+        """The messages of ``topics`` in the order they are stored (each topic's in log-time
+        order as written), without building mcap's record objects for the others: a chunk's
+        records are stepped over by their headers (opcode, length; MCAP's "Records"), its
+        messages read at their fixed offsets. Several times faster than :meth:`messages` on a
+        recording whose status topics are most of it; a bag without a summary (not finished)
+        is read by :meth:`messages` instead."""
+        wanted = set(topics)
+        if self._scan is not None:
+            yield from self._scanned(list(wanted))
+            return
+        with open(self.path, "rb") as stream:
+            summary = self._reader(stream).get_summary()
+            assert summary is not None  # _finished() said so
+            channels = {cid: (channel, summary.schemas[channel.schema_id]) for cid, channel in summary.channels.items()
+                        if channel.topic in wanted and channel.schema_id in summary.schemas}
+            stream.seek(0)
+            for record in StreamReader(stream, emit_chunks=True).records:
+                if isinstance(record, Chunk):
+                    yield from _chunk_messages(record, channels)
+                elif isinstance(record, Message) and record.channel_id in channels:
+                    yield _recorded(*channels[record.channel_id][::-1], record)
 
     def decoded(self, topics: Iterable[str] | None = None) -> Iterator[tuple[Recorded, Any]]:
         for recorded in self.messages(topics):
@@ -232,6 +258,28 @@ class BagReader:
         if summary is None or summary.statistics is None:
             return {}
         return {summary.channels[cid].topic: n for cid, n in summary.statistics.channel_message_counts.items()}
+
+
+_RECORD = struct.Struct("<BQ")  # a record's opcode and content length
+_MESSAGE = struct.Struct("<HIQQ")  # a Message record's channel id, sequence, log time, publish time
+
+
+def _chunk_messages(chunk: Chunk, channels: dict[int, tuple[Channel, Schema]]) -> Iterator[Recorded]:
+    """The messages of ``channels`` in a chunk (decompressed by mcap), others stepped over."""
+    records, end = get_chunk_data_stream(chunk)
+    data = records.read(end)
+    texts = {cid: schema_.data.decode("utf-8", errors="replace") for cid, (_, schema_) in channels.items()}
+    pos = 0
+    while pos < end:
+        opcode, length = _RECORD.unpack_from(data, pos)
+        pos += _RECORD.size
+        if opcode == Opcode.MESSAGE:
+            channel_id, sequence, log_time, _ = _MESSAGE.unpack_from(data, pos)
+            if channel_id in channels:
+                channel, schema_ = channels[channel_id]
+                yield Recorded(channel.topic, schema_.name, log_time, data[pos + _MESSAGE.size:pos + length], sequence,
+                               texts[channel_id])
+        pos += length
 
 
 def _recorded(schema_: Schema, channel: Channel, message: Message) -> Recorded:

@@ -19,8 +19,8 @@ def verb(action: str) -> tuple[Callable[[argparse.ArgumentParser], None], Callab
 
     def run(args: argparse.Namespace) -> int:
         def body(session) -> int:
-            client = session.client(args.supervisor)
-            return print_reply(action, client.action(action, raise_on_error=False), args.supervisor)
+            call = session.action_call(args.supervisor)
+            return print_reply(action, call.call(action, args.timeout, raise_on_error=False), args.supervisor)
 
         return run_verb(args, body)
 

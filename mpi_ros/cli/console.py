@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from typing import Any, Self, TextIO
 
@@ -80,16 +81,29 @@ class Session:
 
     def client(self, supervisor: int):
         """A MotionClient of ``supervisor``, once the suite and that supervisor are on the graph."""
+        from mpi_ros import graph
         from mpi_ros.client import MotionClient
 
         client = self._keep(MotionClient(supervisor, self.args.namespace, context=self.context,
                                          timeout=self.args.timeout, node_name=self.node_name))
-        client.wait_for_suite(self.args.timeout, supervisor)
+        # The supervisor's own endpoints, not the suite's nodes first: they are what a goal needs
+        graph.wait_for_endpoints(client.node, client.namespace, supervisor, client.servers_ready,
+                                 self.args.timeout, "its actions and services")
         warn_twins(self.args, client)
         if not client.wait_for_server(self.args.timeout):
             raise UsageError(f"{client.prefix} is on the graph but its actions and services did not answer "
                              f"within {self.args.timeout:g} s: is the suite shutting down?")
         return client
+
+    def action_call(self, supervisor: int):
+        """An ActionCall of ``supervisor``, once its action service is reachable: all a one-shot
+        action waits for (a MotionClient would wait for the suite's nodes and both actions)."""
+        from mpi_ros.action_call import ActionCall
+
+        call = self._keep(ActionCall(supervisor, self.args.namespace, context=self.context,
+                                     node_name=self.node_name))
+        call.wait_ready(self.args.timeout)
+        return call
 
     def watcher(self):
         """A Watcher of the suite, once the suite (and --supervisor, if given) is on the graph."""
@@ -167,8 +181,25 @@ def print_reply(action: str, reply, supervisor: int, out: TextIO | None = None) 
     refusal = f": {reply.detail}" if reply.detail and not reply.ok else ""  # e.g. which fault persists
     print(f"{action}: {reply.message} (code {reply.code}), state {reply.state_name}, sample {reply.sample}{refusal}",
           file=out)
-    _hint(reply.message, supervisor)
+    persisting = PERSISTS.findall(reply.detail) if not reply.ok else []
+    if persisting:  # a RESET refused: another RESET would be refused as well
+        print(f"hint: {persists_hint(persisting, supervisor)}", file=sys.stderr)
+    else:
+        _hint(reply.message, supervisor)
     return OK if reply.ok else REFUSED
+
+
+# How the fault monitor words a fault whose condition still holds at a RESET (docs/faults.md).
+PERSISTS = re.compile(r"axis (\d+) ([A-Z_]+) persists")
+CONDITIONS = ("AMP_FAULT", "ENCODER_FAULT")  # injected conditions: `mpi-ros fault NAME --clear` ends them
+
+
+def persists_hint(persisting: list[tuple[str, str]], supervisor: int) -> str:
+    """What to do when RESET was refused because faults persist: end their causes first."""
+    steps = [f"`mpi-ros fault {fault} --axis {axis} --clear`" if fault in CONDITIONS
+             else f"bring axis {axis} out of {fault}" for axis, fault in persisting]
+    return (f"ms{supervisor} stays in ERROR while the fault persists: first {' and '.join(steps)}, "
+            f"then `mpi-ros reset{'' if supervisor == 0 else f' --supervisor {supervisor}'}`")
 
 
 def _hint(message: str, supervisor: int) -> None:

@@ -2,12 +2,13 @@
 
   mpi-ros plot --type S_CURVE --distance 1000 --velocity 500 --acceleration 5000 --jerk-percent 50 [-o FILE]
   mpi-ros plot --request "{type: VELOCITY, velocity: -300, acceleration: 5000, start_velocity: 100}"
-  mpi-ros plot BAG [-o FILE] [--axis N ...]
+  mpi-ros plot BAG [-o FILE] [--axis N ...] [--from S] [--to S]
 
 Without BAG: the profile's position, velocity, acceleration and jerk as the controller plans
 it, with ruckig's profile for the same request overlaid (see mpi-ros crosscheck for the
 verdict). With BAG (a bag directory or an .mcap file): the recorded axes and supervisor
-states over time.
+states over time, the events labelled where they have room; --from/--to plot a window (s
+since the first message, as the x axis), where every event gets its label sooner.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", help="PNG to write (default: profile.png, or <bag name>.png)")
     bag = parser.add_argument_group("bag options")
     bag.add_argument("--axis", type=int, action="append", metavar="N", help="only these axes (repeatable)")
+    bag.add_argument("--from", dest="start", type=float, metavar="S", help="start of the window, s (default 0)")
+    bag.add_argument("--to", dest="end", type=float, metavar="S", help="end of the window, s (default: the end)")
     profile = parser.add_argument_group("profile options (without BAG)")
     profile.add_argument("--request", help="the whole request as YAML or key=value,... (as mpi-ros crosscheck)")
     profile.add_argument("--type", default="S_CURVE", help="TRAPEZOIDAL, S_CURVE or VELOCITY (default S_CURVE)")
@@ -80,7 +83,7 @@ def _plot_bag(args) -> int:
         return 2
     output = args.output or f"{Path(args.bag.rstrip('/')).stem or 'bag'}.png"
     try:
-        path = plot_bag(args.bag, output, args.axis)
+        path = plot_bag(args.bag, output, args.axis, args.start, args.end)
     except (OSError, ValueError) as exc:
         print(f"mpi-ros plot: {exc}", file=sys.stderr)
         return 2

@@ -51,6 +51,23 @@ DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")  # mpi_ros.s
 RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
 
 
+PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")
+FAST_DDS = ("", "rmw_fastrtps_cpp", "rmw_fastrtps_dynamic_cpp")  # RMW_IMPLEMENTATION values ("" = the default)
+
+
+def announce_often(environ) -> str | None:
+    """Point Fast DDS at config/fastdds_discovery.xml (the suite announces itself every 0.1 s,
+    so a one-shot verb finds it at once) unless a profile file or another middleware was chosen.
+    Returns the file set, or None. Before rclpy.init; the goal front's process inherits it."""
+    from mpi_ros import config as suite_config
+
+    if environ.get("RMW_IMPLEMENTATION", "") not in FAST_DDS or any(environ.get(v) for v in PROFILE_VARIABLES):
+        return None
+    path = str(suite_config.config_file("fastdds_discovery.xml"))
+    environ[PROFILE_VARIABLES[0]] = path
+    return path
+
+
 def discovery_range(flag: str | None, config_path: str | None, environ) -> tuple[str, str]:
     """(ROS_AUTOMATIC_DISCOVERY_RANGE value, where it came from): the flag, the environment,
     ros.discovery of the configuration file (default localhost). Raises ConfigError."""
@@ -124,6 +141,7 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
         print(f"{prog}: invalid configuration: {exc}", file=sys.stderr)
         return 2
     os.environ[RANGE_VARIABLE] = reach
+    profile = announce_often(os.environ)
     report_crashes(sys.stderr)  # from here on C code runs: the middleware's
 
     import rclpy
@@ -172,7 +190,7 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
              f"{cfg.controller.sample_rate:g} Hz, time scale {time_scale:g}, config {cfg.source}, "
              f"namespace {cfg.ros.namespace}, discovery {reach} ({told_by}"
              + (f", static peers {os.environ['ROS_STATIC_PEERS']}" if os.environ.get("ROS_STATIC_PEERS") else "")
-             + ")")
+             + ")" + (f", DDS profile {profile}" if profile else ""))
     # What start-up built (rclpy, numpy, the suite) lives as long as the process: frozen, a full
     # collection no longer walks it. Unfrozen, such collections took up to 111 ms during a
     # 100,000-point stream (bench/RESULTS.md), a stall the 128-frame buffer (128 ms of 1 ms

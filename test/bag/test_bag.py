@@ -372,6 +372,21 @@ def convert_ns(stamp) -> int:
     return stamp.sec * 1_000_000_000 + stamp.nanosec
 
 
+def test_play_takes_the_topic_names_echo_takes_and_refuses_one_the_bag_lacks(capsys):
+    from mpi_ros.cli import main
+    from mpi_ros.cli.play import resolve_topics
+
+    bag = FIXTURES / "bags" / "estop_reset"
+    recorded = BagReader(bag).topics()
+    assert resolve_topics(["events", "ms0/status", "joint_states", "/mpi/commands"], "/mpi", recorded) == [
+        "/mpi/events", "/mpi/ms0/status", "/joint_states", "/mpi/commands"]
+    assert main(["play", str(bag), "--topics", "events", "evnts"]) == 2  # before publishing anything
+    err = capsys.readouterr().err
+    assert err.startswith("mpi-ros play: no topic /mpi/evnts in the bag: it has /joint_states, /mpi/axis0/status")
+    assert main(["play", str(bag), "--topics", "events", "--namespace", "/cell_a"]) == 2
+    assert "no topic /cell_a/events in the bag" in capsys.readouterr().err
+
+
 def test_plot_of_a_bag_writes_a_png(tmp_path):
     from mpi_ros.plot.bag import plot_bag
 

@@ -95,6 +95,21 @@ def test_no_suite_exits_2_saying_where_it_looked_and_what_to_do():
     assert message.count("(supervisors found under /mpi)") <= 1
 
 
+def test_a_one_shot_action_waits_for_its_one_service_not_the_goal_client():
+    """`mpi-ros e-stop` and its kin build an ActionCall (the action service alone), not a
+    MotionClient (both actions, their round trips, rclpy.action and numpy to import first)."""
+    import subprocess
+    import sys
+
+    from .conftest import REPO, with_timeout
+
+    probe = ("import sys; from mpi_ros.cli import main; status = main(sys.argv[1:]); "
+             "print(status, 'mpi_ros.client' in sys.modules, 'rclpy.action' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", probe, *with_timeout(["reset"])], capture_output=True, text=True,
+                          timeout=WAIT * 2, cwd=REPO, check=False)
+    assert done.stdout.splitlines()[-1] == "0 False False", done.stdout + done.stderr
+
+
 def test_bad_ros_arguments_are_a_usage_error(capsys):
     assert console("status", "--once", "--ros-args", "-p", "nonsense") == 2
     assert "invalid ROS arguments" in capsys.readouterr().err
@@ -167,16 +182,16 @@ def test_status_once_prints_every_supervisor_and_axis(ms0, capsys):
     assert console("status", "--once") == 0
     lines = capsys.readouterr().out.splitlines()
     assert re.match(r"/mpi  sample \d+$", lines[0])
-    assert lines[1].split() == ["supervisor", "state", "axes", "move", "type", "pending", "last", "action"]
-    header = next(line for line in lines if line.startswith("axis"))
-    assert header.split() == ["axis", "ms", "state", "command", "actual", "velocity", "DONE", "AT_TARGET",
-                              "IN_FINE_POSITION", "SETTLED"]
+    assert lines[1].split() == ["ms", "state", "axes", "move", "type", "pending", "last", "action"]
+    header = next(line for line in lines if line.startswith("axis"))  # off a terminal: every column
+    assert header.split() == ["axis", "ms", "state", "command", "actual", "error", "velocity", "actual", "vel",
+                              "DONE", "AT_TARGET", "IN_FINE_POSITION", "SETTLED", "faults"]
     rows = {line.split()[0]: line.split() for line in lines[lines.index(header) + 1:]}
     assert sorted(rows) == ["0", "1", "2", "3"]
     assert [rows[k][1] for k in "0123"] == ["0", "0", "1", "1"]  # owning supervisor
-    state, velocity, done, settled = rows["0"][2], rows["0"][5], rows["0"][6], rows["0"][9]
-    assert (state, velocity, done, settled) == ("IDLE", "0.0", "yes", "yes")
-    assert all(bit in ("yes", "-") for row in rows.values() for bit in row[6:])
+    state, velocity, done, settled, faults = rows["0"][2], rows["0"][6], rows["0"][8], rows["0"][11], rows["0"][12]
+    assert (state, velocity, done, settled, faults) == ("IDLE", "0.0", "yes", "yes", "-")
+    assert all(bit in ("yes", "-") for row in rows.values() for bit in row[8:12])
 
 
 def test_status_live_prints_tables_until_ctrl_c(running):
@@ -298,9 +313,17 @@ def test_fault_injects_and_clears_and_reset_says_what_persists(ms1, capsys):
     assert "AMP_FAULT on axis 3: MPIMessageOK (code 0), faults [AMP_FAULT]" in capsys.readouterr().out
     ms1.wait_for_state("ERROR", WAIT)
     assert console("reset", "-s", "1") == 1
-    assert "RESET: MPIMotionMessageERROR" in (out := capsys.readouterr().out) and "axis 3 AMP_FAULT persists" in out
+    captured = capsys.readouterr()
+    assert "RESET: MPIMotionMessageERROR" in captured.out and "axis 3 AMP_FAULT persists" in captured.out
+    # not "`mpi-ros reset` leaves it": another RESET would be refused too
+    assert captured.err == ("hint: ms1 stays in ERROR while the fault persists: first "
+                            "`mpi-ros fault AMP_FAULT --axis 3 --clear`, then `mpi-ros reset --supervisor 1`\n")
     assert console("fault", "AMP_FAULT", "--axis", "3", "--clear", "-s", "1") == 0
-    capsys.readouterr()
+    captured = capsys.readouterr()
+    assert captured.out.startswith("AMP_FAULT on axis 3 cleared: MPIMessageOK (code 0), faults [AMP_FAULT]")
+    assert captured.err == ("hint: the condition is gone, but AMP_FAULT stays latched on axis 3 (and its "
+                            "supervisor in ERROR) until a RESET: `mpi-ros reset --supervisor 1`\n")
+    ms1.wait_for_state("ERROR", WAIT, newer_than=ms1.status(WAIT).sample)  # still
     assert console("fault", "OVERHEAT", "--axis", "3", "-s", "1") == 1
     assert "MPIMessagePARAM_INVALID" in (out := capsys.readouterr().out) and "unknown fault" in out
     assert console("reset", "-s", "1") == 0

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 import io
+import os
+import re
 from types import SimpleNamespace
 
 import pytest
@@ -15,10 +17,11 @@ from mpi_ros.cli.goals import ProgressView, goal_from_args
 from mpi_ros.cli.status import _live, render
 
 
-def _axis(number: int, supervisor: int, position: float = 0.0, **bits) -> SimpleNamespace:
+def _axis(number: int, supervisor: int, position: float = 0.0, faults: tuple[str, ...] = (), **bits) -> SimpleNamespace:
     flags = {"done": True, "at_target": True, "in_fine_position": True, "settled": True, **bits}
     return SimpleNamespace(number=number, supervisor=supervisor, state_name="IDLE", command_position=position,
-                           actual_position=position, command_velocity=0.0, sample=100, **flags)
+                           actual_position=position, position_error=0.0, command_velocity=0.0, actual_velocity=0.0,
+                           sample=100, faults=faults, **flags)
 
 
 def _supervisor(number: int, axes: list, state: str = "IDLE", last_action: str = "NONE") -> SimpleNamespace:
@@ -27,15 +30,23 @@ def _supervisor(number: int, axes: list, state: str = "IDLE", last_action: str =
                            action_source="USER", sample=100)
 
 
+def _axis_rows(lines: list[str]) -> list[list[str]]:
+    first = next(i for i, line in enumerate(lines) if line.startswith("axis"))
+    return [line.split() for line in lines[first + 1:] if line[:1].isdigit()]
+
+
 def test_render_has_a_row_per_supervisor_and_axis_with_the_status_bits():
     ms0 = _supervisor(0, [_axis(0, 0, 1000.0), _axis(1, 0, settled=False)], "MOVING", last_action="START")
-    lines = render({0: ms0}, {4: _axis(4, -1)}, "/mpi")
-    assert lines[0] == "/mpi  sample 100"
-    assert lines[2].split() == ["ms0", "MOVING", "0", "1", "3", "S_CURVE", "0", "START", "(USER)"]
-    rows = [line.split() for line in lines[5:]]
-    assert rows[0] == ["0", "0", "IDLE", "1000.0", "1000.0", "0.0", "yes", "yes", "yes", "yes"]
-    assert rows[1][-1] == "-"  # not SETTLED
-    assert rows[2][:2] == ["4", "-"]  # an axis no supervisor has
+    for width in (80, 200):
+        lines = render({0: ms0}, {4: _axis(4, -1)}, "/mpi", width=width)
+        assert lines[0] == "/mpi  sample 100"
+        assert lines[2].split() == ["ms0", "MOVING", "0", "1", "3", "S_CURVE", "0", "START", "(USER)"]
+        rows = _axis_rows(lines)
+        assert rows[0][:6] == ["0", "0", "IDLE", "1000.0", "1000.0", "0.0"]
+        assert rows[1][rows[1].index("-") if width == 80 else -2] == "-"  # not SETTLED
+        assert rows[2][:2] == ["4", "-"]  # an axis no supervisor has
+    assert _axis_rows(render({0: ms0}, {}, "/mpi", width=80))[0][-4:] == ["y", "y", "y", "y"]
+    assert _axis_rows(render({0: ms0}, {}, "/mpi", width=200))[0][-5:] == ["yes", "yes", "yes", "yes", "-"]
     idle = render({0: _supervisor(0, [])}, {}, "/mpi")
     assert idle[2].split()[-1] == "-"  # no action yet
 
@@ -44,34 +55,143 @@ def test_render_says_when_the_status_is_stale():
     assert "(no newer status for 3 s: is the suite still running?)" in render({}, {}, "/mpi", stale=3.0)[0]
 
 
+def _cell(axes: int = 4) -> tuple[dict, dict]:
+    """Two supervisors, their axes far from zero (the widest numbers), one axis faulted."""
+    numbers = list(range(axes))
+    ms = {n: _supervisor(n, [_axis(k, n, -1234567.8, faults=("AMP_FAULT",) if k == 3 else ())
+                             for k in numbers[2 * n:2 * n + 2]], "STOPPING_ERROR", "E_STOP") for n in (0, 1)}
+    return ms, {}
+
+
+@pytest.mark.parametrize("width", [80, 100, 127, 128, 200])
+def test_no_line_of_the_table_reaches_the_last_column(width):
+    lines = render(*_cell(), "/mpi", stale=12.0, width=width)
+    assert max(len(line) for line in lines) <= width - 1
+    text = "\n".join(lines)
+    assert "AMP_FAULT" in text  # a column of its own from 128 on, a line of its own below
+    assert ("D T F S" in text) == (width < 128) and ("IN_FINE_POSITION" in text) == (width >= 128)
+
+
+class Terminal:
+    """A terminal of ``columns`` x ``rows``, as far as the live view drives one: text wraps
+    at the last column, a newline at the bottom scrolls a line into the scrollback (the main
+    screen only), ESC[H homes the cursor, ESC[nF goes up n lines, ESC[K and ESC[J clear to
+    the end of the line and of the screen, ESC[?1049h/l switch to the alternate screen and
+    back (the main screen as it was), other sequences change nothing seen here."""
+
+    def __init__(self, columns: int, rows: int):
+        self.columns, self.rows = columns, rows
+        self.scrollback: list[str] = []
+        self.main = self._blank()
+        self.screen, self.row, self.col = self.main, 0, 0
+        self.saved = (0, 0)
+
+    def _blank(self) -> list[list[str]]:
+        return [[" "] * self.columns for _ in range(self.rows)]
+
+    def feed(self, text: str) -> None:
+        for token in re.split(r"(\x1b\[[?0-9;]*[A-Za-z]|\n)", text):
+            if token == "\n":
+                self._newline()
+            elif token.startswith("\x1b["):
+                self._escape(token)
+            else:
+                for char in token:
+                    if self.col == self.columns:  # the pending wrap of a full line
+                        self._newline()
+                    self.screen[self.row][self.col] = char
+                    self.col += 1
+
+    def _newline(self) -> None:
+        self.col = 0
+        if self.row < self.rows - 1:
+            self.row += 1
+            return
+        top = self.screen.pop(0)
+        if self.screen is self.main:
+            self.scrollback.append("".join(top).rstrip())
+        self.screen.append([" "] * self.columns)
+
+    def _escape(self, token: str) -> None:
+        code, final = token[2:-1], token[-1]
+        if token == "\x1b[?1049h":
+            self.saved, self.screen, self.row, self.col = (self.row, self.col), self._blank(), 0, 0
+        elif token == "\x1b[?1049l":
+            self.screen, (self.row, self.col) = self.main, self.saved
+        elif final == "H":
+            self.row, self.col = 0, 0
+        elif final == "F":
+            self.row, self.col = max(self.row - int(code or 1), 0), 0
+        elif final == "K":
+            self.screen[self.row][self.col:] = [" "] * (self.columns - self.col)
+        elif final == "J":
+            self.screen[self.row][self.col:] = [" "] * (self.columns - self.col)
+            for line in self.screen[self.row + 1:]:
+                line[:] = [" "] * self.columns
+
+    def lines(self) -> list[str]:
+        """What the operator can scroll through: the scrollback and the screen, blank lines at the end left out."""
+        shown = [*self.scrollback, *("".join(line).rstrip() for line in self.screen)]
+        while shown and not shown[-1]:
+            shown.pop()
+        return shown
+
+
 class _Watcher:
-    """Serves the same tables, then Ctrl-C on the third look."""
+    """Serves the same tables, then Ctrl-C on look ``stop``."""
 
     namespace = "/mpi"
 
-    def __init__(self):
-        self.looks = 0
+    def __init__(self, stop: int = 3):
+        self.looks, self.stop, self.seen = 0, stop, []
 
     def latest(self):
         self.looks += 1
-        if self.looks == 3:
+        if self.looks == self.stop:
             raise KeyboardInterrupt
-        return {0: _supervisor(0, [_axis(0, 0), _axis(1, 0)])}, {}
+        return _cell()
 
     def twins_on_graph(self) -> list[str]:
         return []  # one suite: no warning line
 
 
-def test_live_status_redraws_in_place_on_a_terminal():
-    out = io.StringIO()
+class _Frames(io.StringIO):
+    """The live view's output, and the terminal it is fed to, frame by frame (a flush each)."""
+
+    def __init__(self, terminal: Terminal):
+        super().__init__()
+        self.terminal, self.after_frame = terminal, []
+
+    def flush(self) -> None:
+        self.terminal.feed(self.getvalue())
+        self.seek(0)
+        self.truncate()
+        self.after_frame.append(self.terminal.lines())
+
+
+@pytest.mark.parametrize("columns, rows", [(80, 24), (200, 50)])
+def test_live_status_redraws_in_place_without_stacking(columns, rows):
+    terminal = Terminal(columns, rows)
+    terminal.feed("$ mpi-ros status\n")
+    frames = _Frames(terminal)
     with pytest.raises(KeyboardInterrupt):
-        _live(_Watcher(), out, tty=True, interval=0.0)
-    text = out.getvalue()
-    table_lines = len(render(*_Watcher().latest(), "/mpi"))
-    assert text.startswith("\x1b[?25l")  # cursor hidden while drawing ...
-    assert text.endswith("\x1b[?25h")  # ... and shown again, Ctrl-C or not
-    assert text.count(f"\x1b[{table_lines}F") == 1  # the second table goes up over the first
-    assert text.count("/mpi  sample 100") == 2
+        _live(_Watcher(stop=4), frames, tty=True, interval=0.0, size=lambda: os.terminal_size((columns, rows)))
+    first, second, third, after = frames.after_frame
+    table = render(*_cell(), "/mpi", width=columns)
+    assert first == second == third == table  # each redraw over the last: not one line more
+    assert max(len(line) for line in first) < columns  # nothing wrapped
+    assert after == ["$ mpi-ros status", *table]  # the operator's screen back, with the last table on it
+
+
+def test_live_status_on_a_short_terminal_cuts_the_table_and_says_so():
+    terminal = Terminal(80, 10)
+    frames = _Frames(terminal)
+    with pytest.raises(KeyboardInterrupt):
+        _live(_Watcher(), frames, tty=True, interval=0.0, size=lambda: os.terminal_size((80, 10)))
+    first, second, after = frames.after_frame
+    assert first == second and len(first) == 10  # the screen's rows, none scrolled away
+    assert first[-1].startswith("... ") and first[-1].endswith("more lines: a taller terminal shows them")
+    assert after[-13:] == render(*_cell(), "/mpi", width=80)  # all of the last table left on leaving
 
 
 def test_live_status_off_a_terminal_prints_tables_one_after_another():
@@ -79,6 +199,7 @@ def test_live_status_off_a_terminal_prints_tables_one_after_another():
     with pytest.raises(KeyboardInterrupt):
         _live(_Watcher(), out, tty=False, interval=0.0)
     assert "\x1b" not in out.getvalue() and out.getvalue().count("/mpi  sample 100") == 2
+    assert "IN_FINE_POSITION" in out.getvalue()  # off a terminal, every column
 
 
 def _feedback(progress: float, state: str = "MOVING") -> SimpleNamespace:

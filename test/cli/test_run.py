@@ -5,6 +5,7 @@ from __future__ import annotations
 import platform
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -69,3 +70,17 @@ def test_crash_reports_are_left_alone_without_a_file_descriptor():
     before = faulthandler.is_enabled()
     assert report_crashes(io.StringIO()) is False  # stderr captured in-process, as run() in tests
     assert faulthandler.is_enabled() == before
+
+
+# -- the suite's DDS announcements (config/fastdds_discovery.xml) ------------------------------------
+def test_the_suite_announces_itself_often_unless_a_profile_or_middleware_was_chosen(tmp_path):
+    from mpi_ros.cli.run import announce_often
+
+    environ: dict[str, str] = {}
+    chosen = announce_often(environ)
+    assert chosen is not None and environ["FASTRTPS_DEFAULT_PROFILES_FILE"] == chosen
+    assert "<leaseAnnouncement><sec>0</sec><nanosec>100000000</nanosec></leaseAnnouncement>" in Path(chosen).read_text()
+    own = {"FASTDDS_DEFAULT_PROFILES_FILE": str(tmp_path / "mine.xml")}
+    assert announce_often(own) is None and "FASTRTPS_DEFAULT_PROFILES_FILE" not in own
+    cyclone = {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}
+    assert announce_often(cyclone) is None and cyclone == {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}

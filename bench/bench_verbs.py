@@ -1,0 +1,199 @@
+"""One-shot verbs from invocation to effect (issue 36): how long after an operator presses
+Enter on `mpi-ros e-stop` does the E_STOP take effect?
+
+Per run: the time is read just before the verb's process is started (``python -P -m
+mpi_ros.cli VERB``, what the installed ``mpi-ros`` script runs); the effect is the sample at
+which the controller applied the command, as the suite publishes it on ``/mpi/commands``
+(``stamp = epoch + sample / rate``, controller time anchored to the wall clock; the suite
+runs in real time). Also given: when that message reached this process, and when the verb's
+process had ended (it printed the answer), and the CPU time the process used (what it
+costs whatever the load: on a machine whose cores are taken by others, wall time is
+several times that).
+
+Each run is a cycle on ms0: ``move --no-wait`` (a 200-count S-curve), ``e-stop``, ``reset``.
+The suite of each source tree (this one and ``--baseline``, extracted with git archive) runs
+in turn, each with its own verbs; the trees alternate ``--rounds`` times, since the machine
+is shared and its load changes by the minute (the load average is printed with the figures).
+
+    python -P bench/bench_verbs.py [--runs 8] [--rounds 2] [--baseline REV|none]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "bench"))  # run with -P: the sibling bench_controller
+from bench_controller import baseline_tree  # noqa: E402 - after the path it is found on
+
+os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(150, 200)))
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+BASELINE = "e99f630"  # before issue 36
+SUITE_UP = 60.0  # s the suite may take to come up on a busy machine
+EFFECT_WAIT = 10.0  # s a verb's command may take to show on /mpi/commands
+CYCLE = (("move", ["move", "--no-wait", "--position", "200", "0", "--velocity", "2000", "--acceleration",
+                   "20000", "--jerk-percent", "50"], "motion_start", ""),
+         ("e-stop", ["e-stop"], "action", "E_STOP"),
+         ("reset", ["reset"], "action", "RESET"))
+
+
+@dataclass(frozen=True)
+class Run:
+    verb: str
+    effect: float  # s from the process' start to the stamp of the sample the command took effect at
+    arrival: float  # s from the process' start to /mpi/commands reaching this process
+    exited: float  # s from the process' start to its end
+    status: int
+    cpu: float  # s of CPU the process used (user + system), whatever the machine's load
+
+
+class Commands:
+    """/mpi/commands as it arrives: (arrival time, stamp in s, operation, request)."""
+
+    def __init__(self) -> None:
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+        from mpi_ros.msg import Command
+
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context)
+        self.node = Node("bench_verbs", context=self.context)
+        self.seen: list[tuple[float, float, str, str]] = []
+        self.arrived = threading.Condition()
+        self.node.create_subscription(Command, "/mpi/commands", self._on_command,
+                                      QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.thread = threading.Thread(target=self.executor.spin, daemon=True)
+        self.thread.start()
+
+    def _on_command(self, msg: Any) -> None:
+        with self.arrived:
+            self.seen.append((time.time(), msg.stamp.sec + msg.stamp.nanosec * 1e-9, msg.operation, msg.request))
+            self.arrived.notify_all()
+
+    def wait_for(self, after: int, operation: str, word: str) -> tuple[float, float] | None:
+        """(arrival, stamp) of the first command after index ``after`` of ``operation`` naming ``word``."""
+        def found() -> tuple[float, float] | None:
+            return next(((arrival, stamp) for arrival, stamp, op, request in self.seen[after:]
+                         if op == operation and word in request), None)
+
+        with self.arrived:
+            self.arrived.wait_for(lambda: found() is not None, EFFECT_WAIT)
+            return found()
+
+    def close(self) -> None:
+        self.executor.shutdown(timeout_sec=2.0)
+        self.node.destroy_node()
+        self.context.try_shutdown()
+
+
+def start_suite(tree: Path) -> subprocess.Popen:
+    suite = subprocess.Popen([sys.executable, "-P", "-m", "mpi_ros.cli", "run"], cwd=tree, env=_env(tree),
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    up = threading.Event()
+
+    def read() -> None:
+        for line in suite.stdout:  # type: ignore[union-attr]
+            if "suite up" in line:
+                up.set()
+
+    threading.Thread(target=read, daemon=True).start()
+    if not up.wait(SUITE_UP):
+        suite.kill()
+        raise RuntimeError(f"the suite of {tree} did not come up within {SUITE_UP:g} s")
+    return suite
+
+
+def _env(tree: Path) -> dict[str, str]:
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (str(tree), os.environ.get("PYTHONPATH", "")) if p))
+
+
+def one(tree: Path, commands: Commands, verb: str, argv: list[str], operation: str, word: str) -> Run:
+    after = len(commands.seen)
+    start = time.time()
+    verb_process = subprocess.Popen([sys.executable, "-P", "-m", "mpi_ros.cli", *argv, "--timeout", "10"], cwd=tree,
+                                    env=_env(tree), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, wait_status, usage = os.wait4(verb_process.pid, 0)  # its CPU time too
+    exited = time.time() - start
+    status = os.waitstatus_to_exitcode(wait_status)
+    verb_process.returncode = status
+    errors = verb_process.stderr.read().decode() if verb_process.stderr else ""
+    effect = commands.wait_for(after, operation, word)
+    if effect is None:
+        raise RuntimeError(f"{verb}: no command on /mpi/commands (exit {status}: {errors.strip()})")
+    return Run(verb, effect[1] - start, effect[0] - start, exited, status, usage.ru_utime + usage.ru_stime)
+
+
+def measure(tree: Path, runs: int) -> list[Run]:
+    suite = start_suite(tree)
+    commands = Commands()
+    try:
+        one(tree, commands, *CYCLE[2])  # a first RESET: the suite and this process have met
+        return [one(tree, commands, *step) for _ in range(runs) for step in CYCLE]
+    finally:
+        commands.close()
+        suite.terminate()
+        suite.wait(timeout=30)
+
+
+def table(results: dict[str, list[Run]]) -> list[str]:
+    lines = ["| tree | verb | runs | effect median | effect max | command received median | process ended median | "
+             "CPU of the process median |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for tree, runs in results.items():
+        for verb, *_ in CYCLE:
+            mine = [run for run in runs if run.verb == verb]
+            failed = sum(run.status not in (0, 1) for run in mine)
+            effect = [run.effect for run in mine]
+            lines.append(f"| {tree} | {verb} | {len(mine)}{f' ({failed} failed)' if failed else ''} | "
+                         f"{statistics.median(effect):.2f} s | {max(effect):.2f} s | "
+                         f"{statistics.median(run.arrival for run in mine):.2f} s | "
+                         f"{statistics.median(run.exited for run in mine):.2f} s | "
+                         f"{statistics.median(run.cpu for run in mine):.2f} s |")
+    return lines
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--runs", type=int, default=8, help="cycles per round and tree (default 8)")
+    parser.add_argument("--rounds", type=int, default=2, help="rounds, the trees alternating (default 2)")
+    parser.add_argument("--baseline", default=BASELINE, help=f"revision to compare with (default {BASELINE}), or none")
+    args = parser.parse_args()
+    results: dict[str, list[Run]] = {}
+    with tempfile.TemporaryDirectory(prefix="bench_verbs_") as scratch:
+        trees = [(REPO, "this tree")]
+        if args.baseline != "none":
+            old = baseline_tree(args.baseline, Path(scratch))
+            if old is None:
+                print(f"(no baseline: `git archive {args.baseline}` failed)")
+            else:
+                trees.append((old, args.baseline))
+        loads = [os.getloadavg()[0]]
+        for _ in range(args.rounds):
+            for tree, name in trees:
+                results.setdefault(name, []).extend(measure(tree, args.runs))
+                loads.append(os.getloadavg()[0])
+    print(f"ROS_DOMAIN_ID {os.environ['ROS_DOMAIN_ID']}, {os.cpu_count()} cores, 1-minute load average "
+          f"{min(loads):.1f} to {max(loads):.1f} during the runs")
+    print()
+    print("\n".join(table(results)))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,122 @@
+"""`mpi-ros console` driven headless by Textual's pilot against a real suite, at 80x24 and
+200x50: what is on screen, the keys' actions as the supervisors' status shows them, the jog
+and its stop, the command line."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+
+import pytest
+
+from mpi_ros.cli.tui import Link, make_app
+
+from .conftest import WAIT
+
+pytestmark = pytest.mark.usefixtures("suite_process")
+
+
+def _args(**options) -> argparse.Namespace:
+    return argparse.Namespace(namespace="/mpi", supervisor=None, timeout=WAIT, jog_speed=1000.0,
+                              jog_acceleration=10000.0, ros_args=[], **options)
+
+
+@pytest.fixture
+def link(clients, module_context):
+    made = Link(_args(), context=module_context)
+    yield made
+    made.close()
+
+
+def _log(app) -> str:
+    from textual.widgets import RichLog
+
+    return "\n".join(line.text for line in app.query_one(RichLog).lines)
+
+
+async def _until(pilot, predicate, what: str) -> None:
+    """Let the application run until ``predicate()``; fail after WAIT s."""
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + WAIT
+    while not predicate():
+        if loop.time() > deadline:
+            pytest.fail(f"no {what} within {WAIT} s")
+        await pilot.pause(0.05)
+
+
+def _screen(app) -> str:
+    """The text on the screen, as the operator reads it (from the SVG screenshot)."""
+    import html
+    import re
+
+    svg = app.export_screenshot()
+    return html.unescape(re.sub(r"<[^>]+>", "", svg.split("</style>")[-1])).replace("\xa0", " ")
+
+
+async def _type(pilot, app, line: str) -> None:
+    """Open the command line with ":", put ``line`` in it (pressing each key takes seconds on a busy machine), Enter."""
+    from textual.widgets import Input
+
+    await pilot.press("colon")
+    box = app.query_one(Input)
+    assert box.has_focus
+    box.value = line
+    await pilot.press("enter")
+
+
+def _state(client):
+    return client.status(WAIT).state_name
+
+
+@pytest.mark.parametrize("size", [(80, 24), (200, 50)])
+def test_the_console_shows_the_suite_and_its_keys_act(link, ms0, size):
+    async def drive():
+        app = make_app(link, _args())
+        async with app.run_test(size=size) as pilot:
+            from textual.widgets import DataTable
+
+            table = app.query_one(DataTable)
+            await _until(pilot, lambda: table.row_count == 6, "row per supervisor and axis")
+            assert [table.get_row_at(k)[0] for k in range(6)] == ["ms0 *", "  axis0", "  axis1", "ms1",
+                                                                  "  axis2", "  axis3"]
+            assert app.size == size and table.region.width <= size[0]
+            keys = ("space STOP", "e E_STOP", "r RESET", "u RESUME")
+            await _until(pilot, lambda: all(key in _screen(app) for key in keys), "the keys on screen")
+            assert "selected ms0" in _screen(app)
+            await pilot.press("e")
+            ms0.wait_for_state("ERROR", WAIT)
+            await _until(pilot, lambda: "E_STOP ms0: MPIMessageOK" in _log(app), "E_STOP's answer in the log")
+            await pilot.press("r")
+            ms0.wait_for_state("IDLE", WAIT)
+            await _until(pilot, lambda: table.get_row_at(0)[1] == "IDLE", "ms0 IDLE in the table")
+
+    asyncio.run(drive())
+
+
+def test_an_arrow_jogs_and_the_jog_stops_when_the_key_is_no_longer_repeated(link, ms0):
+    async def drive():
+        app = make_app(link, _args())
+        async with app.run_test(size=(80, 24)) as pilot:
+            await pilot.press("right")
+            # one press, no repeat: a VELOCITY move in the + direction, STOPped JOG_RELEASE s later
+            await _until(pilot, lambda: "jog ms0 +1000 counts/s" in _log(app), "the jog in the log")
+            stopped = ms0.wait_for(lambda s: s.state_name == "STOPPED" and s.motion_type == "VELOCITY", WAIT,
+                                   "the jog stopped")
+            assert stopped.last_action == "STOP" and stopped.axes[0].command_position > 0.0
+
+    asyncio.run(drive())
+
+
+def test_the_command_line_takes_the_one_shot_verbs(link, ms0):
+    async def drive():
+        app = make_app(link, _args())
+        async with app.run_test(size=(200, 50)) as pilot:
+            await _type(pilot, app, "move --position 300 0 -v 3000 -a 30000")
+            ms0.wait_for(lambda s: s.state_name == "IDLE" and s.axes[0].command_position == 300.0, WAIT, "at 300")
+            await _type(pilot, app, "stop --supervisor 1")
+            await _type(pilot, app, "jump")
+            await _until(pilot, lambda: "STOP ms1: MPIMotionMessageIDLE" in _log(app), "the refused STOP")
+            assert "move sent to ms0" in _log(app)
+            assert "unknown command 'jump': the console takes move, modify, stop" in _log(app)
+
+    asyncio.run(drive())
