@@ -20,7 +20,7 @@ another shell: `mpi-ros status`, `mpi-ros move ...` (see `mpi-ros --help`); or, 
 of run, `mpi-ros demo` for a narrated, recorded tour.
 
 One suite per namespace: before it creates its nodes, the suite looks for the namespace's
-controller node on the graph for up to 3.5 s (mpi_ros/ros/twin.py); if another suite is there
+controller node on the graph for up to 1.5 s (mpi_ros/ros/twin.py); if another suite is there
 it says where (namespace, domain, the other process where it can) and exits with status 2.
 """
 

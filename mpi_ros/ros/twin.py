@@ -5,12 +5,13 @@ namespace").
 Two suites under one namespace would both answer every goal and service (one ``move`` moves
 both twins, topics come at twice the rate) while a console shows only one of them. The
 graph has no lock to take, so the check is a look: the probe waits up to DISCOVERY for
-``<ns>/controller`` to appear. Discovery of a node already running took 0.23 to 3.2 s here
-from the probe's start (median about 0.5 s; 45 tries on 2 cores at load 5, bench/RESULTS.md,
-"Finding a suite on the graph"): most come with Fast DDS's first announcements, the rest with
-its periodic participant announcement, every 3 s by default. DISCOVERY covers that period; a
-twin that discovery still has not shown by then starts, and the console warns about it
-(``MotionClient.twins_on_graph``).
+``<ns>/controller`` to appear. A suite announces itself every 0.1 s (config/fastdds_discovery.xml):
+discovery showed a running one 0.29 to 0.59 s after the probe started (10 tries, 2 cores at
+load 3 to 4; with Fast DDS's default announcement every 3 s it took 0.23 to 3.2 s, median 0.5 s,
+in 45 tries at load 5). DISCOVERY leaves room for a loaded machine. A suite started with a
+Fast DDS profile of its own announces itself every 3 s unless the profile says otherwise, and
+may then be missed; a twin that discovery has not shown by then starts, and the console warns
+about it (``MotionClient.twins_on_graph``).
 
 Who the other suite is: the graph gives its node's enclave; the process is read from the
 GUID of one of its endpoints where the middleware is Fast DDS, whose GUID prefix holds the
@@ -33,7 +34,7 @@ from pathlib import Path
 from rclpy.context import Context
 from rclpy.node import Node, NodeNameNonExistentError
 
-DISCOVERY = 3.5  # s the probe waits for an existing suite's controller node (Fast DDS announces every 3 s)
+DISCOVERY = 1.5  # s the probe waits for an existing suite's controller node (announced every 0.1 s)
 POLL = 0.02  # s between looks at the graph
 CONTROLLER = "controller"  # the suite's controller node, <ns>/controller (ControllerNode)
 FAST_DDS_VENDOR = b"\x01\x0f"  # eProsima's RTPS vendor id, the first two bytes of its GUIDs
