@@ -45,7 +45,7 @@ def load_average() -> str:
 
 def command(seconds: float, rate: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     """Times and a command of quintic moves with pauses between them."""
-    t = np.arange(int(round(seconds * rate)) + 1) / rate
+    t = np.arange(round(seconds * rate) + 1) / rate
     u = np.zeros_like(t)
     start, position = 0.05, 0.0
     while start < seconds:

@@ -368,7 +368,7 @@ def ruckig_rows(count: int, rounds: int, revision: str | None) -> list[str]:
 
 
 def main(revision: str | None = None, count: int = 1000, rounds: int = 3) -> list[str]:
-    return type_rows() + [""] + ruckig_rows(count, rounds, revision)
+    return [*type_rows(), "", *ruckig_rows(count, rounds, revision)]
 
 
 if __name__ == "__main__":

@@ -133,7 +133,7 @@ class JointStates:
     (bench/bench_joints.py, bench/RESULTS.md "Joint states in SI units").
     """
 
-    __slots__ = ("names", "_scale", "_offset", "_identity")
+    __slots__ = ("_identity", "_offset", "_scale", "names")
 
     def __init__(self, joints: Sequence[AxisJoint]):
         self.names: tuple[str, ...] = tuple(j.name for j in joints)

@@ -42,7 +42,8 @@ def test_one_exception_class_per_message_with_the_same_name_and_code():
     assert {m.name: m.code for m in Message} == errors.CODES
     for name in expected:
         cls = getattr(errors, name)
-        assert cls.message_name == name and issubclass(cls, errors.MpiError)
+        assert cls.message_name == name
+        assert issubclass(cls, errors.MpiError)
         assert errors.error_for(name) is cls
 
 
@@ -66,11 +67,13 @@ def test_a_message_this_client_does_not_know_still_raises_by_name():
     assert first is errors.error_for("MPIMotionMessageFROM_THE_FUTURE")  # made once: `except` on it works
     with pytest.raises(first) as caught:
         errors.raise_for("MPIMotionMessageFROM_THE_FUTURE")
-    assert isinstance(caught.value, errors.MpiError) and caught.value.message == "MPIMotionMessageFROM_THE_FUTURE"
+    assert isinstance(caught.value, errors.MpiError)
+    assert caught.value.message == "MPIMotionMessageFROM_THE_FUTURE"
 
 
 def test_connection_errors_are_not_controller_errors():
-    assert issubclass(errors.SuiteNotFound, errors.NoResponse) and issubclass(errors.NoResponse, TimeoutError)
+    assert issubclass(errors.SuiteNotFound, errors.NoResponse)
+    assert issubclass(errors.NoResponse, TimeoutError)
     assert not issubclass(errors.NoSuchSupervisor, errors.MpiError)
 
 
@@ -78,7 +81,8 @@ def test_enums_name_what_the_controller_names():
     assert set(EventType) == {e.name for e in MPIEventType if e.name and e is not MPIEventType.NONE}
     assert set(State) == {s.name for s in MPIState}
     assert {"STOP", "E_STOP", "ABORT", "E_STOP_ABORT", "RESET", "RESUME", "MAP"} == set(Action)
-    assert MotionType.S_CURVE == "S_CURVE" and f"{MotionType.VELOCITY}" == "VELOCITY"
+    assert MotionType.S_CURVE == "S_CURVE"
+    assert f"{MotionType.VELOCITY}" == "VELOCITY"
 
 
 def test_fill_sets_nested_fields_and_makes_numbers_float64():
@@ -87,12 +91,14 @@ def test_fill_sets_nested_fields_and_makes_numbers_float64():
     goal = fill(MotionStart.Goal(), {"type": MotionType.S_CURVE, "position": [1000, 0],
                                      "trajectory": [{"velocity": 500, "acceleration": 5000}],
                                      "attributes": ["RELATIVE"], "id": 7.0})
-    assert goal.type == "S_CURVE" and type(goal.type) is str
+    assert goal.type == "S_CURVE"
+    assert type(goal.type) is str
     assert list(goal.position) == [1000.0, 0.0]
-    assert goal.trajectory[0].velocity == 500.0 and goal.id == 7
+    assert goal.trajectory[0].velocity == 500.0
+    assert goal.id == 7
 
 
-@pytest.mark.parametrize("data, text", [
+@pytest.mark.parametrize(("data", "text"), [
     ({"positions": [1.0]}, "positions: no such field in MotionStart_Goal (fields: "),
     ({"position": 5.0}, "position: expected a list, got 5.0"),
     ({"position": ["a"]}, "position[0]: expected a number, got 'a'"),
@@ -116,7 +122,8 @@ def test_message_to_dict_and_message_class():
 
     status = MotionStatus(number=1, state_name="IDLE", axis_numbers=[2, 3], axes=[AxisStatus(number=2)])
     plain = message_to_dict(status)
-    assert plain["number"] == 1 and plain["axis_numbers"] == [2, 3]
+    assert plain["number"] == 1
+    assert plain["axis_numbers"] == [2, 3]
     assert plain["axes"][0]["number"] == 2
     assert plain["header"] == {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}  # nested messages as dicts
     assert list(plain)[:3] == ["header", "sample", "number"]  # in field order
@@ -126,7 +133,7 @@ def test_message_to_dict_and_message_class():
         message_class("MotionStatus")
 
 
-@pytest.mark.parametrize("message, sample, end, status, outcome", [
+@pytest.mark.parametrize(("message", "sample", "end", "status", "outcome"), [
     ("MPIMessageOK", 10, 500, 4, Outcome.DONE),
     ("MPIMessagePARAM_INVALID", 10, 10, 6, Outcome.REFUSED),
     ("MPIMotionMessageERROR", 10, 900, 6, Outcome.ENDED),
@@ -136,8 +143,10 @@ def test_motion_result_outcome(message, sample, end, status, outcome):
     raw = SimpleNamespace(message=message, code=0, state_name="IDLE", actual_position=[1.0], command_position=[1.0],
                           move_id=0, sample=sample, end_sample=end, detail="")
     result = MotionResult.from_ros(raw, status)
-    assert result.outcome is outcome and result.ok == (message == "MPIMessageOK")
-    assert result.state is State.IDLE and result.actual_position == (1.0,)
+    assert result.outcome is outcome
+    assert result.ok == (message == "MPIMessageOK")
+    assert result.state is State.IDLE
+    assert result.actual_position == (1.0,)
 
 
 def test_client_and_errors_import_nothing_of_the_simulated_controller():
@@ -291,7 +300,8 @@ def test_stream_opens_the_path_then_appends_a_chunk_per_cue_the_last_final(recor
                                         timeout=5.0)
     kind, first, start = recorder.sent.wait(1)
     assert (kind, first["type"], first["final"], first["empty_count"]) == ("start", "BESSEL", False, 7)
-    assert first["position"] == [1.0, -1.0, 2.0, -2.0, 3.0, -3.0] and first["time"] == [0.01] * 3
+    assert first["position"] == [1.0, -1.0, 2.0, -2.0, 3.0, -3.0]
+    assert first["time"] == [0.01] * 3
     cue.low(100)
     kind, second, _ = recorder.sent.wait(2)
     assert (kind, second["attributes"], second["final"], second["position"]) == (
@@ -305,7 +315,8 @@ def test_stream_opens_the_path_then_appends_a_chunk_per_cue_the_last_final(recor
         future.set_result(_ros_result(detail="points executed"))
     start.set_result(_ros_result(detail="motion done; path peaks ..."))
     thread.join(5.0)
-    assert outcome["result"].detail == "motion done; path peaks ..." and len(recorder.sent.goals) == 3
+    assert outcome["result"].detail == "motion done; path peaks ..."
+    assert len(recorder.sent.goals) == 3
 
 
 def test_stream_ignores_cues_of_other_supervisors_and_of_stale_statuses(recorder, cue):
@@ -327,28 +338,33 @@ def test_stream_ignores_cues_of_other_supervisors_and_of_stale_statuses(recorder
     no_append_after(140, 2)
     recorder.sent.goals[0][2].set_result(_ros_result("MPIMotionMessageERROR", "E_STOP by CONTROLLER"))
     thread.join(5.0)
-    assert isinstance(outcome["error"], errors.MPIMotionMessageERROR) and len(recorder.sent.goals) == 2
+    assert isinstance(outcome["error"], errors.MPIMotionMessageERROR)
+    assert len(recorder.sent.goals) == 2
 
 
 def test_stream_raises_a_refused_start_and_a_refused_append(recorder, cue):
     thread, outcome = _stream_in_thread(recorder, MotionType.SPLINE, POINTS, [0.01] * 7, chunk=4, timeout=5.0)
     recorder.sent.wait(1)[2].set_result(_ros_result("MPIMotionMessagePATH_ERROR", "final is false", 10, 10, 6))
     thread.join(5.0)
-    assert isinstance(outcome["error"], errors.MPIMotionMessagePATH_ERROR) and len(recorder.sent.goals) == 1
+    assert isinstance(outcome["error"], errors.MPIMotionMessagePATH_ERROR)
+    assert len(recorder.sent.goals) == 1
     recorder.sent = _Sent()
     thread, outcome = _stream_in_thread(recorder, MotionType.PT, POINTS, [0.01] * 7, chunk=2, timeout=5.0)
     recorder.sent.wait(1)
     cue.low(200)
     recorder.sent.wait(2)[2].set_result(_ros_result("MPIMessagePARAM_INVALID", "position needs ...", 210, 210, 6))
     thread.join(5.0)
-    assert isinstance(outcome["error"], errors.MPIMessagePARAM_INVALID) and len(recorder.sent.goals) == 2
+    assert isinstance(outcome["error"], errors.MPIMessagePARAM_INVALID)
+    assert len(recorder.sent.goals) == 2
 
 
 def test_a_path_that_fits_one_chunk_is_one_final_goal(recorder):
     thread, outcome = _stream_in_thread(recorder, MotionType.PVT, POINTS[:2], [0.5, 0.5],
                                         velocities=[(1.0, 1.0), (0.0, 0.0)], timeout=5.0)
     kind, goal, future = recorder.sent.wait(1)
-    assert kind == "start" and "final" not in goal and goal["point_velocity"] == [1.0, 1.0, 0.0, 0.0]
+    assert kind == "start"
+    assert "final" not in goal
+    assert goal["point_velocity"] == [1.0, 1.0, 0.0, 0.0]
     future.set_result(_ros_result())
     thread.join(5.0)
     assert outcome["result"].ok
@@ -358,7 +374,8 @@ def test_path_sends_one_goal_and_raises_as_move_does(recorder):
     running = recorder.path(MotionType.PT, POINTS[:2], [0.1, 0.1], attributes=["RELATIVE"], wait=False, id=3)
     kind, goal, future = recorder.sent.wait(1)
     assert (kind, goal["attributes"], goal["id"]) == ("start", ["RELATIVE"], 3)
-    assert goal["position"] == [1.0, -1.0, 2.0, -2.0] and goal["time"] == [0.1, 0.1]
+    assert goal["position"] == [1.0, -1.0, 2.0, -2.0]
+    assert goal["time"] == [0.1, 0.1]
     future.set_result(_ros_result("MEIMotionMessageBAD_PATH_DATA", "a path value is infinite or NaN", 5, 5, 6))
     with pytest.raises(errors.MEIMotionMessageBAD_PATH_DATA):
         running.wait()
@@ -382,7 +399,9 @@ def test_a_goal_whose_status_ended_without_a_result_asks_for_it_again():
     server = SimpleNamespace(server_is_ready=lambda: True)
     goal = Goal(client, handle, Future(), threading.Event(), server)  # type: ignore[arg-type]
     result = goal.wait(10.0)
-    assert result.message == "MPIMessageOK" and goal.asked_again == 1 and len(asked) == 1
+    assert result.message == "MPIMessageOK"
+    assert goal.asked_again == 1
+    assert len(asked) == 1
 
 
 class _Dropping:
@@ -411,7 +430,9 @@ def _probe(actions: dict, seconds: float) -> tuple[bool, float]:
 def test_a_lost_readiness_answer_costs_a_resend_not_a_second():
     start, modify = _Dropping(lost=1), _Dropping(lost=0)
     answered, took = _probe({start: MotionStart, modify: MotionStart}, 10.0)
-    assert answered and len(start.requests) == 2 and len(modify.requests) == 1
+    assert answered
+    assert len(start.requests) == 2
+    assert len(modify.requests) == 1
     assert took < client_module._PROBE_ANSWER  # the second request went out after _PROBE_FIRST
 
 
@@ -419,10 +440,13 @@ def test_a_late_answer_to_an_earlier_readiness_request_counts():
     start = _Dropping(lost=100)
     threading.Timer(0.25, lambda: start.requests[0].set_result("late")).start()
     answered, _ = _probe({start: MotionStart}, 10.0)
-    assert answered and 2 <= len(start.requests) < 100
+    assert answered
+    assert 2 <= len(start.requests) < 100
 
 
 def test_readiness_without_any_answer_is_false_at_the_deadline():
     start = _Dropping(lost=100)
     answered, took = _probe({start: MotionStart}, 0.5)
-    assert not answered and took >= 0.5 and len(start.requests) >= 3  # 0, 0.1, 0.3 s
+    assert not answered
+    assert took >= 0.5
+    assert len(start.requests) >= 3

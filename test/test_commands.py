@@ -25,13 +25,15 @@ def ctl():
 
 def test_motion_start_runs_to_done_and_reports_the_move(ctl):
     reply = apply(ctl, Command("motion_start", 0, request=GOAL))
-    assert reply.accepted and reply.serial > 0 and reply.state is MPIState.MOVING
+    assert reply.accepted
+    assert reply.serial > 0
+    assert reply.state is MPIState.MOVING
     assert ctl.run_until(lambda c: c.supervisor(0).state is MPIState.IDLE, 10_000, chunk=100)
     assert ctl.axes[0].command_position == 100.0
 
 
 @pytest.mark.parametrize(
-    "command, message",
+    ("command", "message"),
     [
         (Command("motion_start", 0, request={**GOAL, "type": "NOPE"}), "MPIMotionMessageTYPE_INVALID"),
         (Command("motion_start", 0, request={**GOAL, "hold": [{"type": "NOPE"}]}), "MPIMessagePARAM_INVALID"),
@@ -57,7 +59,8 @@ def test_bad_requests_get_the_spec_message_and_change_nothing(ctl, command, mess
 def test_commands_round_trip_through_json():
     command = Command("motion_start", 0, -1, GOAL)
     again = Command.from_json(command.operation, command.supervisor, command.axis, command.to_json())
-    assert again == command and json.loads(command.to_json()) == GOAL
+    assert again == command
+    assert json.loads(command.to_json()) == GOAL
 
 
 def test_every_operation_applies(ctl):
@@ -80,7 +83,8 @@ def test_every_operation_applies(ctl):
     assert ctl.supervisor(0).config.decel_time.stop == 0.2
     assert ctl.supervisor(1).axis_list == [3]
     assert [a.command_position for a in ctl.axes[:2]] == [5.0, 6.0]
-    assert ctl.io.gates_closed[1] and ctl.axes[2].in_position.settling_time == 0.1
+    assert ctl.io.gates_closed[1]
+    assert ctl.axes[2].in_position.settling_time == 0.1
 
 
 # ------------------------------------------------------------------ values the controller cannot hold ----
@@ -101,7 +105,8 @@ def test_axis_settling_time_1e308_is_refused_and_the_clock_runs(ctl):
     # MPI 002 MPIAxisInPosition settlingTime: seconds, counted in samples.
     before = ctl.axes[0].in_position.copy()
     reply = apply(ctl, Command("axis_config_set", axis=0, request={"in_position": {"settling_time": 1e308}}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("settling_time:")
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert reply.detail.startswith("settling_time:")
     assert ctl.axes[0].in_position == before
     _goal_runs_to_idle(ctl)
 
@@ -110,7 +115,8 @@ def test_a_fine_tolerance_the_encoder_cannot_resolve_is_refused_with_why(ctl):
     # MPI 002 status tables, NOTE 3: |target - actual| < positionFine; the default encoder reads
     # whole counts, so a reading can be 0.5 count from any target and 0.5 could never be met
     reply = apply(ctl, Command("axis_config_set", axis=1, request={"in_position": {"position_fine": 0.5}}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("position_fine:")
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert reply.detail.startswith("position_fine:")
     assert ctl.axes[1].in_position.position_fine == 10.0
 
 
@@ -120,7 +126,8 @@ def test_normal_feedrate_out_of_range_is_refused_and_goals_end(ctl, feedrate):
     # 1e-300 made the execute callback raise. MPI 000 MPIMotionConfig normalFeedrate (1.0 = 100 %).
     config = {"decel_time_stop": 0.5, "decel_time_e_stop": 0.05, "normal_feedrate": feedrate}
     reply = apply(ctl, Command("config_set", 0, request={"config": config}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("normal_feedrate:")
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert reply.detail.startswith("normal_feedrate:")
     assert ctl.supervisor(0).config.normal_feedrate == 1.0
     _goal_runs_to_idle(ctl)
 
@@ -129,7 +136,8 @@ def test_position_set_of_an_actual_1e308_is_refused(ctl):
     # issue 9: accepted, then position_get read -inf while status showed 0. MPI 000
     # mpiMotionPositionSet / 002 mpiAxisActualPositionSet: positions a controller can hold.
     reply = apply(ctl, Command("position_set", 0, request={"actual": [1e308, 0.0], "command": [0.0, 0.0]}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("actual[0]:")
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert reply.detail.startswith("actual[0]:")
     ctl.step(10)
     assert ctl.supervisor(0).position_get() == (Message.MPIMessageOK, [0.0, 0.0], [0.0, 0.0])
 
@@ -138,7 +146,8 @@ def test_position_set_of_an_actual_1e308_is_refused(ctl):
 def test_axis_position_set_past_what_a_controller_holds_is_refused(ctl, which):
     # MPI 002 mpiAxisActualPositionSet, mpiAxisCommandPositionSet, mpiAxisOriginSet
     reply = apply(ctl, Command("axis_position_set", axis=0, request={"which": which, "value": 1e308}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("value:")
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert reply.detail.startswith("value:")
     assert (ctl.axes[0].cmd_p, ctl.axes[0].act_p, ctl.axes[0].origin) == (0.0, 0.0, 0.0)
 
 
@@ -147,7 +156,8 @@ def test_config_set_refuses_an_unknown_field(ctl):
     # whole MPIMotionConfig, MPI 000): the request cannot be read, PARAM_INVALID, nothing changes
     config = {"decel_time_stop": 0.2, "decel_time_e_stop": 0.02, "normal_feedrate": 1.0, "blend_limt": 0.5}
     reply = apply(ctl, Command("config_set", 0, request={"config": config}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and "blend_limt" in reply.detail
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert "blend_limt" in reply.detail
     assert ctl.supervisor(0).config.decel_time.stop == 0.5
 
 
@@ -155,10 +165,11 @@ def test_params_set_checks_every_value_it_stores(ctl):
     # MPI 000 mpiMotionParamsSet stores the parameters for a later start (params None): a value
     # no controller holds is refused now, not at that start
     reply = apply(ctl, Command("params_set", 0, request={"params": {**GOAL, "position": [1e300, 0.0]}}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and reply.detail.startswith("position[0]:")
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert reply.detail.startswith("position[0]:")
 
 
-@pytest.mark.parametrize("empty_count,message", [
+@pytest.mark.parametrize(("empty_count", "message"), [
     (-1, "MPIMessageOK"),  # MPI 000 MPIMotionPoint: "-1 => disable"
     (0, "MPIMessageOK"),  # MPI 001 EMPTY_COUNT: "To disable ..., set the value to zero"
     (2**40, "MPIMessagePARAM_INVALID"),  # MPI 000 MPIMotionPoint: long emptyCount
@@ -174,7 +185,8 @@ def test_config_set_with_no_axes_answers_axis_count(ctl):
     assert apply(ctl, Command("axis_list_set", 1, request={"axis_numbers": [], "map": False})).accepted
     config = {"decel_time_stop": 0.2, "decel_time_e_stop": 0.02, "normal_feedrate": 1.0}
     reply = apply(ctl, Command("config_set", 1, request={"config": config}))
-    assert reply.message is Message.MPIMotionMessageAXIS_COUNT and reply.detail
+    assert reply.message is Message.MPIMotionMessageAXIS_COUNT
+    assert reply.detail
     assert ctl.supervisor(1).config.decel_time.stop == 0.5
 
 
@@ -197,7 +209,7 @@ def _to_state(ctl, state: str) -> None:
     assert ctl.supervisor(0).state.name == state.split(" ")[0]
 
 
-@pytest.mark.parametrize("state,settable", [
+@pytest.mark.parametrize(("state", "settable"), [
     ("IDLE (new)", True),
     ("IDLE (move done)", True),  # 002: "set the command position when the motion is in an IDLE state"
     ("MOVING", False),  # 002 error check: "Axis is in a STOPPING, STOPPED, or MOVING state"
@@ -227,7 +239,8 @@ def test_the_axis_service_and_position_set_follow_one_rule(state, settable):
         ctl.step(200)
         if settable and state.startswith("IDLE"):
             # the command rests where it was set; a finished move does not pull it back
-            assert a0.command_position == target and abs(a0.actual_position - target) < 2.0
+            assert a0.command_position == target
+            assert abs(a0.actual_position - target) < 2.0
         elif not settable:
             assert a0.command_position != target or before == target
     assert answers == [expected, expected]
@@ -270,9 +283,9 @@ REQUESTS = [
 def _fields(request, path=()):
     """Every path into a request (its fields, nested ones and list elements)."""
     for key, value in (request.items() if isinstance(request, dict) else enumerate(request)):
-        yield path + (key,)
+        yield (*path, key)
         if isinstance(value, (dict, list)):
-            yield from _fields(value, path + (key,))
+            yield from _fields(value, (*path, key))
 
 
 def _with(request, path, value):
@@ -315,10 +328,14 @@ def test_a_bug_is_an_internal_error_logged_with_its_traceback(ctl, monkeypatch, 
         reply = apply(ctl, Command("motion_start", 0, request=GOAL))
     assert reply.message is INTERNAL_ERROR is Message.MPIMessageNO_MEMORY
     assert reply.message is not Message.MPIMessagePARAM_INVALID
-    assert "internal error" in reply.detail and type(exception).__name__ in reply.detail
-    assert reply.state is MPIState.IDLE and not reply.accepted
+    assert "internal error" in reply.detail
+    assert type(exception).__name__ in reply.detail
+    assert reply.state is MPIState.IDLE
+    assert not reply.accepted
     records = [r for r in caplog.records if r.name == "mpi_ros.commands"]
-    assert len(records) == 1 and records[0].exc_info and records[0].exc_info[1] is exception
+    assert len(records) == 1
+    assert records[0].exc_info
+    assert records[0].exc_info[1] is exception
     monkeypatch.undo()
     _goal_runs_to_idle(ctl)
 

@@ -17,16 +17,18 @@ def test_default_config_builds_the_documented_controller():
     assert cfg.axis_count == 4
     assert [(s.number, s.axes) for s in cfg.supervisors] == [(0, [0, 1]), (1, [2, 3])]
     ctl = cfg.build_controller()
-    assert ctl.rate == 2000.0 and ctl.config.frame_buffer_size == 128
+    assert ctl.rate == 2000.0
+    assert ctl.config.frame_buffer_size == 128
     assert [ms.mapped for ms in ctl.supervisors] == [[0, 1], [2, 3]]
     assert all(ms.state is MPIState.IDLE for ms in ctl.supervisors)
     ms0 = ctl.supervisor(0)
     assert (ms0.config.decel_time.stop, ms0.config.decel_time.e_stop) == (0.5, 0.05)
-    assert cfg.ros.status_rate == 100.0 and cfg.ros.namespace == "/mpi"
+    assert cfg.ros.status_rate == 100.0
+    assert cfg.ros.namespace == "/mpi"
 
 
 @pytest.mark.parametrize(
-    "data, where",
+    ("data", "where"),
     [
         ({"supervisors": [{"axes": [7]}]}, "supervisors[0].axes[0]"),
         ({"supervisors": [{"axes": []}]}, "supervisors[0].axes"),
@@ -69,7 +71,7 @@ def test_per_axis_overrides(tmp_path):
 
 # ------------------------------------------------------------------ ranges: one validator per struct ----
 @pytest.mark.parametrize(
-    "data, where",
+    ("data", "where"),
     [
         # issue 9: "blend_limit: 5.0 with decel_time_stop: 2.0 starts with the defaults"
         ({"supervisor_defaults": {"config": {"blend_limit": 5.0, "decel_time_stop": 2.0}}},
@@ -109,8 +111,8 @@ def test_per_axis_frame_buffer_sizes_reach_the_controller():
     ctl = cfg.build_controller()
     assert [ctl.config.frame_buffer_size_of(n) for n in range(4)] == [64, 64, 512, 512]
     assert [s.size for s in ctl.supervisor(1).frame_buffer_status()[1]] == [512, 512]
+    cfg.supervisors[0].axes = [1, 2]  # past the loader: the controller answers it
     with pytest.raises(config.ConfigError, match=r"supervisors\[0\]\.axes: .*AXIS_FRAME_COUNT"):
-        cfg.supervisors[0].axes = [1, 2]  # past the loader: the controller answers it
         cfg.build_controller()
 
 
@@ -125,7 +127,7 @@ def test_configured_values_reach_the_controller():
 
 
 @pytest.mark.parametrize(
-    "spoil, where",
+    ("spoil", "where"),
     [
         (lambda c: setattr(c.supervisors[1].config, "blend_limit", 5.0), "supervisors[1].config.blend_limit"),
         (lambda c: setattr(c.supervisors[0].config, "normal_feedrate", 1e308), "supervisors[0].config.normal_feedrate"),
@@ -147,7 +149,7 @@ def test_build_controller_never_drops_a_refused_value(spoil, where):
     assert str(error.value).startswith(where)
 
 
-@pytest.mark.parametrize("key, values", [
+@pytest.mark.parametrize(("key", "values"), [
     ("normal_feedrate", [1.0, 1e-3, 1e3, 9.9e-4, 1000.1, 0.0, 1e308]),
     ("blend_limit", [-1.0, 1.0, 1.0001, -2.0]),
     ("decel_time_stop", [1e-6, 21474.0, 0.0, 1e9]),
@@ -168,7 +170,7 @@ def test_yaml_service_and_controller_agree_on_motion_config(key, values):
         assert by_yaml is by_service, (key, value)
 
 
-@pytest.mark.parametrize("key, values", [
+@pytest.mark.parametrize(("key", "values"), [
     ("settling_time", [0.0, 21474.0, 1e308, -1.0]),
     ("position_fine", [0.51, 1e14, 0.5, 0.0]),
     ("velocity", [1e-3, 3e38, 0.0, 1e39]),

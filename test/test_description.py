@@ -39,12 +39,15 @@ def test_the_gantry_is_a_chain_of_its_joints_with_their_types_axes_and_limits():
     assert (joints["y"].limit.lower, joints["y"].limit.upper) == (0.0, 0.6)
     # Z counts downward (counts_per_unit -1e6, offset 0.3): the positive count limit (250,000)
     # is the lower limit in metres
-    assert joints["z"].limit.lower == pytest.approx(0.05) and joints["z"].limit.upper == 0.3
+    assert joints["z"].limit.lower == pytest.approx(0.05)
+    assert joints["z"].limit.upper == 0.3
     assert joints["z"].limit.velocity == 0.2
     assert joints["c"].limit.velocity == pytest.approx(2 * math.pi)
     # a continuous joint has no position limits (the parser reads absent ones as 0: look at the text)
     limit = ET.fromstring(description.generate(load(GANTRY))).find("joint[@name='c']/limit")
-    assert limit is not None and "lower" not in limit.attrib and "upper" not in limit.attrib
+    assert limit is not None
+    assert "lower" not in limit.attrib
+    assert "upper" not in limit.attrib
 
 
 def test_a_side_without_a_software_limit_is_the_32_bit_range_and_velocity_0_means_none_given():
@@ -81,14 +84,16 @@ def test_a_bad_joint_axis_is_refused_with_its_key():
 
 def test_a_namespace_prefixes_every_joint_and_link():
     robot = parsed(load(GANTRY, overrides={"ros": {"namespace": "/cell_a"}}))
-    assert robot.name == "cell_a" and robot.get_root() == "cell_a/base_link"
+    assert robot.name == "cell_a"
+    assert robot.get_root() == "cell_a/base_link"
     assert robot.get_chain("cell_a/base_link", "cell_a/c_link", links=False) == \
         ["cell_a/x", "cell_a/y", "cell_a/z", "cell_a/c"]
 
 
 def test_without_joints_the_description_is_the_base_link_alone():
     robot = parsed(load())
-    assert [link.name for link in robot.links] == ["base_link"] and robot.joints == []
+    assert [link.name for link in robot.links] == ["base_link"]
+    assert robot.joints == []
 
 
 # -- forward kinematics over the parsed chain ---------------------------------------------------
@@ -149,7 +154,8 @@ def test_forward_kinematics_at_the_twins_joint_states_puts_each_link_where_the_c
         assert poses["c_link"][:3, :3] == pytest.approx(np.array(
             [[math.cos(c), -math.sin(c), 0.0], [math.sin(c), math.cos(c), 0.0], [0.0, 0.0, 1.0]]), abs=1e-12)
         if samples == 500:
-            assert 0.0 < counts[0] < 250_000.0 and 0.0 < counts[3] < 2_500.0
+            assert 0.0 < counts[0] < 250_000.0
+            assert 0.0 < counts[3] < 2_500.0
     assert counts == pytest.approx([250_000.0, 100_000.0, 100_000.0, 2_500.0], abs=10.0)
 
 

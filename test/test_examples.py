@@ -11,7 +11,7 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
-@pytest.mark.parametrize("name, expect", [
+@pytest.mark.parametrize(("name", "expect"), [
     ("01_controller_move.py", "MOTION_DONE"),
     ("02_stop_resume_e_stop.py", "RESET: MPIMessageOK -> IDLE"),
     ("04_record_and_replay.py", "zero differences"),

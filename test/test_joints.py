@@ -21,7 +21,8 @@ def _with_joint(joint: dict, axis: int = 0):
 def test_axes_without_a_joint_keep_their_names_and_counts():
     joints = load().axis_joints()
     assert [j.name for j in joints] == ["axis0", "axis1", "axis2", "axis3"]
-    assert joints[1].position(1234.5) == 1234.5 and joints[1].rate(-7.0) == -7.0
+    assert joints[1].position(1234.5) == 1234.5
+    assert joints[1].rate(-7.0) == -7.0
 
 
 def test_the_gantry_names_its_joints_in_si_units():
@@ -82,7 +83,8 @@ def test_joint_states_convert_every_axis_as_its_joint_and_leave_the_others_bit_f
     out = states.convert(position, velocity, effort)
     for k in (0, 2, 3):  # counts as they were, the sign of a zero included
         for converted, given in zip(out, (position, velocity, effort), strict=True):
-            assert converted[k] == given[k] and math.copysign(1.0, converted[k]) == math.copysign(1.0, given[k])
+            assert converted[k] == given[k]
+            assert math.copysign(1.0, converted[k]) == math.copysign(1.0, given[k])
     joint = joints[1]
     assert (out[0][1], out[1][1], out[2][1]) == (joint.position(1000.0), joint.rate(-400.0), joint.rate(8000.0))
     assert (out[0][1], out[1][1], out[2][1]) == (0.0, 0.2, -4.0)

@@ -32,7 +32,7 @@ def _state(ctl) -> tuple:
             tuple((a.cmd_p, a.act_p, a.origin) for a in ctl.axes))
 
 
-@pytest.mark.parametrize("operation,request_", [
+@pytest.mark.parametrize(("operation", "request_"), [
     ("motion_start", {"type": "S_CURVE", "position": [1.0] * 1_000_000}),
     ("motion_start", {"type": "BOGUS", "position": [1.0] * (MAX_REQUEST_VALUES + 1)}),  # size first, then the type
     ("motion_modify", {"type": "PT", "position": [0.0] * 40_000, "time": [0.01] * 30_000}),  # the arrays together
@@ -100,7 +100,8 @@ def test_a_request_within_the_limit_is_recorded_whole():
 def test_a_marker_in_a_request_counts_as_what_it_stands_for(ctl):
     # a marker within the limits is no list: refused as unreadable, like any other mapping there
     reply = apply(ctl, Command("motion_start", 0, request={"type": "PT", "position": {"omitted_values": 4}}))
-    assert reply.message is PARAM and reply.detail.startswith("position: a list expected"), reply.detail
+    assert reply.message is PARAM, reply.detail
+    assert reply.detail.startswith("position: a list expected"), reply.detail
     assert not rq.request_size({"p": {"omitted_values": MAX_REQUEST_VALUES + 1}}).ok
     assert not rq.request_size({"p": {"omitted_characters": MAX_REQUEST_TEXT + 1}}).ok
     # not a marker: other keys, or a count that is not a count
@@ -113,19 +114,24 @@ def test_any_nesting_is_measured_without_recursion(ctl):
     for _ in range(10_000):
         deep = [deep]
     size = rq.request_size({"position": deep})
-    assert size.values == 10_000 and size.ok
+    assert size.values == 10_000
+    assert size.ok
     reply = apply(ctl, Command("motion_start", 0, request={"type": "S_CURVE", "position": deep}))
     assert reply.message is PARAM  # answered, not a RecursionError (an internal error)
 
 
 def test_refusals_quote_values_cut_short(ctl):
     reply = apply(ctl, Command("motion_start", 0, request={"type": "Q" * 10_000}))
-    assert reply.message is Message.MPIMotionMessageTYPE_INVALID and len(reply.detail) < 200, reply.detail
+    assert reply.message is Message.MPIMotionMessageTYPE_INVALID, reply.detail
+    assert len(reply.detail) < 200, reply.detail
     reply = apply(ctl, Command("config_set", 0, request={"config": {"user_label": "L" * 1000, "decel_time_stop": 0.5,
                                                                       "decel_time_e_stop": 0.05,
                                                                       "normal_feedrate": 1.0}}))
-    assert reply.message is PARAM and len(reply.detail) < 200, reply.detail
-    assert shown(10**5000) == "<int>" and shown(1e308) == "1e+308" and shown("abc") == "'abc'"
+    assert reply.message is PARAM, reply.detail
+    assert len(reply.detail) < 200, reply.detail
+    assert shown(10**5000) == "<int>"
+    assert shown(1e308) == "1e+308"
+    assert shown("abc") == "'abc'"
 
 
 def test_axis_list_set_and_map_is_all_or_nothing(ctl):

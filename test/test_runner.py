@@ -40,7 +40,8 @@ def test_a_command_takes_effect_at_the_next_sample_and_listeners_see_it():
     reply, sample = runner.submit(Command("motion_start", 0, request=GOAL))
     # docs/decisions.md, "Samples, commands and replay": a command is applied at the first sample after
     # the controller's current one
-    assert sample == 38 and log == [(38, "motion_start", "MPIMessageOK")]
+    assert sample == 38
+    assert log == [(38, "motion_start", "MPIMessageOK")]
     runner.step(2000)
     assert [end.message.name for end in runner.ctl.move_log.ends(reply.serial)] == ["MPIMessageOK"]
 
@@ -95,7 +96,8 @@ def test_after_the_change_hooks_the_ends_are_read_and_the_log_may_let_them_go(ca
     runner.step(2000)
     second, _ = runner.submit(Command("motion_start", 0, request=GOAL))
     runner.step(2000)
-    assert seen[1] == [first.serial] and seen[-1] == [second.serial]  # each end read by the hook
+    assert seen[1] == [first.serial]
+    assert seen[-1] == [second.serial]
     assert runner.ctl.move_log.ends(first.serial) == ()
 
     def failing(ctl):
@@ -106,7 +108,8 @@ def test_after_the_change_hooks_the_ends_are_read_and_the_log_may_let_them_go(ca
     runner.step(2000)
     fourth, _ = runner.submit(Command("motion_start", 0, request=GOAL))
     runner.step(2000)
-    assert runner.ctl.move_log.ends(third.serial) and runner.ctl.move_log.ends(fourth.serial)
+    assert runner.ctl.move_log.ends(third.serial)
+    assert runner.ctl.move_log.ends(fourth.serial)
     assert "a change hook failed" in caplog.text
 
 

@@ -63,7 +63,8 @@ def test_the_packaged_file_gives_the_schemas_defaults():
     schema's default, so the table's defaults are what the suite runs with."""
     data = yaml.safe_load((ROOT / "config" / "default.yaml").read_text(encoding="utf-8"))
     defaults = {s.name: s.default for s in settings.ROS}
-    assert data["ros"] and {key: defaults[key] for key in data["ros"]} == data["ros"]
+    assert data["ros"]
+    assert {key: defaults[key] for key in data["ros"]} == data["ros"]
     assert data["supervisor_defaults"]["lost_client_timeout"] == settings.LOST_CLIENT.default
     assert config.load().ros == settings.RosSettings()
     assert config.SupervisorSpec.__dataclass_fields__["lost_client_timeout"].default == settings.LOST_CLIENT.default
@@ -71,7 +72,7 @@ def test_the_packaged_file_gives_the_schemas_defaults():
 
 # -- the file's validation -----------------------------------------------------------------------
 
-@pytest.mark.parametrize("key, value, text", [
+@pytest.mark.parametrize(("key", "value", "text"), [
     ("status_rate", 5000.0, "ros.status_rate: must be a finite number > 0 and <= 1000, got 5000.0"),
     ("status_rate", 0.0, "ros.status_rate: must be a finite number > 0 and <= 1000, got 0.0"),
     ("feedback_rate", -1.0, "ros.feedback_rate: must be a finite number > 0, got -1.0"),
@@ -162,7 +163,7 @@ def _request_refusal(read, value) -> str:
     return error.value.detail
 
 
-@pytest.mark.parametrize("kind, value", [
+@pytest.mark.parametrize(("kind", "value"), [
     (int, 3.0), (int, True), (int, "3"), (int, None),
     (bool, 1), (bool, 0), (bool, "true"), (bool, 1.0),
     (float, True), (float, "fast"), (float, [1.0]), (float, 10**400),
@@ -177,14 +178,15 @@ def test_the_file_and_the_requests_refuse_the_same_values(kind, value):
     assert _request_refusal(requests._READ.of(kind), value).startswith("field: ")
 
 
-@pytest.mark.parametrize("kind, value, read", [
+@pytest.mark.parametrize(("kind", "value", "read"), [
     (int, 3, 3), (int, np.int64(-2), -2), (bool, True, True), (bool, False, False),
     (float, 7, 7.0), (float, "1e9", 1e9), (float, np.float32(0.5), 0.5), (str, "S_CURVE", "S_CURVE"),
 ])
 def test_the_file_and_the_requests_read_the_same_values_alike(kind, value, read):
     from_file = config.read_value(value, kind(), "key")
     from_request = requests._READ.of(kind)(value, "field")
-    assert from_file == from_request == read and type(from_file) is type(from_request) is kind
+    assert from_file == from_request == read
+    assert type(from_file) is type(from_request) is kind
 
 
 def test_the_rule_holds_where_requests_and_files_are_read():

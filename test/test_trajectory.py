@@ -48,7 +48,8 @@ def read(joints, names, points):
 # -- reading: names and shapes ---------------------------------------------------------
 def test_names_in_any_order_map_to_the_supervisor_axes(joints):
     t = read(ms0(joints), ["y", "x"], [([0.2, 0.1], [], 1.0)])
-    assert t.positions.tolist() == [[0.1, 0.2]] and t.velocities is None
+    assert t.positions.tolist() == [[0.1, 0.2]]
+    assert t.velocities is None
 
 
 @pytest.mark.parametrize(("names", "words"), [
@@ -111,7 +112,9 @@ def test_points_become_counts_and_time_from_start_becomes_intervals(joints):
     # z: counts_per_unit -1e6, offset 0.3 m (count 0 is z = 0.3 m); c: 10,000 counts a turn
     t = read(ms1(joints), ["c", "z"], [([math.pi, 0.25], [0.0, -0.05], 0.5), ([0.0, 0.2], [0.0, 0.0], 1.25)])
     request = t.chunks()[0].motion_request()
-    assert request["type"] == "PVT" and request["final"] is True and request["attributes"] == []
+    assert request["type"] == "PVT"
+    assert request["final"] is True
+    assert request["attributes"] == []
     assert request["position"] == pytest.approx([50_000.0, 5_000.0, 100_000.0, 0.0])
     assert request["point_velocity"] == pytest.approx([50_000.0, 0.0, 0.0, 0.0])
     assert request["time"] == pytest.approx([0.5, 0.75])
@@ -221,7 +224,8 @@ def test_a_chunk_for_other_axes_is_refused(gantry, joints):
     ctl = gantry.build_controller()
     chunk = read(ms1(joints), ["z", "c"], [([0.2, 1.0], [], 1.0)]).chunks()[0]
     reply = apply(ctl, command(chunk, supervisor=0))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and "not supervisor 0's axes" in reply.detail
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert "not supervisor 0's axes" in reply.detail
 
 
 # -- the runner's scheduled commands and the feed ----------------------------------------
@@ -258,8 +262,11 @@ def test_a_10000_point_trajectory_is_streamed_through_the_frame_buffer(gantry, j
     while runner.ctl.sample < 41_000:
         runner.step(500)
         frames.append(runner.ctl.axis_snapshot(0).frame_count)
-    assert warnings == [] and trajectories.snapshot().accepted == 1
-    assert "FRAMES_EMPTY" not in events and "FRAMES_LOW" not in events and "E_STOP" not in events
+    assert warnings == []
+    assert trajectories.snapshot().accepted == 1
+    assert "FRAMES_EMPTY" not in events
+    assert "FRAMES_LOW" not in events
+    assert "E_STOP" not in events
     assert 0 < max(frames) <= 128
     assert runner.ctl.supervisor(0).state is MPIState.IDLE
     assert si_positions(runner.ctl, joints, (0, 1)) == pytest.approx([x[-1], 0.0], abs=1e-12)
@@ -271,6 +278,9 @@ def test_the_feed_refuses_and_counts(gantry):
     assert trajectories.receive(["x", "y"], [([0.9, 0.0], [], 1.0)], 0) is None  # 0.9 m/s from x = 0: at apply
     runner.step(10)
     counts = trajectories.snapshot()
-    assert counts.refused == {"MPIMessagePARAM_INVALID": 2} and counts.accepted == 0
-    assert "unknown joint 'q'" in warnings[0] and "over its max_velocity" in warnings[1]
-    assert runner.ctl.supervisor(0).state is MPIState.IDLE and runner.scheduled() == 0
+    assert counts.refused == {"MPIMessagePARAM_INVALID": 2}
+    assert counts.accepted == 0
+    assert "unknown joint 'q'" in warnings[0]
+    assert "over its max_velocity" in warnings[1]
+    assert runner.ctl.supervisor(0).state is MPIState.IDLE
+    assert runner.scheduled() == 0

@@ -79,7 +79,7 @@ class AxisTwin:
         self.rate = rate
         t = recording.time - recording.time[0]
         self._t = t
-        n = int(math.floor(t[-1] * rate + _ON_GRID)) + 1
+        n = math.floor(t[-1] * rate + _ON_GRID) + 1
         if (n - 1) / rate < t[-1]:
             n += 1  # a last grid point past the end (the spline extrapolates one piece)
         self.grid = np.arange(n) / rate

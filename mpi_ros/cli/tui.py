@@ -25,7 +25,7 @@ import io
 import shlex
 import threading
 import time
-from typing import Any
+from typing import Any, ClassVar
 
 from .console import OK, UsageError, add_target_options, fail
 
@@ -108,7 +108,7 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
         #command { dock: bottom; display: none; }
         #command.open { display: block; }
         """
-        BINDINGS = [
+        BINDINGS: ClassVar[list[Binding | tuple[str, str] | tuple[str, str, str]]] = [
             Binding("space", "act('STOP')", "STOP"),
             Binding("e", "act('E_STOP')", "E_STOP"),
             Binding("ctrl+e", "act('E_STOP')", "E_STOP (anywhere)", priority=True, show=False),

@@ -141,7 +141,7 @@ class Mapping:
         """The same problem with max_jerk = inf (for a bound: looser, still a lower bound)."""
         assert self.limits is not None  # a problem ruckig was given
         limits = RuckigLimits(**{**_asdict(self.limits), "max_jerk": INF})
-        return Mapping(limits, self.exact, self.reasons, self.notes + (note,), False)
+        return Mapping(limits, self.exact, self.reasons, (*self.notes, note), False)
 
 
 def _asdict(limits: RuckigLimits) -> dict:

@@ -63,4 +63,4 @@ def format_table(entries: Sequence[tuple[ProfileRequest | None, CrossCheck | str
     counts = {v: sum(1 for _, r in entries if not isinstance(r, str) and r.verdict is v) for v in Verdict}
     refused = sum(1 for _, r in entries if isinstance(r, str))
     summary = ", ".join(f"{n} {v.name}" for v, n in counts.items()) + (f", {refused} REFUSED" if refused else "")
-    return "\n".join(lines + ([""] + footnotes if footnotes else []) + ["", f"{len(entries)} request(s): {summary}"])
+    return "\n".join(lines + (["", *footnotes] if footnotes else []) + ["", f"{len(entries)} request(s): {summary}"])

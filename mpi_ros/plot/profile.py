@@ -51,7 +51,7 @@ def _curves(segments: Sequence[Segment], start: tuple[float, float, float], hori
         accs.append(np.zeros_like(local))
         js.append(np.zeros_like(local))
     if not ts:
-        return (np.zeros(1),) + tuple(np.array([x]) for x in (start[0], start[1], 0.0, 0.0))
+        return (np.zeros(1), *tuple(np.array([x]) for x in (start[0], start[1], 0.0, 0.0)))
     return tuple(np.concatenate(x) for x in (ts, ps, vs, accs, js))
 
 

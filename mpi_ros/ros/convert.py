@@ -201,7 +201,7 @@ def default_epoch() -> int:
 
 def sample_ns(sample: int, rate: float) -> int:
     """Controller time of a sample since sample 0, in ns."""
-    return int(round(sample * 1e9 / rate))
+    return round(sample * 1e9 / rate)
 
 
 def stamp_ns(sample: int, rate: float, epoch_ns: int | None = None) -> int:

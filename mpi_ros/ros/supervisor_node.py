@@ -411,7 +411,7 @@ class SupervisorNode(Node):
         return response
 
     def _on_trigger(self, action: str, response):
-        reply, sample = self.runner.submit(Command(Operation.ACTION, self.number, request={"action": action}))
+        reply, _sample = self.runner.submit(Command(Operation.ACTION, self.number, request={"action": action}))
         response.success = reply.message is Message.MPIMessageOK
         response.message = reply.message.name + (f": {reply.detail}" if reply.detail else "")
         return response

@@ -35,7 +35,8 @@ def test_a_bag_recorded_before_a_type_changed_replays_by_its_own_definitions():
     assert "feedforward" not in status.schema_text
     report = replay(bag)
     assert report.identical, report.summary()
-    assert report.commands == 2 and report.statuses > 100
+    assert report.commands == 2
+    assert report.statuses > 100
 
 
 def test_a_bag_recorded_before_the_headers_replays_with_its_stamps_compared():
@@ -45,12 +46,16 @@ def test_a_bag_recorded_before_the_headers_replays_with_its_stamps_compared():
     bag = FIXTURES / "older" / "p2p_modify_before_headers"
     reader = BagReader(bag)
     status = next(msg for item, msg in reader.decoded() if item.type == "mpi_ros/msg/AxisStatus")
-    assert hasattr(status, "stamp") and not hasattr(status, "header")
+    assert hasattr(status, "stamp")
+    assert not hasattr(status, "header")
     report = replay(bag)
     assert report.identical, report.summary()
-    assert report.commands == 2 and report.statuses > 100 and report.events > 0
+    assert report.commands == 2
+    assert report.statuses > 100
+    assert report.events > 0
     moved = replay(bag, overrides={"controller": {"sample_rate": 1000.0}})  # other stamps at the same samples
-    assert not moved.identical and "stamp" in moved.first.field
+    assert not moved.identical
+    assert "stamp" in moved.first.field
 
 
 def test_schemas_are_written_as_rosbag2_writes_them():
@@ -107,7 +112,9 @@ def test_a_recording_names_each_source_in_its_headers(tmp_path):
 def test_fixture_replays_with_zero_differences(bag):
     report = replay(bag)
     assert report.identical, report.summary()
-    assert report.commands > 0 and report.statuses > 100 and report.events > 0
+    assert report.commands > 0
+    assert report.statuses > 100
+    assert report.events > 0
 
 
 def rosbags_reads_every_message(bag: Path) -> dict[str, int]:
@@ -152,7 +159,9 @@ def test_rosbags_reads_every_message(bag):
     # count what was read, not what the metadata claims (docs/recording.md, "Reading: count what was read")
     assert counted == claimed == BagReader(bag).counts()
     assert sum(counted.values()) == info["message_count"]
-    assert counted["/mpi/commands"] > 0 and counted["/joint_states"] > 0 and counted["/mpi/configuration"] == 1
+    assert counted["/mpi/commands"] > 0
+    assert counted["/joint_states"] > 0
+    assert counted["/mpi/configuration"] == 1
 
 
 @pytest.mark.parametrize("bag", BAGS, ids=[b.name for b in BAGS])
@@ -192,7 +201,8 @@ def test_the_writer_stores_canonical_cdr_where_rclpy_pads():
     data = cdr.serialize(msg)
     assert len(padded) - len(data) == 4  # one empty float64[]: 4 bytes counted, none written
     read = store.deserialize_cdr(data, "sensor_msgs/msg/JointState")
-    assert list(read.position) == [1.0] and list(read.effort) == []
+    assert list(read.position) == [1.0]
+    assert list(read.effort) == []
     assert bytes(store.serialize_cdr(read, "sensor_msgs/msg/JointState")) == data
     assert deserialize_message(data, JointState) == msg
 
@@ -233,7 +243,8 @@ def test_replay_names_what_a_bag_lacks(tmp_path):
             assert "configuration" not in str(caught.value)
         result = subprocess.run([str(exe), "replay", str(bag)], capture_output=True, text=True, timeout=60)
         assert result.returncode == 2, result.stderr
-        assert "Traceback" not in result.stderr and str(caught.value) in result.stderr
+        assert "Traceback" not in result.stderr
+        assert str(caught.value) in result.stderr
         assert result.stderr.startswith("mpi-ros replay: ")
 
 
@@ -258,10 +269,13 @@ def test_a_bag_with_the_configuration_topic_but_no_metadata_replays(tmp_path):
 def test_a_changed_controller_parameter_is_reported_as_a_divergence():
     report = replay(FIXTURES / "bags" / "p2p_modify",
                     overrides={"axes": {"defaults": {"plant": {"bandwidth_hz": 25.0}}}})
-    assert not report.identical and report.first is not None
+    assert not report.identical
+    assert report.first is not None
     # the servo model changed, so the actual position/velocity are where it shows first
-    assert "actual" in report.first.field and report.first.difference > 0.0
-    assert report.first.sample < 100 and report.largest
+    assert "actual" in report.first.field
+    assert report.first.difference > 0.0
+    assert report.first.sample < 100
+    assert report.largest
     command_fields = [f for f in report.largest if f.endswith("command_position")]
     assert not command_fields  # the commanded profile itself is unchanged
 
@@ -269,7 +283,8 @@ def test_a_changed_controller_parameter_is_reported_as_a_divergence():
 def test_a_changed_stop_time_diverges_at_the_stop():
     report = replay(FIXTURES / "bags" / "stop_resume",
                     overrides={"supervisor_defaults": {"config": {"decel_time_stop": 0.4}}})
-    assert report.first.sample > 900 and "command" in report.first.field
+    assert report.first.sample > 900
+    assert "command" in report.first.field
 
 
 def test_live_run_recorded_with_mpi_ros_run_replays_exactly(tmp_path, ros_context):
@@ -303,7 +318,8 @@ def test_live_run_recorded_with_mpi_ros_run_replays_exactly(tmp_path, ros_contex
     assert process.returncode == 0, err
     report = replay(bag)
     assert report.identical, report.summary()
-    assert report.commands == 6 and report.statuses > 50
+    assert report.commands == 6
+    assert report.statuses > 50
     # independent readers read all of it
     assert rosbags_reads_every_message(bag) == BagReader(bag).counts() == mcap_ros2_reads_every_message(bag)
 
@@ -363,7 +379,9 @@ def test_playback_of_a_bag_from_before_the_headers_sends_the_installed_types(ros
     assert done.wait(10.0), f"received {len(received)} of {len(recorded)}"
     for old, new in zip(recorded, received, strict=True):
         assert (new.header.stamp.sec, new.header.stamp.nanosec) == (old.stamp.sec, old.stamp.nanosec)
-        assert new.header.frame_id == "" and new.sample == old.sample and new.state_name == old.state_name
+        assert new.header.frame_id == ""
+        assert new.sample == old.sample
+        assert new.state_name == old.state_name
         assert [a.command_position for a in new.axes] == [a.command_position for a in old.axes]
         assert [convert_ns(a.header.stamp) for a in new.axes] == [convert_ns(a.stamp) for a in old.axes]
 
@@ -391,13 +409,18 @@ def test_plot_of_a_bag_writes_a_png(tmp_path):
     from mpi_ros.plot.bag import plot_bag
 
     out = plot_bag(FIXTURES / "bags" / "two_supervisors", tmp_path / "two.png")
-    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 20_000
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert out.stat().st_size > 20_000
 
 
 def test_plot_reads_the_stamps_of_a_bag_from_before_the_headers():
     from mpi_ros.plot.bag import _series
 
     axes, states, events = _series(BagReader(FIXTURES / "older" / "p2p_modify_before_headers"))
-    assert sorted(axes) == [0, 1, 2, 3] and states and events
+    assert sorted(axes) == [0, 1, 2, 3]
+    assert states
+    assert events
     times = axes[0]["t"]
-    assert 0.0 <= times[0] < 0.1 and times == sorted(times) and times[-1] > 1.0  # s since the first stamp
+    assert 0.0 <= times[0] < 0.1
+    assert times == sorted(times)
+    assert times[-1] > 1.0

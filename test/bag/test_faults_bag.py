@@ -37,10 +37,13 @@ def test_the_fixture_holds_every_fault_its_injections_and_the_refused_resets():
 def test_the_fixture_replays_every_fault_with_zero_differences():
     report = replay(BAG)
     assert report.identical, report.summary()
-    assert report.commands == 16 and report.events > 50
+    assert report.commands == 16
+    assert report.events > 50
 
 
 def test_a_changed_fault_limit_is_caught_as_a_divergence():
     # a looser following-error limit: the aggressive move no longer trips it
     report = replay(BAG, overrides={"axes": {"overrides": {0: {"faults": {"following_error_limit": 1000.0}}}}})
-    assert not report.identical and report.first is not None and report.first.sample < 100
+    assert not report.identical
+    assert report.first is not None
+    assert report.first.sample < 100

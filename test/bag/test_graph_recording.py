@@ -138,19 +138,23 @@ def test_a_bag_recorded_by_a_separate_generic_recorder_replays_exactly(tmp_path,
         if late is not None:
             late.kill()
         suite.shutdown()
-    assert "recorded" in early_out and "recorded" in late_out
+    assert "recorded" in early_out
+    assert "recorded" in late_out
 
     bag = BagReader(tmp_path / "early.mcap")
     assert bag.metadata("mpi_ros") is None  # no help from mpi-ros record: the graph only
     assert set(bag.topics()) >= SUITE_TOPICS
     report = replay(tmp_path / "early.mcap")
     assert report.identical, report.summary()
-    assert report.commands == 7 and report.statuses > 1000 and report.events == events > 10
+    assert report.commands == 7
+    assert report.statuses > 1000
+    assert report.events == events > 10
 
     # the late recorder missed the first moves' statuses and events, not their commands
     late_bag = BagReader(tmp_path / "late.mcap")
     late_report = replay(tmp_path / "late.mcap")
     assert late_report.identical, late_report.summary()
-    assert late_report.commands == 7 and 0 < late_report.events < report.events
+    assert late_report.commands == 7
+    assert 0 < late_report.events < report.events
     first_status = min(msg.sample for _, msg in late_bag.decoded(["/mpi/ms0/status"]))
     assert first_status > 3000

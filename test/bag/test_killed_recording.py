@@ -71,8 +71,10 @@ def test_a_killed_recording_replays_as_truncated_and_the_suite_restarts(tmp_path
     assert commands == ["motion_start"]  # everything up to the last complete record is there
     replayed = subprocess.run(mpi_ros("replay", str(bag)), capture_output=True, text=True, timeout=120)
     assert "Traceback" not in replayed.stderr
-    assert "truncated bag" in replayed.stderr and "read up to its last complete record" in replayed.stderr
-    assert replayed.returncode == 0 and "zero differences" in replayed.stdout, replayed.stdout + replayed.stderr
+    assert "truncated bag" in replayed.stderr
+    assert "read up to its last complete record" in replayed.stderr
+    assert replayed.returncode == 0, replayed.stdout + replayed.stderr
+    assert "zero differences" in replayed.stdout, replayed.stdout + replayed.stderr
 
     restarted = subprocess.Popen(mpi_ros("run", "--config", str(config), "--time-scale", "2"), cwd=tmp_path,
                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
@@ -87,10 +89,12 @@ def test_a_killed_recording_replays_as_truncated_and_the_suite_restarts(tmp_path
                                          lambda msg: (got.append(msg), arrived.set()), latched)
             assert arrived.wait(WAIT), "no configuration from the restarted suite"
             running = yaml.safe_load(got[0].config)
-            assert running["ros"]["feedback_rate"] == 25.0 and got[0].ros_namespace == "/killed"
+            assert running["ros"]["feedback_rate"] == 25.0
+            assert got[0].ros_namespace == "/killed"
             assert ms0.move([0.0, 0.0], velocity=50000.0, acceleration=500000.0,
                             deceleration=500000.0).message == "MPIMessageOK"
     finally:
         restarted.send_signal(signal.SIGINT)
         _, err = restarted.communicate(timeout=WAIT)
-    assert restarted.returncode == 0 and "Traceback" not in err
+    assert restarted.returncode == 0
+    assert "Traceback" not in err

@@ -106,7 +106,8 @@ def test_a_state_shorter_than_the_least_band_is_drawn_that_wide_over_its_neighbo
     assert [state for _, _, state in drawn] == ["MOVING", "IDLE", "STOPPING_ERROR", "ERROR"]  # narrow ones last
     widths = {state: width for _, width, state in drawn}
     assert widths["STOPPING_ERROR"] == widths["ERROR"] == pytest.approx(least)
-    assert widths["MOVING"] == pytest.approx(4.0) and widths["IDLE"] == pytest.approx(10.0 - 4.003)
+    assert widths["MOVING"] == pytest.approx(4.0)
+    assert widths["IDLE"] == pytest.approx(10.0 - 4.003)
     # in a window of 0.2 s, 2 ms is wide enough on its own
     assert dict((s, w) for _, w, s in plot.bands(transitions, (3.9, 4.1)))["STOPPING_ERROR"] == pytest.approx(0.002)
 
@@ -115,11 +116,12 @@ def test_a_window_plots_that_part_and_the_title_says_which(figures):
     fig = figures("two_supervisors", start=0.5, end=1.25)
     assert fig.axes[0].get_xlim() == (0.5, 1.25)
     for line in fig.axes[0].lines:
-        assert min(line.get_xdata()) >= 0.5 and max(line.get_xdata()) <= 1.25
+        assert min(line.get_xdata()) >= 0.5
+        assert max(line.get_xdata()) <= 1.25
     assert "; plotted 0.5 to 1.25 s\n" in fig.get_suptitle()
 
 
-@pytest.mark.parametrize("start, end, message", [
+@pytest.mark.parametrize(("start", "end", "message"), [
     (2.0, 1.0, "--from 2 s is not before --to 1 s"),
     (5.0, None, "--from 5 s is past the end of the recording, which is 2.998 s long"),
     (-2.0, -1.0, "--to -1 s is before the recording's first message"),
@@ -163,4 +165,5 @@ def test_reading_in_stored_order_gives_what_mcap_gives(name):
     reader = BagReader(BAGS / name)
     topics = [topic for topic in reader.topics() if topic != "/mpi/configuration"]
     fast = list(reader.stored(topics))
-    assert fast == list(reader.messages(topics, in_order=False)) and len(fast) > 100
+    assert fast == list(reader.messages(topics, in_order=False))
+    assert len(fast) > 100

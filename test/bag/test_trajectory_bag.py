@@ -41,7 +41,9 @@ def test_a_streamed_and_replaced_trajectory_run_replays_with_zero_differences(tm
         runner.step(100)
     finally:
         recorder.close()
-    assert warnings and "over its max_velocity" in warnings[0] and len(warnings) == 1
+    assert warnings
+    assert "over its max_velocity" in warnings[0]
+    assert len(warnings) == 1
     # The first trajectory's chunks at the start (sample 10: chunks 0 and 1), then each as the
     # one before it begins (its predecessor's predecessor done: 10 + 0.32 s, 10 + 0.64 s); the
     # fifth (due at 10 + 0.96 s) was dropped by the replacement, which took effect at 1510.
@@ -49,4 +51,5 @@ def test_a_streamed_and_replaced_trajectory_run_replays_with_zero_differences(tm
     assert applied == [(s, Operation.JOINT_TRAJECTORY, "MPIMessageOK") for s in (11, 11, 651, 1291, 1511)]
     report = replay(tmp_path / "run")
     assert report.identical, report.summary()
-    assert report.commands == len(applied) and report.statuses > 100
+    assert report.commands == len(applied)
+    assert report.statuses > 100

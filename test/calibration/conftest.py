@@ -94,7 +94,7 @@ def third_order(made: Made, axis: int, extra_pole_hz: float, sigma: float, step:
     num = np.polymul([p["acceleration_feedforward"], 2.0 * z * w * p["velocity_feedforward"], w * w], [pole])
     den = np.polymul([1.0, 2.0 * z * w, w * w], [1.0, pole])
     t = made.time - made.time[0]
-    fine = np.arange(int(round(t[-1] * RATE)) + 1) / RATE
+    fine = np.arange(round(t[-1] * RATE) + 1) / RATE
     command = np.interp(fine, t, made.command[axis])
     # Settled on the first command (at rest): the states of a plant at rest are its position only.
     _, out, _ = lsim((num, den), command - command[0], fine)

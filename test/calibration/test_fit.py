@@ -52,9 +52,11 @@ def test_fit_finds_the_plant_that_made_the_recording(made, make_noisy, true_plan
     for key in ("bandwidth_hz", "velocity_feedforward", "acceleration_feedforward"):
         assert getattr(fit.fitted, key) == pytest.approx(true[key], rel=0.05), key
     assert fit.fitted.damping == pytest.approx(true["damping"], abs=0.05)
-    assert fit.resolution == 0.5 and fit.fitted.encoder_resolution == 0.5
+    assert fit.resolution == 0.5
+    assert fit.fitted.encoder_resolution == 0.5
     assert fit.matched
-    assert fit.before.max > 5.0 and fit.after.max <= 1.5  # 3 encoder steps: noise and rounding
+    assert fit.before.max > 5.0
+    assert fit.after.max <= 1.5
     assert fit.starts >= 3
 
 
@@ -82,6 +84,8 @@ def test_white_noise_is_told_from_a_smooth_error():
     noise = rng.normal(0.0, 0.3, 20_000)
     smooth = 0.5 * np.sin(np.linspace(0.0, 20.0, 20_000))
     white, structured = split_noise(noise)
-    assert white == pytest.approx(0.3, rel=0.05) and structured < 0.05
+    assert white == pytest.approx(0.3, rel=0.05)
+    assert structured < 0.05
     white, structured = split_noise(noise + smooth)
-    assert white == pytest.approx(0.3, rel=0.05) and structured == pytest.approx(0.5 / np.sqrt(2.0), rel=0.1)
+    assert white == pytest.approx(0.3, rel=0.05)
+    assert structured == pytest.approx(0.5 / np.sqrt(2.0), rel=0.1)

@@ -27,7 +27,9 @@ def test_fit_prints_the_residuals_and_a_block_that_configures_the_twin(tmp_path,
     block, png = tmp_path / "fitted.yaml", tmp_path / "fit.png"
     assert main(["fit", str(csv_recording), "--output", str(block), "--plot", str(png)]) == 0
     out = capsys.readouterr().out
-    assert "residual, configured" in out and "residual, fitted" in out and out.count("MATCH:") == 2
+    assert "residual, configured" in out
+    assert "residual, fitted" in out
+    assert out.count("MATCH:") == 2
     assert png.stat().st_size > 10_000
     fitted = yaml.safe_load(block.read_text())
     config = suite_config.load(overrides=fitted)  # pasted into the default configuration: valid
@@ -43,7 +45,8 @@ def test_fit_prints_the_residuals_and_a_block_that_configures_the_twin(tmp_path,
     out = capsys.readouterr().out
     difference = next(line for line in out.splitlines() if "twin - recorded" in line)
     rms, largest, _ = (float(x) for x in difference.split()[-3:])
-    assert rms < 0.4 and largest <= 1.5
+    assert rms < 0.4
+    assert largest <= 1.5
     assert "axis 0" not in out
 
 
@@ -61,7 +64,8 @@ def test_fit_of_a_bag_the_suite_recorded(tmp_path, true_plants, capsys):
     bag = record(scenario, tmp_path / "bag")
     assert main(["fit", str(bag), "--axis", "0", "--axis", "1"]) == 0
     out = capsys.readouterr().out
-    assert "the configuration recorded in" in out and "at 2000 Hz" in out
+    assert "the configuration recorded in" in out
+    assert "at 2000 Hz" in out
     fitted = yaml.safe_load(out[out.index("# mpi-ros fit"):])["axes"]["overrides"]
     for axis, true in true_plants.items():
         plant = fitted[axis]["plant"]
@@ -86,14 +90,14 @@ def _moving(n: int) -> list[str]:
     return [f"{i / 1000.0},{10.0 * i},{10.0 * i - 1.0}" for i in range(n)]
 
 
-@pytest.mark.parametrize("rows,args,message", [
+@pytest.mark.parametrize(("rows", "args", "message"), [
     ([f"{i / 1000.0},5.0,5.0" for i in range(200)], [], "the command never moves"),
     (_moving(20), [], "only 20 samples"),
-    (_moving(100)[:50] + ["0.05,nan,499.0"] + _moving(100)[51:], [], "command_position is not a finite number"),
-    (_moving(100) + ["0.1,1000.0,"], [], "101 command positions but 100 actual positions"),
+    ([*_moving(100)[:50], "0.05,nan,499.0", *_moving(100)[51:]], [], "command_position is not a finite number"),
+    ([*_moving(100), "0.1,1000.0,"], [], "101 command positions but 100 actual positions"),
     (_moving(100), ["--axis", "3"], "axis 3 is not in the recording (it has axes 0)"),
-    (_moving(100)[:10] + ["0.005,100.0,99.0"] + _moving(100)[11:], [], "time does not increase at sample 10"),
-    (_moving(100)[:10] + ["0.01,x,99.0"] + _moving(100)[11:], [], "row 12, column command_position"),
+    ([*_moving(100)[:10], "0.005,100.0,99.0", *_moving(100)[11:]], [], "time does not increase at sample 10"),
+    ([*_moving(100)[:10], "0.01,x,99.0", *_moving(100)[11:]], [], "row 12, column command_position"),
 ])
 def test_bad_recordings_are_refused_with_exit_2(tmp_path, capsys, rows, args, message):
     path = _csv(tmp_path / "bad.csv", "time,command_position,actual_position", rows)
@@ -131,7 +135,8 @@ def test_columns_of_several_axes_may_end_early(tmp_path):
                 "axis2_command_position,axis2_actual_position", rows)
     recording = read(path)
     assert sorted(recording.axes) == [0, 2]
-    assert len(recording.axes[0].time) == 100 and len(recording.axes[2].time) == 60
+    assert len(recording.axes[0].time) == 100
+    assert len(recording.axes[2].time) == 60
     assert np.array_equal(recording.axes[2].command, 2.0 * np.arange(60))
 
 

@@ -38,7 +38,8 @@ def test_version_matches_package_xml():
 def test_registered_subcommands_follow_the_contract(name):
     module = importlib.import_module(COMMANDS[name])
     assert (module.__doc__ or "").strip(), f"{COMMANDS[name]} needs a docstring (its help)"
-    assert callable(module.add_arguments) and callable(module.run)
+    assert callable(module.add_arguments)
+    assert callable(module.run)
 
 
 def test_parser_lists_every_subcommand():
@@ -53,7 +54,7 @@ def test_no_subcommand_is_an_error(capsys):
     assert exc.value.code == 2
 
 
-@pytest.mark.parametrize("argv,own,ros", [
+@pytest.mark.parametrize(("argv", "own", "ros"), [
     (["run", "--config", "a.yaml"], ["run", "--config", "a.yaml"], []),
     (["--config", "a.yaml", "--ros-args", "-r", "__ns:=/x"],
      ["--config", "a.yaml"], ["--ros-args", "-r", "__ns:=/x"]),
@@ -107,5 +108,7 @@ def test_started_as_the_suite_executable_messages_name_it(monkeypatch, capsys):
 
 def test_help_says_where_to_start_and_what_exit_statuses_mean():
     text = build_parser().format_help()
-    assert "mpi-ros run " in text and "mpi-ros status" in text and "mpi-ros demo" in text
+    assert "mpi-ros run " in text
+    assert "mpi-ros status" in text
+    assert "mpi-ros demo" in text
     assert "Exit status: 0 OK; 1 refused by the controller" in text

@@ -46,7 +46,8 @@ def test_move_from_goal_yaml_with_a_flag_overriding_it_on_ms1(ms1, capsys):
     assert console("move", "--goal", goal, "--velocity", "5000", "--supervisor", "1") == 0
     out = capsys.readouterr().out
     expected = f"command position [{start[0] - 200.0:.1f}, {start[1] + 300.0:.1f}]"
-    assert "MPIMessageOK (code 0) DONE" in out and expected in out
+    assert "MPIMessageOK (code 0) DONE" in out
+    assert expected in out
 
 
 def test_a_move_with_a_wrong_number_of_positions_is_refused_with_exit_1(ms0):
@@ -136,11 +137,13 @@ def test_stop_resume_e_stop_reset_change_the_state_as_status_shows(ms0, capsys):
     ms0.wait_for(lambda s: s.state_name == "MOVING" and s.axes[0].at_velocity, WAIT, "moving at velocity")
 
     proc = mpi_ros("e-stop")
-    assert proc.returncode == 0 and "E_STOP: MPIMessageOK (code 0), state STOPPING_ERROR" in proc.stdout
+    assert proc.returncode == 0
+    assert "E_STOP: MPIMessageOK (code 0), state STOPPING_ERROR" in proc.stdout
     ms0.wait_for_state("ERROR", WAIT)
     assert console("status", "--once") == 0  # every supervisor
     table = capsys.readouterr().out
-    assert _table_row(table, "ms0")[1] == "ERROR" and _table_row(table, "ms1")[1] == "IDLE"
+    assert _table_row(table, "ms0")[1] == "ERROR"
+    assert _table_row(table, "ms1")[1] == "IDLE"
     assert "E_STOP (USER)" in table
 
     assert console("move", "--position", "0", "0", "-v", "100", "-a", "1000", "-d", "1000") == 1
@@ -149,7 +152,8 @@ def test_stop_resume_e_stop_reset_change_the_state_as_status_shows(ms0, capsys):
     assert "`mpi-ros reset` leaves it" in captured.err
 
     proc = mpi_ros("reset")
-    assert proc.returncode == 0 and "RESET: MPIMessageOK (code 0), state IDLE" in proc.stdout
+    assert proc.returncode == 0
+    assert "RESET: MPIMessageOK (code 0), state IDLE" in proc.stdout
     ms0.wait_for_state("IDLE", WAIT)
 
 
@@ -279,7 +283,9 @@ def test_echo_of_an_unknown_topic_lists_the_suites_topics(capsys):
     assert console("echo", "nope", "--once") == 2
     err = capsys.readouterr().err
     assert err.startswith("mpi-ros echo: no topic /mpi/nope: the suite publishes /clock, /diagnostics, ")
-    assert "/mpi/events" in err and "/mpi/ms0/status" in err and "_action" not in err
+    assert "/mpi/events" in err
+    assert "/mpi/ms0/status" in err
+    assert "_action" not in err
 
 
 def test_a_closed_pipe_ends_a_live_view_quietly(running):
@@ -287,7 +293,8 @@ def test_a_closed_pipe_ends_a_live_view_quietly(running):
     echo.expect("---")
     echo.process.stdout.close()  # the reader leaves, as `| head` does
     status, _, err = echo.finish()
-    assert status == 0 and "Traceback" not in err, err
+    assert status == 0, err
+    assert "Traceback" not in err, err
 
 
 # -- the demo ---------------------------------------------------------------------------------------
@@ -314,7 +321,8 @@ def test_fault_injects_and_clears_and_reset_says_what_persists(ms1, capsys):
     ms1.wait_for_state("ERROR", WAIT)
     assert console("reset", "-s", "1") == 1
     captured = capsys.readouterr()
-    assert "RESET: MPIMotionMessageERROR" in captured.out and "axis 3 AMP_FAULT persists" in captured.out
+    assert "RESET: MPIMotionMessageERROR" in captured.out
+    assert "axis 3 AMP_FAULT persists" in captured.out
     # not "`mpi-ros reset` leaves it": another RESET would be refused too
     assert captured.err == ("hint: ms1 stays in ERROR while the fault persists: first "
                             "`mpi-ros fault AMP_FAULT --axis 3 --clear`, then `mpi-ros reset --supervisor 1`\n")
@@ -325,6 +333,7 @@ def test_fault_injects_and_clears_and_reset_says_what_persists(ms1, capsys):
                             "supervisor in ERROR) until a RESET: `mpi-ros reset --supervisor 1`\n")
     ms1.wait_for_state("ERROR", WAIT, newer_than=ms1.status(WAIT).sample)  # still
     assert console("fault", "OVERHEAT", "--axis", "3", "-s", "1") == 1
-    assert "MPIMessagePARAM_INVALID" in (out := capsys.readouterr().out) and "unknown fault" in out
+    assert "MPIMessagePARAM_INVALID" in (out := capsys.readouterr().out)
+    assert "unknown fault" in out
     assert console("reset", "-s", "1") == 0
     assert "state IDLE" in capsys.readouterr().out

@@ -69,7 +69,8 @@ def test_no_line_of_the_table_reaches_the_last_column(width):
     assert max(len(line) for line in lines) <= width - 1
     text = "\n".join(lines)
     assert "AMP_FAULT" in text  # a column of its own from 128 on, a line of its own below
-    assert ("D T F S" in text) == (width < 128) and ("IN_FINE_POSITION" in text) == (width >= 128)
+    assert ("D T F S" in text) == (width < 128)
+    assert ("IN_FINE_POSITION" in text) == (width >= 128)
 
 
 class Terminal:
@@ -169,7 +170,7 @@ class _Frames(io.StringIO):
         self.after_frame.append(self.terminal.lines())
 
 
-@pytest.mark.parametrize("columns, rows", [(80, 24), (200, 50)])
+@pytest.mark.parametrize(("columns", "rows"), [(80, 24), (200, 50)])
 def test_live_status_redraws_in_place_without_stacking(columns, rows):
     terminal = Terminal(columns, rows)
     terminal.feed("$ mpi-ros status\n")
@@ -189,8 +190,10 @@ def test_live_status_on_a_short_terminal_cuts_the_table_and_says_so():
     with pytest.raises(KeyboardInterrupt):
         _live(_Watcher(), frames, tty=True, interval=0.0, size=lambda: os.terminal_size((80, 10)))
     first, second, after = frames.after_frame
-    assert first == second and len(first) == 10  # the screen's rows, none scrolled away
-    assert first[-1].startswith("... ") and first[-1].endswith("more lines: a taller terminal shows them")
+    assert first == second
+    assert len(first) == 10
+    assert first[-1].startswith("... ")
+    assert first[-1].endswith("more lines: a taller terminal shows them")
     assert after[-13:] == render(*_cell(), "/mpi", width=80)  # all of the last table left on leaving
 
 
@@ -198,7 +201,8 @@ def test_live_status_off_a_terminal_prints_tables_one_after_another():
     out = io.StringIO()
     with pytest.raises(KeyboardInterrupt):
         _live(_Watcher(), out, tty=False, interval=0.0)
-    assert "\x1b" not in out.getvalue() and out.getvalue().count("/mpi  sample 100") == 2
+    assert "\x1b" not in out.getvalue()
+    assert out.getvalue().count("/mpi  sample 100") == 2
     assert "IN_FINE_POSITION" in out.getvalue()  # off a terminal, every column
 
 
@@ -233,7 +237,8 @@ def test_goal_from_flags():
                                     "jerk_percent": 50.0}],
                     "id": 7, "attributes": ["RELATIVE", "ID"]}
     velocity = goal_from_args(_args("--type", "velocity", "-v", "-300", "-a", "2000"))
-    assert velocity["type"] == "VELOCITY" and "position" not in velocity
+    assert velocity["type"] == "VELOCITY"
+    assert "position" not in velocity
 
 
 def test_goal_yaml_with_flags_overriding_its_fields():
@@ -241,14 +246,15 @@ def test_goal_yaml_with_flags_overriding_its_fields():
                                           "trajectory: [{velocity: 1, acceleration: 2}, {velocity: 3}]}",
                                 "-v", "500", "--delay", "0.5", "0.5"))
     assert goal["trajectory"] == [{"velocity": 500.0, "acceleration": 2}, {"velocity": 500.0}]  # every axis'
-    assert goal["attributes"] == ["APPEND", "DELAY"] and goal["delay"] == [0.5, 0.5]
+    assert goal["attributes"] == ["APPEND", "DELAY"]
+    assert goal["delay"] == [0.5, 0.5]
     goal = goal_from_args(_args("--goal", "{position: [1, 2], trajectory: [{velocity: 1, deceleration: 9}, "
                                           "{velocity: 1}]}", "-a", "5000"))
     # no deceleration is made up (docs/decisions.md, "Deceleration"): the goal is the controller's to refuse
     assert [t.get("deceleration") for t in goal["trajectory"]] == [9, None]
 
 
-@pytest.mark.parametrize("argv, text", [
+@pytest.mark.parametrize(("argv", "text"), [
     (["-p", "1", "2", "-a", "5"], "--velocity and --deceleration needed for a S_CURVE move"),
     (["-p", "1", "2", "-v", "1", "-a", "5"], "--deceleration needed for a S_CURVE move"),
     (["--type", "VELOCITY"], "--velocity and --acceleration needed for a VELOCITY move"),
@@ -269,4 +275,6 @@ def test_every_console_verb_explains_itself_with_an_example(verb):
     text = sub.format_help()
     assert f"\n  mpi-ros {verb}" in text  # an example command line
     if verb != "demo":
-        assert "--namespace NS" in text and "--supervisor N" in text and "--timeout S" in text
+        assert "--namespace NS" in text
+        assert "--supervisor N" in text
+        assert "--timeout S" in text

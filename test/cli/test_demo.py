@@ -48,7 +48,8 @@ def test_demo_tours_records_and_plots(tmp_path):
     assert lines[-3] == f"bag:   {out / 'bag'}   (replay it: mpi-ros replay {out / 'bag'})"
     for name in ("bag/metadata.yaml", "tour.png", "s_curve_vs_ruckig.png", "suite.log", "suite.yaml"):
         assert (out / name).is_file(), name
-    assert str(out / "tour.png") in lines[-2] and str(out / "s_curve_vs_ruckig.png") in lines[-1]
+    assert str(out / "tour.png") in lines[-2]
+    assert str(out / "s_curve_vs_ruckig.png") in lines[-1]
     assert "mpi_ros suite stopped" in (out / "suite.log").read_text()  # stopped cleanly: the bag is whole
     assert yaml.safe_load((out / "suite.yaml").read_text())["ros"]["namespace"] == "/demo"
 
@@ -61,4 +62,5 @@ def test_demo_usage_errors(tmp_path):
     assert proc.stderr.strip() == (f"mpi-ros demo: {tmp_path / 'full'} exists and is not an empty directory: "
                                    "pass --output DIR")
     proc = mpi_ros("demo", "--time-scale", "0")
-    assert proc.returncode == 2 and "--time-scale must be > 0" in proc.stderr
+    assert proc.returncode == 2
+    assert "--time-scale must be > 0" in proc.stderr

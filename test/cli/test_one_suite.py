@@ -24,7 +24,8 @@ def test_a_second_suite_in_the_namespace_is_refused_and_another_namespace_starts
     assert f"mpi-ros run: a suite already runs under /mpi on ROS_DOMAIN_ID {domain}: its node /mpi/controller " \
            f"(enclave /) is on the graph, on this host, pid {first.process.pid}: " in err
     assert "One suite per namespace: stop that one, or start this one with another --namespace" in err
-    assert "suite up" not in err and "Traceback" not in err  # refused before any node of its own
+    assert "suite up" not in err
+    assert "Traceback" not in err
 
     other = running("run", "--time-scale", "2", "--namespace", "/other")
     other.expect("namespace /other", "stderr")
@@ -48,8 +49,10 @@ def test_the_probe_finds_a_suite_within_the_discovery_time_and_says_so_when_none
     began = time.monotonic()
     found = twin.find_suite(ros_context, "/mpi")
     took = time.monotonic() - began
-    assert found is not None and took < twin.DISCOVERY + 1.0  # + the probe's own node and endpoint look-up
-    assert found.enclave == "/" and found.origin.text.startswith(f"on this host, pid {suite_process.process.pid}: ")
+    assert found is not None
+    assert took < twin.DISCOVERY + 1.0
+    assert found.enclave == "/"
+    assert found.origin.text.startswith(f"on this host, pid {suite_process.process.pid}: ")
     assert not found.origin.gone
 
     began = time.monotonic()
@@ -67,7 +70,8 @@ def test_the_console_warns_about_nodes_on_the_graph_twice(suite_process, ros_con
     watcher = Watcher(context=ros_context, timeout=WAIT, node_name="twin_watcher")
     try:
         watcher.wait_for_suite(WAIT)
-        assert watcher.twins_on_graph() == [] and twins_warning(watcher) is None
+        assert watcher.twins_on_graph() == []
+        assert twins_warning(watcher) is None
         twin = Node("controller", namespace="/mpi", context=ros_context)  # what a second suite shows
         try:
             pause, deadline = threading.Event(), time.monotonic() + WAIT
@@ -101,8 +105,11 @@ def test_where_the_other_process_runs_is_read_from_its_guid(tmp_path):
     mine = gid(fast, here, 1)
     assert origin(gid(fast, here, 4464), mine, proc).text == "on this host, pid 70000: python -m mpi_ros.cli run"
     gone = origin(gid(fast, here, 4465), mine, proc)
-    assert gone.gone and "4465 modulo 65536" in gone.text and "no longer running" in gone.text
+    assert gone.gone
+    assert "4465 modulo 65536" in gone.text
+    assert "no longer running" in gone.text
     elsewhere = origin(gid(fast, b"\x00\x01", 4464), mine, proc)
-    assert not elsewhere.gone and elsewhere.text.startswith("on another host (DDS host id 0001)")
+    assert not elsewhere.gone
+    assert elsewhere.text.startswith("on another host (DDS host id 0001)")
     assert origin(gid(b"\x01\x10", here, 4464), mine, proc).text.startswith("its process unknown (its middleware")
     assert origin(None, mine, proc).text.startswith("its process unknown (none of its endpoints")

@@ -78,9 +78,12 @@ def test_the_suite_announces_itself_often_unless_a_profile_or_middleware_was_cho
 
     environ: dict[str, str] = {}
     chosen = announce_often(environ)
-    assert chosen is not None and environ["FASTRTPS_DEFAULT_PROFILES_FILE"] == chosen
+    assert chosen is not None
+    assert environ["FASTRTPS_DEFAULT_PROFILES_FILE"] == chosen
     assert "<leaseAnnouncement><sec>0</sec><nanosec>100000000</nanosec></leaseAnnouncement>" in Path(chosen).read_text()
     own = {"FASTDDS_DEFAULT_PROFILES_FILE": str(tmp_path / "mine.xml")}
-    assert announce_often(own) is None and "FASTRTPS_DEFAULT_PROFILES_FILE" not in own
+    assert announce_often(own) is None
+    assert "FASTRTPS_DEFAULT_PROFILES_FILE" not in own
     cyclone = {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}
-    assert announce_often(cyclone) is None and cyclone == {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}
+    assert announce_often(cyclone) is None
+    assert cyclone == {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}

@@ -79,7 +79,8 @@ def test_the_console_shows_the_suite_and_its_keys_act(link, ms0, size):
             await _until(pilot, lambda: table.row_count == 6, "row per supervisor and axis")
             assert [table.get_row_at(k)[0] for k in range(6)] == ["ms0 *", "  axis0", "  axis1", "ms1",
                                                                   "  axis2", "  axis3"]
-            assert app.size == size and table.region.width <= size[0]
+            assert app.size == size
+            assert table.region.width <= size[0]
             keys = ("space STOP", "e E_STOP", "r RESET", "u RESUME")
             await _until(pilot, lambda: all(key in _screen(app) for key in keys), "the keys on screen")
             assert "selected ms0" in _screen(app)
@@ -102,7 +103,8 @@ def test_an_arrow_jogs_and_the_jog_stops_when_the_key_is_no_longer_repeated(link
             await _until(pilot, lambda: "jog ms0 +1000 counts/s" in _log(app), "the jog in the log")
             stopped = ms0.wait_for(lambda s: s.state_name == "STOPPED" and s.motion_type == "VELOCITY", WAIT,
                                    "the jog stopped")
-            assert stopped.last_action == "STOP" and stopped.axes[0].command_position > 0.0
+            assert stopped.last_action == "STOP"
+            assert stopped.axes[0].command_position > 0.0
 
     asyncio.run(drive())
 

@@ -18,8 +18,10 @@ def test_default_set_covers_every_verdict_but_disagree(capsys):
     assert main(["crosscheck"]) == 0
     out = capsys.readouterr().out
     lines = out.splitlines()
-    assert lines[0].split()[:2] == ["#", "request"] and "verdict" in lines[0]
-    assert f"{len(EXAMPLES)} request(s):" in out and "0 DISAGREE" in out
+    assert lines[0].split()[:2] == ["#", "request"]
+    assert "verdict" in lines[0]
+    assert f"{len(EXAMPLES)} request(s):" in out
+    assert "0 DISAGREE" in out
     for word in ("AGREE", "DIFFER_EXPLAINED", "DECELERATION_DIFFERS", "START_VELOCITY", "REVERSAL_ASYMMETRIC",
                  "ACCELERATION_STEP", "jerk from the velocity reached"):
         assert word in out
@@ -31,8 +33,11 @@ def test_requests_from_arguments(capsys):
     out = capsys.readouterr().out
     rows = [line for line in out.splitlines() if line[:1].isdigit() and "request(s)" not in line]
     assert len(rows) == 2
-    assert rows[0].startswith("1  S_CURVE x=1000") and " 2.1 " in rows[0] and "AGREE" in rows[0]
-    assert rows[1].startswith("2  VELOCITY") and "AGREE" in rows[1]
+    assert rows[0].startswith("1  S_CURVE x=1000")
+    assert " 2.1 " in rows[0]
+    assert "AGREE" in rows[0]
+    assert rows[1].startswith("2  VELOCITY")
+    assert "AGREE" in rows[1]
 
 
 def test_requests_from_a_yaml_file(tmp_path, capsys):
@@ -77,7 +82,9 @@ def test_a_disagreement_is_exit_status_1(monkeypatch, capsys):
     monkeypatch.setattr(request_module, "compile_move", wrong)
     assert main(["crosscheck", "type=TRAPEZOIDAL,distance=1000,velocity=500,acceleration=5000"]) == 1
     out = capsys.readouterr().out
-    assert "DISAGREE" in out and "problem: segment" in out and "above the velocity 500.0" in out
+    assert "DISAGREE" in out
+    assert "problem: segment" in out
+    assert "above the velocity 500.0" in out
 
 
 def test_random_survey_prints_statistics(capsys):

@@ -40,7 +40,9 @@ def test_a_correct_plan_agrees():
 def test_planned_with_twice_the_acceleration_is_caught():
     plan = _plan(point_to_point(0.0, 0.0, 1000.0, 0.0, 500.0, 10000.0, 10000.0, 50.0))
     problems = _problems(plan)
-    assert "average rate" in problems and "|a| reaches" in problems and "duration" in problems
+    assert "average rate" in problems
+    assert "|a| reaches" in problems
+    assert "duration" in problems
 
 
 def test_wrong_jerk_share_is_caught():
@@ -57,7 +59,8 @@ def test_position_jump_and_wrong_end_are_caught():
     segments = point_to_point(0.0, 0.0, 1000.0, 0.0, 500.0, 5000.0, 5000.0, 50.0)
     segments[3:] = [seg._replace(p=seg.p + 1.0) for seg in segments[3:]]
     problems = _problems(_plan(segments))
-    assert "jumps" in problems and "ends at" in problems
+    assert "jumps" in problems
+    assert "ends at" in problems
 
 
 def test_trapezoid_with_jerk_is_caught():
@@ -77,7 +80,7 @@ def test_a_bound_case_breaking_a_limit_is_not_explained_away():
 
 def test_velocity_ramp_end_must_match():
     ramp = [Segment(0.1, 0.0, 0.0, 0.0, 1e5), Segment(0.1, 0.0, 500.0, 1e4, -1e5)]
-    plan = _plan(ramp + [Segment(10.0, 0.0, 1000.0, 0.0, 0.0)], Trajectory(1000.0, 5000.0, 0.0, 100.0),
+    plan = _plan([*ramp, Segment(10.0, 0.0, 1000.0, 0.0, 0.0)], Trajectory(1000.0, 5000.0, 0.0, 100.0),
                  target=0.0, velocity_target=1000.0, ramp_end=0.3)
     result = check_plan(plan, MPIMotionType.VELOCITY)
     assert any("ramp_end" in p for p in result.problems)
@@ -104,11 +107,13 @@ def test_vector_move_axes_are_checked_with_their_share_of_the_limits():
     results = [check_plan(plan, S) for plan in move.plans]
     assert [r.verdict for r in results] == [Verdict.AGREE] * 3
     assert results[0].controller_duration == pytest.approx(results[1].controller_duration)
-    assert results[2].controller_duration == 0.0 and results[2].ruckig_duration == 0.0
+    assert results[2].controller_duration == 0.0
+    assert results[2].ruckig_duration == 0.0
 
 
 def test_frame_limit_truncation_is_explained_not_compared():
     request = ProfileRequest(MPIMotionType.TRAPEZOIDAL, 1.0, 10.0, target=10_000.0)
     result = check_plan(request.plan(), request.type)
-    assert result.verdict is Verdict.DIFFER_EXPLAINED and result.reasons == (Reason.TRUNCATED,)
+    assert result.verdict is Verdict.DIFFER_EXPLAINED
+    assert result.reasons == (Reason.TRUNCATED,)
     assert result.ruckig_duration is None

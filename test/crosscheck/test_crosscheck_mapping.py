@@ -43,7 +43,8 @@ def test_jerk_is_4A2_over_f_2minusf_v_and_infinite_at_f0():
 
 def test_long_symmetric_scurve_maps_exactly():
     m = map_point_to_point(0.0, 0.0, 0.0, 1000.0, 0.0, 500.0, 5000.0, 5000.0, 50.0)
-    assert m.exact and not m.reasons
+    assert m.exact
+    assert not m.reasons
     # set explicitly: ruckig's default is 0 (docs/profiles.md, "ruckig's pitfalls")
     assert m.limits.max_velocity == 500.0
     assert m.limits.max_acceleration == pytest.approx(5000.0 / 0.75)
@@ -57,7 +58,8 @@ def test_short_move_takes_the_jerk_from_the_velocity_reached():
     m = map_point_to_point(0.0, 0.0, 0.0, 10.0, 0.0, 500.0, 5000.0, 5000.0, 50.0)
     w = math.sqrt(5000.0 * 10.0)
     assert reached_velocity(10.0, 500.0, 5000.0, 5000.0) == pytest.approx(w)
-    assert m.exact and m.limits.max_jerk == pytest.approx(ramp_jerk(5000.0, 0.5, w))
+    assert m.exact
+    assert m.limits.max_jerk == pytest.approx(ramp_jerk(5000.0, 0.5, w))
     assert any("velocity reached" in note for note in m.notes)
     result = check_request(ProfileRequest(MPIMotionType.S_CURVE, 500.0, 5000.0, jerk_percent=50.0, target=10.0))
     assert result.verdict is Verdict.AGREE
@@ -68,10 +70,12 @@ def test_trapezoid_with_accel_ne_decel_swaps_signed_limits_with_the_direction():
     backward = map_point_to_point(0.0, 0.0, 0.0, -1000.0, 0.0, 500.0, 5000.0, 2000.0, 0.0)
     assert (forward.limits.max_acceleration, forward.limits.min_acceleration) == (5000.0, -2000.0)
     assert (backward.limits.max_acceleration, backward.limits.min_acceleration) == (2000.0, -5000.0)
-    assert forward.exact and backward.exact and forward.limits.max_jerk == math.inf
+    assert forward.exact
+    assert backward.exact
+    assert forward.limits.max_jerk == math.inf
 
 
-@pytest.mark.parametrize("distance,v0,vf,expected", [
+@pytest.mark.parametrize(("distance", "v0", "vf", "expected"), [
     (100.0, 0.0, 0.0, False),
     (100.0, -300.0, 0.0, True),       # moving away from the target
     (1.0, 300.0, 0.0, True),           # cannot stop in time: overshoot and come back
@@ -107,17 +111,22 @@ def test_modify_with_acceleration_is_compared_from_zero_acceleration():
     # state, and the full-state duration is reported for information.
     result = check_request(ProfileRequest(MPIMotionType.TRAPEZOIDAL, 500.0, 5000.0, target=1000.0,
                                           start_velocity=200.0, start_acceleration=3000.0))
-    assert result.verdict is Verdict.DIFFER_EXPLAINED and result.reasons == (Reason.ACCELERATION_STEP,)
-    assert result.exact and result.ruckig.current_acceleration == 0.0
+    assert result.verdict is Verdict.DIFFER_EXPLAINED
+    assert result.reasons == (Reason.ACCELERATION_STEP,)
+    assert result.exact
+    assert result.ruckig.current_acceleration == 0.0
     assert result.duration_relative <= 1e-12
     s = check_request(ProfileRequest(MPIMotionType.VELOCITY, 300.0, 5000.0, jerk_percent=50.0,
                                      start_velocity=100.0, start_acceleration=4000.0))
-    assert s.ruckig_full_state_duration is not None and s.ruckig_full_state_duration < s.ruckig_duration
+    assert s.ruckig_full_state_duration is not None
+    assert s.ruckig_full_state_duration < s.ruckig_duration
 
 
 def test_velocity_maps_to_the_velocity_interface():
     m = map_velocity(0.0, 100.0, 0.0, -300.0, 5000.0, 40.0)
-    assert m.exact and m.limits.control == "velocity" and m.limits.target_velocity == -300.0
+    assert m.exact
+    assert m.limits.control == "velocity"
+    assert m.limits.target_velocity == -300.0
     assert m.limits.max_jerk == pytest.approx(ramp_jerk(5000.0, 0.4, 400.0))
 
 
@@ -136,7 +145,8 @@ def test_solver_segments_match_ruckigs_own_sampling():
     p, v, a, _ = sample(profile.segments, times)
     for t, pi, vi, ai in zip(times, p, v, a, strict=True):
         (rp,), (rv,), (ra,) = trajectory.at_time(float(t))
-        assert pi == pytest.approx(rp, abs=1e-7) and vi == pytest.approx(rv, abs=1e-7)
+        assert pi == pytest.approx(rp, abs=1e-7)
+        assert vi == pytest.approx(rv, abs=1e-7)
         assert ai == pytest.approx(ra, abs=1e-5)
 
 

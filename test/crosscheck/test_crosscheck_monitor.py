@@ -46,14 +46,17 @@ def test_start_and_modify_are_checked_without_events(rig):
     reply, _ = runner.submit(Command("motion_modify", 0, request=_goal(position=(-200.0, 300.0))))
     assert reply.accepted
     assert sum(monitor.verdicts.values()) == 4
-    assert monitor.verdicts[Verdict.DISAGREE] == 0 and not found
+    assert monitor.verdicts[Verdict.DISAGREE] == 0
+    assert not found
     assert not _crosscheck_events(ctl)
     summary = monitor.summary()
-    assert summary["checked"] == 4 and summary["disagree"] == 0 and summary["last_disagreement"] == ""
+    assert summary["checked"] == 4
+    assert summary["disagree"] == 0
+    assert summary["last_disagreement"] == ""
 
 
 def test_check_command_returns_the_results_of_the_move(rig):
-    ctl, runner, monitor, _ = rig
+    _ctl, runner, monitor, _ = rig
     command = Command("motion_start", 0, request=_goal(kind="TRAPEZOIDAL", position=(0.0, -700.0)))
     reply, _ = runner.submit(command)
     results = monitor.check_command(command, reply)
@@ -87,17 +90,21 @@ def test_a_wrong_plan_produces_a_crosscheck_event(rig, monkeypatch):
     assert reply.accepted  # the command itself is not refused: the check reports
     events = _crosscheck_events(ctl)
     assert [(e.supervisor, e.axis, e.move_id) for e in events] == [(0, 0, 42)]
-    assert "DISAGREE" in events[0].detail and "average rate" in events[0].detail
-    assert len(found) == 1 and found[0].result.axis == 0 and found[0].sample == sample
+    assert "DISAGREE" in events[0].detail
+    assert "average rate" in events[0].detail
+    assert len(found) == 1
+    assert found[0].result.axis == 0
+    assert found[0].sample == sample
     assert MPIEventType.CROSSCHECK in ctl.supervisor(0).latched
     summary = monitor.summary()
-    assert summary["disagree"] == 1 and "DISAGREE" in summary["last_disagreement"]
+    assert summary["disagree"] == 1
+    assert "DISAGREE" in summary["last_disagreement"]
     # axis 1 does not move: nothing to get wrong
     assert monitor.verdicts[Verdict.AGREE] == 1
 
 
 def test_the_event_follows_the_notify_mask(rig, monkeypatch):
-    ctl, runner, monitor, found = rig
+    ctl, runner, _monitor, found = rig
     assert runner.submit(Command("event_notify_set", 0, request={"event_types": ["MOTION_DONE"]}))[0].accepted
     _plan_with_twice_the_acceleration(monkeypatch)
     runner.submit(Command("motion_start", 0, request=_goal()))
@@ -126,7 +133,8 @@ def test_refused_and_unchecked_commands_are_ignored(rig):
     reply, _ = runner.submit(Command("motion_start", 0, request=goal))
     assert reply.accepted
     runner.submit(Command("action", 0, request={"action": "STOP"}))
-    assert sum(monitor.verdicts.values()) == 0 and monitor.errors == 0
+    assert sum(monitor.verdicts.values()) == 0
+    assert monitor.errors == 0
 
 
 def test_a_fault_in_the_check_is_counted_not_raised(rig, monkeypatch):
@@ -138,5 +146,7 @@ def test_a_fault_in_the_check_is_counted_not_raised(rig, monkeypatch):
     monkeypatch.setattr(monitor_module, "check_plan", broken)
     reply, _ = runner.submit(Command("motion_start", 0, request=_goal()))
     assert reply.accepted
-    assert monitor.errors == 2 and "boom" in monitor.summary()["last_error"]
-    assert not found and not _crosscheck_events(ctl)
+    assert monitor.errors == 2
+    assert "boom" in monitor.summary()["last_error"]
+    assert not found
+    assert not _crosscheck_events(ctl)

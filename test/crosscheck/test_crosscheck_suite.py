@@ -83,7 +83,8 @@ def test_a_disagreement_is_an_event_and_a_diagnostic(crosscheck_suite, probe, mo
     good, _ = suite.runner.submit(Command("motion_start", 0, request={
         "type": "S_CURVE", "position": [100.0, 0.0],
         "trajectory": [{"velocity": 500.0, "acceleration": 5000.0, "deceleration": 5000.0, "jerk_percent": 50.0}]}))
-    assert good.accepted and suite.crosscheck.summary()["agree"] == 2
+    assert good.accepted
+    assert suite.crosscheck.summary()["agree"] == 2
     suite.runner.step(2000)
 
     real = motion_module.compile_move
@@ -108,7 +109,9 @@ def test_a_disagreement_is_an_event_and_a_diagnostic(crosscheck_suite, probe, mo
     assert status.level == DiagnosticStatus.WARN
     values = {kv.key: kv.value for kv in status.values}
     # axis 1 of the second move does not move: nothing to get wrong (AGREE)
-    assert values["disagree"] == "1" and values["agree"] == "3" and "DISAGREE" in values["last_disagreement"]
+    assert values["disagree"] == "1"
+    assert values["agree"] == "3"
+    assert "DISAGREE" in values["last_disagreement"]
 
 
 def test_crosscheck_is_off_by_default(ros_context):

@@ -103,8 +103,10 @@ def test_goal_service_and_topic_cross_processes(ros_context, peer):
 
         node.create_subscription(AxisStatus, "/mpi/axis0/status", on_status, 10)
         status = spin_until(executor, status_future, "/mpi/axis0/status")
-        assert status.number == 0 and status.state_name == "IDLE"
-        assert status.command_position == 12.5 and status.sample >= 1
+        assert status.number == 0
+        assert status.state_name == "IDLE"
+        assert status.command_position == 12.5
+        assert status.sample >= 1
 
         # Action: send a goal written as the README's send_goal example, with feedback.
         client = ActionClient(node, MotionStart, "/mpi/ms0/motion_start")
@@ -142,14 +144,17 @@ def test_goal_service_and_topic_cross_processes(ros_context, peer):
         # Service: MotionAction; the peer ends the goal when it answers.
         response = spin_until(
             executor, service.call_async(MotionAction.Request(action="STOP")), "service response")
-        assert response.message == "MPIMessageOK" and response.code == 0
-        assert response.state_name == "after STOP" and response.sample == 42
+        assert response.message == "MPIMessageOK"
+        assert response.code == 0
+        assert response.state_name == "after STOP"
+        assert response.sample == 42
 
         wrapped = spin_until(executor, result_future, "goal result")
         from action_msgs.msg import GoalStatus
         assert wrapped.status == GoalStatus.STATUS_SUCCEEDED
         result = wrapped.result
-        assert result.message == "MPIMessageOK" and result.state_name == "IDLE"
+        assert result.message == "MPIMessageOK"
+        assert result.state_name == "IDLE"
         assert list(result.actual_position) == [1000.0, 0.0]
         assert result.detail == "S_CURVE with 1 trajectory element(s)"
 

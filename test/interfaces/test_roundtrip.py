@@ -80,7 +80,7 @@ def value_for(slot_type, seed: int, default=None):
             value = float(seed) + 0.5          # exact in float32 too
             return value + 1.0 if value == default else value
         if t in _INT_RANGES:
-            lo, hi = _INT_RANGES[t]
+            _lo, hi = _INT_RANGES[t]
             value = 1 + seed % min(hi, 100)
             if value == default:
                 value = value + 1 if value < hi else value - 1
@@ -130,8 +130,8 @@ def test_interfaces_were_found():
     assert kinds == {"msg", "srv", "action"}, f"interface files missing under {REPO}"
 
 
-@pytest.mark.parametrize("sub,name,part", CASES,
-                         ids=[".".join((s, n) + p) for s, n, p in CASES])
+@pytest.mark.parametrize(("sub", "name", "part"), CASES,
+                         ids=[".".join((s, n, *p)) for s, n, p in CASES])
 def test_roundtrip(sub, name, part):
     from rclpy.serialization import deserialize_message, serialize_message
 
@@ -142,7 +142,8 @@ def test_roundtrip(sub, name, part):
         assert not _equal(getattr(msg, field), getattr(default, field)), \
             f"{field} still has its default value"
     data = serialize_message(msg)
-    assert isinstance(data, bytes) and len(data) > 0
+    assert isinstance(data, bytes)
+    assert len(data) > 0
     back = deserialize_message(data, cls)
     assert back == msg
     # (Not comparing bytes of a second serialisation: CDR alignment padding is not zeroed.)

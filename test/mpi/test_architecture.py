@@ -60,7 +60,7 @@ def test_the_controller_has_no_import_cycle():
 
     def visit(node: str, path: list[str]) -> None:
         if node in path:
-            pytest.fail("import cycle: " + " -> ".join(path[path.index(node):] + [node]))
+            pytest.fail("import cycle: " + " -> ".join([*path[path.index(node):], node]))
         if node in done:
             return
         for child in sorted(graph[node]):

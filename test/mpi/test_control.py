@@ -27,8 +27,11 @@ def test_defaults():
     # issue 3: "sample rate (default 2000 Hz) ... frame buffer size (128)"; MPI 000, mpiMotionStart "With the
     # sample rate configured for 2000 (default)"; README.md, "Configuration": 4 axes, 2 supervisors
     ctl = Controller()
-    assert ctl.rate == 2000.0 and ctl.config.frame_buffer_size == 128
-    assert len(ctl.axes) == 4 and ctl.config.supervisor_count == 2 and not ctl.config.firmware_option_21
+    assert ctl.rate == 2000.0
+    assert ctl.config.frame_buffer_size == 128
+    assert len(ctl.axes) == 4
+    assert ctl.config.supervisor_count == 2
+    assert not ctl.config.firmware_option_21
 
 
 def test_sample_rate_must_be_positive():
@@ -66,7 +69,8 @@ def test_validate_after_create_and_delete(ctl, ms):
     assert ms.validate().ok
     assert ctl.delete_motion(ms).ok
     assert ms.validate() is M.MPIMessageHANDLE_INVALID
-    assert ctl.supervisor(0) is None and len(ctl.axes) == 4
+    assert ctl.supervisor(0) is None
+    assert len(ctl.axes) == 4
     assert ctl.delete_motion(ms) is M.MPIMessageHANDLE_INVALID
     assert ms.start(T.TRAPEZOIDAL) is M.MPIMessageHANDLE_INVALID
     assert ms.action(MPIAction.STOP) is M.MPIMessageHANDLE_INVALID
@@ -124,7 +128,8 @@ def test_a_long_move_simulates_far_faster_than_real_time(ctl, ms, params):
 
 def test_gates_and_io(ctl):
     # MPI 000, MEIMotionAttrHoldTypeGATE meiControlGateGet/Set; io.py: the simulated I/O image
-    assert ctl.gate_set(3, True).ok and ctl.gate_get(3) == (M.MPIMessageOK, True)
+    assert ctl.gate_set(3, True).ok
+    assert ctl.gate_get(3) == (M.MPIMessageOK, True)
     assert ctl.gate_get(32)[0] is M.MPIMessagePARAM_INVALID
     assert ctl.io_set(IoSpace.MOTOR_DEDICATED_IO, 3, 0b101).ok
     assert ctl.io_get(IoSpace.MOTOR_DEDICATED_IO, 3) == (M.MPIMessageOK, 0b101)
@@ -135,8 +140,9 @@ def test_gates_and_io(ctl):
 def test_supervisors_are_listed_by_number(ctl):
     # MPI 000, mpiMotionNumber mpiMotionNumber: the index of a Motion object
     _, b = ctl.create_motion(1)
-    _, a = ctl.create_motion(0)
-    assert [s.number for s in ctl.supervisors] == [0, 1] and ctl.supervisor(1) is b
+    _, _a = ctl.create_motion(0)
+    assert [s.number for s in ctl.supervisors] == [0, 1]
+    assert ctl.supervisor(1) is b
 
 
 def test_drain_events_empties_the_queue(ctl, ms, params):
@@ -157,7 +163,8 @@ def test_events_not_drained_are_bounded_the_oldest_going_first(ctl, ms, params, 
     bounded.listeners.append(heard.append)
     for n in range(5):
         bounded.emit(control.MPIEventType.MOTION_DONE, sample=n)
-    assert [e.sample for e in bounded.events] == [2, 3, 4] and [e.sample for e in heard] == [0, 1, 2, 3, 4]
+    assert [e.sample for e in bounded.events] == [2, 3, 4]
+    assert [e.sample for e in heard] == [0, 1, 2, 3, 4]
 
 
 def test_motion_snapshot(ctl, ms, params, run_to):
@@ -165,11 +172,17 @@ def test_motion_snapshot(ctl, ms, params, run_to):
     ms.start(T.S_CURVE, params=params((1000.0, 0.0), jerk_percent=20.0))
     ctl.step(1000)
     snap = ms.snapshot()
-    assert snap.state is MPIState.MOVING and snap.axis_numbers == (0, 1) and snap.motion_type == "S_CURVE"
-    assert not snap.done and 0.0 < snap.progress < 1.0 and snap.feedrate == 1.0
+    assert snap.state is MPIState.MOVING
+    assert snap.axis_numbers == (0, 1)
+    assert snap.motion_type == "S_CURVE"
+    assert not snap.done
+    assert 0.0 < snap.progress < 1.0
+    assert snap.feedrate == 1.0
     run_to(ctl, ms, MPIState.IDLE, 10_000, chunk=100)
     snap = ms.snapshot()
-    assert snap.done and snap.at_target and snap.progress == 1.0
+    assert snap.done
+    assert snap.at_target
+    assert snap.progress == 1.0
 
 
 def test_settling_at_rest_does_not_depend_on_how_samples_are_batched():

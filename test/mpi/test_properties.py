@@ -58,7 +58,8 @@ def trajectories(draw, kind):
 def rig(axes=1, **config):
     ctl = Controller(ControllerConfig(axis_count=axes, supervisor_count=1, **config))
     _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set(list(range(axes))).ok and ms.action(MPIAction.MAP).ok
+    assert ms.axis_list_set(list(range(axes))).ok
+    assert ms.action(MPIAction.MAP).ok
     ms.log_open(50_000_000)
     return ctl, ms
 
@@ -131,7 +132,8 @@ def test_point_to_point_limits_and_target(kind, data, distance):
     run_idle(ctl, ms)
     log = logged(ms)
     check_sampled_limits(log[:, 2], traj.velocity, up, down)
-    assert ctl.axes[0].command_position == distance and log[-1, 0] == distance
+    assert ctl.axes[0].command_position == distance
+    assert log[-1, 0] == distance
 
 
 @settings(max_examples=100, **SETTINGS)

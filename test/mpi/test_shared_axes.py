@@ -95,7 +95,8 @@ def test_remap_refused_while_a_leaving_axis_still_creeps(ctl, ms):
     assert ctl.axes[0].cmd_v > 0.0
     assert ms.axis_list_set([2]).ok
     assert ms.action(A.MAP) is Message.MPIMotionMessageSTOPPED
-    assert ms.mapped == [0, 1] and ms.state is MPIState.STOPPED
+    assert ms.mapped == [0, 1]
+    assert ms.state is MPIState.STOPPED
 
 
 @pytest.mark.parametrize("action", [A.E_STOP, A.STOP, A.ABORT])
@@ -115,7 +116,8 @@ def test_an_action_from_a_second_supervisor_stops_the_whole_vector(ctl, action):
         if v0 != 0.0:
             ratios.append(v1 / v0)
         assert owned_and_reported(ctl)
-    assert ctl.axes[0].cmd_v == 0.0 and ctl.axes[1].cmd_v == 0.0
+    assert ctl.axes[0].cmd_v == 0.0
+    assert ctl.axes[1].cmd_v == 0.0
     assert all(math.isclose(r, 0.5, rel_tol=1e-9) for r in ratios)
     final = {A.STOP: MPIState.STOPPED, A.E_STOP: MPIState.ERROR, A.ABORT: MPIState.ERROR}[action]
     run_to_state(ctl, a, final)
@@ -147,13 +149,15 @@ def test_resume_from_a_second_supervisor_continues_the_shared_motion(ctl):
     assert b.action(A.RESUME).ok
     assert a.state is MPIState.MOVING
     ctl.step(500)
-    assert ctl.axes[0].cmd_v > 0.0 and owned_and_reported(ctl)
+    assert ctl.axes[0].cmd_v > 0.0
+    assert owned_and_reported(ctl)
 
 
 def test_stop_from_a_second_supervisor_with_nothing_moving_is_refused(ctl):
     a, b = sharing_axis_1(ctl)
     assert b.action(A.STOP) is Message.MPIMotionMessageIDLE
-    assert a.state is MPIState.IDLE and b.state is MPIState.IDLE
+    assert a.state is MPIState.IDLE
+    assert b.state is MPIState.IDLE
 
 
 # ------------------------------------------------------------ the state table on shared axes ----
@@ -164,7 +168,8 @@ def shared_in(state: MPIState):
     a, b = sharing_axis_1(ctl)
     drive_to(ctl, a, state)
     ctl.drain_events()
-    assert b.own_state is MPIState.IDLE and b.state is state
+    assert b.own_state is MPIState.IDLE
+    assert b.state is state
     return ctl, a, b
 
 
@@ -184,7 +189,7 @@ SHARED_CELLS = {
 SHARED = [(state, name, *SHARED_CELLS.get((state, name), (message, after))) for state, name, message, after in CELLS]
 
 
-@pytest.mark.parametrize("state,name,message,after", SHARED, ids=[f"{c[0].name}-{c[1]}" for c in SHARED])
+@pytest.mark.parametrize(("state", "name", "message", "after"), SHARED, ids=[f"{c[0].name}-{c[1]}" for c in SHARED])
 def test_cell_from_the_supervisor_sharing_an_axis(state, name, message, after):
     # docs/state-machine.md's state x action table holds for a supervisor in the state its axes show: a command
     # to supervisor 1 answers as the table says for that state, and both supervisors then show the
@@ -201,7 +206,7 @@ def test_cell_from_the_supervisor_sharing_an_axis(state, name, message, after):
 SHARED_REFUSALS = [c for c in SHARED if c[2] is not Message.MPIMessageOK]
 
 
-@pytest.mark.parametrize("state,name,message,after", SHARED_REFUSALS,
+@pytest.mark.parametrize(("state", "name", "message", "after"), SHARED_REFUSALS,
                          ids=[f"{c[0].name}-{c[1]}" for c in SHARED_REFUSALS])
 def test_refused_cell_from_the_sharing_supervisor_changes_nothing(state, name, message, after):
     # docs/state-machine.md: '"msg X" = refused with MPIMotionMessageX, nothing changes', on shared axes too
@@ -218,10 +223,12 @@ def test_a_start_may_not_take_an_axis_out_of_a_stopped_vector(ctl):
     stopped_mid_move(ctl, a)
     outcome, _ = b.command(T.TRAPEZOIDAL, MotionAttr.NONE, make_params((10.0, 10.0)), modify=False)
     message, detail = outcome.message, outcome.detail
-    assert message is Message.MPIMotionMessageSTOPPED and "supervisor 0" in detail
+    assert message is Message.MPIMotionMessageSTOPPED
+    assert "supervisor 0" in detail
     assert a.action(A.RESUME).ok
     ctl.step(500)
-    assert ctl.axes[0].cmd_v > 0.0 and ctl.axes[1].owner == 0
+    assert ctl.axes[0].cmd_v > 0.0
+    assert ctl.axes[1].owner == 0
 
 
 def test_reset_from_the_sharing_supervisor_clears_the_other_s_error(ctl):
@@ -229,7 +236,8 @@ def test_reset_from_the_sharing_supervisor_clears_the_other_s_error(ctl):
     a, b = sharing_axis_1(ctl)
     drive_to(ctl, a, MPIState.ERROR)
     assert b.action(A.RESET).ok
-    assert a.state is MPIState.IDLE and b.state is MPIState.IDLE
+    assert a.state is MPIState.IDLE
+    assert b.state is MPIState.IDLE
     assert b.start(T.TRAPEZOIDAL, params=make_params((10.0, 10.0))).ok
 
 
@@ -244,11 +252,12 @@ def test_a_reset_refused_by_a_fault_on_a_shared_axis_names_the_fault(ctl):
     run_to_state(ctl, b, MPIState.ERROR)
     outcome = a.action_detail(A.RESET)
     assert outcome.message is Message.MPIMotionMessageERROR
-    assert "axis 1 AMP_FAULT persists" in outcome.detail and "supervisor 1" in outcome.detail
+    assert "axis 1 AMP_FAULT persists" in outcome.detail
+    assert "supervisor 1" in outcome.detail
     assert b.state is MPIState.ERROR
 
 
-@pytest.mark.parametrize("action,column", [(A.STOP, "stop"), (A.E_STOP, "stop"), (A.ABORT, "abort")])
+@pytest.mark.parametrize(("action", "column"), [(A.STOP, "stop"), (A.E_STOP, "stop"), (A.ABORT, "abort")])
 def test_status_bits_after_an_action_from_the_sharing_supervisor(ctl, action, column):
     # MPI 002, the status-bit tables with settleOnStop/settleOnEstop FALSE: "After STOP (E-STOP)":
     # IN_FINE_POSITION, IN_COARSE_POSITION and AT_TARGET FALSE, DONE "TRUE when command velocity
@@ -262,7 +271,9 @@ def test_status_bits_after_an_action_from_the_sharing_supervisor(ctl, action, co
     ctl.step(2000)
     for n in (0, 1):
         bits = ctl.axes[n].status
-        assert not (bits.in_fine_position or bits.in_coarse_position or bits.at_target), (column, n)
+        assert not bits.in_fine_position, (column, n)
+        assert not bits.in_coarse_position, (column, n)
+        assert not bits.at_target, (column, n)
         assert bits.done, (column, n)
 
 
@@ -271,9 +282,12 @@ def test_status_bits_of_axes_a_remap_released(ctl, ms):
     # rest where they stopped and keep the after-STOP bits (DONE, not AT_TARGET: they never got
     # to the target), while the new list starts clean.
     stopped_mid_move(ctl, ms)
-    assert ms.axis_list_set([2]).ok and ms.action(A.MAP).ok
+    assert ms.axis_list_set([2]).ok
+    assert ms.action(A.MAP).ok
     ctl.step(100)
     for n in (0, 1):
         bits = ctl.axes[n].status
-        assert bits.done and not bits.at_target and not bits.in_fine_position
+        assert bits.done
+        assert not bits.at_target
+        assert not bits.in_fine_position
         assert ctl.axes[n].cmd_v == 0.0

@@ -13,6 +13,7 @@ goal's result, the commands NS_A applied meanwhile) and shows new goals work on 
 
 from __future__ import annotations
 
+import itertools
 import json
 import statistics
 import sys
@@ -58,7 +59,7 @@ class Inbox:
 
 
 def in_order(samples: list[int]) -> bool:
-    return all(a <= b for a, b in zip(samples, samples[1:], strict=False))
+    return all(a <= b for a, b in itertools.pairwise(samples))
 
 
 def discover(namespace: str) -> tuple[MotionClient, float]:
@@ -144,9 +145,9 @@ def bench(namespace: str, count: int, discoveries: int = 5) -> dict:
     taken = statuses.since(began)
     rate = len(taken) / window
     samples = [m.sample for m in statuses.since(0)]
-    steps = {b - a for a, b in zip(samples, samples[1:], strict=False)}
+    steps = {b - a for a, b in itertools.pairwise(samples)}
     period = round(2000.0 / 100.0)  # samples between statuses at the default rates
-    missed = sum(max(0, (b - a) // period - 1) for a, b in zip(samples, samples[1:], strict=False))
+    missed = sum(max(0, (b - a) // period - 1) for a, b in itertools.pairwise(samples))
     client.close()
     ms = 1000.0
     return {"namespace": namespace, "discovery_s": round(statistics.median(found), 3),

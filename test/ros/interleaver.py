@@ -57,7 +57,7 @@ def _goal(rng: random.Random, axes: int, kind: str) -> dict[str, Any]:
         "type": motion_type,
         "trajectory": [{"velocity": velocity, "acceleration": acceleration,
                         "deceleration": rng.uniform(5_000.0, 200_000.0), "jerk_percent": rng.choice((0.0, 50.0))}],
-        "attributes": list(rng.choice(ATTRIBUTES if kind == "start" else ATTRIBUTES + (("AUTO_START",),))),
+        "attributes": list(rng.choice(ATTRIBUTES if kind == "start" else (*ATTRIBUTES, ("AUTO_START",)))),
     }
     if motion_type != "VELOCITY":
         goal["position"] = [rng.uniform(-5_000.0, 5_000.0) for _ in range(axes)]

@@ -119,7 +119,8 @@ def test_a_result_asked_after_it_expired_is_unknown(suite, probe, drive):
         late = _done(handle.get_result_async(), "late result")
         if late.status == GoalStatus.STATUS_UNKNOWN or expired.wait(0.1):
             break
-    assert late is not None and late.status == GoalStatus.STATUS_UNKNOWN
+    assert late is not None
+    assert late.status == GoalStatus.STATUS_UNKNOWN
 
 
 def test_the_status_array_shows_each_goal_to_its_end(suite, probe, drive):

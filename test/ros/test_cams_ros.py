@@ -67,7 +67,8 @@ def test_cam_goal_from_send_goal_yaml_follows_the_master_to_its_end(suite, clien
     applied.wait(4)
     drive(lambda: running.done, samples=20_000)
     result = running.wait()
-    assert result.message == "MPIMessageOK" and result.move_id == 7
+    assert result.message == "MPIMessageOK"
+    assert result.move_id == 7
     # at the end of the table: the sums of the slave distances
     assert suite.runner.read(lambda ctl: (ctl.axes[2].command_position, ctl.axes[3].command_position)) == (
         300.0, -100.0)
@@ -86,7 +87,8 @@ def test_client_cam_follows_a_line_shaft_encoder_and_stops(suite, client1, axes,
     start = suite.runner.ctl.sample
     drive(lambda: suite.runner.ctl.sample >= start + 1250, samples=2000, chunk=50)  # 2500 master counts: 5 cycles
     state, position = suite.runner.read(lambda ctl: (ctl.supervisor(1).state.name, ctl.axes[2].command_position))
-    assert state == "MOVING" and 0.0 <= position <= 100.0
+    assert state == "MOVING"
+    assert 0.0 <= position <= 100.0
     client1.stop()
     drive(lambda: running.done, samples=5000)
     assert running.wait(raise_on_error=False).message == "MPIMotionMessageSTOPPED"

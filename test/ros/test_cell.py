@@ -113,7 +113,8 @@ def test_two_namespaced_suites_share_a_graph_without_colliding(cell, probe, ros_
             assert [a.header.frame_id for a in status.axes] == [f"{ns}/axis0", f"{ns}/axis1"]
             assert events[ns].wait(lambda m: m.type == "MOTION_DONE").header.frame_id == f"{ns}/ms0"
             settled = events[ns].wait(lambda m: m.type == "SETTLED")  # an axis' event: the axis
-            assert settled.axis >= 0 and settled.header.frame_id == f"{ns}/axis{settled.axis}"
+            assert settled.axis >= 0
+            assert settled.header.frame_id == f"{ns}/axis{settled.axis}"
             assert commands[ns].wait(lambda m: m.operation == "motion_start").header.frame_id == f"{ns}/ms0"
         topics = dict(probe.get_topic_names_and_types())
         assert "/joint_states" not in topics  # the default topic is left to a suite in /mpi
@@ -126,13 +127,14 @@ def test_two_namespaced_suites_share_a_graph_without_colliding(cell, probe, ros_
 
 def test_the_namespace_and_discovery_keys_are_validated():
     for bad in ("cell_a", "/", "/cell a", "/1cell", "/cell_a/", "/cell-a"):
-        with pytest.raises(config.ConfigError, match="ros.namespace"):
+        with pytest.raises(config.ConfigError, match=r"ros\.namespace"):
             cell_config(bad, True)
     assert config.load(overrides={"ros": {"namespace": "/plant/cell_a"}}).ros.joint_prefix == "plant/cell_a/"
-    assert config.load().ros.joint_states_topic == "/joint_states" and config.load().ros.joint_prefix == ""
-    with pytest.raises(config.ConfigError, match="ros.discovery: one of localhost, subnet"):
+    assert config.load().ros.joint_states_topic == "/joint_states"
+    assert config.load().ros.joint_prefix == ""
+    with pytest.raises(config.ConfigError, match=r"ros\.discovery: one of localhost, subnet"):
         config.load(overrides={"ros": {"discovery": "everywhere"}})
-    with pytest.raises(config.ConfigError, match="ros.clock: expected true or false"):
+    with pytest.raises(config.ConfigError, match=r"ros\.clock: expected true or false"):
         config.load(overrides={"ros": {"clock": "yes"}})
     assert run_cli.DISCOVERY_RANGES == config.DISCOVERY_RANGES  # (kept apart so `mpi-ros --help` stays fast)
 

@@ -38,12 +38,17 @@ def test_axis_status_is_stamped_with_anchored_controller_time_at_the_status_rate
     every = round(rate / suite.config.ros.status_rate)
     assert [m.sample for m in messages] == list(range(messages[0].sample, messages[0].sample + 5 * every, every))
     for msg in messages:
-        assert msg.number == 2 and msg.state_name == "IDLE" and msg.state == AxisStatus.STATE_IDLE
+        assert msg.number == 2
+        assert msg.state_name == "IDLE"
+        assert msg.state == AxisStatus.STATE_IDLE
         # controller time anchored to the wall clock: epoch + sample / rate
         stamp = msg.header.stamp
         assert stamp.sec * 1_000_000_000 + stamp.nanosec == suite.epoch_ns + round(msg.sample * 1e9 / rate)
         assert msg.header.frame_id == "mpi/axis2"  # the source, named as /diagnostics names it
-        assert msg.done and msg.in_fine_position and msg.settled and msg.amp_enabled
+        assert msg.done
+        assert msg.in_fine_position
+        assert msg.settled
+        assert msg.amp_enabled
         assert msg.supervisor in (-1, 1)
 
 
@@ -60,7 +65,8 @@ def test_events_arrive_in_order_with_move_ids_and_none_is_lost_in_a_burst(suite,
     assert [m.sample for m in seen] == sorted(m.sample for m in seen)
     # each header names the event's source: its axis if it names one, else its supervisor
     assert all(m.header.frame_id == (f"mpi/axis{m.axis}" if m.axis >= 0 else f"mpi/ms{m.supervisor}") for m in seen)
-    assert {m.header.frame_id for m in done} == {"mpi/ms0"} and any(m.axis >= 0 for m in seen)
+    assert {m.header.frame_id for m in done} == {"mpi/ms0"}
+    assert any(m.axis >= 0 for m in seen)
     assert all(m.header.stamp.sec * 1_000_000_000 + m.header.stamp.nanosec
                == suite.epoch_ns + round(m.sample * 1e9 / suite.controller.rate) for m in seen)
     controller_events = suite.runner.read(lambda ctl: len(ctl.events))
@@ -74,7 +80,8 @@ def test_joint_states_report_every_axis(suite, probe, drive):
     drive(lambda: bool(joints.messages))
     msg = joints.messages[0]
     assert list(msg.name) == ["axis0", "axis1", "axis2", "axis3"]
-    assert len(msg.position) == 4 and len(msg.velocity) == 4
+    assert len(msg.position) == 4
+    assert len(msg.velocity) == 4
     assert list(msg.effort) == [0.0] * 4  # the servo's effort: at rest, none
 
 
@@ -112,7 +119,8 @@ def test_clock_follows_the_controller(suite, probe, drive):
     drive(lambda: len(ticks) >= 3, chunk=20)
     stamps = [t.clock.sec * 1_000_000_000 + t.clock.nanosec for t in ticks[:3]]
     period = round(1e9 / suite.config.ros.clock_rate)
-    assert stamps == sorted(stamps) and stamps[1] - stamps[0] == period
+    assert stamps == sorted(stamps)
+    assert stamps[1] - stamps[0] == period
     # the same time base as every stamp: epoch + sample / rate, at whole samples
     assert all((t - suite.epoch_ns) % round(1e9 / suite.controller.rate) == 0 for t in stamps)
 
@@ -121,7 +129,8 @@ def test_axis_services_config_and_positions(suite, client, probe, service, appli
     from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisPositionSet
 
     config = service(probe, AxisConfigGet, "/mpi/axis0/config_get", AxisConfigGet.Request())
-    assert config.message == "MPIMessageOK" and config.in_position.position_fine == 10.0
+    assert config.message == "MPIMessageOK"
+    assert config.in_position.position_fine == 10.0
     request = AxisConfigSet.Request(in_position=config.in_position)
     request.in_position.settling_time = 0.05
     assert service(probe, AxisConfigSet, "/mpi/axis0/config_set", request).message == "MPIMessageOK"

@@ -86,9 +86,12 @@ def test_values_are_python_values_not_arrays():
     goal = convert.fill(MotionModify.Goal(), {"type": "S_CURVE", "position": [1.0, 2.0], "element_id": [3],
                                               "trajectory": [{"velocity": 5.0}], "attributes": ["AUTO_START"]})
     data = convert.to_dict(goal)
-    assert type(data["position"]) is list and type(data["position"][0]) is float
-    assert type(data["element_id"]) is list and type(data["element_id"][0]) is int
-    assert data["trajectory"][0]["velocity"] == 5.0 and type(data["trajectory"]) is list
+    assert type(data["position"]) is list
+    assert type(data["position"][0]) is float
+    assert type(data["element_id"]) is list
+    assert type(data["element_id"][0]) is int
+    assert data["trajectory"][0]["velocity"] == 5.0
+    assert type(data["trajectory"]) is list
     assert data["attributes"] == ["AUTO_START"]
     fix = NavSatFix()
     assert type(convert.to_dict(fix)["position_covariance"][0]) is float  # a fixed array (numpy)
@@ -101,12 +104,14 @@ def test_the_dict_is_the_callers_own():
     data["position"].append(9.0)
     data["attributes"].append("DELAY")
     data["type"] = "VELOCITY"
-    assert list(goal.position) == [1.0] and goal.attributes == ["APPEND"] and goal.type == "TRAPEZOIDAL"
+    assert list(goal.position) == [1.0]
+    assert goal.attributes == ["APPEND"]
+    assert goal.type == "TRAPEZOIDAL"
 
 
 def test_a_class_that_is_not_generated_is_read_by_its_slots():
     class Stored:  # what a bag reader builds from the definition a bag stores
-        __slots__ = ("type", "position", "_hidden")
+        __slots__ = ("_hidden", "position", "type")
 
         def __init__(self):
             self.type = "S_CURVE"

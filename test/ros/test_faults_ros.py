@@ -62,21 +62,29 @@ def test_an_injected_amplifier_fault_shows_everywhere_and_recovers_with_reset(su
     assert (answer.message, list(answer.faults)) == ("MPIMessageOK", ["AMP_FAULT"])
     seen = events.wait_for(lambda ms: any(m.type == "ABORT" for m in ms))
     fault = next(m for m in seen if m.type == "AMP_FAULT")
-    assert fault.axis == 1 and fault.supervisor == 0 and "AMP_FAULT" in fault.detail and "axis 1" in fault.detail
+    assert fault.axis == 1
+    assert fault.supervisor == 0
+    assert "AMP_FAULT" in fault.detail
+    assert "axis 1" in fault.detail
     # diagnostics come at 1 Hz of controller time: step until one shows the fault
     drive(lambda: any(_faulted(a, "mpi/axis1") for a in diagnostics.messages), samples=20_000, chunk=100)
     entry = _diagnostic(next(a for a in diagnostics.messages if _faulted(a, "mpi/axis1")), "mpi/axis1")
-    assert "AMP_FAULT" in entry.message and {v.key: v.value for v in entry.values}["amp_enabled"] == "False"
+    assert "AMP_FAULT" in entry.message
+    assert {v.key: v.value for v in entry.values}["amp_enabled"] == "False"
     last = status.wait_for(lambda ms: ms and ms[-1].state_name == "ERROR")[-1]
-    assert list(last.faults) == ["AMP_FAULT"] and not last.amp_enabled
+    assert list(last.faults) == ["AMP_FAULT"]
+    assert not last.amp_enabled
 
     refused = service(probe, MotionAction, "/mpi/ms0/action", MotionAction.Request(action="RESET"))
-    assert refused.message == "MPIMotionMessageERROR" and refused.state_name == "ERROR"
+    assert refused.message == "MPIMotionMessageERROR"
+    assert refused.state_name == "ERROR"
     assert "axis 1 AMP_FAULT persists" in refused.detail
     trigger = service(probe, Trigger, "/mpi/ms0/reset", Trigger.Request())
-    assert not trigger.success and "AMP_FAULT persists" in trigger.message
+    assert not trigger.success
+    assert "AMP_FAULT persists" in trigger.message
     reply = client.action("RESET", raise_on_error=False)  # the Python client carries the reason too
-    assert reply.message == "MPIMotionMessageERROR" and "axis 1 AMP_FAULT persists" in reply.detail
+    assert reply.message == "MPIMotionMessageERROR"
+    assert "axis 1 AMP_FAULT persists" in reply.detail
 
     cleared = service(probe, AxisFaultInject, "/mpi/axis1/fault_inject",
                       AxisFaultInject.Request(fault="AMP_FAULT", active=False))
@@ -100,7 +108,9 @@ def test_each_fault_reaches_its_state_shows_in_status_and_diagnostics_and_recove
     answer = service(probe, AxisFaultInject, "/mpi/axis3/fault_inject", AxisFaultInject.Request(fault=fault))
     assert (answer.message, list(answer.faults)) == ("MPIMessageOK", [fault])
     trip = next(m for m in events.wait_for(lambda ms: any(m.type == fault for m in ms)) if m.type == fault)
-    assert (trip.axis, trip.supervisor) == (3, 1) and f"{fault} " in trip.detail and "axis 3" in trip.detail
+    assert (trip.axis, trip.supervisor) == (3, 1)
+    assert f"{fault} " in trip.detail
+    assert "axis 3" in trip.detail
     def shown() -> bool:
         last = status.messages[-1] if status.messages else None
         return (last is not None and last.state_name == state and list(last.faults) == [fault]
@@ -108,7 +118,8 @@ def test_each_fault_reaches_its_state_shows_in_status_and_diagnostics_and_recove
 
     drive(shown, samples=20_000, chunk=100)
     entry = _diagnostic(next(a for a in diagnostics.messages if _faulted(a, "mpi/axis3")), "mpi/axis3")
-    assert fault in entry.message and {v.key: v.value for v in entry.values}["faults"] == fault
+    assert fault in entry.message
+    assert {v.key: v.value for v in entry.values}["faults"] == fault
     if fault in ("AMP_FAULT", "ENCODER_FAULT"):  # conditions that hold until cleared
         service(probe, AxisFaultInject, "/mpi/axis3/fault_inject", AxisFaultInject.Request(fault=fault, active=False))
     reset = service(probe, MotionAction, "/mpi/ms1/action", MotionAction.Request(action="RESET"))
@@ -151,10 +162,13 @@ def test_a_following_error_configured_by_service_ends_the_goal_in_error(suite, c
     goal = client.start(AGGRESSIVE)
     drive(lambda: goal.done)
     result = goal.wait(raise_on_error=False)
-    assert result.message == "MPIMotionMessageERROR" and result.state_name == "ERROR"
+    assert result.message == "MPIMotionMessageERROR"
+    assert result.state_name == "ERROR"
     trip = next(m for m in events.wait_for(lambda ms: any(m.type == "LIMIT_ERROR" for m in ms))
                 if m.type == "LIMIT_ERROR")
-    assert trip.axis == 0 and "following error" in trip.detail and "E_STOP" in trip.detail
+    assert trip.axis == 0
+    assert "following error" in trip.detail
+    assert "E_STOP" in trip.detail
     assert suite.runner.read(lambda ctl: ctl.supervisor(0).state) is MPIState.ERROR
     reset = service(probe, MotionAction, "/mpi/ms0/action", MotionAction.Request(action="RESET"))
     assert reset.message == "MPIMessageOK"
@@ -162,9 +176,11 @@ def test_a_following_error_configured_by_service_ends_the_goal_in_error(suite, c
 
 def test_bad_fault_requests_are_refused_with_a_clear_message(suite, probe, service):
     answer = service(probe, AxisFaultInject, "/mpi/axis0/fault_inject", AxisFaultInject.Request(fault="MELTDOWN"))
-    assert answer.message == "MPIMessagePARAM_INVALID" and "unknown fault" in answer.detail
+    assert answer.message == "MPIMessagePARAM_INVALID"
+    assert "unknown fault" in answer.detail
     answer = _set_config(probe, service, 2, _get_config(probe, service, 2), amp_fault_action="SHRUG")
-    assert answer.message == "MPIMessagePARAM_INVALID" and "amp_fault_action" in answer.detail
+    assert answer.message == "MPIMessagePARAM_INVALID"
+    assert "amp_fault_action" in answer.detail
     assert _get_config(probe, service, 2).amp_fault_action == "ABORT"  # unchanged
     assert suite.runner.read(lambda ctl: (ctl.supervisor(0).state, ctl.supervisor(1).state)) == (
         MPIState.IDLE, MPIState.IDLE)

@@ -30,9 +30,11 @@ def test_each_supervisor_reports_its_axes_buffer_and_a_mixed_list_is_refused(sui
     # MPI 000, MPIMotionMessageAXIS_FRAME_COUNT: "All axes appended to a Motion object must have the same
     # frame buffer size"
     edit = service(probe, AxisListEdit, "/mpi/ms0/axis_list_edit", AxisListEdit.Request(operation="APPEND", axis=2))
-    assert edit.message == "MPIMotionMessageAXIS_FRAME_COUNT" and list(edit.axis_numbers) == [0, 1]
+    assert edit.message == "MPIMotionMessageAXIS_FRAME_COUNT"
+    assert list(edit.axis_numbers) == [0, 1]
     listing = service(probe, AxisListGet, "/mpi/ms0/axis_list_get", AxisListGet.Request())
-    assert list(listing.axis_numbers) == [0, 1] and list(listing.mapped_axis_numbers) == [0, 1]
+    assert list(listing.axis_numbers) == [0, 1]
+    assert list(listing.mapped_axis_numbers) == [0, 1]
 
 
 def test_positions_past_2_31_read_back_as_the_32_bit_controller_holds_them(suite, client, applied, drive,
@@ -48,6 +50,8 @@ def test_positions_past_2_31_read_back_as_the_32_bit_controller_holds_them(suite
     applied.wait(2)
     drive(lambda: goal.done)
     result = goal.wait(WAIT)
-    assert result.message == "MPIMessageOK" and list(result.command_position) == [-HALF + 100.0, 0.0]
+    assert result.message == "MPIMessageOK"
+    assert list(result.command_position) == [-HALF + 100.0, 0.0]
     position = service(probe, PositionGet, "/mpi/ms0/position_get", PositionGet.Request())
-    assert list(position.command) == [-HALF + 100.0, 0.0] and abs(position.actual[0] - (-HALF + 100.0)) < 10.0
+    assert list(position.command) == [-HALF + 100.0, 0.0]
+    assert abs(position.actual[0] - (-HALF + 100.0)) < 10.0

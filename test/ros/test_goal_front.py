@@ -45,7 +45,9 @@ def test_requests_become_plain_values():
     request.goal.type = "S_CURVE"
     request.goal.position = [1.0, 2.0]
     plain_key, goal = goal_endpoints.plain_request("goal", request)
-    assert plain_key == key and goal["type"] == "S_CURVE" and goal["position"] == [1.0, 2.0]
+    assert plain_key == key
+    assert goal["type"] == "S_CURVE"
+    assert goal["position"] == [1.0, 2.0]
 
     cancel = MotionStart.Impl.CancelGoalService.Request()
     cancel.goal_info.goal_id.uuid = list(key)
@@ -59,25 +61,29 @@ def test_requests_become_plain_values():
 
 def test_responses_are_built_from_plain_values():
     accepted = goal_endpoints.response_message(MotionStart, "goal", (True, 5_000_000_006))
-    assert accepted.accepted and (accepted.stamp.sec, accepted.stamp.nanosec) == (5, 6)
+    assert accepted.accepted
+    assert (accepted.stamp.sec, accepted.stamp.nanosec) == (5, 6)
     assert not goal_endpoints.response_message(MotionStart, "goal", (False, None)).accepted
 
     key = uuid.uuid4().bytes
     cancel = goal_endpoints.response_message(MotionStart, "cancel", (0, [(key, 7_000_000_008)]))
     (info,) = cancel.goals_canceling
-    assert cancel.return_code == 0 and bytes(info.goal_id.uuid) == key
+    assert cancel.return_code == 0
+    assert bytes(info.goal_id.uuid) == key
     assert (info.stamp.sec, info.stamp.nanosec) == (7, 8)
 
     result = goal_endpoints.response_message(MotionStart, "result",
                                              (GoalStatus.STATUS_SUCCEEDED, MotionStart.Result(message="MPIMessageOK")))
-    assert result.status == GoalStatus.STATUS_SUCCEEDED and result.result.message == "MPIMessageOK"
+    assert result.status == GoalStatus.STATUS_SUCCEEDED
+    assert result.result.message == "MPIMessageOK"
 
 
 def test_a_goal_that_cannot_be_read_is_carried_as_its_error():
     """An internal error reading a goal goes to the goal's result (aborted), not up the loop."""
     request = SimpleNamespace(goal_id=SimpleNamespace(uuid=[0] * 16), goal=object())  # no message: reading fails
     key, goal = goal_endpoints.plain_request("goal", request)
-    assert key == bytes(16) and isinstance(goal, AttributeError)
+    assert key == bytes(16)
+    assert isinstance(goal, AttributeError)
 
 
 # -- the front on the graph ------------------------------------------------------------------------
@@ -99,7 +105,8 @@ def test_the_services_are_the_fronts(suite, probe):
             break
     assert wanted <= held
     ms0 = [name for name, _ in probe.get_service_names_and_types_by_node("ms0", "/mpi")]
-    assert "/mpi/ms0/action" in ms0 and not [name for name in ms0 if "/_action/" in name]
+    assert "/mpi/ms0/action" in ms0
+    assert not [name for name in ms0 if "/_action/" in name]
 
 
 def test_the_front_ends_with_the_suite(ros_context, suite_config):
@@ -108,10 +115,12 @@ def test_the_front_ends_with_the_suite(ros_context, suite_config):
     running = Suite(suite_config, time_scale=None, context=ros_context)
     running.start(spin_in_thread=True)
     relay = running.goal_loop
-    assert isinstance(relay, GoalRelay) and relay.front_alive()
+    assert isinstance(relay, GoalRelay)
+    assert relay.front_alive()
     front = relay.front_pid
     running.shutdown()
-    assert not relay.front_alive() and not _running(front)
+    assert not relay.front_alive()
+    assert not _running(front)
 
 
 _KILLED_SUITE = """
@@ -222,6 +231,7 @@ def test_shutdown_ends_pending_goals_and_answers_them(ros_context, suite_config)
         running.runner.step(200)
         running.shutdown()
         result = goal.wait(raise_on_error=False)
-        assert result.message == "MPIMotionMessageSTOPPED" and goal.handle.status == GoalStatus.STATUS_ABORTED
+        assert result.message == "MPIMotionMessageSTOPPED"
+        assert goal.handle.status == GoalStatus.STATUS_ABORTED
     finally:
         client.close()

@@ -268,11 +268,13 @@ def test_more_goals_than_executor_threads_still_get_answers(suite, sender, probe
     results = sender.wait_results(goals)
     outcomes = [(r.status, r.result.message) for r in results]
     done = outcomes.index((GoalStatus.STATUS_ABORTED, "MPIMotionMessageERROR"))
-    assert done >= 10 and set(outcomes[:done]) == {(GoalStatus.STATUS_SUCCEEDED, "MPIMessageOK")}
+    assert done >= 10
+    assert set(outcomes[:done]) == {(GoalStatus.STATUS_SUCCEEDED, "MPIMessageOK")}
     assert set(outcomes[done:]) == {(GoalStatus.STATUS_ABORTED, "MPIMotionMessageERROR")}
     # the appended moves ran in order, each goal ended with its own move
     ends = [r.result.end_sample for r in results[:done]]
-    assert ends == sorted(ends) and [r.result.command_position[0] for r in results[1:done]] == [
+    assert ends == sorted(ends)
+    assert [r.result.command_position[0] for r in results[1:done]] == [
         100.0 + 10.0 * i for i in range(1, done)]
 
 

@@ -68,7 +68,8 @@ def test_a_goal_ended_once_keeps_its_first_end():
     goals.accept(key(1), 5)
     goals.end(key(1), gt.ABORTED)
     assert goals.end(key(1), gt.SUCCEEDED) is None
-    assert not goals.cancel(key(1)) and not goals.execute(key(1))
+    assert not goals.cancel(key(1))
+    assert not goals.execute(key(1))
     assert goals.status(key(1)) == gt.ABORTED
 
 
@@ -91,7 +92,8 @@ def test_a_reused_goal_id_and_a_non_terminal_end_are_refused():
         goals.accept(key(1), 6)
     with pytest.raises(ValueError):
         goals.end(key(1), gt.EXECUTING)
-    assert key(1) in goals and len(goals) == 1
+    assert key(1) in goals
+    assert len(goals) == 1
     assert goals.status(key(9)) == gt.UNKNOWN
 
 
@@ -110,14 +112,17 @@ def two_ended(apart: float) -> tuple[GoalTable, FakeClock]:
 def test_results_expire_result_timeout_after_their_goal_ended():
     goals, clock = two_ended(4.0)
     clock.now += 5.9
-    assert not goals.expire_due() and goals.expire() == []
+    assert not goals.expire_due()
+    assert goals.expire() == []
     clock.now += 0.2  # 10.1 s after the first ended, 6.1 after the second
     assert goals.expire_due()
     assert goals.expire() == [key(1)]
-    assert key(1) not in goals and key(2) in goals
+    assert key(1) not in goals
+    assert key(2) in goals
     clock.now += 4.0
     assert goals.expire() == [key(2)]
-    assert len(goals) == 0 and not goals.expire_due()
+    assert len(goals) == 0
+    assert not goals.expire_due()
 
 
 def test_expiring_until_a_time_keeps_the_results_that_expire_after_it():
@@ -133,7 +138,8 @@ def test_a_goal_that_has_not_ended_never_expires():
     goals, clock = table(timeout=1.0)
     goals.accept(key(1), 5)
     clock.now += 1e6
-    assert goals.expire() == [] and key(1) in goals
+    assert goals.expire() == []
+    assert key(1) in goals
 
 
 # -- the cancel policy (action_msgs/srv/CancelGoal) ---------------------------------------------

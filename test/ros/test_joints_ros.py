@@ -30,7 +30,8 @@ def test_joint_states_are_in_metres_and_radians_under_the_joint_names(suite, cli
     xy = client.start({"type": "S_CURVE", "position": [250_000.0, 100_000.0], "trajectory": S_CURVE})
     zc = client1.start({"type": "S_CURVE", "position": [100_000.0, 2_500.0], "trajectory": S_CURVE})
     drive(lambda: xy.done and zc.done)
-    assert xy.wait(10.0).message == "MPIMessageOK" and zc.wait(10.0).message == "MPIMessageOK"
+    assert xy.wait(10.0).message == "MPIMessageOK"
+    assert zc.wait(10.0).message == "MPIMessageOK"
     at = suite.controller.sample
     seen = joints.wait_for(lambda ms: bool(ms) and ms[-1].header.stamp.sec * 10**9 + ms[-1].header.stamp.nanosec
                            >= suite.epoch_ns + round((at - 20) * 1e9 / suite.controller.rate))
@@ -43,7 +44,8 @@ def test_joint_states_are_in_metres_and_radians_under_the_joint_names(suite, cli
     assert max(math.hypot(m.velocity[0], m.velocity[1]) for m in seen) == pytest.approx(0.2, rel=0.02)
     # (Z's counts go up while it moves down: the joint's velocity is negative, bar the servo's
     # small overshoot as it settles)
-    assert min(m.velocity[2] for m in seen) < -0.15 and max(m.velocity[2] for m in seen) < 0.01
+    assert min(m.velocity[2] for m in seen) < -0.15
+    assert max(m.velocity[2] for m in seen) < 0.01
     # effort: the servo's acceleration demand in m/s^2, of the order of the 2 m/s^2 asked
     assert 1.0 < max(abs(m.effort[0]) for m in seen) < 10.0
     # every value is the axis' counts converted (the controller's own numbers, at that sample)

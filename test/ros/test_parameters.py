@@ -39,7 +39,7 @@ def test_without_parameters_the_file_rules():
     assert (cfg.ros.status_rate, scale) == (100.0, 2.0)
 
 
-@pytest.mark.parametrize("param, key", [("status_rate:=5000.0", "ros.status_rate"),
+@pytest.mark.parametrize(("param", "key"), [("status_rate:=5000.0", "ros.status_rate"),
                                         ("sample_rate:=-1.0", "controller.sample_rate"),
                                         ("time_scale:=-2.0", "time_scale")])
 def test_bad_parameters_stop_the_start_with_the_key_named(param, key):
@@ -58,7 +58,8 @@ def test_an_integer_where_a_number_is_meant_counts_and_a_wrong_type_is_named():
         cfg, scale = parameters.resolve(context, None, 1.0)
     finally:
         context.try_shutdown()
-    assert (cfg.ros.status_rate, scale) == (200.0, 2.0) and isinstance(scale, float)
+    assert (cfg.ros.status_rate, scale) == (200.0, 2.0)
+    assert isinstance(scale, float)
     context = context_with("crosscheck:=3")
     try:
         with pytest.raises(ConfigError, match=r"^crosscheck: expected true or false, got 3"):
@@ -96,8 +97,10 @@ def test_each_parameter_has_its_own_descriptor_with_type_range_and_description()
     assert set(descriptors) == {"config", "time_scale", "sample_rate", *parameters.ROS_KEYS}
     assert len({id(d) for d in descriptors.values()}) == len(descriptors)  # not one shared object
     for name, descriptor in descriptors.items():
-        assert descriptor.name == name and descriptor.read_only
-        assert descriptor.description and f"-p {name}:=VALUE" in descriptor.additional_constraints
+        assert descriptor.name == name
+        assert descriptor.read_only
+        assert descriptor.description
+        assert f"-p {name}:=VALUE" in descriptor.additional_constraints
     assert descriptors["status_rate"].type == ParameterType.PARAMETER_DOUBLE
     assert (descriptors["status_rate"].floating_point_range[0].from_value,
             descriptors["status_rate"].floating_point_range[0].to_value) == (0.0, 1000.0)
@@ -106,7 +109,8 @@ def test_each_parameter_has_its_own_descriptor_with_type_range_and_description()
     assert descriptors["config"].type == ParameterType.PARAMETER_STRING
     assert descriptors["status_rate"].description == "Hz: how often MotionStatus and AxisStatus are published " \
                                                      "(ros.status_rate)"
-    assert values["sample_rate"] == 2000.0 and values["time_scale"] == 1.0
+    assert values["sample_rate"] == 2000.0
+    assert values["time_scale"] == 1.0
 
 
 def test_the_descriptors_are_the_schemas():
@@ -140,10 +144,11 @@ def test_a_schema_change_shows_in_the_descriptor(monkeypatch):
     descriptors, _ = _described()
     described = descriptors["feedback_rate"]
     assert described.floating_point_range[0].to_value == 50.0
-    assert "a changed doc" in described.description and "<= 50" in described.additional_constraints
+    assert "a changed doc" in described.description
+    assert "<= 50" in described.additional_constraints
 
 
-@pytest.mark.parametrize("param, text", [
+@pytest.mark.parametrize(("param", "text"), [
     ("crosscheck:=1", "crosscheck: expected true or false, got 1"),  # the one reader: 1 is not true
     ("feedback_rate:=fast", "feedback_rate: expected a finite number, got 'fast'"),
     ("config:=3", "config: expected a string, got 3"),

@@ -98,7 +98,8 @@ def element_at(sample: int, ids, times) -> int | None:
 def started(applied) -> int:
     """The sample at which the test's first goal (a MotionStart) took effect."""
     sample, command, reply = applied.wait(1)
-    assert command.operation == "motion_start" and reply.message.name == "MPIMessageOK", reply
+    assert command.operation == "motion_start", reply
+    assert reply.message.name == "MPIMessageOK", reply
     return sample
 
 
@@ -156,7 +157,8 @@ def test_frame_goal_runs_its_frames(suite, client, applied, drive):
     begin = started(applied)
     drive(lambda: running.done, chunk=40)
     result = running.wait()
-    assert result.message == "MPIMessageOK" and result.end_sample >= begin + RATE
+    assert result.message == "MPIMessageOK"
+    assert result.end_sample >= begin + RATE
     assert [round(p, 9) for p in result.command_position] == [500.0, 0.0]
 
 
@@ -187,12 +189,14 @@ def test_streamed_path_appends_end_with_their_points_and_the_start_with_the_path
     result = start.wait()
     assert [(r.message, r.detail) for r in ends] == [("MPIMessageOK", "points executed")] * 3
     assert [r.end_sample for r in ends] == sorted(r.end_sample for r in ends)
-    assert result.message == "MPIMessageOK" and result.detail.startswith("motion done; path peaks")
+    assert result.message == "MPIMessageOK"
+    assert result.detail.startswith("motion done; path peaks")
     assert result.end_sample >= ends[-1].end_sample
     assert list(result.command_position) == line(270, 1)
     axis.wait_for(lambda m: m.sample >= ends[-1].end_sample, "an axis status at the path's last point")
     counts = [m.frame_count for m in axis.messages]
-    assert max(counts) == 128 and min(counts) >= 0  # never more than the buffer holds
+    assert max(counts) == 128
+    assert min(counts) >= 0
     assert not [e for e in events.messages if e.type in ("E_STOP", "FRAMES_EMPTY")]
 
 
@@ -221,7 +225,8 @@ def test_empty_count_zero_rests_on_the_last_point_until_an_empty_final_append(su
                             "empty_count": 0})
     started(applied)
     drive(lambda: running.done or any(e.type == "FRAMES_EMPTY" and e.supervisor == 0 for e in events.messages))
-    assert not running.done and client.status().state_name == "MOVING"
+    assert not running.done
+    assert client.status().state_name == "MOVING"
     close = client.modify({"type": "PT", "attributes": ["APPEND"], "final": True})
     drive(lambda: running.done and close.done)
     assert close.wait().message == running.wait().message == "MPIMessageOK"
@@ -232,7 +237,8 @@ def test_spline_may_not_stay_open(suite, client):
     # MPI 000: SPLINE may not carry APPEND, so it cannot be left open for more points.
     running = client.start({"type": "SPLINE", "position": line(1, 3), "time": [0.1] * 3, "final": False})
     result = running.wait(raise_on_error=False)
-    assert result.message == "MPIMotionMessagePATH_ERROR" and result.state_name == "IDLE"
+    assert result.message == "MPIMotionMessagePATH_ERROR"
+    assert result.state_name == "IDLE"
 
 
 # -- bad data ------------------------------------------------------------------------------------------
@@ -262,7 +268,8 @@ def test_client_path_pvt_pick_and_place_stops_at_rest(suite, client, drive):
                           element_ids=[1, 2, 3], wait=False)
     drive(lambda: running.done, chunk=40)
     result = running.wait()
-    assert result.command_position == (1000.0, 0.0) and result.detail.startswith("motion done; path peaks")
+    assert result.command_position == (1000.0, 0.0)
+    assert result.detail.startswith("motion done; path peaks")
 
 
 def test_client_stream_keeps_a_10000_point_path_going(suite, client, events, cues, applied):
@@ -288,7 +295,8 @@ def test_client_stream_keeps_a_10000_point_path_going(suite, client, events, cue
     streaming.join(WAIT)
     assert "error" not in outcome, outcome
     result = outcome["result"]
-    assert result.message == "MPIMessageOK" and result.state_name == "IDLE"
+    assert result.message == "MPIMessageOK"
+    assert result.state_name == "IDLE"
     assert max(abs(p - e) for p, e in zip(result.command_position, points[-1], strict=True)) < 1e-6
     sends = [(c.operation, c.request["final"]) for _, c, _ in applied.commands]
     assert sends == [("motion_start", False)] + [("motion_modify", False)] * 98 + [("motion_modify", True)]
@@ -316,13 +324,15 @@ def test_client_stream_ahead_keeps_chunks_queued_beyond_the_buffer_cue(suite, cl
     applied.wait(4)  # nothing stepped: no FRAMES_LOW cue, the client sent ahead
     runner = suite.runner
     runner.step(150)  # one point a sample: the start's chunk done, the first append's half
-    assert len(applied.commands) == 4 and not outcome
+    assert len(applied.commands) == 4
+    assert not outcome
     runner.step(60)  # the first append's last point (sample 200) reached: its goal ends, one more goes
     applied.wait(5)
     step_gated(suite, applied, streaming, closing=count // chunk)
     streaming.join(WAIT)
     assert "error" not in outcome, outcome
-    assert outcome["result"].message == "MPIMessageOK" and outcome["result"].command_position[0] == count
+    assert outcome["result"].message == "MPIMessageOK"
+    assert outcome["result"].command_position[0] == count
     sends = [(c.operation, c.request["final"]) for _, c, _ in applied.commands]
     assert sends == [("motion_start", False)] + [("motion_modify", False)] * 8 + [("motion_modify", True)]
     assert not [e for e in events.messages if e.type in ("E_STOP", "FRAMES_EMPTY")]

@@ -39,7 +39,7 @@ def test_another_rclpy_is_refused_naming_its_version(version):
 def test_a_bad_action_server_setting_names_its_key():
     from mpi_ros import config
 
-    with pytest.raises(config.ConfigError, match="ros.action_server: one of batched, rclpy, got 'stock'"):
+    with pytest.raises(config.ConfigError, match=r"ros\.action_server: one of batched, rclpy, got 'stock'"):
         config.load(overrides={"ros": {"action_server": "stock"}})
-    with pytest.raises(config.ConfigError, match="ros.goal_process: the goal front serves the batched"):
+    with pytest.raises(config.ConfigError, match=r"ros\.goal_process: the goal front serves the batched"):
         config.load(overrides={"ros": {"action_server": "rclpy", "goal_process": True}})

@@ -48,28 +48,35 @@ def test_the_configuration_is_latched_for_late_joiners(suite, probe):
     inbox = Inbox(probe, SuiteConfiguration, "/mpi/configuration", LATE_JOINER)  # joins after the suite
     (msg,) = inbox.wait_for(1)
     assert yaml.safe_load(msg.config) == suite.config.raw
-    assert msg.sample_rate == suite.controller.rate and msg.start_sample == 0
-    assert msg.epoch_ns == suite.epoch_ns and _ns(msg.stamp) == suite.epoch_ns
-    assert msg.ros_namespace == "/mpi" and msg.mpi_ros_version and msg.source == suite.config.source
+    assert msg.sample_rate == suite.controller.rate
+    assert msg.start_sample == 0
+    assert msg.epoch_ns == suite.epoch_ns
+    assert _ns(msg.stamp) == suite.epoch_ns
+    assert msg.ros_namespace == "/mpi"
+    assert msg.mpi_ros_version
+    assert msg.source == suite.config.source
     # the epoch is the wall clock when the suite was built (moments ago)
     assert before - 120 * 10**9 < suite.epoch_ns <= time.time_ns()
 
 
 def test_every_applied_command_is_published_with_its_effective_sample(suite, client, probe, applied, drive):
     goal = client.start(MOVE)
-    sample, command, reply = applied.wait(1)
+    sample, _command, reply = applied.wait(1)
     # transient local: a subscriber that joins after the command still gets it
     inbox = Inbox(probe, CommandMsg, "/mpi/commands", LATE_JOINER)
     (msg,) = inbox.wait_for(1)
     assert (msg.sample, msg.operation, msg.supervisor, msg.axis) == (sample, "motion_start", 0, -1)
-    assert json.loads(msg.request)["position"] == MOVE["position"] and msg.message == reply.message.name
+    assert json.loads(msg.request)["position"] == MOVE["position"]
+    assert msg.message == reply.message.name
     assert _ns(msg.header.stamp) == suite.epoch_ns + round(sample * 1e9 / suite.controller.rate)
     assert msg.header.frame_id == "mpi/ms0"  # the object it addressed (convert.frame_id)
     drive(lambda: goal.done)
     assert client.action("STOP", raise_on_error=False).message == "MPIMotionMessageIDLE"  # refused: still published
     (_, stop) = inbox.wait_for(2)
-    assert stop.operation == "action" and json.loads(stop.request) == {"action": "STOP"}
-    assert stop.message == "MPIMotionMessageIDLE" and stop.sample > msg.sample
+    assert stop.operation == "action"
+    assert json.loads(stop.request) == {"action": "STOP"}
+    assert stop.message == "MPIMotionMessageIDLE"
+    assert stop.sample > msg.sample
     assert stop.header.frame_id == "mpi/ms0"
 
 
@@ -88,12 +95,14 @@ def test_stamps_of_every_topic_are_the_wall_anchored_controller_time(suite, prob
     for msg in (status.messages[0], axis.messages[0], *status.messages[0].axes):
         assert _ns(msg.header.stamp) == suite.epoch_ns + round(msg.sample * 1e9 / rate)
     # the headers name their sources (convert.frame_id), the nested axes included
-    assert status.messages[0].header.frame_id == "mpi/ms1" and axis.messages[0].header.frame_id == "mpi/axis3"
+    assert status.messages[0].header.frame_id == "mpi/ms1"
+    assert axis.messages[0].header.frame_id == "mpi/axis3"
     assert [a.header.frame_id for a in status.messages[0].axes] == ["mpi/axis2", "mpi/axis3"]
     # no sample field: a whole number of samples after the epoch, no later than the controller
     for t in (_ns(joints.messages[0].header.stamp), _ns(clock.messages[0].clock)):
         samples = (t - suite.epoch_ns) * rate / 1e9
-        assert samples == int(samples) and 0 < samples <= suite.controller.sample
+        assert samples == int(samples)
+        assert 0 < samples <= suite.controller.sample
     # wall-clock time, not "seconds since the suite started": tools without sim time take it as now
     assert abs(_ns(axis.messages[0].header.stamp) - time.time_ns()) < 120 * 10**9
 
@@ -118,9 +127,11 @@ def test_joint_effort_is_the_servo_loop_output():
     assert axis.servo_effort() == pytest.approx(10000.0, rel=1e-6)
     assert convert.joint_state(ctl, 0).effort[0] == axis.servo_effort()
     ctl.step(int(2.0 * ctl.rate))  # cruising
-    assert axis.cmd_a == 0.0 and axis.servo_effort() == pytest.approx(0.0, abs=1e-3)
+    assert axis.cmd_a == 0.0
+    assert axis.servo_effort() == pytest.approx(0.0, abs=1e-3)
     ctl.step(int(4.0 * ctl.rate))  # decelerated, done and settled
-    assert axis.cmd_v == 0.0 and axis.servo_effort() == pytest.approx(0.0, abs=1e-6)
+    assert axis.cmd_v == 0.0
+    assert axis.servo_effort() == pytest.approx(0.0, abs=1e-6)
     apply(ctl, Command("motion_start", 0, request={
         "type": "TRAPEZOIDAL", "position": [0.0, 0.0],
         "trajectory": [{"velocity": 4000.0, "acceleration": 10000.0, "deceleration": 10000.0}]}))
@@ -128,7 +139,8 @@ def test_joint_effort_is_the_servo_loop_output():
     assert axis.servo_effort() != 0.0
     apply(ctl, Command("action", 0, request={"action": "ABORT"}))
     ctl.step(10)
-    assert not axis.amp_enabled and axis.servo_effort() == 0.0
+    assert not axis.amp_enabled
+    assert axis.servo_effort() == 0.0
 
 
 def test_an_event_burst_is_whole_for_a_deep_subscriber_and_cut_to_5_by_the_tools_default(suite, ros_context):
@@ -181,7 +193,8 @@ def test_an_event_burst_is_whole_for_a_deep_subscriber_and_cut_to_5_by_the_tools
         spin_until(lambda: publisher.get_subscription_count() >= 2, "default subscriber not matched")
         runner.step(1)  # the burst, while the subscribers are not being spun
         burst = runner.read(lambda ctl: list(ctl.events)[before:])
-        assert len(burst) == size and {e.sample for e in burst} == {burst_at}
+        assert len(burst) == size
+        assert {e.sample for e in burst} == {burst_at}
         assert publisher.wait_for_all_acked(Duration(seconds=WAIT))  # both have received all of it
         spin_until(lambda: len(deep) >= before + size and len(default) >= 5, "the burst")
         for _ in range(10):  # anything more the default subscription would still hold
@@ -210,6 +223,7 @@ def test_each_parameter_has_its_own_descriptor(suite, probe, service):
     assert by_name["crosscheck"].type == ParameterType.PARAMETER_BOOL
     assert by_name["status_rate"].type == ParameterType.PARAMETER_DOUBLE
     status_range = by_name["status_rate"].floating_point_range
-    assert status_range and status_range[0].to_value == 1000.0
+    assert status_range
+    assert status_range[0].to_value == 1000.0
     assert len({d.description for d in described}) == len(names)  # not one shared text
     assert all(d.read_only for d in described)

@@ -90,7 +90,8 @@ def test_random_action_interleavings_keep_the_state_machine_consistent(script):
         ctl.step(samples)
         assert _finite_state(ctl)
         if ms.state is MPIState.ERROR:
-            assert ms.current is None and not ms.queue  # nothing pending survives ERROR
+            assert ms.current is None
+            assert not ms.queue
         if ms.state is MPIState.IDLE:
             assert all(not ctl.axes[n].holding for n in ms.mapped)
 

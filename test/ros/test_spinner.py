@@ -35,7 +35,8 @@ def test_stop_ends_a_spinner_asleep_in_its_wait(node_and_executor):
     assert not spinner.ended
     # nothing else to do: the executor waits with no timeout, and stop must still end it
     assert spinner.stop(WAIT)
-    assert spinner.ended and spinner.error is None
+    assert spinner.ended
+    assert spinner.error is None
 
 
 def test_stop_before_start_has_nothing_to_wait_for(node_and_executor):
@@ -61,5 +62,6 @@ def test_a_callback_that_raises_ends_the_spinner_with_its_error(node_and_executo
     # rclpy re-raises a callback's exception in spin_once, in the next round that has work:
     # one more trigger gives it that round
     node.create_guard_condition(lambda: None).trigger()
-    assert spinner.join(WAIT) and spinner.ended
+    assert spinner.join(WAIT)
+    assert spinner.ended
     assert isinstance(spinner.error, ZeroDivisionError)

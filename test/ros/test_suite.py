@@ -19,7 +19,8 @@ def test_an_executor_stopped_by_an_error_is_reported_and_the_rest_keep_spinning(
         broken.create_guard_condition(lambda: None).trigger()  # the round that re-raises it
         [failed] = [s for s in suite.spinners if s.name == broken.get_name()]
         assert failed.join(WAIT)
-        assert suite.failed() == [failed] and isinstance(failed.error, ZeroDivisionError)
+        assert suite.failed() == [failed]
+        assert isinstance(failed.error, ZeroDivisionError)
         # another node's executor still runs its callbacks
         ran = threading.Event()
         suite.supervisor_nodes[1].create_guard_condition(ran.set).trigger()

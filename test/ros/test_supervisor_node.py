@@ -26,7 +26,8 @@ def state_of(suite, number=0):
 def test_move_reaches_target_and_succeeds_with_ok(suite, client, applied, drive):
     goal = client.start(move([1000.0, -250.0]))
     sample, command, reply = applied.wait(1)
-    assert command.operation == "motion_start" and reply.message.name == "MPIMessageOK"
+    assert command.operation == "motion_start"
+    assert reply.message.name == "MPIMessageOK"
     drive(lambda: goal.done)
     result = goal.wait()
     # docs/decisions.md, "The ROS goals": the goal succeeds when the motion is DONE, with MPIMessageOK.
@@ -34,7 +35,8 @@ def test_move_reaches_target_and_succeeds_with_ok(suite, client, applied, drive)
     assert (result.message, result.code, result.state_name) == ("MPIMessageOK", 0, "IDLE")
     assert list(result.command_position) == [1000.0, -250.0]  # exactly on target
     assert all(abs(a - t) < 10.0 for a, t in zip(result.actual_position, [1000.0, -250.0], strict=True))  # positionFine
-    assert result.sample == sample and result.end_sample > sample
+    assert result.sample == sample
+    assert result.end_sample > sample
     # Never reported done while the axes still move: DONE needs the settled actual position.
     done_axes = suite.runner.read(lambda ctl: [ctl.axes[n].status.done for n in (0, 1)])
     assert done_axes == [True, True]
@@ -48,7 +50,8 @@ def test_feedback_reports_progress_and_positions(suite, client, applied, drive):
     goal.wait()
     assert seen, "no feedback"
     last = seen[-1]
-    assert last.state_name in ("MOVING", "IDLE") and len(last.command_position) == 2
+    assert last.state_name in ("MOVING", "IDLE")
+    assert len(last.command_position) == 2
     assert all(0.0 <= fb.progress <= 1.0 for fb in seen)
     assert [fb.progress for fb in seen] == sorted(fb.progress for fb in seen)
 
@@ -67,7 +70,8 @@ def test_e_stop_mid_move_ends_goal_with_error_then_reset_returns_idle(suite, cli
     result = goal.wait(raise_on_error=False)
     # MPI 000, MPIMotionMessageERROR MPIMotionMessageERROR: "in an error state due to an E_STOP or ABORT action"
     assert goal.handle.status == GoalStatus.STATUS_ABORTED
-    assert result.message == "MPIMotionMessageERROR" and "E_STOP" in result.detail
+    assert result.message == "MPIMotionMessageERROR"
+    assert "E_STOP" in result.detail
     assert result.state_name == "ERROR"
     with pytest.raises(errors.MPIMotionMessageERROR):
         goal.wait()
@@ -90,7 +94,8 @@ def test_stop_ends_goal_stopped_and_resume_completes_the_move(suite, client, app
     result = goal.wait(raise_on_error=False)
     # docs/state-machine.md: STOP -> STOPPING -> STOPPED; docs/decisions.md, "The ROS goals": the goal
     # ends with MPIMotionMessageSTOPPED.
-    assert result.message == "MPIMotionMessageSTOPPED" and result.state_name == "STOPPED"
+    assert result.message == "MPIMotionMessageSTOPPED"
+    assert result.state_name == "STOPPED"
     stopped_at = suite.runner.ctl.axes[0].command_position
     assert stopped_at < 8000.0
     assert client.resume().state_name == "MOVING"
@@ -143,7 +148,8 @@ def test_a_velocity_modify_goal_succeeds_only_once_its_own_velocity_is_reached(s
     assert command_velocity() == [200.0, 200.0]
     modify = client.modify(velocity(-300.0))
     sample, command, reply = applied.wait(2)
-    assert command.operation == "motion_modify" and reply.message.name == "MPIMessageOK"
+    assert command.operation == "motion_modify"
+    assert reply.message.name == "MPIMessageOK"
     ramped = []  # the first sample at which the commanded velocity is -300 on both axes
     drive(lambda: ramped or (command_velocity() == [-300.0, -300.0] and ramped.append(suite.runner.ctl.sample)),
           chunk=1)
@@ -165,13 +171,14 @@ def test_cancel_is_a_stop(suite, client, applied, drive):
     cancel.join(timeout=10.0)
     result = goal.wait(raise_on_error=False)
     assert goal.handle.status == GoalStatus.STATUS_CANCELED
-    assert result.message == "MPIMotionMessageSTOPPED" and result.state_name == "STOPPED"
+    assert result.message == "MPIMotionMessageSTOPPED"
+    assert result.state_name == "STOPPED"
     # decelerated over decelTime.stop, not an abrupt halt: the axis went on after cancel
     assert applied.commands[1][1].request == {"action": "STOP"}
 
 
 @pytest.mark.parametrize(
-    "goal, message",
+    ("goal", "message"),
     [
         ({"type": "WARP_DRIVE", "position": [1.0, 0.0]}, "MPIMotionMessageTYPE_INVALID"),
         ({**S_CURVE, "attributes": ["TELEPORT"], "position": [1.0, 0.0]}, "MPIMotionMessageTYPE_INVALID"),
@@ -251,14 +258,16 @@ def test_trigger_services_answer_the_spec_message(suite, probe, service):
     stop = service(probe, Trigger, "/mpi/ms0/stop", Trigger.Request())
     assert (stop.success, stop.message.split(":")[0]) == (False, "MPIMotionMessageIDLE")
     reset = service(probe, Trigger, "/mpi/ms0/reset", Trigger.Request())
-    assert reset.success and reset.message.startswith("MPIMessageOK")
+    assert reset.success
+    assert reset.message.startswith("MPIMessageOK")
 
 
 def test_action_service_rejects_unknown_actions(suite, probe, service):
     from mpi_ros.srv import MotionAction
 
     response = service(probe, MotionAction, "/mpi/ms0/action", MotionAction.Request(action="SELF_DESTRUCT"))
-    assert response.message == "MPIMessagePARAM_INVALID" and response.state_name == "IDLE"
+    assert response.message == "MPIMessagePARAM_INVALID"
+    assert response.state_name == "IDLE"
 
 
 def test_config_and_params_services_round_trip(suite, probe, service):
@@ -316,10 +325,12 @@ def test_axis_list_position_frame_buffer_and_event_services(suite, probe, servic
     )
 
     listing = service(probe, AxisListGet, "/mpi/ms0/axis_list_get", AxisListGet.Request())
-    assert list(listing.axis_numbers) == [0, 1] and list(listing.mapped_axis_numbers) == [0, 1]
+    assert list(listing.axis_numbers) == [0, 1]
+    assert list(listing.mapped_axis_numbers) == [0, 1]
     # MPI 000, mpiMotionAxisAppend, return values MPIMessageOBJECT_ON_LIST: "axis is already on the list"
     edit = service(probe, AxisListEdit, "/mpi/ms0/axis_list_edit", AxisListEdit.Request(operation="APPEND", axis=1))
-    assert edit.message == "MPIMessageOBJECT_ON_LIST" and list(edit.axis_numbers) == [0, 1]
+    assert edit.message == "MPIMessageOBJECT_ON_LIST"
+    assert list(edit.axis_numbers) == [0, 1]
     edit = service(probe, AxisListEdit, "/mpi/ms0/axis_list_edit", AxisListEdit.Request(operation="APPEND", axis=9))
     assert edit.message == "MPIMessageHANDLE_INVALID"
 
@@ -340,4 +351,5 @@ def test_axis_list_position_frame_buffer_and_event_services(suite, probe, servic
     bad = service(probe, EventNotifySet, "/mpi/ms0/event_notify_set", EventNotifySet.Request(event_types=["NOPE"]))
     assert bad.message == "MPIMessagePARAM_INVALID"
     reset = service(probe, EventReset, "/mpi/ms0/event_reset", EventReset.Request(event_types=["ALL"]))
-    assert reset.message == "MPIMessageOK" and list(reset.latched_event_types) == []
+    assert reset.message == "MPIMessageOK"
+    assert list(reset.latched_event_types) == []

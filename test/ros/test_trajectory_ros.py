@@ -86,7 +86,8 @@ def test_a_published_pvt_trajectory_moves_ms0_through_its_points(suite, probe, p
     publish(message(["y", "x"], [(p[::-1], v[::-1], t) for p, v, t in POINTS]))
     suite.runner.step(1)
     sample, command, reply = applied.wait(1)
-    assert command.operation == "joint_trajectory" and reply.message.name == "MPIMessageOK", reply.detail
+    assert command.operation == "joint_trajectory", reply.detail
+    assert reply.message.name == "MPIMessageOK", reply.detail
     begin = sample - 1  # the path runs from this sample's time on (recorded with the next)
     drive(lambda: suite.runner.ctl.sample > begin + 1.7 * RATE)
     end = statuses.wait_for(lambda m: m.sample >= begin + 1.7 * RATE, "a status after the path")
@@ -108,7 +109,8 @@ def test_a_future_stamp_starts_the_path_then(suite, publish, applied):
     stamp = suite.epoch_ns + round(start / RATE * 1e9)
     publish(message(["x", "y"], [([0.1, 0.0], [], 0.5)], stamp))
     suite.runner.step(start - 1 - suite.runner.ctl.sample)  # one sample short of the stamp
-    assert suite.runner.read(lambda ctl: ctl.supervisor(0).state.name) == "IDLE" and not applied.commands
+    assert suite.runner.read(lambda ctl: ctl.supervisor(0).state.name) == "IDLE"
+    assert not applied.commands
     suite.runner.step(10)
     sample, command, reply = applied.wait(1)
     assert (sample, command.operation, reply.message.name) == (start + 1, "joint_trajectory", "MPIMessageOK")
@@ -138,7 +140,8 @@ def test_each_refusal_moves_nothing_and_is_counted_on_diagnostics(suite, probe, 
     assert commands == [("joint_trajectory", "MPIMessagePARAM_INVALID"), ("action", "MPIMessageOK"),
                         ("joint_trajectory", "MPIMotionMessageERROR")]
     counts = suite.supervisor_nodes[0].trajectories.snapshot()
-    assert counts.received == 6 and counts.accepted == 0
+    assert counts.received == 6
+    assert counts.accepted == 0
     assert dict(counts.refused) == {"MPIMessagePARAM_INVALID": 3, "MPIMotionMessagePATH_ERROR": 1,
                                     "MEIMotionMessageBAD_PATH_DATA": 1, "MPIMotionMessageERROR": 1}
 
@@ -150,5 +153,6 @@ def test_each_refusal_moves_nothing_and_is_counted_on_diagnostics(suite, probe, 
     found = diagnostics.wait_for(counted, "/diagnostics counting 6 refusals")
     status = next(s for s in found.status if s.name == "mpi/ms0/joint_trajectory")
     values = {v.key: v.value for v in status.values}
-    assert values["refused_MPIMotionMessagePATH_ERROR"] == "1" and values["accepted"] == "0"
+    assert values["refused_MPIMotionMessagePATH_ERROR"] == "1"
+    assert values["accepted"] == "0"
     assert "supervisor is ERROR" in values["last_refusal"]

@@ -121,11 +121,16 @@ def test_a_killed_client_has_its_motion_stopped_with_an_event(suite, drive, tmp_
     assert TIMEOUT <= took < LEASE + TIMEOUT + LOADED
     # the client did not cancel (no STOP action of its own): the watchdog stopped the motion
     assert [c.operation for _, c, _ in seen.commands] == ["motion_start", Operation.CLIENT_LOST]
-    assert command.supervisor == 1 and reply.message.name == "MPIMessageOK" and reply.state is MPIState.STOPPING
+    assert command.supervisor == 1
+    assert reply.message.name == "MPIMessageOK"
+    assert reply.state is MPIState.STOPPING
     lost = [e for e in seen.events if e.type_name == "CLIENT_LOST"]
-    assert len(lost) == 1 and lost[0].supervisor == 1 and "left the graph" in lost[0].detail
+    assert len(lost) == 1
+    assert lost[0].supervisor == 1
+    assert "left the graph" in lost[0].detail
     after = [e.type_name for e in seen.events[seen.events.index(lost[0]):] if e.supervisor == 1]
-    assert after[:2] == ["CLIENT_LOST", "STOP"] and lost[0].sample == sample - 1  # applied at the next sample
+    assert after[:2] == ["CLIENT_LOST", "STOP"]
+    assert lost[0].sample == sample - 1
     drive(lambda: suite.runner.read(lambda ctl: ctl.supervisor(1).state is MPIState.STOPPED))
     assert suite.runner.read(lambda ctl: ctl.supervisor(0).state) is MPIState.IDLE  # the other one untouched
     assert watchdog.watched == 0  # the goal ended (STOPPED): nothing left to watch
@@ -147,7 +152,8 @@ def test_a_client_lost_command_replays_as_recorded():
         reply = apply(ctl, Command(Operation.CLIENT_LOST, 0, request=lost))
         answers.append((reply.message, reply.state, [(e.sample, e.type_name, e.detail) for e in events]))
     assert answers[0] == answers[1]
-    assert answers[0][0].name == "MPIMessageOK" and answers[0][1] is MPIState.STOPPING
+    assert answers[0][0].name == "MPIMessageOK"
+    assert answers[0][1] is MPIState.STOPPING
     refused = apply(config.load().build_controller(), Command(Operation.CLIENT_LOST, 0, request={"detail": 5}))
     assert refused.message.name == "MPIMessagePARAM_INVALID"
 
@@ -197,12 +203,15 @@ def test_the_watchdog_times_the_clients_absence_and_forgives_a_return():
     assert not lost
     now[0] = 8.0
     watchdog.check()
-    assert len(lost) == 1 and "67676767" in lost[0] and "1 s" in lost[0]
+    assert len(lost) == 1
+    assert "67676767" in lost[0]
+    assert "1 s" in lost[0]
     assert watchdog.watched == 0
     watchdog.watch(b"h" * 16, topic)  # a goal that ended is forgotten, never stopped
     now[0] = 20.0
     watchdog.check()
-    assert watchdog.watched == 0 and len(lost) == 1
+    assert watchdog.watched == 0
+    assert len(lost) == 1
 
 
 def test_a_goal_whose_client_was_never_seen_is_stopped_after_the_discovery_grace():
@@ -217,15 +226,18 @@ def test_a_goal_whose_client_was_never_seen_is_stopped_after_the_discovery_grace
     watchdog.watch(b"g" * 16, topic)
     now[0] = 10.0 + 0.5 + DISCOVERY_GRACE - 0.01
     watchdog.check()
-    assert not lost and "came 1.49 s ago" in watchdog.describe_watched()[0]
+    assert not lost
+    assert "came 1.49 s ago" in watchdog.describe_watched()[0]
     now[0] = 10.0 + 0.5 + DISCOVERY_GRACE
     watchdog.check()
-    assert len(lost) == 1 and watchdog.watched == 0
+    assert len(lost) == 1
+    assert watchdog.watched == 0
     watchdog.watch(b"h" * 16, topic)  # seen late (discovery lagged): watched as usual from then on
     graph.subscribers[topic] = [b"A" * 16]
     now[0] = 30.0
     watchdog.check()
-    assert len(lost) == 1 and watchdog.watched == 1
+    assert len(lost) == 1
+    assert watchdog.watched == 1
 
 
 def test_a_goal_whose_clients_are_all_detached_is_not_watched():
@@ -248,9 +260,11 @@ def test_a_goal_whose_clients_are_all_detached_is_not_watched():
     watchdog.check()
     now[0] = 0.5
     watchdog.check()
-    assert len(lost) == 1 and "68686868" in lost[0]
+    assert len(lost) == 1
+    assert "68686868" in lost[0]
     graph.subscribers[topic] = []  # a detached client seen only after its goal: forgotten then
     watchdog.watch(b"i" * 16, topic)
     graph.subscribers[topic] = [b"D" * 16]
     watchdog.check()
-    assert watchdog.watched == 0 and len(lost) == 1
+    assert watchdog.watched == 0
+    assert len(lost) == 1

@@ -477,7 +477,7 @@ class Axis:
             i += 1
         if cuts[-1] <= t_to:
             cuts.append(math.inf)
-        return [(a, b, self._forced(command, a, b, clock)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
+        return [(a, b, self._forced(command, a, b, clock)) for a, b in itertools.pairwise(cuts)]
 
     def steady(self, clock: ProfileClock | None) -> bool:
         """At rest with the loop settled: every coming sample is the same."""

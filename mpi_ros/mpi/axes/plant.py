@@ -333,7 +333,7 @@ class _FreeTable:
     from the C library's scalar functions (the same on every CPU); beyond, products
     Phi((a + b) dt) = Phi(a dt) Phi(b dt), using M^2 = kappa I."""
 
-    __slots__ = ("p", "q", "k", "kappa", "block_p", "block_q", "block_k", "_p2", "_q2", "_bp", "_bq", "_vanishing")
+    __slots__ = ("_bp", "_bq", "_p2", "_q2", "_vanishing", "block_k", "block_p", "block_q", "k", "kappa", "p", "q")
 
     def __init__(self, p, q, k, kappa: float):
         self.p, self.q, self.k, self.kappa = p, q, k, kappa

@@ -257,7 +257,7 @@ def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scr
     criterion that cannot hold anywhere (say, no trajectory complete) is not computed."""
     col = rows.col
     work = _Arrays(scratch, trace.cmd_p.shape)
-    bits = scratch.take("status.bits", (len(BITS),) + trace.cmd_p.shape, bool)
+    bits = scratch.take("status.bits", (len(BITS), *trace.cmd_p.shape), bool)
     velocity_ok = np.less(work.absolute_difference(trace.cmd_v, trace.act_v), col["velocity_tol"],
                           out=work.flag("velocity_ok"))
     stopped = np.less(np.abs(trace.cmd_v, out=work.real("difference")), _STOPPED_VELOCITY, out=work.flag("stopped"))

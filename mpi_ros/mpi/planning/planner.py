@@ -261,7 +261,7 @@ def _cap_frames(segments: list[Segment], limit: float, axis: int, notes: PlanNot
                  f"axis {axis}: a frame of {duration:.1f} s exceeds {VELOCITY_FRAME_LIMIT_SAMPLES} samples;"
                  " the axis will stop abruptly after it")
             )
-            return segments[:i] + [Segment(limit, p, v, a, j)], True
+            return [*segments[:i], Segment(limit, p, v, a, j)], True
     return segments, False
 
 

@@ -20,8 +20,20 @@ from mpi_ros.mpi.base.types import ActionSource, MPIState
 class SupervisorState:
     """A motion supervisor's own state (MPI 000, MPIState) and what drives it."""
 
-    __slots__ = ("number", "config", "own_state", "last_action", "action_source", "stop_end", "abort_after_stop",
-                 "error_at", "aborted", "unacknowledged", "_clock", "_clock_changed")
+    __slots__ = (
+        "_clock",
+        "_clock_changed",
+        "abort_after_stop",
+        "aborted",
+        "action_source",
+        "config",
+        "error_at",
+        "last_action",
+        "number",
+        "own_state",
+        "stop_end",
+        "unacknowledged",
+    )
 
     def __init__(self, number: int, config: MotionConfig, clock: ProfileClock,
                  clock_changed: Callable[[int, ProfileClock], None]):

@@ -32,7 +32,8 @@ def test_actual_lags_command_and_settles_in_real_time(params):
     axis = ctl.axes[0]
     assert axis.command_position - axis.actual_position > 20.0  # behind while moving forward
     ctl.step(4200 - 1000)  # the command has arrived (2.1 s)
-    assert axis.command_position == 2000.0 and axis.actual_position != 2000.0
+    assert axis.command_position == 2000.0
+    assert axis.actual_position != 2000.0
     assert ctl.run_until(lambda c: axis.actual_position == 2000.0 and abs(axis.act_v) < 1.0, 10_000)
 
 
@@ -52,7 +53,9 @@ def test_origin_offsets_every_reported_position(ctl, ms, params, run_to):
     ms.start(T.TRAPEZOIDAL, params=params((500.0, 0.0)))
     run_to(ctl, ms, MPIState.IDLE, 20_000, chunk=100)
     snap = ctl.axis_snapshot(0)
-    assert snap.command_position == 500.0 and snap.target_position == 500.0 and snap.origin == 100.0
+    assert snap.command_position == 500.0
+    assert snap.target_position == 500.0
+    assert snap.origin == 100.0
     assert ctl.axes[0].cmd_p == 600.0  # the raw command
 
 
@@ -67,9 +70,11 @@ def test_actual_position_set_moves_the_reading_not_the_command(ctl, ms):
     # actual position"
     assert ctl.axis_actual_position_set(0, 250.0).ok
     axis = ctl.axes[0]
-    assert axis.actual_position == 250.0 and axis.command_position == 0.0
+    assert axis.actual_position == 250.0
+    assert axis.command_position == 0.0
     ctl.step(1)
-    assert axis.actual_position != 0.0 and axis.command_position == 0.0
+    assert axis.actual_position != 0.0
+    assert axis.command_position == 0.0
     assert ctl.run_until(lambda c: c.axes[0].actual_position == 0.0, 20_000)  # the loop removes the error
 
 
@@ -77,7 +82,8 @@ def test_command_position_set_when_idle(ctl, ms):
     # MPI 002, MPIAxisMessageCOMMAND_NOT_SET "set the command position when the motion is in an IDLE state"
     assert ctl.axis_command_position_set(1, -75.0).ok
     axis = ctl.axes[1]
-    assert axis.command_position == -75.0 and ctl.axis_snapshot(1).target_position == -75.0
+    assert axis.command_position == -75.0
+    assert ctl.axis_snapshot(1).target_position == -75.0
     assert ctl.run_until(lambda c: axis.actual_position == -75.0, 20_000)
 
 
@@ -125,10 +131,11 @@ def test_non_finite_positions_are_refused(ctl):
     # MPI 000, MPIMessagePARAM_INVALID / docs/quality.md, "Robust": bad input changes nothing
     assert ctl.axis_command_position_set(0, float("inf")) is M.MPIMessagePARAM_INVALID
     assert ctl.axis_actual_position_set(0, float("nan")) is M.MPIMessagePARAM_INVALID
-    assert ctl.axes[0].cmd_p == 0.0 and ctl.axes[0].act_p == 0.0
+    assert ctl.axes[0].cmd_p == 0.0
+    assert ctl.axes[0].act_p == 0.0
 
 
-@pytest.mark.parametrize("field,value", [("position_fine", -1.0), ("position_coarse", -1), ("velocity", -1.0),
+@pytest.mark.parametrize(("field", "value"), [("position_fine", -1.0), ("position_coarse", -1), ("velocity", -1.0),
                                          ("settling_time", float("nan"))])
 def test_in_position_values_are_checked(ctl, field, value):
     # MPI 002, MPIAxisInPosition, tolerance tolerances and settling time are distances, a velocity and a duration
@@ -161,7 +168,8 @@ def test_motion_position_set_checks_its_arrays(ctl, ms):
     # MPI 000, mpiMotionPositionSet arrays "with a size equal to the number of axes"
     assert ms.position_set([1.0], [1.0, 2.0]) is M.MPIMessagePARAM_INVALID
     assert ms.position_set([1.0, float("nan")], [1.0, 2.0]) is M.MPIMessagePARAM_INVALID
-    assert [a.cmd_p for a in ctl.axes[:2]] == [0.0, 0.0] and [a.act_p for a in ctl.axes[:2]] == [0.0, 0.0]
+    assert [a.cmd_p for a in ctl.axes[:2]] == [0.0, 0.0]
+    assert [a.act_p for a in ctl.axes[:2]] == [0.0, 0.0]
     _, empty = ctl.create_motion(1)
     assert empty.position_set([], []) is M.MPIMotionMessageAXIS_COUNT
 
@@ -182,15 +190,19 @@ def test_motion_trajectory_reads_velocity_and_acceleration(ctl, ms, params):
     message, values = ms.trajectory()
     assert message.ok
     (v0, a0), (v1, a1) = values
-    assert a0 == pytest.approx(6000.0) and a1 == pytest.approx(8000.0)
-    assert v0 == pytest.approx(6000.0 * 50 / 2000) and v1 == pytest.approx(8000.0 * 50 / 2000)
+    assert a0 == pytest.approx(6000.0)
+    assert a1 == pytest.approx(8000.0)
+    assert v0 == pytest.approx(6000.0 * 50 / 2000)
+    assert v1 == pytest.approx(8000.0 * 50 / 2000)
 
 
 def test_axis_snapshot_reports_the_owner_and_frames(ctl, ms, ms1, params):
     # MPI 000, MEIMotionFrameBufferStatus, frameCount frameCount; the axis status names the supervisor commanding it
     ms1.start(T.TRAPEZOIDAL, params=params((100.0, 100.0)))
     snap = ctl.axis_snapshot(2)
-    assert snap.supervisor == 1 and snap.state is MPIState.MOVING and snap.frame_count > 0
+    assert snap.supervisor == 1
+    assert snap.state is MPIState.MOVING
+    assert snap.frame_count > 0
     assert ctl.axis_snapshot(0).state is MPIState.IDLE
 
 

@@ -39,7 +39,8 @@ V, ACC = 1000.0, 10_000.0
 def rig(in_position: AxisInPosition, plant: PlantConfig = SLOW):
     ctl = Controller(ControllerConfig(axis_count=1, supervisor_count=1), in_position=in_position, plant=plant)
     _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set([0]).ok and ms.action(MPIAction.MAP).ok
+    assert ms.axis_list_set([0]).ok
+    assert ms.action(MPIAction.MAP).ok
     return ctl, ms, ctl.axes[0]
 
 
@@ -111,7 +112,8 @@ def test_velocity_tolerance_delays_in_fine_position():
 
     loose, _ = fine_sample(AxisInPosition().velocity)
     tight, residual = fine_sample(1.0)
-    assert tight > loose and residual < 1.0
+    assert tight > loose
+    assert residual < 1.0
 
 
 def test_settling_time_zero_sets_in_fine_at_the_first_sample():
@@ -135,7 +137,10 @@ def test_bits_during_a_velocity_move_are_false():
     for _ in range(60):
         ctl.step(50)
         bits = axis.status
-        assert not (bits.in_fine_position or bits.in_coarse_position or bits.at_target or bits.done)
+        assert not (bits.in_fine_position)
+        assert not (bits.in_coarse_position)
+        assert not (bits.at_target)
+        assert not (bits.done)
     assert axis.status.at_velocity
 
 
@@ -177,12 +182,15 @@ def test_after_stop_without_settle_done_is_command_velocity_zero(action):
     # solely on command velocity"
     _, _, _, rows = stop_then_watch(action, AxisInPosition(position_fine=5.0, position_coarse=10**9))
     for _, _, cmd_v, _, _, _, bits in rows:
-        assert not (bits.in_fine_position or bits.in_coarse_position or bits.at_target)
+        assert not (bits.in_fine_position)
+        assert not (bits.in_coarse_position)
+        assert not (bits.at_target)
         assert bits.done == (cmd_v == 0.0)
     assert rows[-1][-1].done
 
 
-@pytest.mark.parametrize("action,flag", [(MPIAction.STOP, "settle_on_stop"), (MPIAction.E_STOP, "settle_on_estop")])
+@pytest.mark.parametrize(("action", "flag"),
+                         [(MPIAction.STOP, "settle_on_stop"), (MPIAction.E_STOP, "settle_on_estop")])
 def test_after_stop_with_settle_in_fine_follows_note_1(action, flag):
     # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, IN_FINE_POSITION (settleOn* =
     # TRUE, "After STOP (E-STOP)"): IN_FINE_POSITION "Based on position error (see note 1)", DONE "Same as
@@ -197,11 +205,12 @@ def test_after_stop_with_settle_in_fine_follows_note_1(action, flag):
         in_fine = run.update(crit) > held_for(tol.settling_time)
         assert bits.in_fine_position == in_fine
         assert bits.done == in_fine
-        assert not (bits.in_coarse_position or bits.at_target)
+        assert not (bits.in_coarse_position)
+        assert not (bits.at_target)
     assert rows[-1][-1].done
 
 
-@pytest.mark.parametrize("action,flag,state,decel", [
+@pytest.mark.parametrize(("action", "flag", "state", "decel"), [
     (MPIAction.STOP, "settle_on_stop", MPIState.STOPPED, 0.5),
     (MPIAction.E_STOP, "settle_on_estop", MPIState.ERROR, 0.05),
 ])
@@ -212,14 +221,16 @@ def test_settle_on_stop_keeps_the_state_until_settled(action, flag, state, decel
     # MPI 002, MPIAxisInPosition, settleOnEstop the same for settleOnEstop and MPIStateSTOPPING_ERROR
     def arrival(settle):
         tol = AxisInPosition(position_fine=2.0, settling_time=0.02, **{flag: settle})
-        _, ms, _, rows = stop_then_watch(action, tol, samples=1600)
+        _, _ms, _, rows = stop_then_watch(action, tol, samples=1600)
         first = next(i for i, row in enumerate(rows) if row[1] is state)
         return rows[first][0] - rows[0][0] + 1, rows[first][-1]
 
     without, _ = arrival(False)
     with_settle, bits = arrival(True)
     assert without == round(decel * RATE)
-    assert with_settle > without and bits.done and bits.in_fine_position
+    assert with_settle > without
+    assert bits.done
+    assert bits.in_fine_position
 
 
 def test_after_abort_only_done_is_true():
@@ -228,10 +239,13 @@ def test_after_abort_only_done_is_true():
     # IN_FINE_POSITION, IN_COARSE_POSITION, AT_TARGET FALSE; DONE TRUE (with either settle setting)
     for settle in (False, True):
         tol = AxisInPosition(position_coarse=10**9, settle_on_stop=settle, settle_on_estop=settle)
-        _, ms, _, rows = stop_then_watch(MPIAction.ABORT, tol, samples=2000)
+        _, _ms, _, rows = stop_then_watch(MPIAction.ABORT, tol, samples=2000)
         for row in rows:
             bits = row[-1]
-            assert bits.done and not (bits.in_fine_position or bits.in_coarse_position or bits.at_target)
+            assert bits.done
+            assert not (bits.in_fine_position)
+            assert not (bits.in_coarse_position)
+            assert not (bits.at_target)
         assert not bits.settled  # the motor coasts, nothing holds it on the command
 
 
@@ -253,7 +267,8 @@ def test_settle_on_estop_cmd_eq_act_command_follows_previous_actual():
         assert axis.amp_enabled
         previous = axis.actual_position
     ctl.step(1)
-    assert ms.state is MPIState.ERROR and ctl.sample == k + 100
+    assert ms.state is MPIState.ERROR
+    assert ctl.sample == k + 100
     assert not axis.amp_enabled
 
 
@@ -281,15 +296,17 @@ def test_settled_event_when_the_axis_rests_on_its_command():
     events = ctl.drain_events()
     settled = [e for e in events if e.type is MPIEventType.SETTLED and e.axis == 0]
     done = [e for e in events if e.type is MPIEventType.MOTION_DONE]
-    assert len(settled) == 1 and len(done) == 1
+    assert len(settled) == 1
+    assert len(done) == 1
     assert settled[0].sample <= done[0].sample
-    assert axis.status.settled and abs(axis.position_error) < 5.0
+    assert axis.status.settled
+    assert abs(axis.position_error) < 5.0
 
 
 def test_coarse_tolerance_does_not_affect_done():
     # MPI 002, MPIAxisInPosition, positionCoarse positionCoarse "This value does not affect the settling time status"
     def done_sample(coarse):
-        ctl, ms, axis = rig(AxisInPosition(position_fine=5.0, position_coarse=coarse))
+        ctl, ms, _axis = rig(AxisInPosition(position_fine=5.0, position_coarse=coarse))
         ms.start(MPIMotionType.TRAPEZOIDAL, params=trapezoid(1000.0))
         ctl.step(int(duration(1000.0) * RATE))
         assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000)
@@ -309,8 +326,12 @@ def test_final_velocity_move_never_sets_at_target_done_or_in_fine_while_it_runs_
     for _ in range(600):
         ctl.step(10)
         bits = axis.status
-        assert not (bits.at_target or bits.done or bits.in_fine_position or bits.trajectory_complete)
-    assert axis.command_position > 1500.0 and axis.cmd_v == 500.0
+        assert not (bits.at_target)
+        assert not (bits.done)
+        assert not (bits.in_fine_position)
+        assert not (bits.trajectory_complete)
+    assert axis.command_position > 1500.0
+    assert axis.cmd_v == 500.0
     assert ms.state is MPIState.MOVING
 
 
@@ -319,13 +340,15 @@ def test_sync_start_sets_at_target_on_each_axis_when_its_command_arrives():
     # axes start together and the shorter one arrives first; it is at its target from then on.
     ctl = Controller(ControllerConfig(axis_count=2, supervisor_count=1))
     _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set([0, 1]).ok and ms.action(MPIAction.MAP).ok
+    assert ms.axis_list_set([0, 1]).ok
+    assert ms.action(MPIAction.MAP).ok
     params = MotionParams(trajectory=[Trajectory(V, ACC, ACC, 0.0)] * 2, position=[500.0, 3000.0])
     assert ms.start(MPIMotionType.TRAPEZOIDAL, MotionAttr.SYNC_START, params).ok
     short, long_ = ctl.axes
     assert ctl.run_until(lambda c: short.command_position == 500.0 and short.cmd_v == 0.0, 20_000)
     ctl.step(1)
-    assert short.status.at_target and not long_.status.at_target
+    assert short.status.at_target
+    assert not long_.status.at_target
     assert long_.cmd_v != 0.0
 
 
@@ -333,7 +356,7 @@ def test_a_velocity_move_reports_no_target_position():
     # MPI 002, the status-bit tables: AT_TARGET is "TRUE when command = target" after a point-to-
     # point move and FALSE "During Velocity Move"; a velocity move has no target at all, so the
     # axis status says so (NaN) instead of the far end of the velocity move's long frame.
-    ctl, ms, axis = rig(AxisInPosition())
+    ctl, ms, _axis = rig(AxisInPosition())
     ms.start(MPIMotionType.VELOCITY, params=MotionParams(trajectory=[Trajectory(500.0, 5000.0)]))
     ctl.step(400)
     assert math.isnan(ctl.axis_snapshot(0).target_position)

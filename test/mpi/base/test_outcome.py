@@ -9,7 +9,8 @@ from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome, Refused
 
 
 def test_an_outcome_is_ok_only_with_the_ok_message():
-    assert VALID.ok and Outcome(Message.MPIMessageOK, "why not").ok
+    assert VALID.ok
+    assert Outcome(Message.MPIMessageOK, "why not").ok
     assert not Outcome(Message.MPIMessagePARAM_INVALID, "velocity: must be > 0").ok
     assert not Outcome(Message.MPIMotionMessageAUTO_START).ok  # accepted, but not OK
 
@@ -33,4 +34,6 @@ def test_a_move_end_reads_through_to_its_outcome():
     end = MoveEnd(7, Outcome(Message.MPIMessageOK, "motion done"), 1200, (1.0, 2.0), (0.5, 2.0), supervisor=1)
     assert (end.message, end.detail, end.succeeded) == (Message.MPIMessageOK, "motion done", True)
     stopped = MoveEnd(7, Outcome(Message.MPIMotionMessageSTOPPED, "replaced by a modify"), 1300)
-    assert not stopped.succeeded and stopped.command_position == () and stopped.supervisor == -1
+    assert not stopped.succeeded
+    assert stopped.command_position == ()
+    assert stopped.supervisor == -1

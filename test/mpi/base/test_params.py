@@ -63,8 +63,10 @@ def test_a_duration_fits_the_sample_counter_at_every_rate():
     # The sample counter is a C long (MPI 000: MPIMotionPoint and MPIMotionAttributes use
     # long for counts); a duration that fits it at the highest rate fits it at every rate.
     assert MAX_DURATION * SAMPLE_RATE_MAX <= LONG_MAX
-    assert check_duration("d", MAX_DURATION).ok and refused(check_duration("d", MAX_DURATION * 1.001), "d")
-    assert check_duration("d", 0.0).ok and refused(check_duration("d", 0.0, positive=True), "d")
+    assert check_duration("d", MAX_DURATION).ok
+    assert refused(check_duration("d", MAX_DURATION * 1.001), "d")
+    assert check_duration("d", 0.0).ok
+    assert refused(check_duration("d", 0.0, positive=True), "d")
     assert refused(check_duration("d", -1e-9), "d")
 
 
@@ -72,7 +74,8 @@ def test_positions_keep_sub_count_resolution():
     # A position plus an origin plus a relative distance stays below 2**49, where a double
     # still resolves 1/16 count: finer than any settling tolerance (002 MPIAxisInPosition).
     assert (3 * MAX_POSITION + 1 / 16) - 3 * MAX_POSITION == 1 / 16
-    assert check_position("p", -MAX_POSITION).ok and refused(check_position("p", 1e308), "p")
+    assert check_position("p", -MAX_POSITION).ok
+    assert refused(check_position("p", 1e308), "p")
 
 
 # ------------------------------------------------------------------ MPIMotionConfig ----
@@ -101,7 +104,7 @@ def test_pause_feedrate_zero_or_within_the_normal_range():
         assert refused(MotionConfig(pause_feedrate=value).validate(), "pause_feedrate")
 
 
-@pytest.mark.parametrize("value,ok", [(-1.0, True), (0.0, True), (1.0, True), (5.0, False), (-1.01, False),
+@pytest.mark.parametrize(("value", "ok"), [(-1.0, True), (0.0, True), (1.0, True), (5.0, False), (-1.01, False),
                                       (math.nan, False)])
 def test_blend_limit_is_a_cosine(value, ok):
     # MPI 000 MEIMotionConfig blendLimit: "If cosine (turn angle) is greater than the
@@ -132,7 +135,7 @@ def test_in_position_defaults_are_valid():
     assert AxisInPosition().validate().ok
 
 
-@pytest.mark.parametrize("field,value", [
+@pytest.mark.parametrize(("field", "value"), [
     ("settling_time", 1e308),  # issue 9: crashed the controller clock on every step
     ("settling_time", MAX_DURATION * 2),
     ("settling_time", -0.01),
@@ -168,7 +171,7 @@ def test_fine_tolerance_must_be_reachable_through_the_encoder():
 
 
 # ------------------------------------------------------------------ the simulated servo ----
-@pytest.mark.parametrize("field,value", [
+@pytest.mark.parametrize(("field", "value"), [
     ("damping", 0.0),
     ("damping", 1.5),  # over-damped: the closed-form response overflows on a long command piece
     ("bandwidth_hz", 0.0),
@@ -191,7 +194,7 @@ def test_plant_defaults_and_ends_are_valid():
 
 
 # ------------------------------------------------------------------ the controller ----
-@pytest.mark.parametrize("field,value", [
+@pytest.mark.parametrize(("field", "value"), [
     ("sample_rate", 0.0),
     ("sample_rate", 1e9),
     ("axis_count", 0),
@@ -243,7 +246,7 @@ def test_params_check_only_what_the_move_reads():
     assert refused(params.validate(), "position[0]")
 
 
-@pytest.mark.parametrize("struct,field", [
+@pytest.mark.parametrize(("struct", "field"), [
     (Hold(type=HoldType.GATE, mask=2**32), "mask"),
     (Hold(type=HoldType.INPUT, pattern=-(2**31) - 1), "pattern"),
     (Hold(type=HoldType.GATE, timeout=MAX_DURATION * 2), "timeout"),
@@ -265,7 +268,7 @@ def test_ids_are_c_longs():
 
 
 # ------------------------------------------------------------------ emptyCount ----
-@pytest.mark.parametrize("empty_count,disabled", [(-1, True), (0, True), (-7, True), (1, False), (5, False)])
+@pytest.mark.parametrize(("empty_count", "disabled"), [(-1, True), (0, True), (-7, True), (1, False), (5, False)])
 def test_empty_count_at_or_below_zero_disables(empty_count, disabled):
     # MPI 000, MPIMotionPoint: "When emptyCount is (-1), the buffer low trigger is disabled";
     # MPI 001, MPIMotionPathAttrMask EMPTY_COUNT: "To disable path-based deceleration, set the
@@ -281,7 +284,7 @@ def test_empty_count_is_a_c_long():
 
 
 # ------------------------------------------------------------------ the controller uses them ----
-@pytest.mark.parametrize("kwargs,field", [
+@pytest.mark.parametrize(("kwargs", "field"), [
     ({"config": ControllerConfig(frame_buffer_size=8)}, "config.frame_buffer_size"),
     ({"config": ControllerConfig(sample_rate=math.inf)}, "config.sample_rate"),
     ({"in_position": AxisInPosition(settling_time=1e308)}, "in_position.settling_time"),
@@ -296,7 +299,8 @@ def test_a_controller_is_not_built_from_values_it_cannot_hold(kwargs, field):
 
 def _mapped(ctl: Controller):
     _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set([0, 1]).ok and ms.action(MPIAction.MAP).ok
+    assert ms.axis_list_set([0, 1]).ok
+    assert ms.action(MPIAction.MAP).ok
     return ms
 
 
@@ -334,7 +338,8 @@ def test_axis_config_set_refuses_a_settling_time_past_the_sample_counter():
     params = MotionParams(trajectory=[Trajectory(1000.0, 1e4, 1e4)], position=[500.0, -500.0])
     assert ms.start(MPIMotionType.TRAPEZOIDAL, params=params).ok
     ctl.step(20_000)  # still settling (21,474 s), but the clock runs
-    assert ctl.axes[0].command_position == 500.0 and ms.state is MPIState.MOVING
+    assert ctl.axes[0].command_position == 500.0
+    assert ms.state is MPIState.MOVING
 
 
 @pytest.mark.parametrize("setter", ["axis_command_position_set", "axis_actual_position_set", "axis_origin_set"])

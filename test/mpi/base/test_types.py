@@ -45,7 +45,8 @@ def test_attribute_masks_mpi_then_mei_in_spec_order():
     mei = ["EVENT", "FINAL_VEL", "NO_REVERSAL", "HOLD", "HOLD_LESS", "HOLD_GREATER", "OUTPUT"]
     assert [int(MotionAttr[n]) for n in mpi] == [1 << i for i in range(len(mpi))]
     mei_bits = [int(MotionAttr[n]) for n in mei]
-    assert mei_bits == sorted(mei_bits) and all(b & (b - 1) == 0 for b in mei_bits)
+    assert mei_bits == sorted(mei_bits)
+    assert all(b & (b - 1) == 0 for b in mei_bits)
     assert not (sum(mei_bits) & sum(1 << i for i in range(len(mpi))))
 
 

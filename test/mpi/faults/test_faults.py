@@ -56,7 +56,8 @@ def test_a_gentle_move_does_not_trip_the_following_error(ctl, ms, run_to):
     configure(ctl, 0, following_error_limit=LIMIT)
     start(ms, (20_000.0, 0.0))
     run_to(ctl, ms, MPIState.IDLE, chunk=50)
-    assert fault_events(ctl) == [] and ctl.faults.names(0) == ()
+    assert fault_events(ctl) == []
+    assert ctl.faults.names(0) == ()
 
 
 def test_a_move_too_aggressive_for_the_bandwidth_trips_at_the_exact_sample(ctl, ms, run_to):
@@ -81,31 +82,45 @@ def test_a_move_too_aggressive_for_the_bandwidth_trips_at_the_exact_sample(ctl, 
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
     events = ctl.drain_events()
     trip = next(e for e in events if e.type is MPIEventType.LIMIT_ERROR)
-    assert trip.sample == expected and trip.axis == 0 and trip.supervisor == 0
-    assert "LIMIT_ERROR" in trip.detail and "axis 0" in trip.detail and "ABORT" in trip.detail
+    assert trip.sample == expected
+    assert trip.axis == 0
+    assert trip.supervisor == 0
+    assert "LIMIT_ERROR" in trip.detail
+    assert "axis 0" in trip.detail
+    assert "ABORT" in trip.detail
     # the default action ABORT follows at the same sample: amplifiers off, ERROR next sample
     abort = next(e for e in events if e.type is MPIEventType.ABORT)
-    assert abort.sample == trip.sample and events.index(abort) > events.index(trip)
+    assert abort.sample == trip.sample
+    assert events.index(abort) > events.index(trip)
     snap = ctl.axis_snapshot(0)
-    assert snap.faults == ("LIMIT_ERROR",) and not snap.amp_enabled and ms.last_action == "ABORT"
+    assert snap.faults == ("LIMIT_ERROR",)
+    assert not snap.amp_enabled
+    assert ms.last_action == "ABORT"
     assert ms.action_source.value == "CONTROLLER"
     # with the amplifier off RESET sets the command to the actual: nothing persists
     assert reset(ms) == Outcome(Message.MPIMessageOK)
-    assert ms.state is MPIState.IDLE and ctl.axis_snapshot(0).faults == () and ctl.axes[0].amp_enabled
+    assert ms.state is MPIState.IDLE
+    assert ctl.axis_snapshot(0).faults == ()
+    assert ctl.axes[0].amp_enabled
 
 
 def test_a_following_error_that_persists_refuses_reset_until_the_loop_removes_it(ctl, ms, run_to):
     configure(ctl, 0, following_error_limit=LIMIT, following_error_action="E_STOP")
     start(ms, (20_000.0, 0.0), AGGRESSIVE)
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
-    assert ctl.faults.names(0) == ("LIMIT_ERROR",) and ctl.axes[0].amp_enabled  # E_STOP: servo on
+    assert ctl.faults.names(0) == ("LIMIT_ERROR",)
+    assert ctl.axes[0].amp_enabled
     # a disturbance pushes the motor 5000 counts off its command (the loop works on it)
     assert ctl.axis_actual_position_set(0, ctl.axes[0].actual_position + 5000.0).ok
     message, detail = _split(reset(ms))
-    assert message is Message.MPIMotionMessageERROR and ms.state is MPIState.ERROR
-    assert "RESET refused" in detail and "axis 0 LIMIT_ERROR persists" in detail and "following error" in detail
+    assert message is Message.MPIMotionMessageERROR
+    assert ms.state is MPIState.ERROR
+    assert "RESET refused" in detail
+    assert "axis 0 LIMIT_ERROR persists" in detail
+    assert "following error" in detail
     assert ctl.run_until(lambda c: abs(c.axes[0].position_error) < LIMIT, 20_000, chunk=20)
-    assert reset(ms).message is Message.MPIMessageOK and ctl.faults.names(0) == ()
+    assert reset(ms).message is Message.MPIMessageOK
+    assert ctl.faults.names(0) == ()
 
 
 def test_following_error_action_none_reports_and_keeps_moving(ctl, ms):
@@ -113,7 +128,8 @@ def test_following_error_action_none_reports_and_keeps_moving(ctl, ms):
     start(ms, (20_000.0, 0.0), AGGRESSIVE)
     ctl.step(200)
     [trip] = fault_events(ctl)
-    assert trip.type is MPIEventType.LIMIT_ERROR and ms.state is MPIState.MOVING
+    assert trip.type is MPIEventType.LIMIT_ERROR
+    assert ms.state is MPIState.MOVING
     assert ctl.axis_snapshot(0).faults == ("LIMIT_ERROR",)
 
 
@@ -136,17 +152,26 @@ def test_a_software_limit_trips_where_the_actual_position_crosses_it(ctl, ms, ru
     before = free.axes[0].actual_position
     free.step(1)
     beyond = (lambda p: p > limit) if limit > 0 else (lambda p: p < limit)
-    assert beyond(free.axes[0].actual_position) and not beyond(before)
-    assert trip.type is fault.event and trip.axis == 0 and fault.value in trip.detail and "E_STOP" in trip.detail
-    assert ms.state is MPIState.STOPPING_ERROR and ms.last_action == "E_STOP"  # the default action
+    assert beyond(free.axes[0].actual_position)
+    assert not beyond(before)
+    assert trip.type is fault.event
+    assert trip.axis == 0
+    assert fault.value in trip.detail
+    assert "E_STOP" in trip.detail
+    assert ms.state is MPIState.STOPPING_ERROR
+    assert ms.last_action == "E_STOP"
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
     # beyond the limit after the E_STOP's deceleration: RESET is refused, saying why
     message, detail = _split(reset(ms))
-    assert message is Message.MPIMotionMessageERROR and f"axis 0 {fault.value} persists" in detail
-    assert ms.state is MPIState.ERROR and ctl.faults.names(0) == (fault.value,)
+    assert message is Message.MPIMotionMessageERROR
+    assert f"axis 0 {fault.value} persists" in detail
+    assert ms.state is MPIState.ERROR
+    assert ctl.faults.names(0) == (fault.value,)
     # the limit moved out of the way (as an operator overrides it to drive back): cleared
     configure(ctl, 0, **{f"software_limit_{side}": 2 * target})
-    assert reset(ms).message is Message.MPIMessageOK and ctl.faults.names(0) == () and ms.state is MPIState.IDLE
+    assert reset(ms).message is Message.MPIMessageOK
+    assert ctl.faults.names(0) == ()
+    assert ms.state is MPIState.IDLE
 
 
 def test_a_software_limit_is_recovered_by_driving_back_inside(ctl, ms, run_to):
@@ -158,7 +183,8 @@ def test_a_software_limit_is_recovered_by_driving_back_inside(ctl, ms, run_to):
     assert reset(ms).message is Message.MPIMotionMessageERROR
     assert ctl.axis_command_position_set(0, 4000.0).ok
     assert ctl.run_until(lambda c: c.axes[0].actual_position <= 5000.0, 20_000, chunk=20)
-    assert reset(ms).message is Message.MPIMessageOK and ms.state is MPIState.IDLE
+    assert reset(ms).message is Message.MPIMessageOK
+    assert ms.state is MPIState.IDLE
 
 
 # -- amplifier fault ------------------------------------------------------------------------
@@ -167,20 +193,26 @@ def test_an_amplifier_fault_disables_the_amplifier_and_aborts(ctl, ms, run_to):
     ctl.step(400)
     assert ctl.axis_fault_inject(1, "AMP_FAULT", True) == Outcome(Message.MPIMessageOK)
     [trip] = fault_events(ctl)
-    assert trip.type is MPIEventType.AMP_FAULT and trip.axis == 1 and "AMP_FAULT" in trip.detail
-    assert not ctl.axes[1].amp_enabled and ctl.axis_snapshot(1).faults == ("AMP_FAULT",)
+    assert trip.type is MPIEventType.AMP_FAULT
+    assert trip.axis == 1
+    assert "AMP_FAULT" in trip.detail
+    assert not ctl.axes[1].amp_enabled
+    assert ctl.axis_snapshot(1).faults == ("AMP_FAULT",)
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
     # the motor coasts to rest
     velocity = abs(ctl.axes[1].act_v)
     ctl.step(400)
     assert abs(ctl.axes[1].act_v) < velocity / 2
     message, detail = _split(reset(ms))
-    assert message is Message.MPIMotionMessageERROR and "axis 1 AMP_FAULT persists" in detail
+    assert message is Message.MPIMotionMessageERROR
+    assert "axis 1 AMP_FAULT persists" in detail
     assert ctl.axis_fault_inject(1, "AMP_FAULT", False).message.ok
     assert ctl.axis_snapshot(1).faults == ("AMP_FAULT",)  # latched until the RESET
     assert reset(ms).message is Message.MPIMessageOK
-    assert ctl.axes[1].amp_enabled and ctl.axes[1].command_position == ctl.axes[1].actual_position
-    assert ctl.axis_snapshot(1).faults == () and ms.state is MPIState.IDLE
+    assert ctl.axes[1].amp_enabled
+    assert ctl.axes[1].command_position == ctl.axes[1].actual_position
+    assert ctl.axis_snapshot(1).faults == ()
+    assert ms.state is MPIState.IDLE
 
 
 def test_an_amplifier_fault_with_action_none_lets_the_motor_coast_behind_its_command(ctl, ms):
@@ -190,8 +222,10 @@ def test_an_amplifier_fault_with_action_none_lets_the_motor_coast_behind_its_com
     assert ctl.axis_fault_inject(1, "AMP_FAULT", True).message.ok
     ctl.step(400)
     axis = ctl.axes[1]
-    assert ms.state is MPIState.MOVING and not axis.amp_enabled
-    assert axis.cmd_v > 1000.0 and abs(axis.act_v) < axis.cmd_v / 2  # the command goes on, the motor slows
+    assert ms.state is MPIState.MOVING
+    assert not axis.amp_enabled
+    assert axis.cmd_v > 1000.0
+    assert abs(axis.act_v) < axis.cmd_v / 2
     # RESET is refused in MOVING (the state table), and stays refused with the fault active
     assert reset(ms).message is Message.MPIMotionMessageMOVING
 
@@ -199,10 +233,13 @@ def test_an_amplifier_fault_with_action_none_lets_the_motor_coast_behind_its_com
 def test_reset_in_idle_clears_a_latched_amplifier_fault(ctl, ms):
     configure(ctl, 0, amp_fault_action="NONE")
     assert ctl.axis_fault_inject(0, "AMP_FAULT", True).message.ok
-    assert ms.state is MPIState.IDLE and not ctl.axes[0].amp_enabled
+    assert ms.state is MPIState.IDLE
+    assert not ctl.axes[0].amp_enabled
     assert reset(ms).message is Message.MPIMotionMessageERROR  # refused: it persists
     assert ctl.axis_fault_inject(0, "AMP_FAULT", False).message.ok
-    assert reset(ms).message is Message.MPIMessageOK and ctl.axes[0].amp_enabled and ctl.faults.names(0) == ()
+    assert reset(ms).message is Message.MPIMessageOK
+    assert ctl.axes[0].amp_enabled
+    assert ctl.faults.names(0) == ()
 
 
 # -- encoder fault --------------------------------------------------------------------------
@@ -224,7 +261,8 @@ def test_an_encoder_fault_aborts_every_axis_that_watches_that_motor(ctl, ms, ms1
     assert fault_events(ctl) == []  # motor 1's encoder: axis 1 has the function disabled
     assert "axis 2 ENCODER_FAULT persists" in reset(ms1).detail
     assert ctl.axis_fault_inject(0, "ENCODER_FAULT", False).message.ok
-    assert reset(ms1).message.ok and reset(ms).message.ok
+    assert reset(ms1).message.ok
+    assert reset(ms).message.ok
     assert ms.state is ms1.state is MPIState.IDLE
 
 
@@ -242,8 +280,10 @@ def test_a_stream_that_runs_dry_trips_frame_underflow_and_its_action(ctl, ms, ru
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
     trips = fault_events(ctl)
     assert [(e.type, e.axis) for e in trips] == [(MPIEventType.FRAME_UNDERFLOW, 0), (MPIEventType.FRAME_UNDERFLOW, 1)]
-    assert ms.last_action == "E_STOP" and ctl.faults.names(0) == ("FRAME_UNDERFLOW",)
-    assert reset(ms).message is Message.MPIMessageOK and ctl.faults.names(0) == ctl.faults.names(1) == ()
+    assert ms.last_action == "E_STOP"
+    assert ctl.faults.names(0) == ("FRAME_UNDERFLOW",)
+    assert reset(ms).message is Message.MPIMessageOK
+    assert ctl.faults.names(0) == ctl.faults.names(1) == ()
 
 
 def test_the_default_underflow_action_none_rests_on_the_last_point_and_reports_it(ctl, ms):
@@ -251,7 +291,8 @@ def test_the_default_underflow_action_none_rests_on_the_last_point_and_reports_i
     ctl.step(400)
     kinds = [(e.type, e.axis) for e in fault_events(ctl)]
     assert kinds == [(MPIEventType.FRAME_UNDERFLOW, 0), (MPIEventType.FRAME_UNDERFLOW, 1)]
-    assert ms.state is MPIState.MOVING and ctl.axes[0].command_position == 800.0
+    assert ms.state is MPIState.MOVING
+    assert ctl.axes[0].command_position == 800.0
 
 
 def test_the_empty_count_e_stop_comes_before_an_underflow(ctl, ms, run_to):
@@ -260,7 +301,8 @@ def test_the_empty_count_e_stop_comes_before_an_underflow(ctl, ms, run_to):
     configure(ctl, 0, frame_underflow_action="ABORT")
     _open_path(ms, empty_count=5)
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
-    assert fault_events(ctl) == [] and ms.last_action == "E_STOP"
+    assert fault_events(ctl) == []
+    assert ms.last_action == "E_STOP"
 
 
 # -- injection and configuration --------------------------------------------------------------
@@ -272,19 +314,27 @@ def test_a_detected_fault_can_be_injected_as_a_one_off_trip(ctl, ms, run_to, fau
                          "frame_underflow_action": "E_STOP_ABORT"})
     assert ctl.axis_fault_inject(1, fault.value.lower(), True).ok
     [trip] = fault_events(ctl)
-    assert trip.type is fault.event and trip.axis == 1 and "injected" in trip.detail
+    assert trip.type is fault.event
+    assert trip.axis == 1
+    assert "injected" in trip.detail
     run_to(ctl, ms, MPIState.ERROR, chunk=50)
-    assert ms.last_action == "E_STOP_ABORT" and not ctl.axes[1].amp_enabled
-    assert reset(ms).message.ok and ctl.faults.names(1) == ()  # nothing holds it
+    assert ms.last_action == "E_STOP_ABORT"
+    assert not ctl.axes[1].amp_enabled
+    assert reset(ms).message.ok
+    assert ctl.faults.names(1) == ()
 
 
 def test_bad_injections_are_refused_and_change_nothing(ctl, ms):
     message, detail = _split(ctl.axis_fault_inject(0, "OVERHEAT", True))
-    assert message is Message.MPIMessagePARAM_INVALID and "unknown fault 'OVERHEAT'" in detail
+    assert message is Message.MPIMessagePARAM_INVALID
+    assert "unknown fault 'OVERHEAT'" in detail
     message, detail = _split(ctl.axis_fault_inject(0, "LIMIT_ERROR", False))
-    assert message is Message.MPIMessagePARAM_INVALID and "trips once" in detail
+    assert message is Message.MPIMessagePARAM_INVALID
+    assert "trips once" in detail
     assert ctl.axis_fault_inject(9, "AMP_FAULT", True).message is Message.MPIAxisMessageAXIS_INVALID
-    assert ctl.drain_events() == [] and ms.state is MPIState.IDLE and ctl.faults.names(0) == ()
+    assert ctl.drain_events() == []
+    assert ms.state is MPIState.IDLE
+    assert ctl.faults.names(0) == ()
 
 
 @pytest.mark.parametrize(("fields", "named"), [
@@ -302,7 +352,8 @@ def test_a_bad_fault_configuration_is_refused_naming_the_field(ctl, fields, name
     before = ctl.axis_fault_config_get(0)[1]
     config = AxisFaultConfig(**{**{k: getattr(before, k) for k in before.__slots__}, **fields})
     verdict = ctl.axis_fault_config_set(0, config)
-    assert verdict.message is Message.MPIMessagePARAM_INVALID and named in verdict.detail
+    assert verdict.message is Message.MPIMessagePARAM_INVALID
+    assert named in verdict.detail
     assert ctl.axis_fault_config_get(0)[1] == before
 
 
@@ -324,9 +375,11 @@ def test_commands_inject_and_configure_with_partial_requests(ctl, ms):
     assert (config.following_error_limit, config.following_error_action, config.encoder_fault_motor_number) == (
         50.0, "E_STOP", 0)
     reply = apply(ctl, Command("axis_fault_config_set", axis=0, request={"config": {"amp_fault_action": "HALT"}}))
-    assert reply.message is Message.MPIMessagePARAM_INVALID and "amp_fault_action" in reply.detail
+    assert reply.message is Message.MPIMessagePARAM_INVALID
+    assert "amp_fault_action" in reply.detail
     reply = apply(ctl, Command("axis_fault_inject", axis=0, request={"fault": "AMP_FAULT"}))
-    assert reply.message.ok and reply.value == ["AMP_FAULT"]
+    assert reply.message.ok
+    assert reply.value == ["AMP_FAULT"]
     reply = apply(ctl, Command("axis_fault_inject", axis=0, request={"fault": 3}))
     assert reply.message is Message.MPIMessagePARAM_INVALID
 

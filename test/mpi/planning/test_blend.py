@@ -29,7 +29,8 @@ def _run(limit: float, second, kind=T.TRAPEZOIDAL, jerk_percent=0.0, append=True
     """Command positions per sample of a move to CORNER with a move to ``second`` appended."""
     ctl = Controller()
     _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set([0, 1]).ok and ms.action(MPIAction.MAP).ok
+    assert ms.axis_list_set([0, 1]).ok
+    assert ms.action(MPIAction.MAP).ok
     _, config = ms.config_get()
     config.blend_limit = limit
     assert ms.config_set(config).ok
@@ -59,7 +60,7 @@ CASES = [  # (blendLimit, turn in degrees, blended?)
 ]
 
 
-@pytest.mark.parametrize("limit,degrees,blended", CASES, ids=[f"{c[0]}-{c[1]:g}deg" for c in CASES])
+@pytest.mark.parametrize(("limit", "degrees", "blended"), CASES, ids=[f"{c[0]}-{c[1]:g}deg" for c in CASES])
 def test_blend_limit_decides_which_turns_blend(limit, degrees, blended):
     # MEIMotionConfig.blendLimit: 1.0 blends all, -1.0 none, 0 excludes turns sharper than 90 degrees (the
     # cosine of the turn compared with -blendLimit: docs/decisions.md)
@@ -76,7 +77,7 @@ def test_blend_limit_decides_which_turns_blend(limit, degrees, blended):
     assert trace[-1] == pytest.approx(_second(degrees), abs=1e-9)
 
 
-@pytest.mark.parametrize("kind,jerk_percent", [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0), (T.S_CURVE, 100.0)])
+@pytest.mark.parametrize(("kind", "jerk_percent"), [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0), (T.S_CURVE, 100.0)])
 @pytest.mark.parametrize("degrees", [30.0, 90.0, 150.0, 180.0])
 def test_a_blended_corner_keeps_the_velocity_and_at_most_doubles_the_acceleration(kind, jerk_percent, degrees):
     # MEIMotionConfig.blendLimit: "the acceleration resulting from the blending can exceed the acceleration limit
@@ -93,7 +94,7 @@ def test_a_blended_corner_keeps_the_velocity_and_at_most_doubles_the_acceleratio
         assert acceleration.max() > 1.9 * peak  # "180 degrees = acceleration*2.0"
 
 
-@pytest.mark.parametrize("kind,jerk_percent", [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0)])
+@pytest.mark.parametrize(("kind", "jerk_percent"), [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0)])
 def test_a_blended_corner_is_the_sum_of_the_two_profiles(kind, jerk_percent):
     # The blend shape (docs/decisions.md, "blendLimit"): the second move's profile, as it runs alone from the
     # corner, starts while the first decelerates, and the two add up; each alone is the profile the ruckig and

@@ -99,7 +99,8 @@ def test_slave_follows_the_table_at_the_masters_position_every_sample(kind):
     assert ms1.state is MPIState.IDLE
     assert (command(ctl, 1), command(ctl, 2)) == (170.0, -20.0)
     events = [e.type for e in ctl.drain_events() if e.supervisor == 1]
-    assert events[0] is MPIEventType.MOTION_START and MPIEventType.MOTION_DONE in events
+    assert events[0] is MPIEventType.MOTION_START
+    assert MPIEventType.MOTION_DONE in events
 
 
 def test_the_slave_servo_follows_its_command():
@@ -112,7 +113,8 @@ def test_the_slave_servo_follows_its_command():
     # few counts of its command (the simulated loop with its velocity feed-forward)
     slave = ctl.axes[1]
     assert slave.cmd_v == pytest.approx(500.0, abs=1e-6)
-    assert abs(slave.position_error) < 5.0 and slave.act_v == pytest.approx(500.0, rel=0.02)
+    assert abs(slave.position_error) < 5.0
+    assert slave.act_v == pytest.approx(500.0, rel=0.02)
 
 
 # ------------------------------------------------------------------ backtracking ----
@@ -150,7 +152,8 @@ def test_no_backtrack_and_no_backtrack_hold_exclude_each_other():
     outcome, _ = ms1.command(T.CAM_LINEAR, A.NO_BACKTRACK | A.NO_BACKTRACK_HOLD,
                                      cam([100.0], [1.0, 1.0]), False)
     message, detail = outcome.message, outcome.detail
-    assert message is M.MPIMotionMessageATTRIBUTE_INVALID and "exclude" in detail
+    assert message is M.MPIMotionMessageATTRIBUTE_INVALID
+    assert "exclude" in detail
 
 
 # ------------------------------------------------------------------ repeat, master start ----
@@ -169,10 +172,12 @@ def test_repeat_runs_many_cycles_without_drift():
     for cycle in range(40):
         ctl.step(start_sample + 100 + 150 * cycle - ctl.sample)
         assert command(ctl, 1) == 10.0 + 30.0 * cycle
-    assert ms1.state is MPIState.MOVING and ms1.progress() == 0.0  # a repeating cam never completes
+    assert ms1.state is MPIState.MOVING
+    assert ms1.progress() == 0.0
     assert ms1.action(MPIAction.STOP) is M.MPIMessageOK
     ctl.step(1000)
-    assert ms1.state is MPIState.STOPPED and ctl.axes[1].cmd_v == 0.0
+    assert ms1.state is MPIState.STOPPED
+    assert ctl.axes[1].cmd_v == 0.0
 
 
 def test_master_start_holds_the_slave_until_the_master_gets_there():
@@ -249,7 +254,7 @@ ORIGIN_MASTERS = [
 ]
 
 
-@pytest.mark.parametrize("name,master,moved", ORIGIN_MASTERS, ids=[m[0] for m in ORIGIN_MASTERS])
+@pytest.mark.parametrize(("name", "master", "moved"), ORIGIN_MASTERS, ids=[m[0] for m in ORIGIN_MASTERS])
 def test_an_origin_change_does_not_move_a_cam_slave(name, master, moved):
     # MPI 002, mpiAxisOriginSet and MPIAxisMasterType AXIS_COMMANDED/ACTUAL_POSITION: the origin only changes
     # how positions are reported; the master axis (or the masterCorrection axis) does not move, so neither
@@ -319,7 +324,8 @@ def test_a_slave_cannot_follow_itself_directly_or_through_other_cams():
     follow(ctl, AxisMaster(S.AXIS_ACTUAL_POSITION, 2))  # axis 2 is a slave of the same cam
     outcome, _ = ms1.command(T.CAM_LINEAR, A.NONE, cam([100.0], [1.0, 1.0]), False)
     message, detail = outcome.message, outcome.detail
-    assert message is M.MPIMessagePARAM_INVALID and "itself" in detail
+    assert message is M.MPIMessagePARAM_INVALID
+    assert "itself" in detail
     # axis 3 follows axis 1; then a cam on axis 1 following axis 3 would be a loop
     _, ms2 = ctl.create_motion(2, 3)
     ctl.axis_master_set(3, AxisMaster(S.MOTOR_FEEDBACK_PRIMARY, 1))
@@ -357,7 +363,8 @@ def test_a_master_that_does_not_exist_is_refused_and_changes_nothing(master, fie
     # masterCorrection: an axis, -1 for none
     ctl = controller()
     verdict = ctl.axis_master_check(1, master)
-    assert verdict.message is M.MPIMessagePARAM_INVALID and verdict.detail.startswith(field)
+    assert verdict.message is M.MPIMessagePARAM_INVALID
+    assert verdict.detail.startswith(field)
     assert ctl.axis_master_set(1, master) is M.MPIMessagePARAM_INVALID
     assert ctl.axes[1].master == AxisMaster()
 
@@ -382,7 +389,8 @@ def test_stop_and_e_stop_bring_the_slaves_to_rest_while_the_master_goes_on(actio
     assert command(ctl, 1) - before == pytest.approx(1000.0 * decel / 2.0, abs=1.0)
     rest = command(ctl, 1)
     ctl.step(200)
-    assert command(ctl, 1) == rest and ctl.supervisor(0).state is MPIState.MOVING
+    assert command(ctl, 1) == rest
+    assert ctl.supervisor(0).state is MPIState.MOVING
 
 
 def test_resume_continues_the_cam_from_where_the_slave_stopped():
@@ -443,9 +451,11 @@ def test_each_validation_rule(kind, attrs, params, message, words):
     ms1 = ctl.supervisor(1)
     outcome, _ = ms1.command(kind, attrs, params, False)
     got, detail = outcome.message, outcome.detail
-    assert got is message and words in detail
+    assert got is message
+    assert words in detail
     ctl.step(10)
-    assert ms1.state is MPIState.IDLE and command(ctl, 1) == 0.0
+    assert ms1.state is MPIState.IDLE
+    assert command(ctl, 1) == 0.0
 
 
 def test_a_linear_cam_ignores_its_gear_ratios():
@@ -463,7 +473,7 @@ def test_cams_cannot_be_modified():
     assert ms1.modify(T.CAM_LINEAR, A.NONE, p()) is M.MPIMessageUNSUPPORTED
 
 
-@pytest.mark.parametrize("kind,params", [
+@pytest.mark.parametrize(("kind", "params"), [
     (T.TRAPEZOIDAL, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)], position=[0.0, 0.0])),
     (T.VELOCITY, MotionParams(trajectory=[Trajectory(500.0, 1e4, 1e4)])),
 ], ids=["TRAPEZOIDAL", "VELOCITY"])
@@ -477,14 +487,16 @@ def test_a_modifiable_type_does_not_replace_a_running_cam(kind, params):
     assert ms1.start(T.CAM_LINEAR, A.NONE, cam([10_000.0], [5000.0, 2000.0])).ok
     ctl.step(100)
     outcome, _ = ms1.command(kind, A.NONE, params, True)
-    assert outcome.message is M.MPIMessageUNSUPPORTED and "CAM_LINEAR" in outcome.detail
+    assert outcome.message is M.MPIMessageUNSUPPORTED
+    assert "CAM_LINEAR" in outcome.detail
     origin = 0.0
     for _ in range(200):
         ctl.step(1)
         travel = command(ctl, 0) - origin
         assert command(ctl, 1) == pytest.approx(0.5 * travel, abs=1e-9)
         assert command(ctl, 2) == pytest.approx(0.2 * travel, abs=1e-9)
-    assert ms1.state is MPIState.MOVING and ms1.current.type is T.CAM_LINEAR
+    assert ms1.state is MPIState.MOVING
+    assert ms1.current.type is T.CAM_LINEAR
 
 
 def test_a_cam_that_does_not_fit_the_frame_buffer():
@@ -505,19 +517,23 @@ def test_axis_config_set_sets_the_master_with_in_position_all_or_nothing():
     request = {"in_position": {"position_fine": 5.0}, "master": {"type": "address", "address": 7},
                "master_correction": 2}
     assert apply(ctl, Command("axis_config_set", axis=1, request=request)).message is M.MPIMessageOK
-    assert ctl.axes[1].master == AxisMaster(S.ADDRESS, 0, 7, 2) and ctl.axes[1].in_position.position_fine == 5.0
+    assert ctl.axes[1].master == AxisMaster(S.ADDRESS, 0, 7, 2)
+    assert ctl.axes[1].in_position.position_fine == 5.0
     # a bad master: nothing changes, in_position neither
     bad = {"in_position": {"position_fine": 9.0}, "master": {"type": "ADDRESS", "address": 9999}}
     reply = apply(ctl, Command("axis_config_set", axis=1, request=bad))
-    assert reply.message is M.MPIMessagePARAM_INVALID and reply.detail.startswith("master.address")
-    assert ctl.axes[1].in_position.position_fine == 5.0 and ctl.axes[1].master.address == 7
+    assert reply.message is M.MPIMessagePARAM_INVALID
+    assert reply.detail.startswith("master.address")
+    assert ctl.axes[1].in_position.position_fine == 5.0
+    assert ctl.axes[1].master.address == 7
     # a request without a master (as recorded before it existed) or with an empty type keeps it
     for keep in ({"in_position": {"position_fine": 6.0}},
                  {"in_position": {"position_fine": 6.0}, "master": {"type": ""}}):
         assert apply(ctl, Command("axis_config_set", axis=1, request=keep)).message is M.MPIMessageOK
         assert ctl.axes[1].master == AxisMaster(S.ADDRESS, 0, 7, 2)
     reply = apply(ctl, Command("axis_config_set", axis=1, request={"master": {"type": "WARP"}}))
-    assert reply.message is M.MPIMessagePARAM_INVALID and "master type" in reply.detail
+    assert reply.message is M.MPIMessagePARAM_INVALID
+    assert "master type" in reply.detail
 
 
 def test_secondary_feedback_set_command():
@@ -528,7 +544,8 @@ def test_secondary_feedback_set_command():
     assert ctl.secondary.at(1, np.array([ctl.sample]), RATE)[0] == 25.0
     for bad, words in (({"motor": 9}, "no motor"), ({"motor": 0, "velocity": float("inf")}, "velocity")):
         reply = apply(ctl, Command("secondary_feedback_set", request=bad))
-        assert reply.message is M.MPIMessagePARAM_INVALID and words in reply.detail
+        assert reply.message is M.MPIMessagePARAM_INVALID
+        assert words in reply.detail
 
 
 # ------------------------------------------------------------------ batching ----

@@ -42,7 +42,8 @@ def test_an_append_that_overflows_is_refused(ctl, ms, params):
     # unexpectedly; MPI 000, MPIMotionMessageFRAME_BUFFER_TOO_SMALL FRAME_BUFFER_TOO_SMALL
     count, refusal = fill(ctl, ms, params)
     assert refusal is Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
-    assert ctl.frame_count(0) <= 128 and ctl.frame_count(0) + 8 > 128  # an S-curve move is 7 + 1 frames
+    assert ctl.frame_count(0) <= 128
+    assert ctl.frame_count(0) + 8 > 128
     assert len(ms.queue) == count - 1
     assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 200_000, chunk=500)
     assert ctl.axes[0].command_position == 1000.0 * count  # every accepted move ran, in order
@@ -54,7 +55,7 @@ def test_the_refusal_changes_nothing(params):
         ctl = Controller()
         _, ms = ctl.create_motion(0)
         ms.axis_list_set([0, 1])
-        count, _ = fill(ctl, ms, params)
+        _count, _ = fill(ctl, ms, params)
         if extra:
             refused = ms.start(T.TRAPEZOIDAL, A.APPEND, params((-5.0, 0.0)))
             assert refused is Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
@@ -69,7 +70,7 @@ def test_the_refusal_changes_nothing(params):
 
 def test_room_frees_up_as_frames_execute(ctl, ms, params):
     # MPI 000, mpiMotionStart the buffer is a FIFO: executed frames leave it
-    count, _ = fill(ctl, ms, params)
+    _count, _ = fill(ctl, ms, params)
     ctl.step(8000)  # some moves done
     assert ms.start(T.S_CURVE, A.APPEND, params((0.0, 0.0), jerk_percent=50.0)).ok
 
@@ -82,7 +83,8 @@ def test_a_larger_buffer_takes_more_moves(params):
         ms.axis_list_set([0, 1])
         return fill(ctl, ms, params)[0]
 
-    assert capacity(128) == 16 and capacity(256) == 32
+    assert capacity(128) == 16
+    assert capacity(256) == 32
 
 
 def test_frame_count_decreases_as_the_move_runs(ctl, ms, params):
@@ -92,7 +94,9 @@ def test_frame_count_decreases_as_the_move_runs(ctl, ms, params):
     while ms.state is MPIState.MOVING:
         counts.append(ctl.frame_count(0))
         ctl.step(25)
-    assert counts[0] == 8 and counts == sorted(counts, reverse=True) and counts[-1] == 1
+    assert counts[0] == 8
+    assert counts == sorted(counts, reverse=True)
+    assert counts[-1] == 1
 
 
 def test_trapezoid_frames():
@@ -100,8 +104,11 @@ def test_trapezoid_frames():
     # to 8 frames/point for S-curve)": here a trapezoid is accel, cruise, decel + the final frame
     plan = AxisPlan(0, [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.9, 50.0, 1e3, 0.0, 0.0),
                         Segment(0.1, 950.0, 1e3, -1e4, 0.0)], 0.0, 1000.0)
-    assert plan.frame_count == 4 and plan.duration == pytest.approx(1.1)
-    assert plan.frames_left(0.0) == 4 and plan.frames_left(0.5) == 3 and plan.frames_left(2.0) == 1
+    assert plan.frame_count == 4
+    assert plan.duration == pytest.approx(1.1)
+    assert plan.frames_left(0.0) == 4
+    assert plan.frames_left(0.5) == 3
+    assert plan.frames_left(2.0) == 1
 
 
 def test_plan_evaluation_ends_exactly_on_target():
@@ -110,21 +117,28 @@ def test_plan_evaluation_ends_exactly_on_target():
     seg = [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.1, 50.0, 1e3, -1e4, 0.0)]
     plan = AxisPlan(0, seg, 0.0, 100.0 + 1e-9)  # rounding in the segments is absorbed at the end
     p, v, a = plan.evaluate(np.array([0.05, plan.duration, plan.duration + 1.0]))
-    assert p[1] == plan.target and p[2] == plan.target and v[2] == 0.0 and a[2] == 0.0
+    assert p[1] == plan.target
+    assert p[2] == plan.target
+    assert v[2] == 0.0
+    assert a[2] == 0.0
 
 
 def test_plan_past_its_end_continues_at_the_final_velocity():
     # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL: "a non-zero target velocity for point to point motion types"
     plan = AxisPlan(0, [Segment(1.0, 0.0, 0.0, 100.0, 0.0)], 0.0, 50.0, final_velocity=100.0)
     p, v, a = plan.evaluate(np.array([1.5]))
-    assert p[0] == pytest.approx(100.0) and v[0] == 100.0 and a[0] == 0.0
+    assert p[0] == pytest.approx(100.0)
+    assert v[0] == 100.0
+    assert a[0] == 0.0
 
 
 def test_an_empty_plan_holds_its_target():
     # frames.py: "one final frame that holds the end state" (a move of zero length)
     plan = AxisPlan(1, [], 5.0, 5.0)
     p, v, _ = plan.evaluate(np.array([0.0, 1.0]))
-    assert plan.duration == 0.0 and list(p) == [5.0, 5.0] and list(v) == [0.0, 0.0]
+    assert plan.duration == 0.0
+    assert list(p) == [5.0, 5.0]
+    assert list(v) == [0.0, 0.0]
 
 
 def test_frames_needed_counts_per_axis():
@@ -133,8 +147,11 @@ def test_frames_needed_counts_per_axis():
     b = AxisPlan(1, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)] * 3, 0.0, 3.0)
     move = Move(0, T.TRAPEZOIDAL, A.NONE, [a, b])
     assert move.frame_counts == {0: 2, 1: 4}
-    assert frames_needed([move, move], 1) == 8 and frames_needed([move], 2) == 0
-    assert move.plan_for(1) is b and move.plan_for(3) is None and move.axes == [0, 1]
+    assert frames_needed([move, move], 1) == 8
+    assert frames_needed([move], 2) == 0
+    assert move.plan_for(1) is b
+    assert move.plan_for(3) is None
+    assert move.axes == [0, 1]
 
 
 @pytest.mark.parametrize("final_velocity", [0.0, 5.0])
@@ -170,10 +187,12 @@ def test_each_axis_reports_its_own_frame_buffer_size():
     _, ms = ctl.create_motion(0)
     _, ms1 = ctl.create_motion(1)
     for sup, axes in ((ms, [0, 1]), (ms1, [2, 3])):
-        assert sup.axis_list_set(axes).ok and sup.action(MPIAction.MAP).ok
+        assert sup.axis_list_set(axes).ok
+        assert sup.action(MPIAction.MAP).ok
     assert [(s.axis, s.size) for s in ms.frame_buffer_status()[1]] == [(0, 256), (1, 256)]
     assert [(s.axis, s.size) for s in ms1.frame_buffer_status()[1]] == [(2, 128), (3, 128)]
-    assert ms.frame_buffer_size == 256 and ms1.frame_buffer_size == 128
+    assert ms.frame_buffer_size == 256
+    assert ms1.frame_buffer_size == 128
 
 
 @pytest.mark.parametrize("edit", ["append", "insert", "list_set"])
@@ -182,20 +201,26 @@ def test_an_axis_of_another_frame_buffer_size_is_refused_and_nothing_changes(edi
     # frame buffer size": answered where the axis is appended (docs/paths.md)
     ctl = _two_sizes()
     _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set([0, 1]).ok and ms.action(MPIAction.MAP).ok
+    assert ms.axis_list_set([0, 1]).ok
+    assert ms.action(MPIAction.MAP).ok
     answer = {"append": lambda: ms.axis_append(2), "insert": lambda: ms.axis_insert(None, 3),
               "list_set": lambda: ms.axis_list_set([0, 2])}[edit]()
     assert answer is Message.MPIMotionMessageAXIS_FRAME_COUNT
-    assert ms.axis_list_get() == (Message.MPIMessageOK, [0, 1]) and ms.mapped == [0, 1]
-    assert ms.axis_list_set([2, 3]).ok and ms.axis_append(1) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_list_get() == (Message.MPIMessageOK, [0, 1])
+    assert ms.mapped == [0, 1]
+    assert ms.axis_list_set([2, 3]).ok
+    assert ms.axis_append(1) is Message.MPIMotionMessageAXIS_FRAME_COUNT
 
 
 def test_an_empty_list_takes_any_size_and_same_sizes_mix():
     ctl = Controller(ControllerConfig(frame_buffer_size=64, axis_frame_buffer_sizes={3: 64, 0: 512}))
     _, ms = ctl.create_motion(0)
-    assert ms.axis_append(1).ok and ms.axis_append(3).ok  # 64 and 64 (the default and an equal override)
-    assert ms.axis_append(2).ok and ms.axis_append(0) is Message.MPIMotionMessageAXIS_FRAME_COUNT
-    assert ms.axis_list_set([0]).ok and ms.frame_buffer_size == 512
+    assert ms.axis_append(1).ok
+    assert ms.axis_append(3).ok
+    assert ms.axis_append(2).ok
+    assert ms.axis_append(0) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_list_set([0]).ok
+    assert ms.frame_buffer_size == 512
 
 
 def test_each_axis_buffer_bounds_its_own_appends(params):
@@ -203,10 +228,13 @@ def test_each_axis_buffer_bounds_its_own_appends(params):
     ctl = _two_sizes()
     _, ms = ctl.create_motion(0)
     _, ms1 = ctl.create_motion(1)
-    assert ms.axis_list_set([0, 1]).ok and ms1.axis_list_set([2, 3]).ok
+    assert ms.axis_list_set([0, 1]).ok
+    assert ms1.axis_list_set([2, 3]).ok
     assert fill(ctl, ms, params) == (32, Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL)
     assert fill(ctl, ms1, params) == (16, Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL)
-    assert ctl.frame_count(0) <= 256 and ctl.frame_count(2) <= 128 and ctl.frame_count(0) > 128
+    assert ctl.frame_count(0) <= 256
+    assert ctl.frame_count(2) <= 128
+    assert ctl.frame_count(0) > 128
 
 
 def test_low_count_defaults_to_a_quarter_of_the_axes_buffer_and_is_bounded_by_it():
@@ -216,13 +244,15 @@ def test_low_count_defaults_to_a_quarter_of_the_axes_buffer_and_is_bounded_by_it
     _, ms = ctl.create_motion(0)
     _, ms1 = ctl.create_motion(1)
     for sup, axes in ((ms, [0, 1]), (ms1, [2, 3])):
-        assert sup.axis_list_set(axes).ok and sup.action(MPIAction.MAP).ok
+        assert sup.axis_list_set(axes).ok
+        assert sup.action(MPIAction.MAP).ok
         assert sup.event_notify_set(MPIEventType.FRAMES_LOW).ok
     ctl.drain_events()
     x = np.arange(1.0, 101.0)
     points = MotionParams(position=list(np.stack([x, x], axis=1).ravel()), time=[0.01] * 100, final=False,
                           empty_count=0)
-    assert ms.start(T.PT, A.NONE, points).ok and ms1.start(T.PT, A.NONE, points).ok
+    assert ms.start(T.PT, A.NONE, points).ok
+    assert ms1.start(T.PT, A.NONE, points).ok
     s0 = ctl.sample
     ctl.step(80 * 20)  # 20 samples a point: 80 points reached
     lows = [(e.supervisor, (e.sample - s0) // 20) for e in ctl.drain_events() if e.type is MPIEventType.FRAMES_LOW]
@@ -240,6 +270,7 @@ def test_low_count_defaults_to_a_quarter_of_the_axes_buffer_and_is_bounded_by_it
                                               ([128], "axis_frame_buffer_sizes")])
 def test_a_bad_axis_frame_buffer_size_is_refused_by_the_one_validator(sizes, field):
     verdict = ControllerConfig(axis_frame_buffer_sizes=sizes).validate()
-    assert not verdict.ok and verdict.detail.startswith(field)
+    assert not verdict.ok
+    assert verdict.detail.startswith(field)
     with pytest.raises(ValueError, match=r"config\.axis_frame_buffer_sizes"):
         Controller(ControllerConfig(axis_frame_buffer_sizes=sizes))

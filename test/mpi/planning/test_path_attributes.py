@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -47,7 +49,9 @@ def test_no_wait_answers_ok_for_what_the_controller_refuses(ctl, notified):
     before = [a.cmd_p for a in ctl.axes]
     outcome, serial = notified.command(T.PT, A.NO_WAIT, MotionParams(position=[0.0, 0.0], time=[0.1]), False)
     message, detail = outcome.message, outcome.detail
-    assert message is M.MPIMessageOK and detail.startswith("NO_WAIT") and serial == 0
+    assert message is M.MPIMessageOK
+    assert detail.startswith("NO_WAIT")
+    assert serial == 0
     ctl.step(1)
     assert events(ctl) == []  # refused (MOVING): no MOTION_START
     assert all(abs(a.cmd_p - b) < 10.0 for a, b in zip(ctl.axes, before, strict=True))
@@ -64,10 +68,12 @@ def test_no_wait_that_starts_sends_motion_start(ctl, notified):
     outcome, serial = notified.command(T.PVT, A.NO_WAIT | A.NO_HANDSHAKE,
                                           MotionParams(**PATH, point_velocity=[0.0] * 4), False)
     message = outcome.message
-    assert message is M.MPIMessageOK and serial == 0
+    assert message is M.MPIMessageOK
+    assert serial == 0
     assert notified.snapshot().state is MPIState.IDLE  # NO_WAIT includes NO_HANDSHAKE
     ctl.step(1)
-    assert notified.state is MPIState.MOVING and (0, "MOTION_START") in events(ctl)
+    assert notified.state is MPIState.MOVING
+    assert (0, "MOTION_START") in events(ctl)
 
 
 def test_expected_axes_must_match_the_axis_count(ms):
@@ -98,7 +104,7 @@ def test_relative_move_is_relative(ctl, ms):
     assert [a.command_position for a in ms.axes] == [510.0, 490.0]
 
 
-@pytest.mark.parametrize("low_count, expected", [(None, 32), (10, 10), (0, None)])
+@pytest.mark.parametrize(("low_count", "expected"), [(None, 32), (10, 10), (0, None)])
 def test_low_count_sets_when_frames_low_is_sent(ctl, notified, low_count, expected):
     # MPI 001, LOW_COUNT: "the number of points below which to trigger the fetch ... LOW_COUNT
     # default is 32" (a quarter of the 128-frame buffer)
@@ -107,7 +113,8 @@ def test_low_count_sets_when_frames_low_is_sent(ctl, notified, low_count, expect
     attrs = A.NONE
     if low_count is not None:
         attrs, params.low_count = A.LOW_COUNT, low_count
-    assert notified.axis_list_set([0]).ok and notified.start(T.PT, attrs, params).ok
+    assert notified.axis_list_set([0]).ok
+    assert notified.start(T.PT, attrs, params).ok
     start = ctl.sample
     ctl.step(n * 20 + 10)
     lows = [sample for sample, kind in events(ctl) if kind == "FRAMES_LOW"]
@@ -163,7 +170,8 @@ def test_feedforward_of_appended_points_follows_on(ctl, ms):
 def _ptf_run(ctl_factory, feedforward, batch):
     ctl = ctl_factory()
     _, ms = ctl.create_motion(0)
-    assert ms.axis_list_set([0]).ok and ms.action(MPIAction.MAP).ok
+    assert ms.axis_list_set([0]).ok
+    assert ms.action(MPIAction.MAP).ok
     assert ms.start(T.PTF, A.NONE, MotionParams(position=[200.0, 600.0], time=[0.2, 0.2],
                                                 feedforward=feedforward)).ok
     actual = {}
@@ -181,7 +189,7 @@ def test_feedforward_drives_the_servo_and_holds_it_off_the_command():
     from mpi_ros.mpi import Controller
 
     _, _, plain = _ptf_run(Controller, [0.0, 0.0], 50)
-    ms, ctl, pushed = _ptf_run(Controller, [20_000.0, 20_000.0], 50)
+    _ms, ctl, pushed = _ptf_run(Controller, [20_000.0, 20_000.0], 50)
     assert [plain[k] != pushed[k] for k in (100, 400, 700)] == [True] * 3  # along the path
     axis = ctl.axes[0]
     w = 2.0 * np.pi * axis.plant.config.bandwidth_hz
@@ -212,7 +220,8 @@ def test_a_held_path_takes_appended_points_and_runs_them_all_once_released(ctl, 
                         empty_count=0)
     assert ms.start(T.PT, A.HOLD, path).ok
     ctl.step(500)
-    assert [a.cmd_p for a in ms.axes] == [0.0, 0.0] and ms.state is MPIState.MOVING
+    assert [a.cmd_p for a in ms.axes] == [0.0, 0.0]
+    assert ms.state is MPIState.MOVING
     assert ms.modify(T.PT, A.APPEND, MotionParams(position=[400.0, 0.0], time=[0.1])).ok
     assert ms.modify(T.PT, A.APPEND | A.HOLD, MotionParams(position=[0.0, 0.0], time=[0.1],
                                                            hold=[hold, hold])) is M.MPIMotionMessageATTRIBUTE_INVALID
@@ -221,9 +230,10 @@ def test_a_held_path_takes_appended_points_and_runs_them_all_once_released(ctl, 
     while ms.state is MPIState.MOVING and len(trace) < 2000:
         ctl.step(1)
         trace.append([a.cmd_p for a in ms.axes])
-    assert trace[199] == pytest.approx([100.0, 0.0]) and trace[599] == pytest.approx([300.0, 50.0])
+    assert trace[199] == pytest.approx([100.0, 0.0])
+    assert trace[599] == pytest.approx([300.0, 50.0])
     assert trace[799] == pytest.approx([400.0, 0.0])  # the appended point, 0.1 s after the last
-    steps = [abs(b[0] - a[0]) for a, b in zip(trace, trace[1:], strict=False)]
+    steps = [abs(b[0] - a[0]) for a, b in itertools.pairwise(trace)]
     assert max(steps) <= 0.5 + 1e-9  # no jump anywhere
 
 
@@ -239,7 +249,8 @@ def test_a_modify_that_replaces_an_open_path_ends_its_appends(ctl, ms):
     replaced = MotionParams(position=[50.0, 50.0], point_velocity=[0.0, 0.0], time=[0.2])
     outcome, serial = ms.command(T.PVT, A.NONE, replaced, True)
     message = outcome.message
-    assert message.ok and serial != appended
+    assert message.ok
+    assert serial != appended
     ends = {end.serial: (end.message, end.detail) for end in ctl.move_log.recent(ms.number)}
     assert ends[appended] == (M.MPIMotionMessageSTOPPED, "replaced by a modify")
     ctl.run_until(lambda c: ms.state is MPIState.IDLE, 10_000)

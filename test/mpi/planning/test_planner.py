@@ -47,7 +47,8 @@ def test_vector_move_is_one_profile_along_the_line():
         assert sx.duration == sy.duration
         assert (sx.v * 4.0, sx.a * 4.0, sx.j * 4.0) == pytest.approx((sy.v * 3.0, sy.a * 3.0, sy.j * 3.0))
     assert max(math.hypot(sx.v, sy.v) for sx, sy in zip(x.segments, y.segments, strict=True)) == pytest.approx(1000.0)
-    assert (x.target, y.target) == (3000.0, 4000.0) and end(x)[0] == pytest.approx(3000.0)
+    assert (x.target, y.target) == (3000.0, 4000.0)
+    assert end(x)[0] == pytest.approx(3000.0)
     assert notes.events == []
 
 
@@ -65,7 +66,8 @@ def test_sync_end_pads_the_start_of_shorter_profiles():
     fast, slow = move.plans
     assert fast.duration == pytest.approx(slow.duration)
     wait = fast.segments[0]
-    assert (wait.v, wait.a, wait.j) == (0.0, 0.0, 0.0) and wait.duration > 0.0
+    assert (wait.v, wait.a, wait.j) == (0.0, 0.0, 0.0)
+    assert wait.duration > 0.0
     assert slow.segments[0].a > 0.0
 
 
@@ -75,14 +77,17 @@ def test_sync_start_pads_the_end_of_shorter_profiles():
     move, _ = compile_(A.SYNC_START, position=(1000.0, 100.0), trajectory=trajectories)
     fast, slow = move.plans
     assert fast.duration == pytest.approx(slow.duration)
-    assert fast.segments[0].a > 0.0 and fast.segments[-1].v == 0.0 and fast.segments[-1].p == 1000.0
+    assert fast.segments[0].a > 0.0
+    assert fast.segments[-1].v == 0.0
+    assert fast.segments[-1].p == 1000.0
 
 
 def test_delay_prepends_a_wait_frame_per_axis():
     # MPI 000, MPIMotionAttrDELAY delay "assign delay times for each Axis"
     move, _ = compile_(A.DELAY, delay=[0.5, 0.0])
     x, y = move.plans
-    assert x.segments[0].duration == 0.5 and x.segments[0].v == 0.0
+    assert x.segments[0].duration == 0.5
+    assert x.segments[0].v == 0.0
     assert x.duration == pytest.approx(y.duration + 0.5)
 
 
@@ -102,10 +107,11 @@ def test_relative_targets_and_truncation():
     move, notes = compile_(A.RELATIVE, position=(2000.0, -3.9), starts=starts)
     assert [p.target for p in move.plans] == [3000.0, -8.0]
     assert [kind for kind, _ in notes.events] == [E.RELATIVE_TRUNCATED]
-    assert "-3.9" in notes.events[0][1] and "axis 1" in notes.events[0][1]
+    assert "-3.9" in notes.events[0][1]
+    assert "axis 1" in notes.events[0][1]
 
 
-@pytest.mark.parametrize("given,stored", [(32767, 32767), (32768, -32768), (-32769, 32767), (1 << 20, 0)])
+@pytest.mark.parametrize(("given", "stored"), [(32767, 32767), (32768, -32768), (-32769, 32767), (1 << 20, 0)])
 def test_id_truncated_to_16_bits(given, stored):
     # MPI 000, MPIMotionAttributes, id "The id is limited to 16-bit resolution by the controller firmware"
     move, notes = compile_(A.ID, id=given)
@@ -132,7 +138,8 @@ def test_frame_longer_than_16384000_samples_is_cut():
     # abruptly after 16,384,000 samples"
     move, notes = compile_(position=(1e6,), trajectory=(Trajectory(1.0, 1e4, 1e4),), rate=100.0)
     plan = move.plans[0]
-    assert plan.truncated and plan.final_velocity == 0.0
+    assert plan.truncated
+    assert plan.final_velocity == 0.0
     assert max(s.duration for s in plan.segments) == 16_384_000 / 100.0
     assert plan.target == pytest.approx(163_840.0, abs=1e-3)
     assert [kind for kind, _ in notes.events] == [E.FRAME_TIME_LIMIT]
@@ -141,7 +148,8 @@ def test_frame_longer_than_16384000_samples_is_cut():
 def test_long_move_within_the_limit_is_not_cut():
     # MPI 000, mpiMotionStart the limit is 16,384,000 samples (2.27 hours at 2000 Hz)
     move, notes = compile_(position=(8_000_000.0,), trajectory=(Trajectory(1000.0, 1e4, 1e4),))
-    assert not move.plans[0].truncated and notes.events == []
+    assert not move.plans[0].truncated
+    assert notes.events == []
 
 
 def test_velocity_move_cruises_for_the_frame_limit():
@@ -149,8 +157,11 @@ def test_velocity_move_cruises_for_the_frame_limit():
     move, _ = compile_(kind=T.VELOCITY, position=(), starts=[AxisStart(0, 0.0)],
                        trajectory=(Trajectory(500.0, 5000.0),))
     plan = move.plans[0]
-    assert plan.is_velocity and plan.velocity_target == 500.0 and plan.ramp_end == pytest.approx(0.1)
-    assert plan.segments[-1].duration == pytest.approx(16_384_000 / RATE) and plan.truncated
+    assert plan.is_velocity
+    assert plan.velocity_target == 500.0
+    assert plan.ramp_end == pytest.approx(0.1)
+    assert plan.segments[-1].duration == pytest.approx(16_384_000 / RATE)
+    assert plan.truncated
 
 
 def test_velocity_move_per_axis_trajectories():
@@ -167,7 +178,8 @@ def test_final_velocity_plans_end_moving():
     plan = move.plans[0]
     assert plan.final_velocity == 250.0
     p, v, _ = end(plan)
-    assert p == pytest.approx(1000.0) and v == pytest.approx(250.0)
+    assert p == pytest.approx(1000.0)
+    assert v == pytest.approx(250.0)
 
 
 def test_final_velocity_off_the_vector_line():
@@ -194,7 +206,8 @@ def test_reversal_profile_from_a_moving_start():
     move, _ = compile_(position=(-100.0,), starts=[AxisStart(0, 0.0, 1000.0)], moving=True)
     plan = move.plans[0]
     velocities = [s.v for s in plan.segments] + [end(plan)[1]]
-    assert max(velocities) == 1000.0 and min(velocities) == pytest.approx(-1000.0)
+    assert max(velocities) == 1000.0
+    assert min(velocities) == pytest.approx(-1000.0)
     assert end(plan)[0] == pytest.approx(-100.0)
 
 
@@ -211,7 +224,8 @@ def test_vector_modify_off_the_line_plans_each_axis():
     starts = [AxisStart(0, 0.0, 1000.0), AxisStart(1, 0.0, 0.0)]
     move, _ = compile_(position=(0.0, 1000.0), starts=starts, moving=True)
     x, y = move.plans
-    assert end(x)[0] == pytest.approx(0.0) and end(y)[0] == pytest.approx(1000.0)
+    assert end(x)[0] == pytest.approx(0.0)
+    assert end(y)[0] == pytest.approx(1000.0)
     assert max(abs(s.v) for s in x.segments) == pytest.approx(1000.0)  # share of the velocity: 1
     assert max(abs(s.v) for s in y.segments) <= 1000.0 + 1e-9
 
@@ -223,7 +237,8 @@ def test_hold_and_outputs_go_to_the_plans():
     output = Output(type=OutputType.OUTPUT, on_mask=1)
     move, _ = compile_(A.HOLD | A.OUTPUT, hold=holds, output=[output])
     assert [p.hold.gate for p in move.plans] == [1, 2]
-    assert move.plans[0].outputs == [output] and move.plans[1].outputs == []
+    assert move.plans[0].outputs == [output]
+    assert move.plans[1].outputs == []
 
 
 def _eager(plan: AxisPlan) -> AxisPlan:
@@ -265,8 +280,10 @@ def test_a_lone_axis_is_stepped_from_its_rows_until_asked_for_its_segments(kind,
     assert [again.segment_poly(t) for t in times] == [eager.segment_poly(t) for t in times]
     for mine, theirs in zip(again.evaluate(times), eager.evaluate(times), strict=True):
         assert np.array_equal(mine, theirs)
-    assert again.segments == eager.segments and all(type(s) is Segment for s in again.segments)
-    assert again == plan and _fields(copy.deepcopy(again)) == _fields(eager)
+    assert again.segments == eager.segments
+    assert all(type(s) is Segment for s in again.segments)
+    assert again == plan
+    assert _fields(copy.deepcopy(again)) == _fields(eager)
 
 
 @pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
@@ -282,7 +299,8 @@ def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving)
         frames = plan.frame_count  # counted from the line, before the segments are made
         eager = _eager(plan)
         assert (frames, plan.duration) == (eager.frame_count, eager.duration)
-        assert plan.segments == eager.segments and len(plan.segments) == frames - 1
+        assert plan.segments == eager.segments
+        assert len(plan.segments) == frames - 1
         for mine, theirs in zip(plan.evaluate(times), eager.evaluate(times), strict=True):
             assert np.array_equal(mine, theirs)
     for plan in compile_(position=(3000.0, -4000.0), kind=kind, trajectory=trajectory, starts=starts)[0].plans:

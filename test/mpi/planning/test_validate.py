@@ -152,7 +152,7 @@ def test_no_backtrack_and_no_backtrack_hold_exclude_each_other():
     assert check_attributes(T.CAM_LINEAR, A.NO_BACKTRACK, full_params(), False).ok
 
 
-@pytest.mark.parametrize("attr,field", [
+@pytest.mark.parametrize(("attr", "field"), [
     (A.DELAY, "delay"),  # MPI 000, MPIMotionMessageATTRIBUTE_INVALID
     (A.FINAL_VEL, "final_velocity"),  # MPI 000, MPIMotionMessageATTRIBUTE_INVALID
     (A.HOLD, "hold"), (A.HOLD_LESS, "hold"), (A.HOLD_GREATER, "hold"),  # MPI 000, MPIMotionMessageATTRIBUTE_INVALID
@@ -242,7 +242,7 @@ def test_velocity_move_velocity_may_be_negative_or_zero():
     assert params_verdict(bad, kind=T.VELOCITY).message is M.MPIMessagePARAM_INVALID
 
 
-@pytest.mark.parametrize("jerk_percent,ok", [(0.0, True), (100.0, True), (-0.1, False), (100.1, False)])
+@pytest.mark.parametrize(("jerk_percent", "ok"), [(0.0, True), (100.0, True), (-0.1, False), (100.1, False)])
 def test_jerk_percent_within_0_and_100(jerk_percent, ok):
     # MPI 000, MPIMotionSCurve S-curve parameters are velocity, acceleration, deceleration and jerkPercent (a
     # percentage)
@@ -263,7 +263,7 @@ def test_non_finite_position_is_param_invalid():
     assert params_verdict(p2p([float("inf"), 0.0])).message is M.MPIMessagePARAM_INVALID
 
 
-@pytest.mark.parametrize("attr,field,value", [
+@pytest.mark.parametrize(("attr", "field", "value"), [
     (A.DELAY, "delay", [0.1]),
     (A.DELAY, "delay", [0.1, -0.1]),
     (A.DELAY, "delay", [0.1, float("nan")]),
@@ -279,7 +279,7 @@ def test_per_axis_attribute_arrays(attr, field, value):
     assert params_verdict(params, attrs=attr).message is M.MPIMessagePARAM_INVALID
 
 
-@pytest.mark.parametrize("hold,ok", [
+@pytest.mark.parametrize(("hold", "ok"), [
     (Hold(type=HoldType.GATE, gate=31), True),
     (Hold(type=HoldType.GATE, gate=32), False),  # MPI 000, MEIMotionAttrHoldSource, gate gate "between 0 and 31"
     (Hold(type=HoldType.GATE, gate=-1), False),
@@ -299,7 +299,7 @@ def test_hold_sources(hold, ok):
     assert params_verdict(p2p(hold=[hold, hold]), attrs=A.HOLD).ok is ok
 
 
-@pytest.mark.parametrize("output,ok", [
+@pytest.mark.parametrize(("output", "ok"), [
     (Output(type=OutputType.OUTPUT, address=0, on_mask=1), True),
     (Output(type=OutputType.OUTPUT, address=64), False),  # docs/decisions.md, "The ROS contract"
     (Output(type=OutputType.MOTOR, motor=3), True),  # MPI 000, MEIMotionAttrOutput, motor motor number
@@ -323,7 +323,7 @@ def test_element_id_needs_values():
 # ------------------------------------------------------------------ ranges ----
 # docs/decisions.md "Validation and ranges": every value a move reads is one a controller can
 # hold (MotionParams.validate, the validator the services and the YAML loader use too).
-@pytest.mark.parametrize("attrs,params", [
+@pytest.mark.parametrize(("attrs", "params"), [
     (A.NONE, p2p([1e300, 0.0])),  # finite, but past any position a controller holds
     (A.NONE, p2p(trajectory=[Trajectory(1e300, 1e4, 1e4)])),
     (A.DELAY, p2p(delay=[0.0, 1e9])),  # more samples than the counter holds
@@ -337,7 +337,8 @@ def test_values_no_controller_holds_are_param_invalid(attrs, params):
     # specified motion parameters are not valid"; C longs and doubles (MPIMotionParams,
     # MPIMotionAttributes, MEIMotionAttrHold/Output), durations that fit the sample counter
     verdict = params_verdict(params, attrs=attrs)
-    assert verdict.message is M.MPIMessagePARAM_INVALID and ":" in verdict.detail
+    assert verdict.message is M.MPIMessagePARAM_INVALID
+    assert ":" in verdict.detail
 
 
 @pytest.mark.parametrize("empty_count", [-1, 0, -100, 1, 5])
@@ -369,7 +370,8 @@ def test_config_set_with_no_axes_answers_axis_count(ctl):
     before = ms.config.copy()
     assert ms.config_set(MotionConfig(normal_feedrate=0.5)) is M.MPIMotionMessageAXIS_COUNT
     assert ms.config == before
-    assert ms.axis_list_set([0]).ok and ms.config_set(MotionConfig(normal_feedrate=0.5)).ok
+    assert ms.axis_list_set([0]).ok
+    assert ms.config_set(MotionConfig(normal_feedrate=0.5)).ok
 
 
 def test_start_in_error_answers_error(ms, bring, params):
@@ -433,7 +435,8 @@ REFUSED = [
 ]
 
 
-@pytest.mark.parametrize("name,modify,kind,attrs,request_params,expected", REFUSED, ids=[r[0] for r in REFUSED])
+@pytest.mark.parametrize(("name", "modify", "kind", "attrs", "request_params", "expected"), REFUSED,
+                         ids=[r[0] for r in REFUSED])
 def test_a_refused_command_changes_nothing(name, modify, kind, attrs, request_params, expected):
     # docs/quality.md, "Robust": bad input gets the reference's message and changes nothing; validate.py: "the first
     # failing check wins and nothing is changed"
@@ -458,7 +461,7 @@ EXTREME = [
 ]
 
 
-@pytest.mark.parametrize("kind,traj", EXTREME)
+@pytest.mark.parametrize(("kind", "traj"), EXTREME)
 def test_extreme_valid_values_never_crash(ctl, ms, kind, traj):
     # docs/quality.md, "Robust": no input can crash a node or leave it inconsistent; bad input gets the
     # reference's message and changes nothing. Finite positive limits at the ends of the float range
@@ -469,4 +472,5 @@ def test_extreme_valid_values_never_crash(ctl, ms, kind, traj):
         assert all(math.isfinite(x) for a in ctl.axes for x in (a.cmd_p, a.cmd_v, a.cmd_a, a.act_p, a.act_v))
     assert ms.action(MPIAction.ABORT).ok
     ctl.step(1)
-    assert ms.action(MPIAction.RESET).ok and ms.state is MPIState.IDLE
+    assert ms.action(MPIAction.RESET).ok
+    assert ms.state is MPIState.IDLE

@@ -77,7 +77,8 @@ def test_a_held_move_reports_its_target_as_a_delayed_one_does():
     # is the target distance (|target - actual| < coarse): 5000 counts away it is FALSE, as while a DELAY waits
     held = _waiting_status(A.HOLD, hold=[Hold(type=HoldType.GATE, gate=3)] * 2)
     delayed = _waiting_status(A.DELAY, delay=[10.0, 10.0])
-    assert held["target_position"] == 5000.0 and not held["in_coarse_position"]
+    assert held["target_position"] == 5000.0
+    assert not held["in_coarse_position"]
     assert held == delayed
 
 
@@ -111,7 +112,7 @@ def test_input_hold_matches_mask_and_pattern(ctl, ms, params):
     assert ctl.axes[0].cmd_p > 0.0
 
 
-@pytest.mark.parametrize("kind,space", [(HoldType.MOTOR_GENERAL_IO, IoSpace.MOTOR_GENERAL_IO),
+@pytest.mark.parametrize(("kind", "space"), [(HoldType.MOTOR_GENERAL_IO, IoSpace.MOTOR_GENERAL_IO),
                                         (HoldType.MOTOR_DEDICATED_IO, IoSpace.MOTOR_DEDICATED_IO)])
 def test_motor_io_hold(ctl, ms, params, kind, space):
     # MPI 000, MEIMotionAttrHoldTypeMOTOR_GENERAL_IO "Motion hold input triggers from a General IO bit"; MPI 000,
@@ -160,7 +161,7 @@ def test_axis_position_hold_greater(ctl, params, kind):
     # MEIMotionAttrHoldTypeAXIS_POSITION_ACTUAL trigger from an axis's actual / command position; MPI 000,
     # MEIMotionAttrHoldSource, axis.number axis.number, axis.position
     hold = Hold(type=kind, number=0, position=400.0)
-    lead, follow = leader_and_follower(ctl, params, hold, A.HOLD | A.HOLD_GREATER)
+    _lead, _follow = leader_and_follower(ctl, params, hold, A.HOLD | A.HOLD_GREATER)
     watched = ctl.axes[0]
     while ctl.axes[2].holding:
         position = watched.command_position if kind is HoldType.AXIS_POSITION_COMMAND else watched.actual_position
@@ -213,9 +214,11 @@ def test_timeout_starts_the_move_anyway(ctl, ms, params):
     k = ctl.sample
     held_start(ms, params, Hold(type=HoldType.GATE, gate=1, timeout=0.1))
     ctl.step(199)
-    assert ctl.axes[0].holding and ctl.axes[0].cmd_p == 0.0
+    assert ctl.axes[0].holding
+    assert ctl.axes[0].cmd_p == 0.0
     ctl.step(1)
-    assert not ctl.axes[0].holding and ctl.sample == k + 200
+    assert not ctl.axes[0].holding
+    assert ctl.sample == k + 200
     timeouts = [e for e in ctl.drain_events() if e.type is E.HOLD_TIMEOUT]
     assert [(e.sample, e.axis) for e in timeouts] == [(k + 200, 0), (k + 200, 1)]
     ctl.step(1)
@@ -245,7 +248,8 @@ def test_same_hold_starts_in_the_same_sample_across_supervisors(ctl, ms, ms1, pa
     ctl.step(1)
     assert all(ctl.axes[n].cmd_p != 0.0 for n in (0, 2, 3))
     released = [e for e in ctl.drain_events() if e.type is E.HOLD_RELEASED]
-    assert len(released) == 4 and len({e.sample for e in released}) == 1
+    assert len(released) == 4
+    assert len({e.sample for e in released}) == 1
 
 
 def test_hold_is_refused_on_modify(ctl, ms, params, bring):
@@ -273,7 +277,9 @@ def test_hold_with_append(ctl, ms, params, run_to):
     hold = Hold(type=HoldType.GATE, gate=3)
     assert ms.start(T.TRAPEZOIDAL, A.APPEND | A.HOLD, params((400.0, 0.0), hold=[hold, hold])).ok
     ctl.step(5000)
-    assert ctl.axes[0].command_position == 200.0 and ctl.axes[0].holding and ms.state is MPIState.MOVING
+    assert ctl.axes[0].command_position == 200.0
+    assert ctl.axes[0].holding
+    assert ms.state is MPIState.MOVING
     ctl.gate_set(3, False)
     run_to(ctl, ms, MPIState.IDLE, 20_000, chunk=100)
     assert ctl.axes[0].command_position == 400.0

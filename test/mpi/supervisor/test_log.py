@@ -23,7 +23,9 @@ def test_log_records_every_sample_up_to_max_entries(ctl, ms, params):
         commands.append((ctl.axes[0].cmd_p, ctl.axes[1].cmd_p))
     log = ms.log
     samples = np.concatenate(log.samples)
-    assert log.count == 500 and log.full and list(samples) == list(range(1, 501))
+    assert log.count == 500
+    assert log.full
+    assert list(samples) == list(range(1, 501))
     columns = np.concatenate(log.columns)
     assert [tuple(row) for row in columns[:, [0, 3]]] == commands[:500]
 
@@ -43,7 +45,8 @@ def test_log_is_the_same_in_any_batches(params):
 
     one, samples = logged(1)
     big, _ = logged(1500)
-    assert np.array_equal(one, big) and samples == list(range(1, 1501))
+    assert np.array_equal(one, big)
+    assert samples == list(range(1, 1501))
 
 
 def test_log_print_writes_the_buffer(tmp_path, ctl, ms, params):
@@ -57,7 +60,9 @@ def test_log_print_writes_the_buffer(tmp_path, ctl, ms, params):
     rows = list(csv.reader(path.open()))
     assert rows[0] == ["sample", "state", "axis0_command", "axis0_actual", "axis0_velocity",
                        "axis1_command", "axis1_actual", "axis1_velocity"]
-    assert len(rows) == 101 and rows[-1][0] == "100" and rows[-1][1] == MPIState.MOVING.name
+    assert len(rows) == 101
+    assert rows[-1][0] == "100"
+    assert rows[-1][1] == MPIState.MOVING.name
     assert float(rows[-1][2]) == ctl.axes[0].command_position
 
 

@@ -4,6 +4,8 @@ over decelTime.eStop; ABORT disables the amplifiers; RESET after ABORT sets comm
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -49,9 +51,11 @@ def test_stop_decelerates_to_zero_over_the_stop_time(params):
     assert ms.action(MPIAction.STOP).ok
     rows = record(ctl, ms, 1000)
     speeds = [np.hypot(r[3], r[6]) for r in rows]
-    assert speeds[-1] == 0.0 and speeds[-2] > 0.0  # zero exactly at 0.5 s
-    assert all(b <= a for a, b in zip(speeds, speeds[1:], strict=False))  # never speeds up while stopping
-    assert ms.state is MPIState.STOPPED and ms.snapshot().feedrate == 0.0
+    assert speeds[-1] == 0.0
+    assert speeds[-2] > 0.0
+    assert all(b <= a for a, b in itertools.pairwise(speeds))  # never speeds up while stopping
+    assert ms.state is MPIState.STOPPED
+    assert ms.snapshot().feedrate == 0.0
 
 
 def test_stop_stays_on_the_path_and_resume_continues_it(params):
@@ -89,7 +93,8 @@ def test_resume_ramps_the_feedrate_back_over_the_stop_time(params):
     assert ms.snapshot().feedrate == pytest.approx(0.5)
     assert ctl.axes[0].cmd_v == pytest.approx(500.0)
     ctl.step(500)
-    assert ms.snapshot().feedrate == 1.0 and ctl.axes[0].cmd_v == 1000.0
+    assert ms.snapshot().feedrate == 1.0
+    assert ctl.axes[0].cmd_v == 1000.0
 
 
 def test_resume_then_stop_again(params):
@@ -114,7 +119,8 @@ def test_e_stop_ramps_to_zero_over_the_e_stop_time(params):
     ctl.step(1000)
     ms.action(MPIAction.E_STOP)
     rows = record(ctl, ms, 100)
-    assert rows[-1][3] == 0.0 and rows[-2][3] > 0.0
+    assert rows[-1][3] == 0.0
+    assert rows[-2][3] > 0.0
     assert rows[0][4] == pytest.approx(-1000.0 / 0.05)  # linear ramp of the feedrate
     assert ms.state is MPIState.ERROR
 
@@ -141,7 +147,8 @@ def test_abort_disables_the_amplifiers_and_freezes_the_command(params):
     assert not ctl.axis_snapshot(0).amp_enabled
     ctl.step(4000)
     axis = ctl.axes[0]
-    assert axis.cmd_p == command and axis.act_p > command + 10.0  # the motor coasted on
+    assert axis.cmd_p == command
+    assert axis.act_p > command + 10.0
     assert abs(axis.act_v) < 1.0  # and came to rest on its own
 
 
@@ -155,9 +162,11 @@ def test_reset_after_abort_sets_command_to_actual(params):
     ctl.step(2000)
     assert ms.action(MPIAction.RESET).ok
     axis = ctl.axes[0]
-    assert axis.amp_enabled and axis.cmd_p == axis.act_p
+    assert axis.amp_enabled
+    assert axis.cmd_p == axis.act_p
     ctl.step(1000)
-    assert axis.cmd_p == axis.act_p and ms.state is MPIState.IDLE  # no jump back to the old command
+    assert axis.cmd_p == axis.act_p
+    assert ms.state is MPIState.IDLE
 
 
 def test_reset_after_e_stop_keeps_the_command(params):
@@ -181,9 +190,11 @@ def test_e_stop_abort_decelerates_then_disables(params):
     ctl.step(1000)
     ms.action(MPIAction.E_STOP_ABORT)
     rows = record(ctl, ms, 99)
-    assert all(a.amp_enabled for a in ms.axes) and rows[-1][3] > 0.0
+    assert all(a.amp_enabled for a in ms.axes)
+    assert rows[-1][3] > 0.0
     ctl.step(1)
-    assert ctl.axes[0].cmd_v == 0.0 and not any(a.amp_enabled for a in ms.axes)
+    assert ctl.axes[0].cmd_v == 0.0
+    assert not any(a.amp_enabled for a in ms.axes)
     assert ms.state is MPIState.ERROR
     ms.action(MPIAction.RESET)
     assert ctl.axes[0].cmd_p == ctl.axes[0].act_p  # it was aborted: command = actual
@@ -232,7 +243,8 @@ def test_abort_in_error_after_e_stop_disables(params):
     assert ctl.run_until(lambda c: ms.state is MPIState.ERROR, 200)
     assert ms.axes[0].amp_enabled
     ms.action(MPIAction.ABORT)
-    assert not ms.axes[0].amp_enabled and ms.state is MPIState.ERROR
+    assert not ms.axes[0].amp_enabled
+    assert ms.state is MPIState.ERROR
 
 
 def test_stop_before_the_move_would_end(params):
@@ -255,10 +267,12 @@ def test_velocity_move_stops_and_resumes(params):
     ctl.step(1000)
     ms.action(MPIAction.STOP)
     ctl.step(1000)
-    assert ctl.axes[0].cmd_v == 0.0 and ms.state is MPIState.STOPPED
+    assert ctl.axes[0].cmd_v == 0.0
+    assert ms.state is MPIState.STOPPED
     ms.action(MPIAction.RESUME)
     ctl.step(1000)
-    assert ctl.axes[0].cmd_v == -800.0 and ms.state is MPIState.MOVING
+    assert ctl.axes[0].cmd_v == -800.0
+    assert ms.state is MPIState.MOVING
 
 
 def test_start_from_a_slowly_moving_stop_keeps_the_velocity(params):
@@ -301,7 +315,8 @@ def test_reset_and_remap_follow_one_rule_while_stopped_axes_creep(params):
     ctl, ms = _creeping(params)
     twin, twin_ms = _creeping(params)
     reset = ms.action_detail(MPIAction.RESET)
-    assert reset.message is Message.MPIMotionMessageSTOPPED and "pauseFeedrate" in reset.detail
+    assert reset.message is Message.MPIMotionMessageSTOPPED
+    assert "pauseFeedrate" in reset.detail
     assert ms.axis_list_set([1]).ok
     remap = ms.action_detail(MPIAction.MAP)
     assert (remap.message, remap.detail) == (reset.message, reset.detail)
@@ -313,7 +328,8 @@ def test_reset_and_remap_follow_one_rule_while_stopped_axes_creep(params):
         assert (ctl.axes[0].cmd_p, ctl.axes[0].cmd_v) == (twin.axes[0].cmd_p, twin.axes[0].cmd_v)
     assert ms.action(MPIAction.E_STOP).ok
     assert ctl.run_until(lambda c: ms.state is MPIState.ERROR, 2000)
-    assert ms.action(MPIAction.RESET).ok and ms.state is MPIState.IDLE
+    assert ms.action(MPIAction.RESET).ok
+    assert ms.state is MPIState.IDLE
 
 
 def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(params):
@@ -325,9 +341,13 @@ def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(par
     ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
     assert ctl.run_until(lambda c: c.axes[0].command_position > 1000.0, 10_000, chunk=10)
     ctl.step(2000)
-    assert ms.state is MPIState.MOVING and ctl.axes[0].cmd_v == 400.0
+    assert ms.state is MPIState.MOVING
+    assert ctl.axes[0].cmd_v == 400.0
     bits = ctl.axes[0].status  # the last frame runs on: not complete, not at the target, not done
-    assert not (bits.trajectory_complete or bits.at_target or bits.done or bits.in_fine_position)
+    assert not (bits.trajectory_complete)
+    assert not (bits.at_target)
+    assert not (bits.done)
+    assert not (bits.in_fine_position)
     assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is Message.MPIMotionMessageMOVING
     assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))).ok
     run_smoothly_to_idle(ctl, ms)
@@ -363,7 +383,9 @@ def test_append_in_stopped_queues_behind_the_pending_profile(params):
     assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((100.0, 0.0))).ok
     stopped_at = ctl.axes[0].cmd_p
     ctl.step(200)
-    assert len(ms.queue) == 1 and ms.state is MPIState.STOPPED and ctl.axes[0].cmd_p == stopped_at
+    assert len(ms.queue) == 1
+    assert ms.state is MPIState.STOPPED
+    assert ctl.axes[0].cmd_p == stopped_at
     assert ms.action(MPIAction.RESUME).ok
     assert ctl.run_until(lambda c: c.axes[0].cmd_p == 5000.0, 20_000)
     assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 40_000, chunk=50)
@@ -398,7 +420,7 @@ def test_a_move_that_starts_in_motion_cannot_wait(params):
     # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "non-zero delay value ... while in motion" and MPI 000,
     # mpiMotionModify "It is impossible to use the HOLD attributes with mpiMotionModify": a move appended behind one
     # that ends moving (FINAL_VEL) starts in motion too, and a wait would stop the axes dead.
-    ctl, ms = two_axes()
+    _ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
     delayed = params((2000.0, 0.0), delay=[0.1, 0.1])
     message = ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.DELAY, delayed)

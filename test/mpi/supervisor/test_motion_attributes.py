@@ -48,7 +48,9 @@ def test_append_begins_after_the_previous_completed_and_settled(ctl, ms, params)
     while not any(e.type is E.MOTION_DONE for e in ctl.events):
         ctl.step(1)
         assert axis.cmd_p <= 1000.0
-    assert axis.status.done and axis.status.settled and axis.cmd_p == 1000.0
+    assert axis.status.done
+    assert axis.status.settled
+    assert axis.cmd_p == 1000.0
     ctl.step(1)
     assert axis.cmd_p > 1000.0  # the next sample runs the appended move
     run_idle(ctl, ms)
@@ -58,7 +60,8 @@ def test_append_begins_after_the_previous_completed_and_settled(ctl, ms, params)
 def test_append_on_an_idle_supervisor_is_a_start(ctl, ms, params):
     # MPI 000, MPIMotionAttrAPPEND APPEND adds to "a previous motion profile": with none, the move starts
     assert ms.start(T.TRAPEZOIDAL, A.APPEND, params((300.0, 0.0))).ok
-    assert ms.state is MPIState.MOVING and not ms.queue
+    assert ms.state is MPIState.MOVING
+    assert not ms.queue
 
 
 def _stopped_then_resumed(append_when_stopped: bool):
@@ -78,7 +81,8 @@ def _stopped_then_resumed(append_when_stopped: bool):
     assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 10_000)
     if append_when_stopped:
         assert ms.start(T.TRAPEZOIDAL, A.APPEND, next(params)).ok
-        assert ms.state is MPIState.STOPPED and ms.snapshot().moves_pending == 1
+        assert ms.state is MPIState.STOPPED
+        assert ms.snapshot().moves_pending == 1
     positions = []
     for _ in range(100):
         ctl.step(1)
@@ -98,7 +102,8 @@ def test_append_while_stopped_queues_behind_the_pending_move_and_resume_runs_bot
     stopped, done_stopped = _stopped_then_resumed(append_when_stopped=True)
     moving, done_moving = _stopped_then_resumed(append_when_stopped=False)
     assert stopped == moving
-    assert stopped[-1] == 2000.0 and done_stopped == done_moving == 2
+    assert stopped[-1] == 2000.0
+    assert done_stopped == done_moving == 2
 
 
 def test_append_with_modify(ctl, ms, params):
@@ -117,7 +122,8 @@ def test_append_velocity_move_after_a_point_to_point(ctl, ms, params):
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     assert ms.start(T.VELOCITY, A.APPEND, params((), velocity=-300.0)).ok
     ctl.step(6000)
-    assert ms.state is MPIState.MOVING and ctl.axes[0].cmd_v == -300.0
+    assert ms.state is MPIState.MOVING
+    assert ctl.axes[0].cmd_v == -300.0
 
 
 # ------------------------------------------------------------------ AUTO_START ----
@@ -173,33 +179,38 @@ def test_illegal_delay_while_the_axes_wait_out_a_delay(ctl, ms, params):
     # DELAY the axes stand still, yet the motion is under way.
     assert ms.start(T.TRAPEZOIDAL, A.DELAY, params((100.0, 0.0), delay=[0.5, 0.5])).ok
     ctl.step(10)
-    assert ms.state is MPIState.MOVING and ctl.axes[0].cmd_v == 0.0
+    assert ms.state is MPIState.MOVING
+    assert ctl.axes[0].cmd_v == 0.0
     assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.1, 0.1])) is M.MPIMotionMessageILLEGAL_DELAY
     ctl.step(1)
-    assert ctl.axes[0].cmd_v == 0.0 and ms.current.plans[0].target == 100.0  # nothing changed
+    assert ctl.axes[0].cmd_v == 0.0
+    assert ms.current.plans[0].target == 100.0
 
 
 def test_delay_with_velocity_move(ctl, ms, params):
     # MPI 000, Move Types: S-Curve, Trapezoidal, Velocity DELAY move types: S-Curve, Trapezoidal, Velocity
     ms.start(T.VELOCITY, A.DELAY, params((), velocity=100.0, delay=[0.01, 0.0]))
     ctl.step(20)
-    assert ctl.axes[0].cmd_v == 0.0 and ctl.axes[1].cmd_v > 0.0
+    assert ctl.axes[0].cmd_v == 0.0
+    assert ctl.axes[1].cmd_v > 0.0
     ctl.step(1)
     assert ctl.axes[0].cmd_v > 0.0
 
 
 # ------------------------------------------------------------------ ID ----
-@pytest.mark.parametrize("given,stored", [(1, 1), (32767, 32767), (-32768, -32768), (65535, -1),
+@pytest.mark.parametrize(("given", "stored"), [(1, 1), (32767, 32767), (-32768, -32768), (65535, -1),
                                           (70000, 4464), (-40000, 25536)])
 def test_id_is_16_bit(ctl, ms, params, given, stored):
     # MPI 000, MPIMotionAttributes, id id "The id is limited to 16-bit resolution by the controller firmware";
     # docs/decisions.md, "Motion": documented quirks are reproduced and reported as events
     assert ms.start(T.TRAPEZOIDAL, A.ID, params((10.0, 0.0), id=given)).ok
-    assert ms.snapshot().move_id == stored and ctl.axes[0].move_id == stored
+    assert ms.snapshot().move_id == stored
+    assert ctl.axes[0].move_id == stored
     truncated = events_of(ctl, E.ID_TRUNCATED)
     assert len(truncated) == (0 if given == stored else 1)
     if truncated:
-        assert truncated[0].move_id == stored and str(given) in truncated[0].detail
+        assert truncated[0].move_id == stored
+        assert str(given) in truncated[0].detail
 
 
 def test_modify_keeps_the_id_unless_given(ctl, ms, params):
@@ -233,7 +244,8 @@ def test_relative_fraction_is_truncated(ctl, ms, params):
         run_idle(ctl, ms)
     assert [a.command_position for a in ms.axes] == [40.0, -8.0]
     events = events_of(ctl, E.RELATIVE_TRUNCATED)
-    assert len(events) == 8 and "10.75" in events[0].detail
+    assert len(events) == 8
+    assert "10.75" in events[0].detail
 
 
 def test_relative_with_append_adds_to_the_previous_target(ctl, ms, params):
@@ -275,7 +287,9 @@ def test_sync_end_ends_together(ctl, ms, params):
     # will use its own MPITrajectory values"; MPI 000, MPIMotionAttrSYNC_END
     ms.start(T.TRAPEZOIDAL, A.SYNC_END, params((1000.0, 100.0), trajectory=SYNC_TRAJ))
     first, last = first_and_last_motion(ctl, ms, 3000)
-    assert last[0] == last[1] and first[0] == 1 and first[1] > 1
+    assert last[0] == last[1]
+    assert first[0] == 1
+    assert first[1] > 1
     assert [a.command_position for a in ms.axes] == [1000.0, 100.0]
 
 
@@ -284,7 +298,8 @@ def test_sync_start_starts_together(ctl, ms, params):
     # shorter profiles"; MPI 000, MPIMotionAttrSYNC_START
     ms.start(T.TRAPEZOIDAL, A.SYNC_START, params((1000.0, 100.0), trajectory=SYNC_TRAJ))
     first, last = first_and_last_motion(ctl, ms, 3000)
-    assert first == [1, 1] and last[1] < last[0]
+    assert first == [1, 1]
+    assert last[1] < last[0]
 
 
 def test_without_sync_one_vector_trajectory(ctl, ms, params):
@@ -295,7 +310,7 @@ def test_without_sync_one_vector_trajectory(ctl, ms, params):
     ctl.step(300)
     vx, vy = (a.cmd_v for a in ms.axes)
     assert (vx, vy) == (pytest.approx(600.0), pytest.approx(800.0))
-    first, last = first_and_last_motion(ctl, ms, 1000)
+    _first, last = first_and_last_motion(ctl, ms, 1000)
     assert last[0] == last[1] == 1200
 
 
@@ -439,14 +454,17 @@ def test_velocity_frame_stops_after_16384000_samples():
     assert ms.start(T.VELOCITY, params=MotionParams(trajectory=[Trajectory(1000.0, 10_000.0)])).ok
     ctl.step(10 + 16_384_000 - 1)
     axis = ctl.axes[0]
-    assert axis.cmd_v == 1000.0 and not events_of(ctl, E.FRAME_TIME_LIMIT)
+    assert axis.cmd_v == 1000.0
+    assert not events_of(ctl, E.FRAME_TIME_LIMIT)
     ctl.step(1)  # the velocity frame has run 16,384,000 samples
-    assert axis.cmd_v == 0.0 and axis.amp_enabled  # stopped abruptly, still servoing
+    assert axis.cmd_v == 0.0
+    assert axis.amp_enabled
     limit = events_of(ctl, E.FRAME_TIME_LIMIT)
     assert [(e.sample, e.axis) for e in limit] == [(10 + 16_384_000, 0)]
     end = axis.cmd_p
     ctl.step(1)
-    assert axis.cmd_p == end and axis.cmd_v == 0.0
+    assert axis.cmd_p == end
+    assert axis.cmd_v == 0.0
     assert ms.state is not MPIState.ERROR
 
 
@@ -459,7 +477,8 @@ def test_point_to_point_frame_over_the_limit_is_cut_and_reported():
     params = MotionParams(trajectory=[Trajectory(1.0, 10_000.0, 10_000.0)], position=[200_000.0])
     assert ms.start(T.TRAPEZOIDAL, params=params).ok
     warned = events_of(ctl, E.FRAME_TIME_LIMIT)
-    assert len(warned) == 1 and warned[0].sample == 0  # reported when the move is planned
+    assert len(warned) == 1
+    assert warned[0].sample == 0
     assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 16_500_000, chunk=1 << 20)
     assert ctl.axes[0].command_position == pytest.approx(163_840.0, abs=1e-3)  # not 200000
     assert len(events_of(ctl, E.FRAME_TIME_LIMIT)) == 1  # and again when it bites

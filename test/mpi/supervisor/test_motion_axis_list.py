@@ -177,7 +177,8 @@ def test_first_next_last_previous(empty):
     while axis is not None:
         backward.append(axis)
         message, axis = empty.axis_previous(axis)
-    assert forward == [4, 6, 8] and backward == [8, 6, 4]
+    assert forward == [4, 6, 8]
+    assert backward == [8, 6, 4]
 
 
 def test_first_and_last_of_an_empty_list(empty):
@@ -226,7 +227,8 @@ def test_map_writes_the_mapping(empty):
     assert empty.config_get()[1].axis_numbers == []
     assert empty.action(MPIAction.MAP).ok
     config = empty.config_get()[1]
-    assert config.axis_numbers == [3, 7] and config.axis_count == 2
+    assert config.axis_numbers == [3, 7]
+    assert config.axis_count == 2
 
 
 def test_map_with_an_empty_list(big, empty):
@@ -242,6 +244,8 @@ def test_map_with_an_empty_list(big, empty):
 def test_create_with_an_initial_axis(big):
     # MPI 000, mpiMotionCreate "The axis parameter specifies the initial element in the list of Axis objects"
     message, ms = big.create_motion(3, axis=5)
-    assert message.ok and ms.axis_list_get()[1] == [5]
+    assert message.ok
+    assert ms.axis_list_get()[1] == [5]
     message, none = big.create_motion(4, axis=99)
-    assert message is M.MPIMessageHANDLE_INVALID and none is None
+    assert message is M.MPIMessageHANDLE_INVALID
+    assert none is None

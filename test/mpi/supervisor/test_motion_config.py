@@ -17,14 +17,16 @@ def test_decel_time_defaults(ms):
     # MPI 000, MPIMotionDecelTime, stop stop "The default value is .5 seconds"; MPI 000, MPIMotionDecelTime, eStop eStop
     # "The default value is .05 seconds"
     config = ms.config_get()[1]
-    assert config.decel_time.stop == 0.5 and config.decel_time.e_stop == 0.05
+    assert config.decel_time.stop == 0.5
+    assert config.decel_time.e_stop == 0.05
 
 
 def test_feedrate_defaults(ms):
     # MPI 000, MPIMotionConfig, normalFeedrate normalFeedrate "The default value is 1.0 (100%)"; MPI 000,
     # MPIMotionConfig, pauseFeedrate pauseFeedrate "The default value is 0.0"
     config = ms.config_get()[1]
-    assert config.normal_feedrate == 1.0 and config.pause_feedrate == 0.0
+    assert config.normal_feedrate == 1.0
+    assert config.pause_feedrate == 0.0
 
 
 def test_mei_config_fields(ms):
@@ -32,12 +34,15 @@ def test_mei_config_fields(ms):
     # MEIMotionConfig, axisCount axisCount/axisNumber = the current mapping; MPI 000, MEIMotionConfig, blendLimit
     # blendLimit
     config = ms.config_get()[1]
-    assert config.user_label == "" and config.axis_numbers == [0, 1] and config.axis_count == 2
+    assert config.user_label == ""
+    assert config.axis_numbers == [0, 1]
+    assert config.axis_count == 2
     config.user_label = "x" * 16
     config.blend_limit = -1.0
     assert ms.config_set(config).ok
     again = ms.config_get()[1]
-    assert again.user_label == "x" * 16 and again.blend_limit == -1.0
+    assert again.user_label == "x" * 16
+    assert again.blend_limit == -1.0
 
 
 def test_config_get_is_a_copy(ms):
@@ -133,7 +138,9 @@ def test_params_get_initially_empty(ms):
     # MPI 000, mpiMotionParamsGet ParamsGet: "These motion parameters will be used if mpiMotionStart(...) is
     # called with Null motion params"
     message, params = ms.params_get()
-    assert message.ok and params.trajectory == [] and params.position == []
+    assert message.ok
+    assert params.trajectory == []
+    assert params.position == []
 
 
 def test_start_with_null_params_uses_the_stored_ones(ctl, ms, params, run_to):
@@ -209,12 +216,14 @@ def test_frame_buffer_status(ctl, ms, params, run_to):
     # MEIMotionFrameBufferStatus, size size "the size of the controller's frame buffer"; MPI 000,
     # MEIMotionFrameBufferStatus, frameCount frameCount "the number of frames in the buffer"
     message, status = ms.frame_buffer_status()
-    assert message.ok and [(s.axis, s.size) for s in status] == [(0, 128), (1, 128)]
+    assert message.ok
+    assert [(s.axis, s.size) for s in status] == [(0, 128), (1, 128)]
     ms.start(T.S_CURVE, params=params((5000.0, 0.0), jerk_percent=50.0))
     first = ms.frame_buffer_status()[1][0].frame_count
     ms.start(T.S_CURVE, MotionAttr.APPEND, params((0.0, 0.0), jerk_percent=50.0))
     second = ms.frame_buffer_status()[1][0].frame_count
-    assert first > 1 and second > first
+    assert first > 1
+    assert second > first
     run_to(ctl, ms, MPIState.IDLE, 50_000, chunk=100)
     assert ms.frame_buffer_status()[1][0].frame_count == 1  # the final frame holding the end
 

@@ -35,7 +35,7 @@ def assert_smooth(velocity, accel_limit):
     assert np.max(np.abs(np.diff(v))) <= accel_limit / RATE * (1 + 1e-9)
 
 
-@pytest.mark.parametrize("kind,jerk_percent", [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 0.0), (T.S_CURVE, 70.0)])
+@pytest.mark.parametrize(("kind", "jerk_percent"), [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 0.0), (T.S_CURVE, 70.0)])
 def test_modify_to_a_farther_target(params, kind, jerk_percent):
     # MPI 000, mpiMotionModify "mpiMotionModify modifies the parameters of a Motion object (motion) if motion is
     # in progress"; the motion continues from where it is to the new target
@@ -50,7 +50,7 @@ def test_modify_to_a_farther_target(params, kind, jerk_percent):
     assert np.max(np.abs(log[:, 2])) <= 1000.0 * (1 + 1e-12)
 
 
-@pytest.mark.parametrize("kind,jerk_percent", [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0)])
+@pytest.mark.parametrize(("kind", "jerk_percent"), [(T.TRAPEZOIDAL, 0.0), (T.S_CURVE, 50.0)])
 def test_modify_to_a_target_behind_reverses(params, kind, jerk_percent):
     # issue 3: "Modify on the fly from the current position, velocity and acceleration (including
     # reversal)"; MPI 000, MPIMotionMessagePROFILE_ERROR (a target "in the reverse direction" is legal without
@@ -61,7 +61,8 @@ def test_modify_to_a_target_behind_reverses(params, kind, jerk_percent):
     assert ms.modify(kind, params=params((-200.0,), jerk_percent=jerk_percent)).ok
     log = finish(ctl, ms)
     velocity = log[:, 2]
-    assert velocity.max() == pytest.approx(1000.0) and velocity.min() == pytest.approx(-1000.0)
+    assert velocity.max() == pytest.approx(1000.0)
+    assert velocity.min() == pytest.approx(-1000.0)
     assert_smooth(velocity, 10_000.0 / (1 - jerk_percent / 200.0))
     assert ctl.axes[0].command_position == -200.0
 
@@ -148,10 +149,12 @@ def test_a_velocity_modify_reaches_its_velocity_at_the_end_of_its_own_ramp(param
     assert ms.modify(T.VELOCITY, params=params((), velocity=-300.0, acceleration=5000.0)).ok
     ramp = 500.0 / 5000.0 * RATE  # samples from +200 to -300 counts/s
     ctl.step(int(ramp) - 2)
-    assert ctl.move_log.recent(ms.number) == first and ctl.axes[0].cmd_v > -300.0  # still ramping through zero
+    assert ctl.move_log.recent(ms.number) == first
+    assert ctl.axes[0].cmd_v > -300.0
     ctl.step(200)
     (end,) = ctl.move_log.recent(ms.number)[len(first):]
-    assert end.message is Message.MPIMessageOK and end.serial == first[0].serial
+    assert end.message is Message.MPIMessageOK
+    assert end.serial == first[0].serial
     assert end.sample >= modified + ramp - 1
     assert ctl.axes[0].cmd_v == pytest.approx(-300.0)
     events = [e for e in ctl.drain_events() if e.type is MPIEventType.MOTION_AT_VELOCITY]
@@ -229,7 +232,8 @@ def test_vector_modify_off_the_line_stops_then_goes_straight_within_the_vector_l
     speed = np.hypot(log[:, 2], log[:, 5])
     assert speed.max() <= 1000.0 * (1 + 1e-9)
     stopped = int(np.flatnonzero(speed < 1e-9)[0])  # at rest once, between the two lines
-    assert abs(log[stopped, 3]) < 1e-9 and log[stopped, 0] > 0.0  # axis 1 waited for the stop
+    assert abs(log[stopped, 3]) < 1e-9
+    assert log[stopped, 0] > 0.0
     plan = ms.current.plans[0] if ms.current else ms.last_move.plans[0]
     assert "stops along its line" in plan.composite
 

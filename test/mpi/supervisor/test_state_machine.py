@@ -127,9 +127,9 @@ def test_the_table_has_every_cell():
     assert cells == {(state, name) for state in S if state is not S.INVALID for name in names}
 
 
-@pytest.mark.parametrize("state,name,message,after", CELLS, ids=[f"{c[0].name}-{c[1]}" for c in CELLS])
+@pytest.mark.parametrize(("state", "name", "message", "after"), CELLS, ids=[f"{c[0].name}-{c[1]}" for c in CELLS])
 def test_cell(state, name, message, after, prepared):
-    ctl, ms = prepared(state)
+    _ctl, ms = prepared(state)
     assert command(ms, name) is message
     assert ms.state is after
 
@@ -146,7 +146,7 @@ def observe(ctl, ms, samples=4000):
 REFUSALS = [c for c in CELLS if c[2] is not OK]
 
 
-@pytest.mark.parametrize("state,name,message,after", REFUSALS, ids=[f"{c[0].name}-{c[1]}" for c in REFUSALS])
+@pytest.mark.parametrize(("state", "name", "message", "after"), REFUSALS, ids=[f"{c[0].name}-{c[1]}" for c in REFUSALS])
 def test_refused_cell_changes_nothing(state, name, message, after, prepared):
     # docs/state-machine.md: '"msg X" = refused with MPIMotionMessageX, nothing changes'
     ctl_a, ms_a = prepared(state)
@@ -178,18 +178,18 @@ def test_modify_auto_start_in_idle_starts_and_answers_auto_start(prepared):
     assert [a.command_position for a in ms.axes] == list(OTHER)
 
 
-@pytest.mark.parametrize("state,message", [(S.STOPPING, STOPPING), (S.STOPPED, STOPPED),
+@pytest.mark.parametrize(("state", "message"), [(S.STOPPING, STOPPING), (S.STOPPED, STOPPED),
                                            (S.STOPPING_ERROR, STOPPING_ERROR), (S.ERROR, ERROR)])
 def test_auto_start_does_not_start_outside_idle(state, message, prepared):
     # MPI 000, MPIMotionMessageAUTO_START AUTO_START converts a modify to a start only in the IDLE state
-    ctl, ms = prepared(state)
+    _ctl, ms = prepared(state)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is message
 
 
 def test_modify_auto_start_while_moving_is_a_plain_modify(prepared):
     # MPI 000, MPIMotionAttrAUTO_START AUTO_START acts "if the modify occurs after the previous motion profile has
     # completed"; while moving the modify answers OK
-    ctl, ms = prepared(S.MOVING)
+    _ctl, ms = prepared(S.MOVING)
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is OK
 
 
@@ -209,7 +209,8 @@ def test_reset_from_stopped_drops_the_pending_profile(prepared):
     # docs/state-machine.md: RESET in STOPPED "OK, to IDLE, pending dropped"
     ctl, ms = prepared(S.STOPPED)
     where = [a.command_position for a in ms.axes]
-    assert ms.action(MPIAction.RESET).ok and ms.state is S.IDLE
+    assert ms.action(MPIAction.RESET).ok
+    assert ms.state is S.IDLE
     ctl.step(2000)
     assert ms.state is S.IDLE
     assert [a.command_position for a in ms.axes] == where
@@ -225,7 +226,8 @@ def test_resume_from_stopped_finishes_the_move():
     ctl.step(400)
     assert ms.action(MPIAction.STOP).ok
     assert ctl.run_until(lambda c: ms.state is S.STOPPED, 5000)
-    assert ms.action(MPIAction.RESUME).ok and ms.state is S.MOVING
+    assert ms.action(MPIAction.RESUME).ok
+    assert ms.state is S.MOVING
     assert ctl.run_until(lambda c: ms.state is S.IDLE, 20_000, chunk=10)
     assert [a.command_position for a in ms.axes] == [2000.0, 1000.0]
 
@@ -239,7 +241,8 @@ def test_stop_completes_to_stopped_after_the_stop_time(prepared):
     ctl.step(999)
     assert ms.state is S.STOPPING
     ctl.step(1)
-    assert ms.state is S.STOPPED and ctl.sample == k + 1000  # 0.5 s at 2000 Hz
+    assert ms.state is S.STOPPED
+    assert ctl.sample == k + 1000
 
 
 def test_e_stop_completes_to_error_after_the_e_stop_time(prepared):
@@ -251,7 +254,8 @@ def test_e_stop_completes_to_error_after_the_e_stop_time(prepared):
     ctl.step(99)
     assert ms.state is S.STOPPING_ERROR
     ctl.step(1)
-    assert ms.state is S.ERROR and ctl.sample == k + 100  # 0.05 s
+    assert ms.state is S.ERROR
+    assert ctl.sample == k + 100
 
 
 def test_abort_reaches_error_at_the_next_sample(prepared):
@@ -272,7 +276,8 @@ def test_e_stop_while_stopping_error_keeps_the_first_ramp(prepared):
     ctl.step(50)
     assert ms.action(MPIAction.E_STOP).ok
     ctl.step(50)
-    assert ms.state is S.ERROR and ctl.sample == k + 100
+    assert ms.state is S.ERROR
+    assert ctl.sample == k + 100
 
 
 def test_e_stop_abort_while_e_stopping_disables_at_the_end(prepared):
@@ -290,7 +295,8 @@ def test_reset_in_error_returns_to_idle_and_allows_a_start(prepared):
     # MPI 000, MPIActionRESET RESET "change to the idle state (MPIStateIDLE), so that motion supervisor can
     # be restarted"
     ctl, ms = prepared(S.ERROR)
-    assert ms.action(MPIAction.RESET).ok and ms.state is S.IDLE
+    assert ms.action(MPIAction.RESET).ok
+    assert ms.state is S.IDLE
     assert ms.start(T.TRAPEZOIDAL, params=p2p(OTHER)).ok
     assert ctl.run_until(lambda c: ms.state is S.IDLE, 20_000, chunk=10)
     assert [a.command_position for a in ms.axes] == list(OTHER)
@@ -327,7 +333,7 @@ def test_stop_records_stop_until_stopped(prepared):
     assert ms.snapshot().last_action == "STOP"
 
 
-@pytest.mark.parametrize("action,event", [("STOP", MPIEventType.STOP), ("E_STOP", MPIEventType.E_STOP),
+@pytest.mark.parametrize(("action", "event"), [("STOP", MPIEventType.STOP), ("E_STOP", MPIEventType.E_STOP),
                                           ("ABORT", MPIEventType.ABORT)])
 def test_actions_emit_their_event_at_the_command_sample(action, event, prepared):
     # MPI 000, mpiMotionAction "How STOP Events Work"; docs/decisions.md, "Samples, commands and replay"

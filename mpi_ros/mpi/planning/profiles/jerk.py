@@ -78,7 +78,7 @@ def point_to_point_jerk(
     if best is None:
         raise ProfileError("no profile reaches the target")
     _, peak, cruise = best
-    segments, (p, v, a), _ = _integrate(p0, v0, a0, _change(v0, a0, peak, accel, decel))
+    segments, (p, _v, _a), _ = _integrate(p0, v0, a0, _change(v0, a0, peak, accel, decel))
     if cruise > 0.0:
         segments.append(Segment(cruise, p, peak, 0.0, 0.0))
         p += peak * cruise

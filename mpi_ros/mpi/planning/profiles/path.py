@@ -321,4 +321,4 @@ def _bspline(values: list[float], dts: list[float], degree: int) -> list[Segment
     return segments
 
 
-__all__ = ["PathKind", "SplineHistory", "path_segments", "peaks", "feedforward_segments"]
+__all__ = ["PathKind", "SplineHistory", "feedforward_segments", "path_segments", "peaks"]

@@ -38,7 +38,7 @@ def velocity_move(
     ramps = plan_velocity(v0, v_target, acceleration)
     ramp_time = sum(r.duration for r in ramps)
     if cruise > 0.0:
-        ramps = ramps + [Ramp(cruise, v_target, v_target)]
+        ramps = [*ramps, Ramp(cruise, v_target, v_target)]
     return reshape(ramps, p0, jerk_percent), ramp_time
 
 

@@ -115,7 +115,7 @@ def end_state(segments: Sequence[Segment], start: tuple[float, float, float]) ->
 class SegmentTable:
     """A profile as arrays, for evaluating many sample times at once."""
 
-    __slots__ = ("start", "end", "p", "v", "a", "j", "count")
+    __slots__ = ("a", "count", "end", "j", "p", "start", "v")
 
     def __init__(self, segments: Sequence[Row], t0: float = 0.0):
         # One array of every segment's fields in a row (np.fromiter: five np.array calls on

@@ -16,6 +16,7 @@ dx/dt^2, so it loses the most.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -123,7 +124,7 @@ def reference_knot_vector(times, degree: int) -> np.ndarray:
 # --- each kind against an independent implementation -------------------------------------
 
 
-@pytest.mark.parametrize("start,start_velocity,positions,times,velocities", CASES)
+@pytest.mark.parametrize(("start", "start_velocity", "positions", "times", "velocities"), CASES)
 def test_pt_is_numpy_interp(start, start_velocity, positions, times, velocities):
     # MPI 000, Streaming Point Motion Type Calculations, PT Moves: "constant velocity segments"
     segments = path_segments(PathKind.PT, start, start_velocity, positions, times)
@@ -136,7 +137,7 @@ def test_pt_is_numpy_interp(start, start_velocity, positions, times, velocities)
     assert_matches(segments, [piece(i) for i in range(len(times))], y, times)
 
 
-@pytest.mark.parametrize("start,start_velocity,positions,times,velocities", CASES)
+@pytest.mark.parametrize(("start", "start_velocity", "positions", "times", "velocities"), CASES)
 def test_pvt_is_the_cubic_hermite_spline(start, start_velocity, positions, times, velocities):
     # MPI 000, Streaming Point Motion Type Calculations, PVT Moves: position and velocity at both ends
     segments = path_segments(PathKind.PVT, start, start_velocity, positions, times, velocities)
@@ -145,16 +146,17 @@ def test_pvt_is_the_cubic_hermite_spline(start, start_velocity, positions, times
     assert_matches(segments, polynomial_pieces(reference), knot_values(start, positions), times)
 
 
-@pytest.mark.parametrize("start,start_velocity,positions,times,velocities", CASES)
+@pytest.mark.parametrize(("start", "start_velocity", "positions", "times", "velocities"), CASES)
 def test_spline_is_the_natural_cubic_spline(start, start_velocity, positions, times, velocities):
     # MPI 000, Streaming Point Motion Type Calculations, Cubic Spline Moves: "a natural cubic spline"
     segments = path_segments(PathKind.SPLINE, start, start_velocity, positions, times)
     reference = CubicSpline(knot_times(times), knot_values(start, positions), bc_type="natural")
     assert_matches(segments, polynomial_pieces(reference), knot_values(start, positions), times)
-    assert segments[0].a == 0.0 and segments[-1].end_state()[2] == pytest.approx(0.0, abs=1e-6)
+    assert segments[0].a == 0.0
+    assert segments[-1].end_state()[2] == pytest.approx(0.0, abs=1e-6)
 
 
-@pytest.mark.parametrize("start,start_velocity,positions,times,velocities", CASES)
+@pytest.mark.parametrize(("start", "start_velocity", "positions", "times", "velocities"), CASES)
 def test_bessel_is_hermite_with_parabola_tangents(start, start_velocity, positions, times, velocities):
     # MPI 000, MPIMotionTypeBESSEL BESSEL "fits a Bessel spline"; de Boor's Bessel tangents and end condition
     segments = path_segments(PathKind.BESSEL, start, start_velocity, positions, times)
@@ -164,7 +166,7 @@ def test_bessel_is_hermite_with_parabola_tangents(start, start_velocity, positio
 
 
 @pytest.mark.parametrize("kind", list(BSPLINES))
-@pytest.mark.parametrize("start,start_velocity,positions,times,velocities", CASES)
+@pytest.mark.parametrize(("start", "start_velocity", "positions", "times", "velocities"), CASES)
 def test_bspline_is_scipys_bspline(kind, start, start_velocity, positions, times, velocities):
     # MPI 000, MPIMotionTypeBSPLINE / BSPLINE2: "3rd order" / "2nd order B spline"
     segments = path_segments(kind, start, start_velocity, positions, times)
@@ -184,7 +186,7 @@ def test_pvt_uses_the_reference_equations_to_the_bit():
     x_start, v_start = 0.1, 0.7
     positions, velocities, times = [3.3, -2.45], [-1.9, 11.0 / 3.0], [0.37, 0.0123]
     segments = path_segments(PathKind.PVT, x_start, v_start, positions, times, velocities)
-    ends = [(x_start, v_start)] + list(zip(positions, velocities, strict=True))
+    ends = [(x_start, v_start), *list(zip(positions, velocities, strict=True))]
     for seg, (x0, v0), (x1, v1), dt in zip(segments, ends, ends[1:], times, strict=False):
         assert (seg.duration, seg.p, seg.v) == (dt, x0, v0)
         assert seg.a == 6 * ((x1 - x0) / dt**2) - (2 * v1 + 4 * v0) / dt
@@ -200,7 +202,8 @@ def test_spline_velocity_is_the_or_form_not_the_typo():
     for i, (seg, dt) in enumerate(zip(segments, times, strict=True)):
         dx, da = y[i + 1] - y[i], acc[i + 1] - acc[i]
         assert seg.v == pytest.approx(dx / dt - (3 * acc[i] + da) * dt / 6, rel=1e-12)
-        assert seg.a == pytest.approx(acc[i], abs=1e-9) and seg.j == pytest.approx(da / dt, rel=1e-9)
+        assert seg.a == pytest.approx(acc[i], abs=1e-9)
+        assert seg.j == pytest.approx(da / dt, rel=1e-9)
 
 
 # --- shapes a user should know about ---------------------------------------------------------
@@ -211,7 +214,8 @@ def test_one_point_is_a_straight_line_except_pvt(kind):
     # two knots: the natural spline, Bessel (no parabola) and both B-splines (degree 1) are the line
     segments = path_segments(kind, 10.0, 0.0, [30.0], [0.5], [0.0])
     if kind is PathKind.PVT:
-        assert segments[0].v == 0.0 and segments[0].end_state()[1] == pytest.approx(0.0, abs=1e-12)
+        assert segments[0].v == 0.0
+        assert segments[0].end_state()[1] == pytest.approx(0.0, abs=1e-12)
         return
     assert segments == [Segment(0.5, 10.0, 40.0, 0.0, 0.0)]
 
@@ -222,7 +226,8 @@ def test_bspline_passes_near_not_through_the_inner_points():
     for kind in BSPLINES:
         table = SegmentTable(path_segments(kind, 0.0, 0.0, positions, times))
         at_points = table.evaluate(knot_times(times))[0]
-        assert at_points[0] == 0.0 and at_points[-1] == pytest.approx(0.0, abs=1e-9)
+        assert at_points[0] == 0.0
+        assert at_points[-1] == pytest.approx(0.0, abs=1e-9)
         assert all(abs(p - x) > 1.0 for p, x in zip(at_points[1:-1], positions[:-1], strict=True))
 
 
@@ -279,7 +284,7 @@ def test_paths_are_contiguous_finite_and_cover_the_times(path, kind):
         assert total_duration(segments) == sum(times)
     # which of position, velocity, acceleration are continuous at the joints
     continuous = {PathKind.PT: 1, PathKind.PVT: 2, PathKind.BESSEL: 2, PathKind.BSPLINE2: 2}.get(kind, 3)
-    for before, after in zip(segments, segments[1:], strict=False):
+    for before, after in itertools.pairwise(segments):
         sizes = [s + n for s, n in zip(term_sizes(before, before.duration), term_sizes(after, 0.0), strict=True)]
         for order in range(continuous):
             assert close(before.end_state()[order], (after.p, after.v, after.a)[order], sizes[order])
@@ -290,7 +295,8 @@ def test_paths_are_contiguous_finite_and_cover_the_times(path, kind):
 def test_interpolating_paths_pass_through_every_point_at_its_time(path, kind):
     start, start_velocity, positions, times, velocities = path
     segments = path_segments(kind, start, start_velocity, positions, times, velocities)
-    assert len(segments) == len(times) and segments[0].p == start
+    assert len(segments) == len(times)
+    assert segments[0].p == start
     for i, seg in enumerate(segments):
         p, v, _ = seg.end_state()
         assert close(p, positions[i], term_sizes(seg, seg.duration)[0])
@@ -303,7 +309,7 @@ def test_interpolating_paths_pass_through_every_point_at_its_time(path, kind):
 @settings(max_examples=60, **SETTINGS)
 @given(paths(), st.sampled_from(list(BSPLINES)))
 def test_bsplines_start_at_the_start_and_end_on_the_last_point(path, kind):
-    start, start_velocity, positions, times, velocities = path
+    start, start_velocity, positions, times, _velocities = path
     segments = path_segments(kind, start, start_velocity, positions, times)
     assert segments[0].p == start
     last = segments[-1]
@@ -354,7 +360,7 @@ def test_feedforward_reaches_each_value_at_its_point_and_is_linear_between(path)
     start, _, values, times, _ = path
     segments = feedforward_segments(start, values, times)
     assert total_duration(segments) == sum(times)
-    for seg, before, value, dt in zip(segments, [start] + values, values, times, strict=False):
+    for seg, before, value, dt in zip(segments, [start, *values], values, times, strict=False):
         assert (seg.duration, seg.p, seg.a, seg.j) == (dt, before, 0.0, 0.0)
         assert close(seg.end_state()[0], value, abs(before) + abs(seg.v) * dt)
         middle = seg.state_at(dt / 2)[0]

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -19,7 +20,7 @@ def duration(plan):
 
 
 def contiguous(plan, v_start, v_final):
-    joints = all(a.v_end == b.v_start for a, b in zip(plan, plan[1:], strict=False))
+    joints = all(a.v_end == b.v_start for a, b in itertools.pairwise(plan))
     return joints and plan[0].v_start == v_start and plan[-1].v_end == v_final
 
 
@@ -43,7 +44,8 @@ def test_short_move_is_a_triangle():
 
 def test_negative_move():
     plan = plan_point_to_point(-500.0, 0.0, 0.0, 1000.0, 10_000.0, 10_000.0)
-    assert min(r.v_end for r in plan) == -1000.0 and distance(plan) == pytest.approx(-500.0)
+    assert min(r.v_end for r in plan) == -1000.0
+    assert distance(plan) == pytest.approx(-500.0)
 
 
 def test_start_above_the_velocity_ramps_down_with_the_deceleration():
@@ -57,7 +59,8 @@ def test_start_above_the_velocity_ramps_down_with_the_deceleration():
 def test_moving_away_from_the_target_turns_back():
     # issue 3 modify "including reversal": moving away from the target, decelerate, reverse, arrive
     plan = plan_point_to_point(-100.0, 500.0, 0.0, 1000.0, 10_000.0, 5_000.0)
-    assert plan[0].v_start == 500.0 and plan[0].v_end == 0.0
+    assert plan[0].v_start == 500.0
+    assert plan[0].v_end == 0.0
     assert plan[0].duration == pytest.approx(0.1)  # decelerating at 5000
     assert plan[1].duration == pytest.approx(abs(plan[1].v_end) / 10_000.0)  # accelerating at 10000
     assert distance(plan) == pytest.approx(-100.0)
@@ -67,7 +70,8 @@ def test_moving_away_from_the_target_turns_back():
 def test_overshoot_when_too_close_to_stop():
     # issue 3 "including reversal": the stopping distance is longer than the distance left
     plan = plan_point_to_point(10.0, 1000.0, 0.0, 1000.0, 10_000.0, 10_000.0)
-    assert plan[0].v_start == 1000.0 and min(r.v_end for r in plan) < 0.0
+    assert plan[0].v_start == 1000.0
+    assert min(r.v_end for r in plan) < 0.0
     assert contiguous(plan, 1000.0, 0.0)
     assert distance(plan) == pytest.approx(10.0)
 
@@ -75,7 +79,8 @@ def test_overshoot_when_too_close_to_stop():
 def test_final_velocity():
     # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL "a non-zero target velocity"
     plan = plan_point_to_point(1000.0, 0.0, 300.0, 1000.0, 10_000.0, 10_000.0)
-    assert plan[-1].v_end == 300.0 and distance(plan) == pytest.approx(1000.0)
+    assert plan[-1].v_end == 300.0
+    assert distance(plan) == pytest.approx(1000.0)
     with pytest.raises(ProfileError):
         plan_point_to_point(1000.0, 0.0, 1500.0, 1000.0, 10_000.0, 10_000.0)
 

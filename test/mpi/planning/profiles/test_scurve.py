@@ -16,13 +16,15 @@ def test_jerk_phases_and_peak():
     # docs/profiles.md, "The trapezoid and the S-curve": jerk phases of f*Ta/2, constant acceleration
     # for (1-f)*Ta, peak acceleration A/(1 - f/2)
     ramp = Ramp(0.1, 0.0, 1000.0)  # A = 10000
-    (t1, _, _, a1, j1), (t2, _, _, a2, j2), (t3, _, _, a3, j3) = reshape([ramp], 0.0, 50.0)
+    (t1, _, _, a1, j1), (t2, _, _, a2, j2), (t3, _, _, _a3, j3) = reshape([ramp], 0.0, 50.0)
     assert (t1, t2, t3) == pytest.approx((0.025, 0.05, 0.025))
-    assert a2 == pytest.approx(10_000.0 / 0.75) and j2 == 0.0
-    assert j1 == pytest.approx(-j3) and a1 == 0.0
+    assert a2 == pytest.approx(10_000.0 / 0.75)
+    assert j2 == 0.0
+    assert j1 == pytest.approx(-j3)
+    assert a1 == 0.0
 
 
-@pytest.mark.parametrize("percent,peak", [(0.0, 1.0), (50.0, 4.0 / 3.0), (100.0, 2.0)])
+@pytest.mark.parametrize(("percent", "peak"), [(0.0, 1.0), (50.0, 4.0 / 3.0), (100.0, 2.0)])
 def test_peak_acceleration_100_133_200_percent(percent, peak):
     # docs/profiles.md: the peak is A, 4/3 A, 2 A at f = 0, 0.5, 1
     segments = reshape([Ramp(0.1, 0.0, 1000.0)], 0.0, percent)
@@ -38,7 +40,8 @@ def test_each_ramp_keeps_its_duration_and_distance(percent):
     segments = reshape(plan, 0.0, percent)
     assert sum(s.duration for s in segments) == pytest.approx(sum(r.duration for r in plan))
     p, v, a = segments[-1].end_state()
-    assert p == pytest.approx(5000.0) and v == pytest.approx(0.0, abs=1e-9)
+    assert p == pytest.approx(5000.0)
+    assert v == pytest.approx(0.0, abs=1e-9)
     if percent > 0.0:
         assert a == pytest.approx(0.0, abs=1e-6)  # an S-curve ramp ends with zero acceleration
 
@@ -57,7 +60,8 @@ def test_zero_percent_is_the_trapezoid():
     # scurve.py: "f = 0 is the trapezoid itself"
     plan = plan_point_to_point(3000.0, 0.0, 0.0, 1000.0, 10_000.0, 5_000.0)
     segments = reshape(plan, 0.0, 0.0)
-    assert all(s.j == 0.0 for s in segments) and len(segments) == len(plan)
+    assert all(s.j == 0.0 for s in segments)
+    assert len(segments) == len(plan)
 
 
 def test_every_ramp_starts_from_zero_acceleration():
@@ -72,7 +76,7 @@ def test_jerk_percent_range(percent):
         reshape([Ramp(1.0, 0.0, 1.0)], 0.0, percent)
 
 
-@pytest.mark.parametrize("percent,distance", [(0.0, 10_000.0), (30.0, 10_000.0), (50.0, 5000.0),
+@pytest.mark.parametrize(("percent", "distance"), [(0.0, 10_000.0), (30.0, 10_000.0), (50.0, 5000.0),
                                               (100.0, 3000.0), (75.0, 20_000.0)])
 def test_duration_equals_ruckig(percent, distance):
     # docs/quality.md, "Correct motion": S-curve/trapezoid durations equal ruckig's time-optimal duration
@@ -101,7 +105,7 @@ def test_tiny_jerk_percent_stays_finite(percent):
     assert segments[-1].end_state()[0] == pytest.approx(10.0)
 
 
-@pytest.mark.parametrize("ramp,percent", [(Ramp(0.0, 0.0, 5e-324), 100.0), (Ramp(5e-324, 0.0, 1e-300), 100.0),
+@pytest.mark.parametrize(("ramp", "percent"), [(Ramp(0.0, 0.0, 5e-324), 100.0), (Ramp(5e-324, 0.0, 1e-300), 100.0),
                                           (Ramp(1e-300, 0.0, 1e-290), 1e-20)])
 def test_ramp_too_short_to_reshape(ramp, percent):
     # docs/quality.md, "Robust" (no input can crash): a ramp whose duration underflows (a VELOCITY move to

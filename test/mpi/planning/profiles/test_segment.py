@@ -18,8 +18,10 @@ def test_state_at_is_constant_jerk_motion():
 def test_chain_is_contiguous_and_drops_empty_pieces():
     segments = chain(0.0, 0.0, 0.0, [(1.0, 6.0), (0.0, 100.0), (1.0, -6.0)])
     assert len(segments) == 2
-    assert segments[1].p == segments[0].end_state()[0] and segments[1].a == segments[0].end_state()[2]
-    assert total_duration(segments) == 2.0 and end_state([], (1.0, 2.0, 3.0)) == (1.0, 2.0, 3.0)
+    assert segments[1].p == segments[0].end_state()[0]
+    assert segments[1].a == segments[0].end_state()[2]
+    assert total_duration(segments) == 2.0
+    assert end_state([], (1.0, 2.0, 3.0)) == (1.0, 2.0, 3.0)
 
 
 def test_table_evaluates_like_the_segments():
@@ -44,7 +46,8 @@ def test_reverses():
     # MPI 000, MEIMotionAttrNO_REVERSAL NO_REVERSAL "prevents a motion profile from changing direction"
     forward = point_to_point(0.0, 500.0, 1000.0, 0.0, 1000.0, 1e4, 1e4, 0.0)
     back = point_to_point(0.0, 500.0, -1000.0, 0.0, 1000.0, 1e4, 1e4, 0.0)
-    assert not reverses(forward, 500.0) and reverses(back, 500.0)
+    assert not reverses(forward, 500.0)
+    assert reverses(back, 500.0)
     assert not reverses(point_to_point(0.0, 0.0, -10.0, 0.0, 1.0, 1.0, 1.0, 0.0), 0.0)
 
 
@@ -52,5 +55,6 @@ def test_velocity_move_segments():
     # MPI 000, MPIMotionTypeVELOCITY VELOCITY "S-Curve acceleration to a constant velocity ... jerkPercent"
     segments, ramp = velocity_move(0.0, 0.0, 500.0, 5000.0, 50.0, cruise=1.0)
     assert ramp == pytest.approx(0.1)
-    assert segments[-1].v == pytest.approx(500.0) and segments[-1].duration == 1.0
+    assert segments[-1].v == pytest.approx(500.0)
+    assert segments[-1].duration == 1.0
     assert max(abs(s.a) for s in segments) == pytest.approx(5000.0 / 0.75)
