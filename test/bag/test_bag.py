@@ -414,13 +414,13 @@ def test_plot_of_a_bag_writes_a_png(tmp_path):
 
 
 def test_plot_reads_the_stamps_of_a_bag_from_before_the_headers():
-    from mpi_ros.plot.bag import _series
+    from mpi_ros.plot.bag import read_recording
 
-    axes, states, events = _series(BagReader(FIXTURES / "older" / "p2p_modify_before_headers"))
-    assert sorted(axes) == [0, 1, 2, 3]
-    assert states
-    assert events
-    times = axes[0]["t"]
+    recording = read_recording(FIXTURES / "older" / "p2p_modify_before_headers")
+    assert sorted(recording.axes) == [0, 1, 2, 3]
+    assert recording.states
+    assert recording.events
+    times = list(recording.axes[0]["t"])
     assert 0.0 <= times[0] < 0.1
     assert times == sorted(times)
     assert times[-1] > 1.0
