@@ -82,7 +82,12 @@ def test_the_console_warns_about_nodes_on_the_graph_twice(suite_process, ros_con
             assert warning == (f"warning: 1 node name(s) of /mpi are on ROS_DOMAIN_ID {os.environ['ROS_DOMAIN_ID']} "
                                f"twice (/mpi/controller): two suites run under one namespace, and both take every "
                                f"command; stop one of them")
-            assert render({}, {}, "/mpi", None, warning)[1] == warning  # under the status table's header
+            # under the status table's header, wrapped to the terminal's width
+            assert render({}, {}, "/mpi", None, width=300, warning=warning)[1] == warning
+            narrow = render({}, {}, "/mpi", None, width=80, warning=warning)
+            wrapped = narrow[1:1 + len(narrow) - len(render({}, {}, "/mpi", None, width=80))]
+            assert all(len(line) < 80 for line in wrapped)
+            assert " ".join(wrapped) == warning
         finally:
             twin.destroy_node()
     finally:
