@@ -18,7 +18,8 @@ import sys
 
 from .console import OK, REFUSED, add_target_options, run_verb
 
-OWNER_WAIT = 1.0  # s for the supervisor's status that says whether it has the axis
+OWNER_WAIT = 3.0  # s for the supervisor's status that says whether it has the axis (a first status may wait
+# for discovery: up to 3 s, Fast DDS's default announcement period, where the suite has no profile of ours)
 
 
 def _reset_command(client, axis: int) -> str:

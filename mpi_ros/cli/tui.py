@@ -135,8 +135,8 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
             self.heading = Static(id="selected")
             self.table: DataTable[str] = DataTable(id="table", cursor_type="none", zebra_stripes=True)
             self.log_view = RichLog(id="events", max_lines=500, wrap=False)
-            self.command_line = Input(placeholder="move --position 1000 0 -v 500 -a 5000   (Enter runs it, Esc closes)",
-                                      id="command")
+            hint = "move --position 1000 0 -v 500 -a 5000 -d 5000   (Enter runs it, Esc closes)"
+            self.command_line = Input(placeholder=hint, id="command")
             yield from (self.heading, self.table, self.log_view, self.command_line, Footer())
 
         def on_ready(self) -> None:  # the screen and its widgets are there (on_mount may come first)

@@ -146,7 +146,9 @@ def test_the_field_reader_reads_what_rclpy_builds():
         for recorded, msg in reader.decoded([t for t, k in reader.topics().items() if k in plot.FIELDS]):
             if recorded.schema_text and recorded.schema_text != schema.ros2msg(recorded.type):
                 continue  # recorded by an older definition: the plot builds those
-            wanted = ("stamp.sec", "stamp.nanosec", *plot.FIELDS[recorded.type])
+            stamp = "header.stamp" if hasattr(msg, "header") else "stamp"
+            wanted = (f"{stamp}.sec", f"{stamp}.nanosec", "header.frame_id" if stamp == "header.stamp" else "sample",
+                      *plot.FIELDS[recorded.type])
             expected = tuple(tuple(v) if name == "axis_numbers" else v
                              for name, v in ((name, _get(msg, name)) for name in wanted))
             assert field_reader(schema.message_class(recorded.type), wanted)(recorded.data) == expected

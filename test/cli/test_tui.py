@@ -113,7 +113,7 @@ def test_the_command_line_takes_the_one_shot_verbs(link, ms0):
     async def drive():
         app = make_app(link, _args())
         async with app.run_test(size=(200, 50)) as pilot:
-            await _type(pilot, app, "move --position 300 0 -v 3000 -a 30000")
+            await _type(pilot, app, "move --position 300 0 -v 3000 -a 30000 -d 30000")
             ms0.wait_for(lambda s: s.state_name == "IDLE" and s.axes[0].command_position == 300.0, WAIT, "at 300")
             await _type(pilot, app, "stop --supervisor 1")
             await _type(pilot, app, "jump")

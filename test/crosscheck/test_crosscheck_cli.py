@@ -123,7 +123,7 @@ def test_plot_rejects_a_bad_request(tmp_path, capsys):
 def test_plot_bag_dispatch(tmp_path, monkeypatch, capsys):
     calls = []
     fake = types.ModuleType("mpi_ros.plot.bag")
-    fake.plot_bag = lambda path, output, axes=None: calls.append((path, output, axes)) or output
+    fake.plot_bag = lambda path, output, axes=None, start=None, end=None: calls.append((path, output, axes)) or output
     monkeypatch.setitem(sys.modules, "mpi_ros.plot.bag", fake)
     bag = tmp_path / "run1"
     bag.mkdir()
