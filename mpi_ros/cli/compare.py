@@ -11,7 +11,6 @@ counts and seconds from the recording's start). Exit status 0, or 2 for bad inpu
 from __future__ import annotations
 
 import argparse
-import sys
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,22 +22,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
-    from mpi_ros.calibration.inputs import gather
-    from mpi_ros.calibration.recording import RecordingError
-    from mpi_ros.config import ConfigError
+    from mpi_ros.cli.fit import gathered
 
-    try:
-        inputs = gather(args.recording, args.axis, args.config, args.rate)
-    except (RecordingError, ConfigError) as exc:
-        print(f"mpi-ros compare: {exc}", file=sys.stderr)
+    inputs = gathered(args, "compare")
+    if inputs is None:
         return 2
     # scipy is imported here, when a comparison runs (never by the suite).
     from mpi_ros.calibration import report
     from mpi_ros.calibration.fit import compare
 
-    print(f"configured plants: {inputs.config_source}")
-    for number in inputs.skipped:
-        print(f"axis {number}: left out, its command never moves")
     for axis in inputs.axes:
         plant = inputs.plants[axis.number]
         print(report.compare_text(axis, inputs.rate, plant, *compare(axis, plant, inputs.rate)))

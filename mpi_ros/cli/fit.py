@@ -32,7 +32,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--rate", type=float, metavar="HZ", help="the controller's sample rate")
 
 
-def run(args) -> int:
+def gathered(args, verb: str):
+    """The recording, the configured plants and the rate of `mpi-ros fit` or `compare` (said
+    on standard output), or None when the input is bad (said on standard error: exit 2)."""
     from mpi_ros.calibration.inputs import gather
     from mpi_ros.calibration.recording import RecordingError
     from mpi_ros.config import ConfigError
@@ -40,15 +42,22 @@ def run(args) -> int:
     try:
         inputs = gather(args.recording, args.axis, args.config, args.rate)
     except (RecordingError, ConfigError) as exc:
-        print(f"mpi-ros fit: {exc}", file=sys.stderr)
+        print(f"mpi-ros {verb}: {exc}", file=sys.stderr)
+        return None
+    print(f"configured plants: {inputs.config_source}")
+    for number in inputs.skipped:
+        print(f"axis {number}: left out, its command never moves")
+    return inputs
+
+
+def run(args) -> int:
+    inputs = gathered(args, "fit")
+    if inputs is None:
         return 2
     # scipy is imported here, when a fit runs (never by the suite).
     from mpi_ros.calibration import report
     from mpi_ros.calibration.fit import fit_axis
 
-    print(f"configured plants: {inputs.config_source}")
-    for number in inputs.skipped:
-        print(f"axis {number}: left out, its command never moves")
     fits = []
     for axis in inputs.axes:
         fit = fit_axis(axis, inputs.rate, inputs.plants[axis.number])
