@@ -22,7 +22,7 @@ from rclpy.type_description_service import START_TYPE_DESCRIPTION_SERVICE_PARAM
 
 from mpi_ros.srv import MotionAction
 
-from . import errors, graph
+from . import discovery, errors
 from .errors import NoResponse, raise_for
 
 
@@ -91,7 +91,7 @@ class ActionCall:
     def wait_ready(self, timeout: float) -> None:
         """Wait until the service is reachable; raises SuiteNotFound, NoSuchSupervisor or
         NoResponse (the supervisor is there, its service is not) after ``timeout`` s."""
-        graph.wait_for_endpoints(self.node, self.namespace, self.supervisor, self._service.service_is_ready,
+        discovery.wait_for_endpoints(self.node, self.namespace, self.supervisor, self._service.service_is_ready,
                                  timeout, "its action service")
 
     def call(self, name: str, timeout: float, raise_on_error: bool = True) -> ActionReply:

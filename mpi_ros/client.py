@@ -56,7 +56,7 @@ from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisFaultInject, MotionAction, MotorFeedbackSecondarySet
 
-from . import errors, graph
+from . import discovery, errors
 from .action_call import ActionReply, State, action_reply
 from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
 
@@ -512,7 +512,7 @@ class _Endpoint:
 
     def supervisors_on_graph(self, namespace: str | None = None) -> list[int]:
         """Numbers of the supervisor nodes (``<namespace>/ms<n>``) on the graph now."""
-        return graph.supervisors_on_graph(self.node, self.namespace if namespace is None else namespace)
+        return discovery.supervisors_on_graph(self.node, self.namespace if namespace is None else namespace)
 
     def twins_on_graph(self, namespace: str | None = None) -> list[str]:
         """The nodes under ``namespace`` that are on the graph more than once: two suites
@@ -548,7 +548,7 @@ class _Endpoint:
         raise SuiteNotFound(self._not_found(timeout))
 
     def _not_found(self, timeout: float) -> str:
-        return graph.not_found(self.node, self.namespace, timeout)
+        return discovery.not_found(self.node, self.namespace, timeout)
 
 
 # -- goals and the motion client ---------------------------------------------------------------------------
@@ -712,7 +712,7 @@ class MotionClient(_Endpoint):
         while not self.servers_ready():
             if time.monotonic() >= deadline:
                 return False
-            pause.wait(graph.READY_POLL)
+            pause.wait(discovery.READY_POLL)
         return self._answered({self._start: MotionStart, self._modify: MotionModify}, deadline)
 
     def servers_ready(self) -> bool:

@@ -81,13 +81,13 @@ class Session:
 
     def client(self, supervisor: int):
         """A MotionClient of ``supervisor``, once the suite and that supervisor are on the graph."""
-        from mpi_ros import graph
+        from mpi_ros import discovery
         from mpi_ros.client import MotionClient
 
         client = self._keep(MotionClient(supervisor, self.args.namespace, context=self.context,
                                          timeout=self.args.timeout, node_name=self.node_name))
         # The supervisor's own endpoints, not the suite's nodes first: they are what a goal needs
-        graph.wait_for_endpoints(client.node, client.namespace, supervisor, client.servers_ready,
+        discovery.wait_for_endpoints(client.node, client.namespace, supervisor, client.servers_ready,
                                  self.args.timeout, "its actions and services")
         warn_twins(self.args, client)
         if not client.wait_for_server(self.args.timeout):

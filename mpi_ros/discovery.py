@@ -1,4 +1,4 @@
-"""Finding the suite on the ROS graph, and saying what was found when it is not there.
+"""Finding the suite on the ROS graph (discovery), and saying what was found when it is not there.
 
 Shared by the client (:mod:`mpi_ros.client`) and the one-shot actions
 (:mod:`mpi_ros.action_call`); it imports nothing heavier than rclpy's node, so a one-shot
