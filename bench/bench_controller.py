@@ -117,6 +117,19 @@ def baseline_tree(revision: str, into: Path) -> Path | None:
     return into / "tree"
 
 
+def compared_trees(baseline: str, into: Path, label: str = "this tree") -> list[tuple[Path, str]]:
+    """This source tree, and the package at ``baseline`` where it can be extracted ("none": only
+    this one): (tree, its name) each, for measurements side by side."""
+    trees = [(REPO, label)]
+    if baseline != "none":
+        old = baseline_tree(baseline, into)
+        if old is None:
+            print(f"(no baseline: `git archive {baseline}` failed)")
+        else:
+            trees.append((old, baseline))
+    return trees
+
+
 def _best(source: Path, case: tuple, rounds: int) -> dict[str, float]:
     runs = [measure_in(source, case) for _ in range(rounds)]
     return {key: max(run[key] for run in runs) for key in runs[0]}

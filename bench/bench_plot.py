@@ -29,7 +29,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "bench"))  # run with -P: the sibling bench_controller
-from bench_controller import baseline_tree  # noqa: E402 - after the path it is found on
+from bench_controller import compared_trees  # noqa: E402 - after the path it is found on
 
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(150, 200)))
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
@@ -128,11 +128,7 @@ def main() -> None:
         if bag is None:
             bag = scratch / "three_minutes"
             record(bag, args.seconds)
-        trees = [(REPO, "this tree")]
-        if args.baseline != "none":
-            old = baseline_tree(args.baseline, scratch)
-            if old is not None:
-                trees.append((old, args.baseline))
+        trees = compared_trees(args.baseline, scratch)
         times: dict[str, list[tuple[float, float]]] = {name: [] for _, name in trees}
         loads = [os.getloadavg()[0]]
         for run in range(args.runs):

@@ -65,7 +65,7 @@ import yaml
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "bench"))  # run with -P: the sibling bench_controller
-from bench_controller import baseline_tree  # noqa: E402 - after the path it is found on
+from bench_controller import compared_trees  # noqa: E402 - after the path it is found on
 
 os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)
 # Its own DDS domain (a pid-based one may be taken by a suite of a concurrent test run).
@@ -640,13 +640,7 @@ def main() -> None:
         profile(CASES[args.profile], args.seconds, Path(args.profile_out), args.profile_time_scale)
         return
     with tempfile.TemporaryDirectory(prefix="bench_suite_baseline_") as tmp:
-        trees = [(REPO, "working tree")]
-        if args.baseline != "none":
-            tree = baseline_tree(args.baseline, Path(tmp))
-            if tree is None:
-                print(f"(no baseline: `git archive {args.baseline}` failed)")
-            else:
-                trees.append((tree, args.baseline))
+        trees = compared_trees(args.baseline, Path(tmp), "working tree")
         results = [run_case(CASES[name], args.seconds, tree=tree, label=label)
                    for _ in range(args.rounds) for name in args.case or CASES for tree, label in trees]
     print(f"`python -P bench/bench_suite.py --seconds {args.seconds:g} --rounds {args.rounds}` on "

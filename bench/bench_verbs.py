@@ -36,7 +36,7 @@ from typing import Any
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "bench"))  # run with -P: the sibling bench_controller
-from bench_controller import baseline_tree  # noqa: E402 - after the path it is found on
+from bench_controller import compared_trees  # noqa: E402 - after the path it is found on
 
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(150, 200)))
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
@@ -178,13 +178,7 @@ def main() -> None:
     args = parser.parse_args()
     results: dict[str, list[Run]] = {}
     with tempfile.TemporaryDirectory(prefix="bench_verbs_") as scratch:
-        trees = [(REPO, "this tree")]
-        if args.baseline != "none":
-            old = baseline_tree(args.baseline, Path(scratch))
-            if old is None:
-                print(f"(no baseline: `git archive {args.baseline}` failed)")
-            else:
-                trees.append((old, args.baseline))
+        trees = compared_trees(args.baseline, Path(scratch))
         loads = [os.getloadavg()[0]]
         for _ in range(args.rounds):
             for tree, name in trees:

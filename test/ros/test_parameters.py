@@ -20,22 +20,30 @@ def context_with(*params: str):
     return context
 
 
-def test_parameters_override_the_file():
-    context = context_with("status_rate:=250.0", "time_scale:=3.0", "crosscheck:=true", "sample_rate:=1000.0")
+def resolved(*params: str, time_scale: float = 1.0):
+    """The configuration and time scale the suite starts with under ``params``."""
+    context = context_with(*params)
     try:
-        cfg, scale = parameters.resolve(context, None, 1.0)
+        return parameters.resolve(context, None, time_scale)
     finally:
         context.try_shutdown()
+
+
+def refusal(*params: str) -> str:
+    """Why the suite refuses to start under ``params`` (the ConfigError's message)."""
+    with pytest.raises(ConfigError) as error:
+        resolved(*params)
+    return str(error.value)
+
+
+def test_parameters_override_the_file():
+    cfg, scale = resolved("status_rate:=250.0", "time_scale:=3.0", "crosscheck:=true", "sample_rate:=1000.0")
     assert (cfg.ros.status_rate, cfg.ros.crosscheck, cfg.controller.sample_rate, scale) == (250.0, True, 1000.0, 3.0)
     assert cfg.ros.feedback_rate == 20.0  # not overridden: the file's value
 
 
 def test_without_parameters_the_file_rules():
-    context = context_with()
-    try:
-        cfg, scale = parameters.resolve(context, None, 2.0)
-    finally:
-        context.try_shutdown()
+    cfg, scale = resolved(time_scale=2.0)
     assert (cfg.ros.status_rate, scale) == (100.0, 2.0)
 
 
@@ -43,29 +51,14 @@ def test_without_parameters_the_file_rules():
                                         ("sample_rate:=-1.0", "controller.sample_rate"),
                                         ("time_scale:=-2.0", "time_scale")])
 def test_bad_parameters_stop_the_start_with_the_key_named(param, key):
-    context = context_with(param)
-    try:
-        with pytest.raises(ConfigError) as error:
-            parameters.resolve(context, None, 1.0)
-    finally:
-        context.try_shutdown()
-    assert str(error.value).startswith(key)
+    assert refusal(param).startswith(key)
 
 
 def test_an_integer_where_a_number_is_meant_counts_and_a_wrong_type_is_named():
-    context = context_with("status_rate:=200", "time_scale:=2")
-    try:
-        cfg, scale = parameters.resolve(context, None, 1.0)
-    finally:
-        context.try_shutdown()
+    cfg, scale = resolved("status_rate:=200", "time_scale:=2")
     assert (cfg.ros.status_rate, scale) == (200.0, 2.0)
     assert isinstance(scale, float)
-    context = context_with("crosscheck:=3")
-    try:
-        with pytest.raises(ConfigError, match=r"^crosscheck: expected true or false, got 3"):
-            parameters.resolve(context, None, 1.0)
-    finally:
-        context.try_shutdown()
+    assert refusal("crosscheck:=3").startswith("crosscheck: expected true or false, got 3")
 
 
 _RCLPY_OWN = ("use_sim_time", "start_type_description_service")  # every rclpy node has these
@@ -156,10 +149,4 @@ def test_a_schema_change_shows_in_the_descriptor(monkeypatch):
     ("result_timeout:=0.0", "ros.result_timeout: must be a finite number > 0, got 0.0"),
 ])
 def test_a_parameter_is_read_as_the_file_is(param, text):
-    context = context_with(param)
-    try:
-        with pytest.raises(ConfigError) as error:
-            parameters.resolve(context, None, 1.0)
-    finally:
-        context.try_shutdown()
-    assert str(error.value) == text
+    assert refusal(param) == text

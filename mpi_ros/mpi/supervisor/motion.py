@@ -27,7 +27,7 @@ from mpi_ros.mpi.axes.trace import Stretch
 from mpi_ros.mpi.base.clock import ProfileClock
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
-from mpi_ros.mpi.base.outcome import MoveEnd, Outcome, Refused
+from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome, Refused
 from mpi_ros.mpi.base.params import AxisMaster, MotionConfig, MotionParams, check_position
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, FrameBufferStatus, MotionSnapshot
 from mpi_ros.mpi.base.types import (
@@ -73,9 +73,6 @@ class _Admitted:
     auto_start: bool
     queued: bool
     open_path: Move | None
-
-
-OUTCOME_OK = Outcome(Message.MPIMessageOK)
 
 
 class MotionSupervisor:
@@ -551,7 +548,7 @@ class MotionSupervisor:
             # MPI 000, MPIMotionMessageILLEGAL_DELAY: a modify with a non-zero delay "while in
             # motion" (the supervisor's motion, even while its axes wait out a DELAY).
             return Outcome(Message.MPIMotionMessageILLEGAL_DELAY, "a modify in motion cannot be delayed")
-        return OUTCOME_OK
+        return VALID
 
     def _plan(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
               admitted: _Admitted) -> Outcome | tuple[Move, PlanNotes]:
@@ -600,7 +597,7 @@ class MotionSupervisor:
             self.stored_params = params.copy()
         if admitted.auto_start:
             return Outcome(Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)")
-        return OUTCOME_OK
+        return VALID
 
     def _check_request(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
                        append_to: bool) -> Outcome:
