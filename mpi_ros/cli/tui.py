@@ -3,13 +3,14 @@
   mpi-ros console                    every supervisor; keys act on the selected one (ms0 first)
   mpi-ros console --jog-speed 2000   counts/s of the arrow keys' jog
 
-Keys (shown at the bottom): space STOP, e E_STOP, r RESET, u RESUME the selected supervisor
-(Tab or 1-9 select another); left/right arrows jog it (a VELOCITY move at --jog-speed, the
-arrow's sign; a terminal reports no key release, so the jog STOPs once the key has not
-repeated for JOG_RELEASE s, and when the console exits); ctrl+e is E_STOP wherever the focus
-is, the command line included; : or / opens the command line, which takes the one-shot
-verbs: move ..., modify ..., stop, e-stop, abort, reset, resume, with their own options
-(--supervisor N among them). q quits.
+Keys (shown at the bottom): space STOP, e E_STOP, r RESET, u RESUME the selected supervisor;
+up/down select an axis (its supervisor with it), Tab the next supervisor; left/right arrows jog
+the selected axis alone (mpi_ros/cli/jog.py: a VELOCITY move at --jog-speed, the other axes at
+0; a terminal reports no key release, so the jog STOPs once the key has not repeated for
+JOG_RELEASE s, and when the console exits); ctrl+e is E_STOP wherever the focus is, the command
+line included; : or / opens the command line, which takes the one-shot verbs: move ...,
+modify ..., stop, e-stop, abort, reset, resume, with their own options (--supervisor N among
+them). q quits.
 
 Why Textual: one library gives the layout, the table, the log, key bindings shown on screen
 and a headless test driver (its pilot); prompt_toolkit with rich would need the three put
@@ -28,8 +29,8 @@ import time
 from typing import Any, ClassVar
 
 from .console import OK, UsageError, add_target_options, fail
+from .jog import Jogger, JogTarget
 
-JOG_RELEASE = 0.35  # s without a repeat of the arrow before the jog stops (terminals repeat every ~0.03-0.1 s)
 REFRESH = 0.1  # s between table refreshes
 VERBS = ("move", "modify", "stop", "e-stop", "abort", "reset", "resume")
 
@@ -100,8 +101,11 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
     from textual.binding import Binding
     from textual.widgets import DataTable, Footer, Input, RichLog, Static
 
+    JOG, AXIS = Binding.Group("jog"), Binding.Group("axis")
+
     class Console(App):
         TITLE = "mpi-ros console"
+        ENABLE_COMMAND_PALETTE = False  # its ^p would take room in the footer for nothing an operator needs
         CSS = """
         #table { height: 1fr; }
         #events { height: 8; border-top: solid $accent; }
@@ -115,9 +119,12 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
             Binding("r", "act('RESET')", "RESET"),
             Binding("u", "act('RESUME')", "RESUME"),
             # priority: the event log would take the arrows to scroll; the command line gets them back
-            Binding("left", "jog(-1)", "jog -", priority=True),
-            Binding("right", "jog(1)", "jog +", priority=True),
-            Binding("tab", "next_supervisor", "next ms"),
+            Binding("left", "jog(-1)", "jog -", priority=True, group=JOG),
+            Binding("right", "jog(1)", "jog +", priority=True, group=JOG),
+            Binding("up", "select_axis(-1)", "axis", priority=True, group=AXIS),
+            Binding("down", "select_axis(1)", "axis", priority=True, group=AXIS),
+            # priority: the screen's own Tab moves the focus; not shown: ↑↓ reach every axis, 80 columns are few
+            Binding("tab", "next_supervisor", "next ms", priority=True, show=False),
             Binding("colon,slash", "command", "command"),
             Binding("escape", "close_command", "close", show=False),
             Binding("q", "quit", "quit"),
@@ -126,8 +133,8 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
         def __init__(self) -> None:
             super().__init__()
             self.selected = link.numbers[0]
-            self.jog_until = 0.0
-            self.jogging: Any = None
+            self.axis = 0  # index in the selected supervisor's axes: the one the arrows jog
+            self.jogger = Jogger(link.clients, args.jog_speed, args.jog_acceleration, args.timeout)
             self.events: Any = None
 
         def compose(self) -> ComposeResult:
@@ -156,16 +163,22 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
                 ms = supervisors[n]
                 table.add_row(f"ms{n}" + (" *" if n == self.selected else ""), ms.state_name, "", "", "", "",
                               f"move {ms.move_id}", f"{ms.last_action} ({ms.action_source})")
-                for axis in ms.axes:
+                for index, axis in enumerate(ms.axes):
                     bits = "".join(letter if getattr(axis, name) else "-" for letter, name in
                                    (("D", "done"), ("T", "at_target"), ("F", "in_fine_position"), ("S", "settled")))
-                    table.add_row(f"  axis{axis.number}", axis.state_name, f"{axis.command_position:.1f}",
+                    mark = " *" if (n, index) == (self.selected, self.axis) else ""
+                    table.add_row(f"  axis{axis.number}{mark}", axis.state_name, f"{axis.command_position:.1f}",
                                   f"{axis.actual_position:.1f}", f"{axis.position_error:.1f}",
                                   f"{axis.command_velocity:.1f}", bits, ", ".join(axis.faults) or "-")
-            self.heading.update(
-                f"selected ms{self.selected}   jog {args.jog_speed:g} counts/s   (D done T at target F fine S settled)")
-            if self.jogging is not None and time.monotonic() > self.jog_until:
-                self._stop_jog()
+            self.heading.update(f"selected ms{self.selected} axis{self._axis_number(supervisors)}  "
+                                f"jog {args.jog_speed:g}/s  D done T at target F fine S settled")
+            self.jogger.expire(time.monotonic())
+            while self.jogger.said:
+                self.say(self.jogger.said.popleft())
+
+        def _axis_number(self, supervisors: dict[int, Any]) -> str:
+            axes = supervisors[self.selected].axes if self.selected in supervisors else []
+            return str(axes[self.axis].number) if self.axis < len(axes) else "?"
 
         def _from_ros(self, msg: Any) -> None:
             if self.is_running:  # the ROS thread may deliver one more as the console closes
@@ -194,30 +207,30 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
         def action_next_supervisor(self) -> None:
             numbers = link.numbers
             self.selected = numbers[(numbers.index(self.selected) + 1) % len(numbers)]
+            self.axis = 0
+
+        def action_select_axis(self, step: int) -> None:
+            """The next (previous) axis row of the table; past a supervisor's last axis, the next one's first."""
+            if self.command_line.has_focus:
+                return
+            supervisors, _ = link.watcher.latest()
+            rows = [(n, index) for n in sorted(supervisors) for index in range(len(supervisors[n].axes))]
+            if (self.selected, self.axis) in rows:
+                self.selected, self.axis = rows[(rows.index((self.selected, self.axis)) + step) % len(rows)]
+            self._refresh()
 
         def action_jog(self, sign: int) -> None:
             box = self.command_line
             if box.has_focus:  # editing a command: the arrows move the cursor
                 (box.action_cursor_right if sign > 0 else box.action_cursor_left)()
                 return
-            self.jog_until = time.monotonic() + JOG_RELEASE
-            if self.jogging == (self.selected, sign):
-                return  # a repeat of the key: the jog goes on
-            client = link.clients[self.selected]
-            goal = {"type": "VELOCITY", "trajectory": [{"velocity": sign * args.jog_speed,
-                                                        "acceleration": args.jog_acceleration,
-                                                        "deceleration": args.jog_acceleration}]}
-            if self.jogging is not None:  # the other direction: modify the running jog
-                client.modify(goal)
-            else:
-                client.start(goal)
-            self.jogging = (self.selected, sign)
-            self.say(f"jog ms{self.selected} {'+' if sign > 0 else '-'}{args.jog_speed:g} counts/s")
-
-        def _stop_jog(self) -> None:
-            supervisor, _ = self.jogging
-            self.jogging = None
-            self._act("STOP", supervisor)
+            supervisors, _ = link.watcher.latest()
+            axes = supervisors[self.selected].axes if self.selected in supervisors else []
+            if self.axis >= len(axes):
+                self.say(f"jog: no status of ms{self.selected} yet")
+                return
+            target = JogTarget(self.selected, self.axis, axes[self.axis].number, sign)
+            self.jogger.press(target, len(axes), time.monotonic())
 
         def action_command(self) -> None:
             box = self.command_line
@@ -237,10 +250,7 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
 
         def on_unmount(self) -> None:
             link.watcher.node.destroy_subscription(self.events)
-            if self.jogging is not None:
-                supervisor, _ = self.jogging
-                self.jogging = None
-                link.clients[supervisor].action("STOP", raise_on_error=False)
+            self.jogger.close()  # a held jog stops with the console
 
     return Console()
 

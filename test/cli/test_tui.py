@@ -44,6 +44,17 @@ async def _until(pilot, predicate, what: str) -> None:
         await pilot.pause(0.05)
 
 
+async def _until_status(pilot, client, predicate, what: str):
+    """The first MotionStatus of ``client`` that shows ``predicate``, waited for in a thread while
+    the application runs on (every status is looked at, not only those seen between pauses)."""
+    from mpi_ros.errors import NoResponse
+
+    try:
+        return await asyncio.to_thread(client.wait_for, predicate, WAIT, what)
+    except NoResponse as exc:
+        pytest.fail(f"{exc}; the console's log:\n{_log(pilot.app)}")
+
+
 def _screen(app) -> str:
     """The text on the screen, as the operator reads it (from the SVG screenshot)."""
     import html
@@ -77,7 +88,7 @@ def test_the_console_shows_the_suite_and_its_keys_act(link, ms0, size):
 
             table = app.query_one(DataTable)
             await _until(pilot, lambda: table.row_count == 6, "row per supervisor and axis")
-            assert [table.get_row_at(k)[0] for k in range(6)] == ["ms0 *", "  axis0", "  axis1", "ms1",
+            assert [table.get_row_at(k)[0] for k in range(6)] == ["ms0 *", "  axis0 *", "  axis1", "ms1",
                                                                   "  axis2", "  axis3"]
             assert app.size == size
             assert table.region.width <= size[0]
@@ -94,19 +105,72 @@ def test_the_console_shows_the_suite_and_its_keys_act(link, ms0, size):
     asyncio.run(drive())
 
 
-def test_an_arrow_jogs_and_the_jog_stops_when_the_key_is_no_longer_repeated(link, ms0):
+@pytest.mark.parametrize("size", [(80, 24), (200, 50)])
+def test_an_arrow_jogs_the_selected_axis_alone_and_stops_when_the_key_is_not_repeated(link, ms0, ms1, size):
+    before = ms0.status(WAIT)
+    others = [a.command_position for a in ms1.status(WAIT).axes]
+
+    async def drive():
+        app = make_app(link, _args())
+        async with app.run_test(size=size) as pilot:
+            await _until(pilot, lambda: "selected ms0 axis0" in _screen(app), "axis0 selected")
+            await pilot.press("down")  # the next axis row: ms0's axis1
+            await _until(pilot, lambda: "selected ms0 axis1" in _screen(app), "axis1 selected")
+            assert "axis1 *" in _screen(app)
+            assert any("jog" in line and "E_STOP" in line for line in _screen(app).splitlines())  # the footer
+            await pilot.press("right")
+            # one press, no repeat: a VELOCITY move of axis1 alone, STOPped JOG_RELEASE s later, then RESET
+            # (a status during the jog may not come on a busy machine: the held jog below looks at one)
+            await _until(pilot, lambda: "jog ms0 axis1 +1000 counts/s" in _log(app), "the jog in the log")
+            await _until(pilot, lambda: "jog ms0 ended: IDLE" in _log(app), "the jog's end in the log")
+
+    asyncio.run(drive())
+    after = ms0.status(WAIT)
+    assert after.state_name == "IDLE"  # RESET dropped the jog's remainder: RESUME cannot restart it
+    assert after.last_action == "RESET"
+    assert after.axes[1].command_position > before.axes[1].command_position
+    assert after.axes[0].command_position == before.axes[0].command_position
+    assert [a.command_position for a in ms1.status(WAIT).axes] == others
+
+
+def test_a_jog_is_refused_while_the_supervisor_runs_another_move(link, ms0):
     async def drive():
         app = make_app(link, _args())
         async with app.run_test(size=(80, 24)) as pilot:
-            await pilot.press("right")
-            # one press, no repeat: a VELOCITY move in the + direction, STOPped JOG_RELEASE s later
-            await _until(pilot, lambda: "jog ms0 +1000 counts/s" in _log(app), "the jog in the log")
-            stopped = ms0.wait_for(lambda s: s.state_name == "STOPPED" and s.motion_type == "VELOCITY", WAIT,
-                                   "the jog stopped")
-            assert stopped.last_action == "STOP"
-            assert stopped.axes[0].command_position > 0.0
+            move = ms0.move([50_000.0, 0.0], 2000.0, 20_000.0, 20_000.0, wait=False)
+            moving = await _until_status(pilot, ms0, lambda s: s.state_name == "MOVING", "the move running")
+            await pilot.press("left")
+            await _until(pilot, lambda: "jog refused: ms0 is MOVING" in _log(app), "the refusal in the log")
+            status = ms0.status(WAIT)
+            assert (status.state_name, status.move_id, status.motion_type) == ("MOVING", moving.move_id, "S_CURVE")
+            move.cancel(WAIT)
 
     asyncio.run(drive())
+
+
+def test_a_held_jog_stops_when_the_console_exits(link, ms0, monkeypatch):
+    from mpi_ros.cli import jog
+
+    monkeypatch.setattr(jog, "JOG_RELEASE", 10 * WAIT)  # held: only the exit can stop it
+
+    async def drive():
+        app = make_app(link, _args())
+        async with app.run_test(size=(80, 24)) as pilot:
+            await _until(pilot, lambda: "selected ms0 axis0" in _screen(app), "axis0 selected")
+            await pilot.press("right")
+            moving = await _until_status(pilot, ms0, lambda s: s.state_name == "MOVING"
+                                         and s.axes[0].command_velocity > 0.0, "axis0 jogging")
+            assert moving.motion_type == "VELOCITY"
+            held = moving.axes[1]
+            assert (held.command_velocity, held.command_position) == (0.0, before.axes[1].command_position)
+            return moving
+
+    before = ms0.status(WAIT)
+    moving = asyncio.run(drive())
+    after = ms0.wait_for(lambda s: s.state_name == "IDLE" and s.sample > moving.sample, WAIT, "the jog stopped")
+    assert after.last_action == "RESET"
+    assert after.axes[1].command_position == before.axes[1].command_position
+    assert after.axes[0].command_position > before.axes[0].command_position
 
 
 def test_the_command_line_takes_the_one_shot_verbs(link, ms0):
