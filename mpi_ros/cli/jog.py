@@ -21,7 +21,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-JOG_RELEASE = 0.35  # s without a repeat of the arrow before the jog stops (terminals repeat every ~0.03-0.1 s)
+# A terminal reports no key release, only repeats: about every 0.03-0.1 s, but the first one
+# comes only after the keyboard's repeat delay (0.25 to 1 s; 0.5-0.66 s by default on X11 and macOS).
+JOG_FIRST = 0.8  # s after a press without a first repeat before the jog stops (a tap jogs this long)
+JOG_RELEASE = 0.35  # s without a further repeat before the jog stops
 
 
 @dataclass(frozen=True, slots=True)
@@ -83,8 +86,8 @@ class Jogger:
     def press(self, target: JogTarget, axes: int, now: float) -> None:
         """An arrow for ``target`` (a supervisor of ``axes`` axes) at monotonic time ``now``."""
         with self._lock:
-            self._until = now + JOG_RELEASE
             previous, self.active = self.active, target
+            self._until = now + (JOG_RELEASE if previous == target else JOG_FIRST)
         if previous == target:
             return  # a repeat of the key: the jog goes on
         goal = jog_goal(axes, target, self.speed, self.acceleration)
@@ -97,7 +100,7 @@ class Jogger:
         self._work.put(lambda: self._start(target, goal))
 
     def expire(self, now: float) -> None:
-        """Stop the jog whose key has not repeated for JOG_RELEASE s."""
+        """Stop the jog whose key has not repeated in time (JOG_FIRST, then JOG_RELEASE s)."""
         with self._lock:
             if self.active is None or now <= self._until:
                 return

@@ -6,8 +6,8 @@
 Keys (shown at the bottom): space STOP, e E_STOP, r RESET, u RESUME the selected supervisor;
 up/down select an axis (its supervisor with it), Tab the next supervisor; left/right arrows jog
 the selected axis alone (mpi_ros/cli/jog.py: a VELOCITY move at --jog-speed, the other axes at
-0; a terminal reports no key release, so the jog STOPs once the key has not repeated for
-JOG_RELEASE s, and when the console exits); ctrl+e is E_STOP wherever the focus is, the command
+0; a terminal reports no key release, so the jog STOPs once the key stops repeating, and when
+the console exits); ctrl+e is E_STOP wherever the focus is, the command
 line included; : or / opens the command line, which takes the one-shot verbs: move ...,
 modify ..., stop, e-stop, abort, reset, resume, with their own options (--supervisor N among
 them). q quits.

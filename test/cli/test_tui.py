@@ -101,6 +101,8 @@ def test_the_console_shows_the_suite_and_its_keys_act(link, ms0, size):
             await pilot.press("r")
             ms0.wait_for_state("IDLE", WAIT)
             await _until(pilot, lambda: table.get_row_at(0)[1] == "IDLE", "ms0 IDLE in the table")
+            await pilot.press("tab")  # the next supervisor, and its first axis
+            await _until(pilot, lambda: "selected ms1 axis2" in _screen(app), "ms1 selected")
 
     asyncio.run(drive())
 
@@ -119,7 +121,7 @@ def test_an_arrow_jogs_the_selected_axis_alone_and_stops_when_the_key_is_not_rep
             assert "axis1 *" in _screen(app)
             assert any("jog" in line and "E_STOP" in line for line in _screen(app).splitlines())  # the footer
             await pilot.press("right")
-            # one press, no repeat: a VELOCITY move of axis1 alone, STOPped JOG_RELEASE s later, then RESET
+            # one press, no repeat: a VELOCITY move of axis1 alone, STOPped JOG_FIRST s later, then RESET
             # (a status during the jog may not come on a busy machine: the held jog below looks at one)
             await _until(pilot, lambda: "jog ms0 axis1 +1000 counts/s" in _log(app), "the jog in the log")
             await _until(pilot, lambda: "jog ms0 ended: IDLE" in _log(app), "the jog's end in the log")
@@ -151,7 +153,7 @@ def test_a_jog_is_refused_while_the_supervisor_runs_another_move(link, ms0):
 def test_a_held_jog_stops_when_the_console_exits(link, ms0, monkeypatch):
     from mpi_ros.cli import jog
 
-    monkeypatch.setattr(jog, "JOG_RELEASE", 10 * WAIT)  # held: only the exit can stop it
+    monkeypatch.setattr(jog, "JOG_FIRST", 10 * WAIT)  # held: only the exit can stop it
 
     async def drive():
         app = make_app(link, _args())
