@@ -68,6 +68,18 @@ _PROCESS_MODULES = {"test_examples.py", "test_client.py", "test_robustness.py", 
                     "test_graph_recording.py", "test_bag.py", "test_lint.py"}
 
 
+# Tests that take tens of seconds (property searches over many batchings, blends swept over angles,
+# long streamed paths): `--fast` leaves them out too. Named by function, so every parameter set.
+_SLOW_TESTS = {"test_any_batching_gives_bit_identical_samples_and_events", "test_stepping_is_chunk_invariant",
+               "test_a_request_that_cannot_be_read_is_the_users_error", "test_blend_limit_decides_which_turns_blend",
+               "test_a_blended_corner_is_the_sum_of_the_two_profiles",
+               "test_a_blended_corner_keeps_the_velocity_and_at_most_doubles_the_acceleration",
+               "test_append_while_stopped_queues_behind_the_pending_move_and_resume_runs_both",
+               "test_append_in_stopped_queues_behind_the_pending_profile",
+               "test_a_10000_point_path_streamed_in_chunks_of_50_runs_without_a_gap",
+               "test_cams_are_bit_identical_however_the_samples_are_batched"}
+
+
 def pytest_collection_modifyitems(config, items):
     tests = os.path.dirname(os.path.abspath(__file__))
     for item in items:
@@ -79,6 +91,8 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker("ros")
         if mark != "process" and parts[-1] in _PROCESS_MODULES:
             item.add_marker("process")
+        if getattr(item, "originalname", item.name) in _SLOW_TESTS:
+            item.add_marker("slow")
 
 
 def pytest_report_header(config):

@@ -9,6 +9,7 @@ its output.
 
 from __future__ import annotations
 
+import ast
 import importlib.util
 import subprocess
 import sys
@@ -37,3 +38,14 @@ def test_ruff_check_is_clean():
 def test_mypy_is_clean():
     # the packages, options and per-module overrides are pyproject.toml's; its cache is .mypy_cache
     _run_clean("mypy", timeout=240)
+
+
+def test_every_test_marked_slow_by_name_exists():
+    # test/conftest.py marks slow tests by function name: a renamed test would silently lose its mark
+    tree = ast.parse((ROOT / "test" / "conftest.py").read_text())
+    slow = next(ast.literal_eval(node.value) for node in tree.body
+                if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == "_SLOW_TESTS")
+    defined = {line.split("def ", 1)[1].split("(", 1)[0]
+               for path in (ROOT / "test").rglob("test_*.py")
+               for line in path.read_text().splitlines() if line.lstrip().startswith("def test_")}
+    assert slow <= defined, f"no such test: {sorted(slow - defined)}"
