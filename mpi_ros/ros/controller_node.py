@@ -33,6 +33,7 @@ from pathlib import Path
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -128,7 +129,7 @@ class ControllerNode(Node):
         # Each valid Axis object's status publisher and services, made and destroyed as axes are
         # created and deleted (_sync_axes). Changed only by outputs of the runner, which run in
         # order with the publishing: a deleted axis' publisher goes after its last status.
-        self._pub_axis_status: dict[int, object] = {}
+        self._pub_axis_status: dict[int, Publisher] = {}
         self._axis_endpoints: dict[int, list] = {}
         self._axes_changed = False  # an axis was created or deleted since the last change hook
         self._axes_synced = threading.Condition()
@@ -270,7 +271,7 @@ class ControllerNode(Node):
         # from the axis topics' snapshots when they were taken now
         values = convert.joint_values(ctl, self._snapshots.taken_axes(ctl) if wire.AVAILABLE else None)
         if len(rows) < len(self._axis_joints):
-            values = tuple([v[row] for row in rows] for v in values)
+            values = ([values[0][r] for r in rows], [values[1][r] for r in rows], [values[2][r] for r in rows])
         position, velocity, effort = joints.convert(*values)
         if wire.AVAILABLE:  # packed straight into CDR
             msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, joints.names, position, velocity, effort)

@@ -9,8 +9,13 @@ import shutil
 import pytest
 
 from mpi_ros import config, flash
-from mpi_ros.srv import AxisFlashConfigGet, AxisFlashConfigSet, MotionConfigGet, MotionFlashConfigGet
-from mpi_ros.srv import MotionFlashConfigSet
+from mpi_ros.srv import (
+    AxisFlashConfigGet,
+    AxisFlashConfigSet,
+    MotionConfigGet,
+    MotionFlashConfigGet,
+    MotionFlashConfigSet,
+)
 
 
 @pytest.fixture
