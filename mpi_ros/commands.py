@@ -60,6 +60,8 @@ class Operation(StrEnum):
     AXIS_POSITION_SET = "axis_position_set"
     AXIS_FAULT_CONFIG_SET = "axis_fault_config_set"
     AXIS_FAULT_INJECT = "axis_fault_inject"
+    AXIS_CREATE = "axis_create"
+    AXIS_DELETE = "axis_delete"
 
 
 # The reference has no "internal error" message; of its generic messages, NO_MEMORY ("not
@@ -343,6 +345,17 @@ def _axis_fault_inject(ctl: Controller, command: Command) -> Reply:
     return Reply(outcome, value=faults)
 
 
+def _axis_create(ctl: Controller, command: Command) -> Reply:
+    """mpiAxisCreate (MPI 002): recorded, so a replay has the same axes at the same sample."""
+    outcome, _ = ctl.axis_create(command.axis)
+    return Reply(outcome)
+
+
+def _axis_delete(ctl: Controller, command: Command) -> Reply:
+    """mpiAxisDelete (MPI 002)."""
+    return Reply(ctl.axis_delete(command.axis))
+
+
 OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {  # by Operation
     Operation.MOTION_START: lambda ctl, c: _motion(ctl, c, modify=False),
     Operation.MOTION_MODIFY: lambda ctl, c: _motion(ctl, c, modify=True),
@@ -363,6 +376,8 @@ OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {  # by Operatio
     Operation.AXIS_POSITION_SET: _axis_position_set,
     Operation.AXIS_FAULT_CONFIG_SET: _axis_fault_config_set,
     Operation.AXIS_FAULT_INJECT: _axis_fault_inject,
+    Operation.AXIS_CREATE: _axis_create,
+    Operation.AXIS_DELETE: _axis_delete,
 }
 
 

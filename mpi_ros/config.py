@@ -22,6 +22,7 @@ from typing import Any
 
 import yaml
 
+from mpi_ros import flash
 from mpi_ros.joints import AxisJoint, Joint, axis_joints
 from mpi_ros.mpi.axes.plant import Plant
 from mpi_ros.mpi.base.events import MPIEventType
@@ -113,6 +114,8 @@ class SuiteConfig:
     secondary: list[SecondaryFeedback] = field(default_factory=list)
     # per axis: the machine's joint (docs/joints.md); None: ``axis<k>`` in counts
     joints: list[Joint | None] = field(default_factory=list)
+    # the flash beside the configuration file (mpi_ros/flash.py); None: no file, no flash
+    flash: Path | None = None
 
     @property
     def axis_count(self) -> int:
@@ -466,7 +469,8 @@ def parse(data: dict, source: str = "<dict>") -> SuiteConfig:
 
 
 def load(path: str | Path | None = None, overrides: dict | None = None) -> SuiteConfig:
-    """Load and validate a YAML configuration file (the packaged default if None)."""
+    """Load and validate a YAML configuration file (the packaged default if None), with its
+    flash (mpi_ros/flash.py) loaded over it and ``overrides`` over both."""
     path = Path(path) if path is not None else default_config_path()
     try:
         text = path.read_text(encoding="utf-8")
@@ -476,4 +480,30 @@ def load(path: str | Path | None = None, overrides: dict | None = None) -> Suite
         data = yaml.safe_load(text) or {}
     except yaml.YAMLError as exc:
         raise ConfigError(f"{path}: not valid YAML ({exc})") from exc
-    return parse(_merge(data, overrides or {}), str(path))
+    if not isinstance(data, dict):
+        return parse(data, str(path))  # (refused: not a mapping)
+    loaded = _with_flash(data, path, overrides or {})
+    loaded.flash = flash.flash_path(path)
+    return loaded
+
+
+def _with_flash(data: dict, path: Path, overrides: dict) -> SuiteConfig:
+    """The configuration with its flash over it. A flash the configuration refuses is named by
+    its path: the file alone is parsed first, so an error of its own stays its own."""
+    where = flash.flash_path(path)
+    try:
+        image = flash.read(where)
+        if image is None:
+            return parse(_merge(data, overrides), str(path))
+        flashed = flash.overlay(data, image, where)
+    except flash.FlashError as exc:
+        raise ConfigError(str(exc)) from exc
+    plain = parse(_merge(data, overrides), str(path))
+    beyond = sorted(n for n in image.axes if n >= plain.axis_count)
+    if beyond:
+        raise ConfigError(f"{where}: axis {beyond[0]} is in the flash but not in the configuration "
+                          f"({plain.axis_count} axes)")
+    try:
+        return parse(_merge(flashed, overrides), str(path))
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: loaded over {path}: {exc}") from exc

@@ -161,6 +161,55 @@ class Controller:
     def supervisor(self, number: int) -> MotionSupervisor | None:
         return self._supervisors.get(number)
 
+    # -- axis objects (docs/decisions.md, "Axis objects") -----------------------------------
+    # The firmware's axes are fixed (config.axis_count, the twin's MEIXmpMAX_Axes); an Axis
+    # object is the application's handle on one of them. Every axis has one at the start.
+    def axis_create(self, number: int) -> tuple[Outcome, Axis | None]:
+        """mpiAxisCreate (MPI 002): MPIAxisMessageAXIS_INVALID "if the axis number is less than
+        zero or greater than or equal to MEIXmpMAX_Axes". Creating a valid one again answers
+        the same object (one handle per axis here)."""
+        if not 0 <= number < len(self.axes):
+            count = len(self.axes)
+            return Outcome(Message.MPIAxisMessageAXIS_INVALID,
+                           f"axis {number}: expected 0 to {count - 1} (MEIXmpMAX_Axes = {count})"), None
+        axis = self.axes[number]
+        axis.valid = True
+        return Outcome(Message.MPIMessageOK), axis
+
+    def axis_delete(self, number: int) -> Outcome:
+        """mpiAxisDelete (MPI 002). Objects are deleted "in reverse order" of their creation
+        (its remarks): an axis a supervisor lists or has mapped is refused with
+        MPIMessageOBJECT_ON_LIST, so no supervisor ever holds a deleted axis."""
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
+        for ms in self.supervisors:
+            if number in ms.axis_list or number in ms.mapped:
+                return Outcome(Message.MPIMessageOBJECT_ON_LIST,
+                               f"axis {number} is on supervisor {ms.number}'s axis list: remove it and MAP first")
+        self.axes[number].valid = False
+        return Outcome(Message.MPIMessageOK)
+
+    def axis_validate(self, number: int) -> Outcome:
+        """mpiAxisValidate (MPI 002): OK for a valid Axis object, HANDLE_INVALID for a deleted one."""
+        if not 0 <= number < len(self.axes):
+            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis {number}: no such axis ({len(self.axes)} axes)")
+        if not self.axes[number].valid:
+            return Outcome(Message.MPIMessageHANDLE_INVALID, f"axis {number} was deleted (mpiAxisCreate it again)")
+        return Outcome(Message.MPIMessageOK)
+
+    def valid_axes(self) -> list[int]:
+        """The numbers of the valid Axis objects, in order."""
+        return [axis.number for axis in self.axes if axis.valid]
+
+    def axis_control(self, number: int) -> Controller | None:
+        """mpiAxisControl (MPI 002): the Control of a valid axis, None (MPIHandleVOID) otherwise."""
+        return self if self.axis_validate(number).ok else None
+
+    def motion_control(self, ms: MotionSupervisor) -> Controller | None:
+        """mpiMotionControl (MPI 000): the Control of a valid motion, None (MPIHandleVOID) otherwise."""
+        return self if ms.valid and self._supervisors.get(ms.number) is ms else None
+
     # -- what supervisors ask of the controller (host.SupervisorHost) ------------------------
     def next_serial(self) -> int:
         """The serial of a move a supervisor takes (each controller counts its own)."""

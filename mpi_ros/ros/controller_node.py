@@ -26,11 +26,14 @@ Stamps (and /clock) are controller time anchored to the wall clock: epoch + samp
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
+from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -38,23 +41,32 @@ from std_msgs.msg import String
 
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Refused
+from mpi_ros.mpi.base.params import AxisMaster, check_settling_reachable, first_refusal
 from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.msg import AxisStatus, MotionEvent, SuiteConfiguration
 from mpi_ros.msg import Command as CommandMsg
 from mpi_ros.srv import (
     AxisConfigGet,
     AxisConfigSet,
+    AxisCreate,
+    AxisDelete,
     AxisFaultConfigGet,
     AxisFaultConfigSet,
     AxisFaultInject,
+    AxisFlashConfigGet,
+    AxisFlashConfigSet,
     AxisPositionSet,
+    AxisValidate,
     GateGet,
     GateSet,
     IoGet,
     IoSet,
+    MotionFlashConfigGet,
+    MotionFlashConfigSet,
     MotorFeedbackSecondarySet,
 )
 
+from .. import flash as flash_file
 from .. import requests as rq
 from ..commands import Command, Operation, Reply, io_space
 from ..config import RosSettings
@@ -93,13 +105,17 @@ class ControllerNode(Node):
     <ns>/robot_description (none: not published)."""
 
     def __init__(self, runner: ControllerRunner, settings: RosSettings, joints: Sequence[AxisJoint] | None = None,
-                 robot_description: str | None = None, **kwargs):
+                 robot_description: str | None = None, flash: Path | None = None, **kwargs):
         super().__init__("controller", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.settings = settings
         self._snapshots = snapshots.shared(runner)
-        self.joints = (convert.default_joints(runner.ctl, settings.joint_prefix) if joints is None
-                       else JointStates(joints))
+        # every axis' joint; /joint_states names those of the valid Axis objects (_joints_of)
+        self._axis_joints = list(joints) if joints is not None else [
+            AxisJoint(a.number, name, None) for a, name in zip(
+                runner.ctl.axes, convert.joint_names(runner.ctl, settings.joint_prefix), strict=True)]
+        self.joints = JointStates(self._axis_joints)
+        self._joint_rows: tuple[int, ...] = tuple(range(len(self._axis_joints)))
         if not wire.AVAILABLE:  # correct, only slower: say so, or a benchmark would not know why
             self.get_logger().warning("the installed interfaces differ from the layouts mpi_ros/ros/wire.py packs: "
                                       "status topics are built as messages (about 3x the CPU)")
@@ -107,20 +123,27 @@ class ControllerNode(Node):
         epoch = convert.epoch_of(runner.ctl)
         self.epoch_ns = convert.anchor(runner.ctl) if epoch is None else epoch
         self._service_group = ReentrantCallbackGroup()
-        count = len(runner.ctl.axes)
-        self._pub_axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
-        for k in range(count):
-            self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp, k=k: self._on_config_get(k, resp))
-            self._service(AxisConfigSet, f"axis{k}/config_set",
-                          lambda req, resp, k=k: self._on_config_set(k, req, resp))
-            self._service(AxisPositionSet, f"axis{k}/position_set",
-                          lambda req, resp, k=k: self._on_position_set(k, req, resp))
-            self._service(AxisFaultConfigGet, f"axis{k}/fault_config_get",
-                          lambda req, resp, k=k: self._on_fault_config_get(k, resp))
-            self._service(AxisFaultConfigSet, f"axis{k}/fault_config_set",
-                          lambda req, resp, k=k: self._on_fault_config_set(k, req, resp))
-            self._service(AxisFaultInject, f"axis{k}/fault_inject",
-                          lambda req, resp, k=k: self._on_fault_inject(k, req, resp))
+        self._flash = flash_file.Flash(flash) if flash is not None else None
+        # what the next start loads where the flash holds nothing: the configuration, as it started
+        self._started = runner.read(_started_configs)
+        # Each valid Axis object's status publisher and services, made and destroyed as axes are
+        # created and deleted (_sync_axes). Changed only by outputs of the runner, which run in
+        # order with the publishing: a deleted axis' publisher goes after its last status.
+        self._pub_axis_status: dict[int, Publisher] = {}
+        self._axis_endpoints: dict[int, list] = {}
+        self._axes_changed = False  # an axis was created or deleted since the last change hook
+        self._axes_synced = threading.Condition()
+        self._sync_axes(tuple(runner.ctl.valid_axes()))
+        self._service(AxisCreate, "axis_create", lambda req, resp: self._on_axis_object(
+            Command(Operation.AXIS_CREATE, axis=req.number), True, resp))
+        self._service(AxisDelete, "axis_delete", lambda req, resp: self._on_axis_object(
+            Command(Operation.AXIS_DELETE, axis=req.number), False, resp))
+        self._service(AxisValidate, "axis_validate", self._on_axis_validate)
+        for n in self._started["supervisors"]:
+            self._service(MotionFlashConfigGet, f"ms{n}/flash_config_get",
+                          lambda req, resp, n=n: self._on_motion_flash_get(n, resp))
+            self._service(MotionFlashConfigSet, f"ms{n}/flash_config_set",
+                          lambda req, resp, n=n: self._on_motion_flash_set(n, req, resp))
         self._service(GateSet, "gate_set", self._on_gate_set)
         self._service(GateGet, "gate_get", self._on_gate_get)
         self._service(IoSet, "io_set", self._on_io_set)
@@ -137,6 +160,7 @@ class ControllerNode(Node):
         self._applied: list = []  # commands applied since the last change hook, to publish after the lock
         runner.on_command(self._on_command)
         runner.on_change(self._collect_commands)
+        runner.on_change(self._collect_axes)
         runner.add_periodic(settings.status_rate, self._collect_axis_status)
         runner.add_periodic(settings.joint_states_rate, self._collect_joints)
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
@@ -148,7 +172,61 @@ class ControllerNode(Node):
             self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns, settings.namespace)))
 
     def _service(self, srv_type, name, callback):
-        self.create_service(srv_type, name, callback, callback_group=self._service_group)
+        return self.create_service(srv_type, name, callback, callback_group=self._service_group)
+
+    # -- axis objects (mpiAxisCreate / mpiAxisDelete: docs/decisions.md, "Axis objects") ----
+    def _axis_services(self, k: int) -> list:
+        return [
+            self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp: self._on_config_get(k, resp)),
+            self._service(AxisConfigSet, f"axis{k}/config_set", lambda req, resp: self._on_config_set(k, req, resp)),
+            self._service(AxisPositionSet, f"axis{k}/position_set",
+                          lambda req, resp: self._on_position_set(k, req, resp)),
+            self._service(AxisFaultConfigGet, f"axis{k}/fault_config_get",
+                          lambda req, resp: self._on_fault_config_get(k, resp)),
+            self._service(AxisFaultConfigSet, f"axis{k}/fault_config_set",
+                          lambda req, resp: self._on_fault_config_set(k, req, resp)),
+            self._service(AxisFaultInject, f"axis{k}/fault_inject",
+                          lambda req, resp: self._on_fault_inject(k, req, resp)),
+            self._service(AxisFlashConfigGet, f"axis{k}/flash_config_get",
+                          lambda req, resp: self._on_axis_flash_get(k, resp)),
+            self._service(AxisFlashConfigSet, f"axis{k}/flash_config_set",
+                          lambda req, resp: self._on_axis_flash_set(k, req, resp)),
+        ]
+
+    def _sync_axes(self, valid: tuple[int, ...]) -> None:
+        """Give each axis in ``valid`` its endpoints and take them from every other one."""
+        with self._axes_synced:
+            for k in [k for k in self._axis_endpoints if k not in valid]:
+                self.destroy_publisher(self._pub_axis_status.pop(k))
+                for service in self._axis_endpoints.pop(k):
+                    self.destroy_service(service)
+            for k in valid:
+                if k not in self._axis_endpoints:
+                    self._pub_axis_status[k] = self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS)
+                    self._axis_endpoints[k] = self._axis_services(k)
+            self._axes_synced.notify_all()
+
+    def _collect_axes(self, ctl):
+        if not self._axes_changed:
+            return None
+        self._axes_changed = False
+        valid = tuple(ctl.valid_axes())
+        return lambda: self._sync_axes(valid)
+
+    def _on_axis_object(self, command: Command, valid: bool, response):
+        """/<ns>/axis_create and axis_delete: answered once the axis' endpoints are there (or gone)."""
+        reply, _ = self.runner.submit(command)
+        if reply.message.ok:
+            with self._axes_synced:
+                if not self._axes_synced.wait_for(lambda: (command.axis in self._axis_endpoints) == valid, 5.0):
+                    self.get_logger().error(f"axis{command.axis}: its endpoints did not follow {command.operation}")
+        response.detail = reply.detail
+        return convert.answer(response, reply)
+
+    def _on_axis_validate(self, request, response):
+        outcome = self.runner.read(lambda ctl: ctl.axis_validate(request.number))
+        response.detail = outcome.detail
+        return convert.answer(response, Reply(outcome))
 
     def publish_configuration(self, config, start_sample: int | None = None) -> SuiteConfiguration:
         """Publish (latched) the configuration the suite runs: ``config`` (a SuiteConfig), the
@@ -160,6 +238,8 @@ class ControllerNode(Node):
 
     # -- applied commands -------------------------------------------------------------------
     def _on_command(self, sample, command, reply) -> None:
+        if command.operation in (Operation.AXIS_CREATE, Operation.AXIS_DELETE) and reply.message.ok:
+            self._axes_changed = True
         # under the runner lock: keep it; it is published once the lock is released
         self._applied.append(convert.command(sample, command, reply, self.runner.ctl.rate, self.epoch_ns,
                                              self.settings.namespace))
@@ -180,17 +260,34 @@ class ControllerNode(Node):
         # packed straight into CDR and published raw where the interfaces allow (wire.py: the
         # same bytes, a third of the work); the snapshots are the supervisors' (snapshots.py)
         encode = wire.axis_status if wire.AVAILABLE else convert.axis_status
-        messages = [encode(self._snapshots.axis(ctl, a.number), ctl.rate, self.epoch_ns, self.settings.namespace)
-                    for a in ctl.axes]
-        return lambda: convert.publish_all(self, zip(self._pub_axis_status, messages, strict=True))
+        publishers = self._pub_axis_status
+        sends = [(publishers[a.number], encode(self._snapshots.axis(ctl, a.number), ctl.rate, self.epoch_ns,
+                                               self.settings.namespace))
+                 for a in ctl.axes if a.valid and a.number in publishers]
+        return lambda: convert.publish_all(self, sends)
 
     def _collect_joints(self, ctl):
-        if not wire.AVAILABLE:
-            msg = convert.joint_state(ctl, self.epoch_ns, self.joints)
-        else:  # packed straight into CDR, from the axis topics' snapshots when they were taken now
-            values = self.joints.convert(*convert.joint_values(ctl, self._snapshots.taken_axes(ctl)))
-            msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, self.joints.names, *values)
+        joints, rows = self._joints_of(ctl)
+        # from the axis topics' snapshots when they were taken now
+        values = convert.joint_values(ctl, self._snapshots.taken_axes(ctl) if wire.AVAILABLE else None)
+        if len(rows) < len(self._axis_joints):
+            values = ([values[0][r] for r in rows], [values[1][r] for r in rows], [values[2][r] for r in rows])
+        position, velocity, effort = joints.convert(*values)
+        if wire.AVAILABLE:  # packed straight into CDR
+            msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, joints.names, position, velocity, effort)
+        else:
+            msg = JointState(name=list(joints.names), position=position, velocity=velocity, effort=effort)
+            msg.header.stamp = convert.stamp(ctl.sample, ctl.rate, self.epoch_ns)
         return lambda: convert.publish(self, self._pub_joints, msg)
+
+    def _joints_of(self, ctl) -> tuple[JointStates, tuple[int, ...]]:
+        """The joints of the valid Axis objects and their rows among all axes (rebuilt when
+        an axis is created or deleted)."""
+        rows = tuple(ctl.valid_axes())
+        if rows != self._joint_rows:
+            self.joints = JointStates([self._axis_joints[row] for row in rows])
+            self._joint_rows = rows
+        return self.joints, rows
 
     def _collect_clock(self, ctl):
         msg = Clock(clock=convert.stamp(ctl.sample, ctl.rate, self.epoch_ns))
@@ -202,7 +299,8 @@ class ControllerNode(Node):
         for ms in ctl.supervisors:
             array.status.append(self._supervisor_diagnostic(ms))
         for axis in ctl.axes:
-            array.status.append(self._axis_diagnostic(ctl, axis))
+            if axis.valid:
+                array.status.append(self._axis_diagnostic(ctl, axis))
         for provider in self.diagnostic_providers:
             array.status.extend(provider(ctl))
         return lambda: convert.publish(self, self._pub_diagnostics, array)
@@ -314,3 +412,69 @@ class ControllerNode(Node):
         response.value = int(value)
         return convert.answer(response, Reply.of(message))
 
+    # -- flash (mpi_ros/flash.py; docs/configuration.md, "Flash") ------------------------------
+    def _flash_entry(self, kind: str, number: int) -> tuple[Reply, dict | None]:
+        if self._flash is None:
+            return Reply.of(Message.MPIMessageUNSUPPORTED, "the suite runs without a configuration file: "
+                            "its flash is a file beside one"), None
+        outcome, entry = self._flash.get(kind, number)
+        return Reply(outcome), (self._started[kind][number] if entry is None else entry) if outcome.ok else None
+
+    def _flash_write(self, kind: str, number: int, entry: dict) -> Reply:
+        if self._flash is None:
+            return self._flash_entry(kind, number)[0]
+        return Reply(self._flash.set(kind, number, entry))
+
+    def _on_motion_flash_get(self, n: int, response):
+        """mpiMotionFlashConfigGet (MPI 000)."""
+        reply, entry = self._flash_entry("supervisors", n)
+        if entry is not None:
+            convert.fill(response.config, rq.motion_config_to_dict(rq.motion_config(entry)))
+        response.detail = reply.detail
+        return convert.answer(response, reply)
+
+    def _on_motion_flash_set(self, n: int, request, response):
+        """mpiMotionFlashConfigSet (MPI 000): checked by MotionConfig's validator, then written."""
+        try:
+            config = rq.motion_config(convert.to_dict(request.config))
+        except Refused as exc:
+            config, reply = None, Reply.of(exc.message, exc.detail)
+        if config is not None:
+            verdict = config.validate()
+            reply = (Reply(verdict) if not verdict.ok
+                     else self._flash_write("supervisors", n, flash_file.motion_entry(config)))
+        response.detail = reply.detail
+        return convert.answer(response, reply)
+
+    def _on_axis_flash_get(self, k: int, response):
+        """mpiAxisFlashConfigGet (MPI 002)."""
+        reply, entry = self._flash_entry("axes", k)
+        if entry is not None:
+            master = dict(entry["master"])
+            correction = master.pop("correction")
+            convert.fill(response.in_position, rq.in_position_to_dict(rq.in_position(entry["in_position"])))
+            convert.fill(response.master, rq.axis_master_to_dict(rq.axis_master(master, correction, AxisMaster())))
+            response.master_correction = correction
+        response.detail = reply.detail
+        return convert.answer(response, reply)
+
+    def _on_axis_flash_set(self, k: int, request, response):
+        """mpiAxisFlashConfigSet (MPI 002): checked as mpiAxisConfigSet checks, then written."""
+        try:
+            in_position = rq.in_position(convert.to_dict(request.in_position))
+            master = rq.axis_master(convert.to_dict(request.master), request.master_correction, AxisMaster())
+            verdict = self.runner.read(lambda ctl: first_refusal((
+                in_position.validate(), check_settling_reachable(in_position, ctl.axes[k].plant.config),
+                ctl.axis_master_check(k, master).prefixed("master."))))
+            reply = (Reply(verdict) if not verdict.ok
+                     else self._flash_write("axes", k, flash_file.axis_entry(in_position, master)))
+        except Refused as exc:
+            reply = Reply.of(exc.message, exc.detail)
+        response.detail = reply.detail
+        return convert.answer(response, reply)
+
+
+def _started_configs(ctl) -> dict[str, dict[int, dict]]:
+    """Every supervisor's and axis' configuration now, in the flash's words."""
+    return {"supervisors": {ms.number: flash_file.motion_entry(ms.config) for ms in ctl.supervisors},
+            "axes": {a.number: flash_file.axis_entry(a.in_position, a.master) for a in ctl.axes}}

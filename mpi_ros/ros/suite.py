@@ -56,7 +56,7 @@ class Suite:
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)
         self.runner = ControllerRunner(self.controller, time_scale)
         self.controller_node = ControllerNode(self.runner, config.ros, config.axis_joints(), self.robot_description,
-                                              context=context)
+                                              flash=config.flash, context=context)
         self.goal_loop: GoalLoop | GoalRelay = (
             GoalRelay(config.ros.namespace, config.ros.executor_threads) if config.ros.goal_process
             else GoalLoop(self.controller_node.context, config.ros.executor_threads))

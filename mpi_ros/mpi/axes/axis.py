@@ -155,6 +155,9 @@ class Axis:
     def __init__(self, number: int, bank: AxisBank, sample_rate: float, in_position: AxisInPosition,
                  plant: PlantConfig):
         self.number = number
+        # an Axis object the application holds (mpiAxisCreate; mpiAxisDelete clears it): the
+        # firmware axis runs either way, an invalid one is no one's to command (Controller.axis_delete)
+        self.valid = True
         self._bank = bank
         self.rate = sample_rate
         self.in_position = in_position.copy()

@@ -45,7 +45,8 @@ class AxisList:
         return len({self._config.frame_buffer_size_of(n) for n in numbers}) > 1
 
     def _check_axis(self, number: int) -> Message:
-        if not 0 <= number < len(self._axes):
+        # MPI 000, mpiMotionAxisAppend: HANDLE_INVALID for no such axis or a deleted Axis object
+        if not 0 <= number < len(self._axes) or not self._axes[number].valid:
             return Message.MPIMessageHANDLE_INVALID
         if not self._axes[number].enabled:
             return Message.MPIMessageOBJECT_NOT_ENABLED

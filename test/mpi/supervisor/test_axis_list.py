@@ -17,7 +17,7 @@ MOVING = M.MPIMotionMessageMOVING
 def axis_list(count: int = 4, disabled: tuple[int, ...] = (), sizes: dict[int, int] | None = None) -> AxisList:
     """An axis list over ``count`` axes (those in ``disabled`` not enabled; ``sizes``: frame
     buffer sizes of some axes, the others 128)."""
-    axes = [SimpleNamespace(enabled=n not in disabled) for n in range(count)]
+    axes = [SimpleNamespace(enabled=n not in disabled, valid=True) for n in range(count)]
     return AxisList(axes, ControllerConfig(axis_count=count, axis_frame_buffer_sizes=sizes or {}))
 
 
