@@ -26,12 +26,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 from mpi_ros.mpi.base.types import MPIMotionType
 from mpi_ros.mpi.planning.frames import AxisPlan
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
-from .limits import check_profile, strip_waits
+from .limits import BlendLimits, check_blend, check_profile, strip_waits
 from .mapping import INF, Mapping, map_point_to_point, map_velocity, peak_acceleration
 from .request import ProfileRequest
 from .request import motion_type as parse_type
@@ -104,6 +105,8 @@ def check_plan(plan: AxisPlan, motion_type: MPIMotionType | str, axis: int | Non
         if plan.truncated:
             return CrossCheck(kind.name, axis, Verdict.DIFFER_EXPLAINED, False, _duration(motion), None,
                               (Reason.TRUNCATED,), ("not compared: the profile was cut at the frame limit",))
+        if plan.blended_from is not None:
+            return _check_blended(plan, kind, axis)
         if plan.composite:
             return CrossCheck(kind.name, axis, Verdict.DIFFER_EXPLAINED, False, _duration(motion), None,
                               (Reason.COMPOSITE,), (f"not compared: {plan.composite}",))
@@ -134,6 +137,28 @@ def check_plan(plan: AxisPlan, motion_type: MPIMotionType | str, axis: int | Non
 
     mapping = mapping.with_jerk(_bound_jerk(compared, duration))  # a bound's max_jerk (if it needs one)
     return _compare(kind, axis, mapping, compared, duration, scales, problems, (p0, v0, 0.0), a0)
+
+
+def _check_blended(plan: AxisPlan, kind: MPIMotionType, axis: int) -> CrossCheck:
+    """A blended corner (planning/blend.py): the appended move's own profile is checked as
+    any plan (limits and ruckig); the blend, that profile plus the rest of the move before,
+    against the limits the reference gives a blend (limits.check_blend)."""
+    parts = plan.blended_from
+    assert parts is not None and plan.limits is not None  # (check_plan's caller: a blended plan)
+    own = check_plan(replace(plan, segments=list(parts.own), composite="", blended_from=None), kind, axis)
+    own_f = plan.limits.jerk_percent / 100.0 if kind is not MPIMotionType.TRAPEZOIDAL else 0.0
+    before = parts.tail_limits or plan.limits  # (a move before without recorded limits: the same)
+    tail_f = before.jerk_percent / 100.0 if any(s.j != 0.0 for s in parts.tail) else 0.0
+    limits = BlendLimits(plan.limits.velocity, peak_acceleration(max(plan.limits.acceleration,
+                                                                     plan.limits.deceleration), own_f),
+                         before.velocity, peak_acceleration(before.deceleration, tail_f))
+    scales = StateDifference(max(own.scales.position, POSITION_FLOOR * abs(plan.target)),
+                             max(own.scales.velocity, limits.tail_velocity),
+                             max(own.scales.acceleration, limits.tail_peak))
+    problems = check_blend(plan.segments, parts.own, parts.tail, limits, scales)
+    verdict = Verdict.DISAGREE if problems or own.verdict is Verdict.DISAGREE else Verdict.DIFFER_EXPLAINED
+    return replace(own, verdict=verdict, reasons=(*own.reasons, Reason.BLENDED), problems=(*own.problems, *problems),
+                   controller_duration=_duration(plan.segments))
 
 
 def _bound_jerk(segments: Sequence[Segment], duration: float) -> float:

@@ -26,10 +26,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 from .mapping import peak_acceleration, ramp_jerk, reverses
-from .result import LIMIT_RTOL, TIME_RESOLUTION, StateDifference
+from .result import LIMIT_RTOL, STATE_RTOL, TIME_RESOLUTION, StateDifference
+from .sampling import UNIFORM_SAMPLES, sample, switching_times
 
 
 def strip_waits(segments: Sequence[Segment]) -> list[Segment]:
@@ -227,3 +230,87 @@ def check_profile(  # noqa: C901 - one check per limit in a row; to be split by 
         if abs(p - target) > p_tol or abs(v - final_velocity) > v_tol:
             problems.append(f"ends at (p={p!r}, v={v!r}), not at (p={target!r}, v={final_velocity!r})")
     return problems
+
+
+@dataclass(frozen=True, slots=True)
+class BlendLimits:
+    """What a blended corner's two profiles were planned with (crosscheck of a blend):
+    each one's velocity limit and peak acceleration (rate/(1-f/2) of its jerk share)."""
+
+    own_velocity: float
+    own_peak: float
+    tail_velocity: float
+    tail_peak: float
+
+
+def check_blend(blended: Sequence[Segment], own: Sequence[Segment], tail: Sequence[Segment],
+                limits: BlendLimits, scales: StateDifference) -> list[str]:
+    """Every limit a blended corner breaks (MEIMotionConfig.blendLimit, MPI 000).
+
+    ``blended``: the profile the axis runs; ``own``: the appended move's profile alone (checked
+    on its own by check_profile and ruckig); ``tail``: the rest of the move before it, less its
+    target. The reference bounds a blend's acceleration by what the two moves allow together:
+    "the acceleration resulting from the blending can exceed the acceleration limit specified
+    in the motion parameters (180 degrees = acceleration*2.0)". So: the blend is the sum of the
+    two profiles; the tail is a deceleration to rest within its own limits; the sum's |v| stays
+    within the larger velocity limit and its |a| within the two peaks added (twice the limit at
+    an about-face of equal moves)."""
+    problems = _superposition(blended, own, tail, scales)
+    v_tol = LIMIT_RTOL * scales.velocity
+    a_tol = LIMIT_RTOL * scales.acceleration
+    if tail:
+        p, v, _ = tail[-1].end_state()
+        if abs(p) > LIMIT_RTOL * scales.position or abs(v) > v_tol:
+            problems.append(f"the move before does not end at rest on its target: {p!r} counts, {v!r} counts/s left")
+        problems += _within(tail, "the move before", limits.tail_velocity, limits.tail_peak, v_tol, a_tol)
+    ceiling = max(limits.own_velocity, limits.tail_velocity)
+    problems += _within(blended, "the blend", ceiling, limits.own_peak + limits.tail_peak, v_tol, a_tol)
+    return problems
+
+
+def _within(segments: Sequence[Segment], name: str, velocity: float, peak: float, v_tol: float,
+            a_tol: float) -> list[str]:
+    """``segments``' |v| within ``velocity`` and |a| within ``peak`` (a is piecewise linear: ends suffice)."""
+    problems = []
+    speed = max(max(abs(lo), abs(hi)) for lo, hi in map(velocity_range, segments))
+    if speed > velocity + v_tol:
+        problems.append(f"{name}: |v| reaches {speed!r}, above the velocity {velocity!r}")
+    reached = max(max(abs(s.a), abs(s.end_state()[2])) for s in segments)
+    if reached > peak * (1.0 + LIMIT_RTOL) + a_tol:
+        problems.append(f"{name}: |a| reaches {reached!r} > {peak!r}")
+    return problems
+
+
+def _superposition(blended: Sequence[Segment], own: Sequence[Segment], tail: Sequence[Segment],
+                   scales: StateDifference) -> list[str]:
+    """The blend is own(t) + tail(t) (the tail at rest on 0 after its end), sampled on a grid
+    and inside every interval between the three profiles' switching times."""
+    if not blended or not own:
+        return ["a blended plan without a profile"]
+    horizon = float(switching_times(blended)[-1])
+    breaks = np.concatenate([switching_times(x) for x in (blended, own, tail) if x])
+    edges = np.unique(np.concatenate(([0.0, horizon], breaks[(breaks > 0.0) & (breaks < horizon)])))
+    inner = np.concatenate([edges[:-1] + q * np.diff(edges) for q in (0.25, 0.5, 0.75)])
+    times = np.concatenate((np.linspace(0.0, horizon, UNIFORM_SAMPLES), inner))
+    pb, vb, ab, _ = sample(blended, times)
+    po, vo, ao = _held(own, times)
+    pt, vt, at = _held(tail, times) if tail else (np.zeros_like(times),) * 3
+    dt = TIME_RESOLUTION * horizon
+    tol = (STATE_RTOL * scales.position + scales.velocity * dt, STATE_RTOL * scales.velocity + scales.acceleration * dt)
+    worst = (float(np.max(np.abs(pb - po - pt))), float(np.max(np.abs(vb - vo - vt))))
+    if worst[0] > tol[0] or worst[1] > tol[1]:
+        return [f"the blend is not the sum of the two moves' profiles: off by {worst[0]:.3g} counts, "
+                f"{worst[1]:.3g} counts/s"]
+    inside = np.abs(ab - ao - at)[UNIFORM_SAMPLES:]
+    if inside.size and float(inside.max()) > STATE_RTOL * scales.acceleration:
+        return [f"the blend's acceleration is not the sum of the two moves': off by {float(inside.max()):.3g}"]
+    return []
+
+
+def _held(segments: Sequence[Segment], times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position, velocity and acceleration of a profile at ``times``; after its end it goes on at
+    its end velocity with no acceleration (as the controller holds a plan's end state)."""
+    end = float(switching_times(segments)[-1])
+    p, v, a, _ = sample(segments, np.minimum(times, end))
+    after = times > end
+    return np.where(after, p + v * (times - end), p), v, np.where(after, 0.0, a)

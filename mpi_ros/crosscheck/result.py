@@ -62,6 +62,10 @@ class Reason(Enum):
         "acceleration (a step, as the firmware does); compared from that state")
     TRUNCATED = (
         "a frame hit the 16,384,000-sample limit: the profile stops there, not at the target")
+    BLENDED = (
+        "a blended corner (MEIMotionConfig.blendLimit): the appended move's own profile is "
+        "compared with ruckig; the blend, its sum with the rest of the move before, is checked "
+        "against the limits (velocity; acceleration up to both peaks added: twice at an about-face)")
     COMPOSITE = (
         "the plan is two profiles, not one (a vector modify off its line stops along the line, "
         "then moves on a new one): each is a vector profile; not compared")

@@ -18,8 +18,9 @@ from __future__ import annotations
 
 import math
 
+from mpi_ros.mpi.base.params import Trajectory
 from mpi_ros.mpi.base.types import POINT_TO_POINT_TYPES, MotionAttr
-from mpi_ros.mpi.planning.frames import AxisPlan, Move
+from mpi_ros.mpi.planning.frames import AxisPlan, BlendParts, Move
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 _WAITS = MotionAttr.DELAY | MotionAttr.HOLD | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER
@@ -76,14 +77,17 @@ def _ramp(segments: list[Segment], last: bool) -> float:
     return total
 
 
-def blended(plan: AxisPlan, tail: list[Segment], rest: float) -> AxisPlan:
+def blended(plan: AxisPlan, tail: list[Segment], rest: float, tail_limits: Trajectory | None = None) -> AxisPlan:
     """``plan`` with ``tail`` (the rest of the previous move's profile, ending at rest at
-    position ``rest``, its target) added while it lasts: the overlapping profiles summed."""
+    position ``rest``, its target; planned with ``tail_limits``) added while it lasts: the
+    overlapping profiles summed. The plan keeps both parts (``blended_from``)."""
     extra = [Segment(s.duration, s.p - rest, s.v, s.a, s.j) for s in tail]
-    return AxisPlan(axis=plan.axis, segments=superpose(list(plan.segments), extra),
+    own = list(plan.segments)
+    return AxisPlan(axis=plan.axis, segments=superpose(own, extra),
                     start_position=plan.start_position, target=plan.target, final_velocity=plan.final_velocity,
                     outputs=plan.outputs, limits=plan.limits, start_velocity=plan.start_velocity,
-                    start_acceleration=plan.start_acceleration, composite="blended with the move before")
+                    start_acceleration=plan.start_acceleration, composite="blended with the move before",
+                    blended_from=BlendParts(tuple(own), tuple(extra), tail_limits))
 
 
 def tail(segments: list[Segment], t: float) -> list[Segment]:

@@ -37,6 +37,16 @@ def reached(rel):
     return rel + POINT_TIME_TOLERANCE
 
 
+@dataclass(frozen=True, slots=True)
+class BlendParts:
+    """The two profiles a blended plan adds up (planning/blend.py, MEIMotionConfig.blendLimit),
+    kept so that each can be checked on its own (the ruckig and limits checks, crosscheck)."""
+
+    own: tuple[Segment, ...]  # the appended move's profile, as planned alone from the corner
+    tail: tuple[Segment, ...]  # the rest of the move before it, from the blend's start, less its target
+    tail_limits: Trajectory | None  # the limits that move's profile was planned with
+
+
 @dataclass(slots=True)
 class AxisPlan:
     """One axis' part of a move; times are profile time from the axis' start."""
@@ -72,6 +82,8 @@ class AxisPlan:
     # BSPLINE/BSPLINE2 (paths.py): the control points and point times of the whole curve, so
     # that points appended to an open path continue the one B-spline of all the points.
     spline: SplineHistory | None = None
+    # A blended corner (blend.py): the two profiles whose sum ``segments`` is; None otherwise.
+    blended_from: BlendParts | None = None
     duration: float = field(init=False)
     _table: SegmentTable | None = field(init=False, default=None, repr=False, compare=False)
 
@@ -118,6 +130,7 @@ class AxisPlan:
         plan.feedforward = None
         plan.cam = None
         plan.spline = None
+        plan.blended_from = None
         plan._table = None
         return plan
 

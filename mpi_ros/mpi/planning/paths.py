@@ -24,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import Refused
 from mpi_ros.mpi.base.params import MotionParams, Output
 from mpi_ros.mpi.base.types import HOLD_ATTRS, MotionAttr, MPIMotionType
 from mpi_ros.mpi.base.wrap import WRAP
@@ -45,6 +47,10 @@ KINDS: dict[MPIMotionType, PathKind] = {
 }
 STREAMED_TYPES = frozenset(KINDS) | {MPIMotionType.FRAME}
 FEEDFORWARD_TYPES = frozenset({MPIMotionType.PTF, MPIMotionType.PVTF})
+# How closely a frame must begin where the axis is (counts, counts/s): the user computes each
+# frame's start from the one before it in floating point, which rounds far below a count.
+FRAME_JOIN_ABS = 1e-6
+FRAME_JOIN_REL = 1e-12
 
 
 @dataclass(slots=True)
@@ -209,13 +215,42 @@ def _points(params: MotionParams, starts: list[PathStart], relative: bool) -> np
 
 def _frame_segments(params: MotionParams, starts: list[PathStart]) -> list[list[Segment]]:
     """FRAME: the user's frames (MEIXmpFrame) run as given, interleaved by axis; positions
-    are user positions (raw = position + origin)."""
+    are user positions (raw = position + origin). Each frame must begin in the state the axis
+    is in when it begins (:func:`_check_frames_join`)."""
     axes = len(starts)
-    return [
+    per_axis = [
         [Segment(f.time, f.position + start.origin, f.velocity, f.acceleration, f.jerk)
          for f in params.frames[k::axes] if f.time > 0.0]
         for k, start in enumerate(starts)
     ]
+    for start, segments in zip(starts, per_axis, strict=True):
+        _check_frames_join(start, segments)
+    return per_axis
+
+
+def _joins(expected: float, given: float) -> bool:
+    """``given`` continues ``expected``: equal within what the user's own arithmetic rounds."""
+    return math.isclose(given, expected, rel_tol=FRAME_JOIN_REL, abs_tol=FRAME_JOIN_ABS)
+
+
+def _check_frames_join(start: PathStart, segments: list[Segment]) -> None:
+    """Refuse frames that would step an axis' command (MPIMotionMessagePATH_ERROR).
+
+    A frame is loaded as a constant-jerk segment from its own position and velocity (MPI 000,
+    MEIMotionFrame / MEIXmpFrame), so a first frame that does not start where the axis is, or
+    a frame that does not start where the one before it ends, makes the command jump (a
+    position step, or a velocity step: an unbounded acceleration). The firmware would load
+    it; the twin refuses it and moves nothing (docs/paths.md, "FRAME moves"). A step in
+    acceleration is allowed, as in every profile that starts with a ramp."""
+    position, velocity = start.position, start.velocity
+    for index, segment in enumerate(segments):
+        if not (_joins(position, segment.p) and _joins(velocity, segment.v)):
+            where = "the axis' command" if index == 0 else f"the end of frame {index - 1}"
+            raise Refused(Message.MPIMotionMessagePATH_ERROR,
+                          f"axis {start.axis}: frame {index} starts at position {segment.p - start.origin:.9g}, "
+                          f"velocity {segment.v:.9g}; {where} is at {position - start.origin:.9g}, "
+                          f"velocity {velocity:.9g} (a FRAME move may not step the command)")
+        position, velocity, _ = segment.end_state()
 
 
 def _element_ids(params: MotionParams, attrs: MotionAttr, count: int) -> tuple[int, ...]:

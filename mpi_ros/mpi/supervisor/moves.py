@@ -308,7 +308,8 @@ class Moves:
             if previous is None:
                 continue
             axis.rebase(t, self.clock_of(axis))
-            move.plans[k] = blend.blended(plan, blend.tail(previous.segments, axis.rel), previous.target)
+            move.plans[k] = blend.blended(plan, blend.tail(previous.segments, axis.rel), previous.target,
+                                           previous.limits)
 
     def fire_outputs(self, plan: AxisPlan) -> None:
         for output in plan.outputs:

@@ -229,6 +229,72 @@ def test_frame_move_runs_the_user_frames_as_given():
     assert ctl.move_log.recent(ms.number)[-1].message is M.MPIMessageOK
 
 
+def _frames_of(per_axis) -> list[UserFrame]:
+    """MEIXmpFrame values of per-axis segments, interleaved by axis (MEIMotionFrame, frame)."""
+    return [UserFrame(s.p, s.v, s.a, s.j, s.duration) for pair in zip(*per_axis, strict=True) for s in pair]
+
+
+def _stepped(per_axis, axis, **change):
+    """``per_axis`` with the first frame of ``axis`` changed by ``change`` (a step at the start)."""
+    first = per_axis[axis][0]
+    values = {"p": first.p, "v": first.v, "a": first.a, "j": first.j, "duration": first.duration} | change
+    moved = Segment(values["duration"], values["p"], values["v"], values["a"], values["j"])
+    return [[moved, *segs[1:]] if k == axis else segs for k, segs in enumerate(per_axis)]
+
+
+FRAME_STEPS = [("position at the start", 0, {"p": START_USER[0] - 5.0}),
+               ("velocity at the start", 1, {"v": 300.0})]
+
+
+@pytest.mark.parametrize(("name", "axis", "change"), FRAME_STEPS, ids=[s[0] for s in FRAME_STEPS])
+def test_a_frame_move_that_would_step_the_command_at_its_start_is_refused(name, axis, change):
+    # MPI 000, MEIMotionFrame / MEIXmpFrame: a frame is a constant-jerk segment from its own position and
+    # velocity, so frames that do not begin where the axis is would make the command jump (a position
+    # step, or a velocity step: an unbounded acceleration). MPIMotionMessagePATH_ERROR: "The specified
+    # multi-point motion path is not valid"; docs/paths.md, "FRAME moves"
+    ctl, ms = new_supervisor()
+    start = place(ctl)
+    per_axis = [chain(START_USER[k], 0.0, 0.0, pieces) for k, pieces in enumerate(_frame_pieces())]
+    outcome, _ = ms.command(T.FRAME, A.NONE, MotionParams(frames=_frames_of(_stepped(per_axis, axis, **change))), False)
+    assert outcome.message is M.MPIMotionMessagePATH_ERROR
+    assert f"axis {axis}" in outcome.detail
+    assert ms.state is MPIState.IDLE
+    ctl.step(20)
+    assert np.array_equal(raw(ctl), start)  # nothing moved: no step, no motion
+
+
+def test_frames_that_do_not_join_are_refused():
+    # MPI 000, MEIMotionFrame: each frame runs on from where the one before it ends; a gap between two
+    # frames of an axis is a step of the command in the middle of the move (docs/paths.md, "FRAME moves")
+    ctl, ms = new_supervisor()
+    place(ctl)
+    per_axis = [chain(START_USER[k], 0.0, 0.0, pieces) for k, pieces in enumerate(_frame_pieces())]
+    second = per_axis[1][1]
+    per_axis[1][1] = Segment(second.duration, second.p + 1.0, second.v, second.a, second.j)
+    outcome, _ = ms.command(T.FRAME, A.NONE, MotionParams(frames=_frames_of(per_axis)), False)
+    assert outcome.message is M.MPIMotionMessagePATH_ERROR
+    assert "axis 1" in outcome.detail
+    assert "frame 1" in outcome.detail
+
+
+def test_appended_frames_begin_where_the_frames_before_them_end():
+    # MPI 000, MPIMotionAttrMaskAPPEND (FRAME: APPEND and ID only) and MEIMotionFrame: appended frames run
+    # on from the end state of the frames loaded before them; ones that do not are refused, nothing changes
+    ctl, ms = new_supervisor()
+    place(ctl)
+    per_axis = [chain(START_USER[k], 0.0, 0.0, pieces) for k, pieces in enumerate(_frame_pieces())]
+    assert ms.start(T.FRAME, A.NONE, MotionParams(frames=_frames_of(per_axis), final=False, empty_count=0)).ok
+    ctl.step(10)
+    ends = [segs[-1].end_state() for segs in per_axis]
+    apart = [[Segment(0.01, p + 1.0, v, a, 0.0)] for p, v, a in ends]  # one count past where they end
+    refused, _ = ms.command(T.FRAME, A.APPEND, MotionParams(frames=_frames_of(apart)), False)
+    assert refused.message is M.MPIMotionMessagePATH_ERROR
+    joined = [[Segment(0.01, p, v, a, 0.0)] for p, v, a in ends]
+    assert ms.command(T.FRAME, A.APPEND, MotionParams(frames=_frames_of(joined)), False)[0].ok
+    run_idle(ctl, ms)
+    assert ctl.move_log.recent(ms.number)[-1].message is M.MPIMessageOK
+
+
 # ------------------------------------------------------------------ 3. batching ----
 def _batching_script():
     """(sample, command) of a streamed PVT path: appends by start and modify, outputs, element
@@ -861,7 +927,8 @@ def _running(kind):
     """A long closed path of ``kind`` (or FRAME moves) in progress: 40 points, 2 s."""
     def setup(ctl, ms):
         if kind is T.FRAME:
-            frames = [UserFrame(0.0, 100.0, 0.0, 0.0, 2.0), UserFrame(0.0, -50.0, 0.0, 0.0, 2.0)]
+            # from rest where the axes are (user 0), accelerating: a FRAME move may not step the command
+            frames = [UserFrame(0.0, 0.0, 100.0, 0.0, 2.0), UserFrame(0.0, 0.0, -50.0, 0.0, 2.0)]
             assert ms.start(T.FRAME, A.NONE, MotionParams(frames=frames)).ok
         else:
             t = np.arange(1.0, 41.0)
