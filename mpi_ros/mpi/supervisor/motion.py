@@ -25,7 +25,7 @@ from mpi_ros.mpi.axes.axis import Axis
 from mpi_ros.mpi.axes.status import StretchStatus
 from mpi_ros.mpi.axes.trace import Stretch
 from mpi_ros.mpi.base.clock import ProfileClock
-from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.events import EventNotify, MPIEventType
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
 from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome, Refused
 from mpi_ros.mpi.base.params import AxisMaster, MotionConfig, MotionParams, check_position
@@ -90,12 +90,23 @@ class MotionSupervisor:
         self._transitions = Transitions(host, self._state, self._moves, self._actions)
         self.stored_params = MotionParams()
         self.stored_type = MPIMotionType.INVALID
-        self.notify_mask = host.config.event_notify
-        self.latched = MPIEventType.NONE
+        self.events = EventNotify(host.config.event_notify)  # (the Axis object has one too)
         self.log: MotionLog | None = None
         self.action_callback: ActionCallback | None = None
 
     # ================================================================= queries ====
+    @property
+    def notify_mask(self) -> MPIEventType:
+        return self.events.mask
+
+    @property
+    def latched(self) -> MPIEventType:
+        return self.events.latched
+
+    @latched.setter
+    def latched(self, latched: MPIEventType) -> None:
+        self.events.latched = latched
+
     @property
     def config(self) -> MotionConfig:
         return self._state.config
@@ -384,14 +395,14 @@ class MotionSupervisor:
             remapped = self._moves.remap()
             if not remapped.ok:
                 return remapped.message
-        self.notify_mask = MPIEventType(mask)
+        self.events.notify_set(mask)
         return OK
 
     def event_reset(self, mask: MPIEventType) -> Message:
         """mpiMotionEventReset: clear latched events."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
-        self.latched &= ~MPIEventType(mask)
+        self.events.reset(mask)
         return OK
 
     def frame_buffer_status(self) -> tuple[Message, list[FrameBufferStatus]]:
@@ -492,6 +503,10 @@ class MotionSupervisor:
         self._notify_action(motion_type, "MODIFY" if modify else "START")
         if not self._axis_list.listed:
             return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes")
+        disabled = [n for n in self._axis_list.listed if not self._host.axes[n].enabled]
+        if disabled:  # MPI 000, MPIMessageOBJECT_NOT_ENABLED: "axis is not an enabled axis"
+            return Outcome(Message.MPIMessageOBJECT_NOT_ENABLED,
+                           f"axis {disabled[0]} is not enabled (its amplifier is off): enable it first")
         bits = int(attrs)
         append = bool(bits & _APPEND)
         verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21, append=append)
