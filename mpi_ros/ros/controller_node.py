@@ -42,12 +42,16 @@ from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.msg import AxisStatus, MotionEvent, SuiteConfiguration
 from mpi_ros.msg import Command as CommandMsg
 from mpi_ros.srv import (
+    AmpEnableSet,
     AxisConfigGet,
     AxisConfigSet,
     AxisFaultConfigGet,
     AxisFaultConfigSet,
     AxisFaultInject,
     AxisPositionSet,
+    EventNotifyGet,
+    EventNotifySet,
+    EventReset,
     GateGet,
     GateSet,
     IoGet,
@@ -121,6 +125,7 @@ class ControllerNode(Node):
                           lambda req, resp, k=k: self._on_fault_config_set(k, req, resp))
             self._service(AxisFaultInject, f"axis{k}/fault_inject",
                           lambda req, resp, k=k: self._on_fault_inject(k, req, resp))
+            self._axis_services(k)
         self._service(GateSet, "gate_set", self._on_gate_set)
         self._service(GateGet, "gate_get", self._on_gate_get)
         self._service(IoSet, "io_set", self._on_io_set)
@@ -149,6 +154,30 @@ class ControllerNode(Node):
 
     def _service(self, srv_type, name, callback):
         self.create_service(srv_type, name, callback, callback_group=self._service_group)
+
+    def _axis_services(self, k: int) -> None:
+        """Amplifier enable and the axis' events (MPI 002, "Event Methods"): the motion's srv types."""
+        self._service(AmpEnableSet, f"axis{k}/amp_enable_set", lambda req, resp, k=k: self._on_amp_enable(k, req, resp))
+        self._service(EventNotifyGet, f"axis{k}/event_notify_get", lambda req, resp, k=k: convert.event_mask_answer(
+            resp, *self.runner.read(lambda ctl: ctl.axis_event_notify_get(k))))
+        self._service(EventNotifySet, f"axis{k}/event_notify_set", lambda req, resp, k=k: convert.answer(
+            resp, self._submit_axis(Operation.AXIS_EVENT_NOTIFY_SET, k, {"event_types": list(req.event_types)})))
+        self._service(EventReset, f"axis{k}/event_reset", lambda req, resp, k=k: self._on_event_reset(k, req, resp))
+
+    def _submit_axis(self, operation: str, k: int, request: dict) -> Reply:
+        reply, _ = self.runner.submit(Command(operation, axis=k, request=request))
+        return reply
+
+    def _on_amp_enable(self, k: int, request, response):
+        reply = self._submit_axis(Operation.AXIS_AMP_ENABLE_SET, k, {"enable": request.enable})
+        response.detail = reply.detail
+        response.enabled = bool(reply.value)
+        return convert.answer(response, reply)
+
+    def _on_event_reset(self, k: int, request, response):
+        reply = self._submit_axis(Operation.AXIS_EVENT_RESET, k, {"event_types": list(request.event_types)})
+        response.latched_event_types = list(reply.value or [])
+        return convert.answer(response, reply)
 
     def publish_configuration(self, config, start_sample: int | None = None) -> SuiteConfiguration:
         """Publish (latched) the configuration the suite runs: ``config`` (a SuiteConfig), the

@@ -614,6 +614,31 @@ class MotionSupervisor:
             return Outcome(Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)")
         return VALID
 
+    def params_validate(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
+                        params: MotionParams | None = None, modify: bool = False) -> tuple[Outcome, int]:
+        """meiMotionParamsValidate (MPI 000): "validates the type-specific motion parameters
+        [...] using the coordinate system of motion", and the number of points they specify
+        (0 for a point-to-point move). The checks are a start's (a modify's, with ``modify``)
+        own: the handle, the axis count, the type, the attributes and the values against the
+        axes; whatever depends on the motion in progress (the state, a running type) is the
+        start's alone. Nothing changes (params None: the stored parameters)."""
+        if not self.valid:
+            return Outcome(Message.MPIMessageHANDLE_INVALID, "invalid motion handle"), 0
+        if not self._axis_list.listed:
+            return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes"), 0
+        params = self.stored_params if params is None else params
+        verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21,
+                                      append=MotionAttr.APPEND in attrs)
+        if verdict.ok:
+            verdict = self._check_request(motion_type, attrs, params, modify, append_to=False)
+        if motion_type in CAM_TYPES:
+            points = len(params.master_distance)  # (MPIMotionCam: pointCount segments)
+        elif motion_type in paths.STREAMED_TYPES:
+            points = paths.point_count(motion_type, params, len(self._axis_list.listed))
+        else:
+            points = 0
+        return verdict, points
+
     def _check_request(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
                        append_to: bool) -> Outcome:
         """The attributes and values of a start or modify (validate.py)."""

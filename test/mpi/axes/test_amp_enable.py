@@ -22,14 +22,16 @@ def test_a_start_on_a_disabled_axis_is_refused_and_changes_nothing(ctl, ms, para
     ctl.step(100)
     assert (ms.state, ctl.axis_snapshot(0).command_position, ctl.axis_snapshot(1).command_position) == before
     assert ms.current is None
-    assert not ctl.axis_snapshot(1).amp_enabled and ctl.axis_snapshot(0).amp_enabled
+    assert not ctl.axis_snapshot(1).amp_enabled
+    assert ctl.axis_snapshot(0).amp_enabled
 
 
 def test_a_modify_with_auto_start_on_a_disabled_axis_is_refused(ctl, ms, params):
     # MPI 000, mpiMotionModify with MPIMotionAttrMaskAUTO_START starts a motion: the same check
     assert ctl.axis_amp_enable_set(0, False).ok
     assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, params((1000.0, 0.0))) is NOT_ENABLED
-    assert ms.state is MPIState.IDLE and ms.current is None
+    assert ms.state is MPIState.IDLE
+    assert ms.current is None
 
 
 def test_enabled_again_the_axis_moves_from_where_the_motor_coasted_to(ctl, ms, params, run_to):
@@ -38,7 +40,8 @@ def test_enabled_again_the_axis_moves_from_where_the_motor_coasted_to(ctl, ms, p
     ctl.step(10)
     assert ctl.axis_amp_enable_set(0, True).ok
     snap = ctl.axis_snapshot(0)
-    assert snap.amp_enabled and snap.command_position == snap.actual_position == 37.0
+    assert snap.amp_enabled
+    assert snap.command_position == snap.actual_position == 37.0
     assert ms.start(T.TRAPEZOIDAL, params=params((500.0, 0.0))).ok
     run_to(ctl, ms, MPIState.IDLE, 20_000, chunk=50)
     assert ctl.axis_snapshot(0).command_position == 500.0
@@ -50,10 +53,12 @@ def test_disabling_a_moving_axis_aborts_its_motion(ctl, ms, params, run_to):
     ctl.step(400)
     ctl.drain_events()
     outcome = ctl.axis_amp_enable_set(1, False)
-    assert outcome.ok and "ABORT" in outcome.detail
+    assert outcome.ok
+    assert "ABORT" in outcome.detail
     run_to(ctl, ms, MPIState.ERROR, 10)
     assert [e.type for e in ctl.drain_events() if e.type is MPIEventType.ABORT] == [MPIEventType.ABORT]
-    assert not ctl.axis_snapshot(0).amp_enabled and not ctl.axis_snapshot(1).amp_enabled
+    assert not ctl.axis_snapshot(0).amp_enabled
+    assert not ctl.axis_snapshot(1).amp_enabled
 
 
 def test_reset_leaves_a_disabled_axis_off_and_its_starts_refused(ctl, ms, params, run_to):
@@ -63,7 +68,8 @@ def test_reset_leaves_a_disabled_axis_off_and_its_starts_refused(ctl, ms, params
     run_to(ctl, ms, MPIState.ERROR, 10)
     assert ms.action_detail(MPIAction.RESET).ok
     assert ms.state is MPIState.IDLE
-    assert ctl.axis_snapshot(0).amp_enabled and not ctl.axis_snapshot(1).amp_enabled
+    assert ctl.axis_snapshot(0).amp_enabled
+    assert not ctl.axis_snapshot(1).amp_enabled
     assert ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0))) is NOT_ENABLED
 
 
@@ -73,7 +79,8 @@ def test_enabling_in_error_waits_for_reset(ctl, ms, params, run_to):
     assert ctl.axis_amp_enable_set(1, False).ok
     run_to(ctl, ms, MPIState.ERROR, 10)
     outcome = ctl.axis_amp_enable_set(1, True)
-    assert outcome.ok and "RESET" in outcome.detail
+    assert outcome.ok
+    assert "RESET" in outcome.detail
     assert not ctl.axis_snapshot(1).amp_enabled  # the ABORT still holds it off
 
 

@@ -39,11 +39,15 @@ def test_axis_events_latch_on_the_axis_until_reset(ctl, ms, params, run_to):
     # MPI 002, mpiAxisEventReset ("Reset events specified in event mask"); motion events stay the Motion's
     _move(ctl, ms, params, run_to)
     latched = ctl.axes[0].events.latched
-    assert latched & E.SETTLED and latched & E.DONE and not latched & E.MOTION_DONE
+    assert latched & E.SETTLED
+    assert latched & E.DONE
+    assert not latched & E.MOTION_DONE
     assert ctl.axis_event_reset(0, E.SETTLED).ok
-    assert not ctl.axes[0].events.latched & E.SETTLED and ctl.axes[0].events.latched & E.DONE
+    assert not ctl.axes[0].events.latched & E.SETTLED
+    assert ctl.axes[0].events.latched & E.DONE
     assert ctl.axes[1].events.latched & E.SETTLED  # the other axis keeps its own
-    assert ctl.axis_event_reset(0, MASK_AXIS).ok and ctl.axes[0].events.latched == E.NONE
+    assert ctl.axis_event_reset(0, MASK_AXIS).ok
+    assert ctl.axes[0].events.latched == E.NONE
 
 
 def test_no_axis_mask_by_default_and_an_unknown_axis_is_refused(ctl):
