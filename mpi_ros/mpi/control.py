@@ -11,6 +11,7 @@ not depend on how the samples are batched.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections import deque
@@ -347,8 +348,21 @@ class Controller:
         verdict = self.axis_master_check(number, master)
         if not verdict.ok:
             return verdict.message
-        self.axes[number].master = master.copy()
+        motor = master.encoder_fault_motor_number
+        if motor is not None:  # its home is the fault configuration (AxisMaster's docstring)
+            faults = self.faults.axes[number].config.copy()
+            faults.encoder_fault_motor_number = motor
+            verdict = self.faults.config_set(number, faults)  # (trips if that encoder faults now)
+            if not verdict.ok:
+                return verdict.message
+        self.axes[number].master = dataclasses.replace(master, encoder_fault_motor_number=None)
         return Message.MPIMessageOK
+
+    def axis_master_get(self, number: int) -> AxisMaster:
+        """mpiAxisConfigGet's master (MPIAxisMaster, with masterCorrection), encoderFaultMotorNumber
+        included."""
+        motor = self.faults.axes[number].config.encoder_fault_motor_number
+        return dataclasses.replace(self.axes[number].master, encoder_fault_motor_number=motor)
 
     def secondary_feedback_set(self, motor: int, feedback: SecondaryFeedback) -> Message:
         """Drive a motor's secondary feedback input (MOTOR_FEEDBACK_SECONDARY masters): from the

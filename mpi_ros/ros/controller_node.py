@@ -281,7 +281,7 @@ class ControllerNode(Node):
 
     # -- services -------------------------------------------------------------------------
     def _on_config_get(self, k: int, response):
-        cfg, master = self.runner.read(lambda ctl: (ctl.axes[k].in_position.copy(), ctl.axes[k].master.copy()))
+        cfg, master = self.runner.read(lambda ctl: (ctl.axes[k].in_position.copy(), ctl.axis_master_get(k)))
         convert.fill(response.in_position, rq.in_position_to_dict(cfg))
         convert.fill(response.master, rq.axis_master_to_dict(master))
         response.master_correction = master.correction
