@@ -58,5 +58,6 @@ def test_the_axis_config_command_carries_it(ctl):
     reply = apply(ctl, Command("axis_config_set", axis=3, request={"master": {"encoder_fault_motor_number": -1}}))
     assert reply.message.ok
     assert ctl.axis_master_get(3).encoder_fault_motor_number == -1
-    assert apply(ctl, Command("axis_config_set", axis=3, request={"master": {"encoder_fault_motor_number": -2}})).message.ok
+    keep = Command("axis_config_set", axis=3, request={"master": {"encoder_fault_motor_number": -2}})
+    assert apply(ctl, keep).message.ok
     assert ctl.axis_master_get(3).encoder_fault_motor_number == -1
