@@ -262,6 +262,8 @@ class ControllerNode(Node):
         status.hardware_id = "mpi_ros simulated controller"
         if snap.faults:
             level, message = DiagnosticStatus.ERROR, f"fault {', '.join(snap.faults)}: RESET once cleared"
+        elif not snap.amp_enabled and not axis.enabled:  # the host's choice (amp_enable_set), not a failure
+            level, message = DiagnosticStatus.WARN, "amplifier disabled by amp_enable_set: enable it to move"
         elif not snap.amp_enabled:
             level, message = DiagnosticStatus.ERROR, "amplifier disabled (ABORT): RESET to enable"
         elif abs(snap.position_error) > axis.in_position.position_coarse:

@@ -6,6 +6,9 @@ MPIAxisMaster.encoderFaultMotorNumber in /mpi/axis<k>/config_get and config_set.
 
 from __future__ import annotations
 
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
 from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.msg import AxisStatus, MotionEvent
 from mpi_ros.msg import MotionParams as MotionParamsMsg
@@ -22,6 +25,15 @@ from mpi_ros.srv import (
 
 from .test_controller_node import Collector
 
+
+@pytest.fixture
+def suite_config():
+    """/diagnostics at 50 Hz of controller time, so a few hundred samples show a change there."""
+    from mpi_ros import config
+
+    return config.load(overrides={"ros": {"diagnostics_rate": 50.0}})
+
+
 MOVE = {"type": "TRAPEZOIDAL", "position": [400.0, 200.0],
         "trajectory": [{"velocity": 4000.0, "acceleration": 40_000.0, "deceleration": 40_000.0}]}
 
@@ -34,6 +46,8 @@ def test_a_disabled_axis_refuses_a_start_and_shows_its_amplifier_off(suite, clie
     drive(lambda: goal.done)
     assert goal.wait(raise_on_error=False).message == "MPIMessageOBJECT_NOT_ENABLED"
     drive(lambda: bool(status.messages) and not status.messages[-1].amp_enabled, samples=2_000)
+    diagnostics = Collector(probe, DiagnosticArray, "/diagnostics")
+    drive(lambda: any(_says_disabled(a) for a in diagnostics.messages), samples=2_000)
     assert suite.runner.read(lambda ctl: ctl.axis_snapshot(0).command_position) == 0.0  # nothing moved
     answer = service(probe, AmpEnableSet, "/mpi/axis1/amp_enable_set", AmpEnableSet.Request(enable=True))
     assert (answer.message, answer.enabled) == ("MPIMessageOK", True)
@@ -104,3 +118,9 @@ def test_the_axis_master_carries_the_encoder_fault_motor(suite, probe, service):
     assert service(probe, AxisConfigSet, "/mpi/axis2/config_set", request).message == "MPIMessagePARAM_INVALID"
     assert service(probe, AxisConfigGet, "/mpi/axis2/config_get",
                    AxisConfigGet.Request()).master.encoder_fault_motor_number == 0
+
+
+def _says_disabled(array: DiagnosticArray) -> bool:
+    """/diagnostics shows axis 1 disabled by the host: a warning that names the service, not an ABORT."""
+    entry = next((s for s in array.status if s.name == "mpi/axis1"), None)
+    return entry is not None and entry.level == DiagnosticStatus.WARN and "amp_enable_set" in entry.message
