@@ -86,3 +86,10 @@ def test_enabling_in_error_waits_for_reset(ctl, ms, params, run_to):
 
 def test_an_unknown_axis_is_refused(ctl):
     assert ctl.axis_amp_enable_set(9, False).message is Message.MPIAxisMessageAXIS_INVALID
+
+
+def test_a_disabled_axis_cannot_be_appended(ctl, ms):
+    # MPI 000, mpiMotionAxisAppend: MPIMessageOBJECT_NOT_ENABLED "axis is not an enabled axis"
+    assert ctl.axis_amp_enable_set(3, False).ok
+    assert ms.axis_append(3) is NOT_ENABLED
+    assert ms.axis_list == [0, 1]
