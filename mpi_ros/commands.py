@@ -62,6 +62,9 @@ class Operation(StrEnum):
     AXIS_FAULT_INJECT = "axis_fault_inject"
     AXIS_CREATE = "axis_create"
     AXIS_DELETE = "axis_delete"
+    AXIS_AMP_ENABLE_SET = "axis_amp_enable_set"
+    AXIS_EVENT_NOTIFY_SET = "axis_event_notify_set"
+    AXIS_EVENT_RESET = "axis_event_reset"
 
 
 # The reference has no "internal error" message; of its generic messages, NO_MEMORY ("not
@@ -260,14 +263,27 @@ def _position_set(ctl: Controller, command: Command) -> Reply:
 
 
 def _event_notify_set(ctl: Controller, command: Command) -> Reply:
-    ms = _supervisor(ctl, command)
-    return Reply.of(ms.event_notify_set(rq.event_mask(command.request.get("event_types"), "event_types")))
+    """mpiMotionEventNotifySet, or mpiAxisEventNotifySet for an axis' command."""
+    mask = rq.event_mask(command.request.get("event_types"), "event_types")
+    if command.operation == Operation.AXIS_EVENT_NOTIFY_SET:
+        return Reply.of(ctl.axis_event_notify_set(command.axis, mask))
+    return Reply.of(_supervisor(ctl, command).event_notify_set(mask))
 
 
 def _event_reset(ctl: Controller, command: Command) -> Reply:
+    """mpiMotionEventReset, or mpiAxisEventReset for an axis' command; the events still latched."""
+    mask = rq.event_mask(command.request.get("event_types"), "event_types")
+    if command.operation == Operation.AXIS_EVENT_RESET:
+        message = ctl.axis_event_reset(command.axis, mask)
+        return Reply.of(message, value=ctl.axes[command.axis].events.latched.names() if message.ok else [])
     ms = _supervisor(ctl, command)
-    message = ms.event_reset(rq.event_mask(command.request.get("event_types"), "event_types"))
-    return Reply.of(message, value=ms.latched.names())
+    return Reply.of(ms.event_reset(mask), value=ms.latched.names())
+
+
+def _axis_amp_enable_set(ctl: Controller, command: Command) -> Reply:
+    """The amplifier enable of an axis (docs/decisions.md, "Amplifier enable")."""
+    outcome = ctl.axis_amp_enable_set(command.axis, rq.boolean(command.request.get("enable", True), "enable"))
+    return Reply(outcome, value=ctl.axes[command.axis].enabled if outcome.ok else None)
 
 
 def _gate_set(ctl: Controller, command: Command) -> Reply:
@@ -378,6 +394,9 @@ OPERATIONS: dict[str, Callable[[Controller, Command], Reply]] = {  # by Operatio
     Operation.AXIS_FAULT_INJECT: _axis_fault_inject,
     Operation.AXIS_CREATE: _axis_create,
     Operation.AXIS_DELETE: _axis_delete,
+    Operation.AXIS_AMP_ENABLE_SET: _axis_amp_enable_set,
+    Operation.AXIS_EVENT_NOTIFY_SET: _event_notify_set,
+    Operation.AXIS_EVENT_RESET: _event_reset,
 }
 
 

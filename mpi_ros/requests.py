@@ -404,7 +404,8 @@ def in_position_to_dict(cfg: AxisInPosition) -> dict[str, Any]:
     return {key: getattr(cfg, key) for key in cfg.__slots__}
 
 
-_MASTER_FIELDS = frozenset({"type", "number", "address"})
+KEEP_MOTOR = -2  # AxisMaster.msg's encoder_fault_motor_number default: keep the current one
+_MASTER_FIELDS = frozenset({"type", "number", "address", "encoder_fault_motor_number"})
 
 
 def axis_master(data: Any, correction: Any, current: AxisMaster) -> AxisMaster:
@@ -425,6 +426,8 @@ def axis_master(data: Any, correction: Any, current: AxisMaster) -> AxisMaster:
                                        "ADDRESS)")
             master.number = integer(data.get("number", 0), "master.number")
             master.address = integer(data.get("address", 0), "master.address")
+        motor = integer(data.get("encoder_fault_motor_number", KEEP_MOTOR), "master.encoder_fault_motor_number")
+        master.encoder_fault_motor_number = None if motor == KEEP_MOTOR else motor
     if correction is not None:
         master.correction = integer(correction, "master_correction")
     return master
@@ -432,7 +435,9 @@ def axis_master(data: Any, correction: Any, current: AxisMaster) -> AxisMaster:
 
 def axis_master_to_dict(master: AxisMaster) -> dict[str, Any]:
     """The AxisMaster message's fields (master_correction is a field of the service beside it)."""
-    return {"type": master.type.name, "number": master.number, "address": master.address}
+    motor = master.encoder_fault_motor_number
+    return {"type": master.type.name, "number": master.number, "address": master.address,
+            "encoder_fault_motor_number": KEEP_MOTOR if motor is None else motor}
 
 
 def secondary_feedback(data: Any) -> tuple[int, SecondaryFeedback]:

@@ -11,6 +11,7 @@ not depend on how the samples are batched.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections import deque
@@ -38,7 +39,7 @@ from mpi_ros.mpi.axes.status import (
 from mpi_ros.mpi.axes.stretch import Stretch
 from mpi_ros.mpi.axes.trace import trace
 from mpi_ros.mpi.base.clock import ProfileClock
-from mpi_ros.mpi.base.events import Event, MPIEventType
+from mpi_ros.mpi.base.events import MASK_AXIS, Event, MPIEventType
 from mpi_ros.mpi.base.io import IoImage
 from mpi_ros.mpi.base.masters import SecondaryInputs, Sources
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
@@ -330,6 +331,46 @@ class Controller:
             return Message.MPIAxisMessageAXIS_INVALID
         return self.axes[number].set_origin(origin)
 
+    def axis_amp_enable_set(self, number: int, enabled: bool) -> Outcome:
+        """The amplifier enable of an axis' motor (MPI 000, MPIMessageOBJECT_NOT_ENABLED).
+        Disabling an axis that a motion moves, or keeps STOPPED, ABORTs that motion first
+        (docs/decisions.md, "Amplifier enable")."""
+        if not 0 <= number < len(self.axes):
+            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"no axis {number}")
+        axis = self.axes[number]
+        state = self.own_state_of(axis.owner) if axis.owner >= 0 else None
+        detail = "amplifier enabled" if enabled else "amplifier disabled: the motor coasts"
+        if not enabled and state not in (None, MPIState.IDLE, MPIState.ERROR):
+            self.act_on(axis.owner, MPIAction.ABORT, ActionSource.USER)
+            detail += f"; the motion of supervisor {axis.owner} was ABORTed"
+            state = self.own_state_of(axis.owner)
+        elif enabled and state in (MPIState.STOPPING_ERROR, MPIState.ERROR) and not axis.amp_enabled:
+            detail = f"enabled: RESET of supervisor {axis.owner} turns the amplifier on"
+        axis.amp_enable_set(enabled, self.time, self.clock_of(axis.owner) if axis.owner >= 0 else None,
+                            servo=state not in (MPIState.STOPPING_ERROR, MPIState.ERROR))
+        return Outcome(Message.MPIMessageOK, detail)
+
+    def axis_event_notify_get(self, number: int) -> tuple[Message, MPIEventType]:
+        """mpiAxisEventNotifyGet (MPI 002)."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID, MPIEventType.NONE
+        return Message.MPIMessageOK, self.axes[number].events.mask
+
+    def axis_event_notify_set(self, number: int, mask: MPIEventType) -> Message:
+        """mpiAxisEventNotifySet (MPI 002): the events an axis generates (MPIEventMaskAXIS) are
+        notified when its mask or a mapped supervisor's asks for them (once, not twice)."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID
+        self.axes[number].events.notify_set(mask)
+        return Message.MPIMessageOK
+
+    def axis_event_reset(self, number: int, mask: MPIEventType) -> Message:
+        """mpiAxisEventReset (MPI 002): clear the axis' latched events in ``mask``."""
+        if not 0 <= number < len(self.axes):
+            return Message.MPIAxisMessageAXIS_INVALID
+        self.axes[number].events.reset(mask)
+        return Message.MPIMessageOK
+
     def axis_in_position_set(self, number: int, in_position: AxisInPosition) -> Message:
         """mpiAxisConfigSet (inPosition), checked by the one AxisInPosition validator (the
         YAML loader and the service use it too) and against the axis' encoder."""
@@ -356,8 +397,21 @@ class Controller:
         verdict = self.axis_master_check(number, master)
         if not verdict.ok:
             return verdict.message
-        self.axes[number].master = master.copy()
+        motor = master.encoder_fault_motor_number
+        if motor is not None:  # its home is the fault configuration (AxisMaster's docstring)
+            faults = self.faults.axes[number].config.copy()
+            faults.encoder_fault_motor_number = motor
+            verdict = self.faults.config_set(number, faults)  # (trips if that encoder faults now)
+            if not verdict.ok:
+                return verdict.message
+        self.axes[number].master = dataclasses.replace(master, encoder_fault_motor_number=None)
         return Message.MPIMessageOK
+
+    def axis_master_get(self, number: int) -> AxisMaster:
+        """mpiAxisConfigGet's master (MPIAxisMaster, with masterCorrection), encoderFaultMotorNumber
+        included."""
+        motor = self.faults.axes[number].config.encoder_fault_motor_number
+        return dataclasses.replace(self.axes[number].master, encoder_fault_motor_number=motor)
 
     def secondary_feedback_set(self, motor: int, feedback: SecondaryFeedback) -> Message:
         """Drive a motor's secondary feedback input (MOTOR_FEEDBACK_SECONDARY masters): from the
@@ -521,11 +575,15 @@ class Controller:
         """Latch the event on every supervisor it concerns and notify those that asked."""
         sample = self.sample if sample is None else sample
         targets = self._event_targets(supervisor, axis)
+        delivered = False
         for ms in targets:
             ms.latched |= kind
             if kind & (ms.notify_mask | (extra_mask if ms.number == supervisor else MPIEventType.NONE)):
                 self._deliver(Event(sample, kind, ms.number, axis, move_id, element_id, detail))
-        if not targets:
+                delivered = True
+        # the axis' own mask (mpiAxisEventNotifySet) asks for what its supervisors' did not
+        wanted = bool(kind & MASK_AXIS) and 0 <= axis < len(self.axes) and self.axes[axis].events.latch(kind)
+        if not targets or (wanted and not delivered):
             self._deliver(Event(sample, kind, supervisor, axis, move_id, element_id, detail))
 
     def _event_targets(self, supervisor: int, axis: int) -> list[MotionSupervisor]:

@@ -46,6 +46,7 @@ from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.msg import AxisStatus, MotionEvent, SuiteConfiguration
 from mpi_ros.msg import Command as CommandMsg
 from mpi_ros.srv import (
+    AmpEnableSet,
     AxisConfigGet,
     AxisConfigSet,
     AxisCreate,
@@ -57,6 +58,9 @@ from mpi_ros.srv import (
     AxisFlashConfigSet,
     AxisPositionSet,
     AxisValidate,
+    EventNotifyGet,
+    EventNotifySet,
+    EventReset,
     GateGet,
     GateSet,
     IoGet,
@@ -191,6 +195,7 @@ class ControllerNode(Node):
                           lambda req, resp: self._on_axis_flash_get(k, resp)),
             self._service(AxisFlashConfigSet, f"axis{k}/flash_config_set",
                           lambda req, resp: self._on_axis_flash_set(k, req, resp)),
+            *self._axis_event_services(k),
         ]
 
     def _sync_axes(self, valid: tuple[int, ...]) -> None:
@@ -227,6 +232,32 @@ class ControllerNode(Node):
         outcome = self.runner.read(lambda ctl: ctl.axis_validate(request.number))
         response.detail = outcome.detail
         return convert.answer(response, Reply(outcome))
+
+    def _axis_event_services(self, k: int) -> list:
+        """Amplifier enable and the axis' events (MPI 002, "Event Methods"): the motion's srv types."""
+        return [
+            self._service(AmpEnableSet, f"axis{k}/amp_enable_set", lambda req, resp: self._on_amp_enable(k, req, resp)),
+            self._service(EventNotifyGet, f"axis{k}/event_notify_get", lambda req, resp: convert.event_mask_answer(
+                resp, *self.runner.read(lambda ctl: ctl.axis_event_notify_get(k)))),
+            self._service(EventNotifySet, f"axis{k}/event_notify_set", lambda req, resp: convert.answer(
+                resp, self._submit_axis(Operation.AXIS_EVENT_NOTIFY_SET, k, {"event_types": list(req.event_types)}))),
+            self._service(EventReset, f"axis{k}/event_reset", lambda req, resp: self._on_event_reset(k, req, resp)),
+        ]
+
+    def _submit_axis(self, operation: str, k: int, request: dict) -> Reply:
+        reply, _ = self.runner.submit(Command(operation, axis=k, request=request))
+        return reply
+
+    def _on_amp_enable(self, k: int, request, response):
+        reply = self._submit_axis(Operation.AXIS_AMP_ENABLE_SET, k, {"enable": request.enable})
+        response.detail = reply.detail
+        response.enabled = bool(reply.value)
+        return convert.answer(response, reply)
+
+    def _on_event_reset(self, k: int, request, response):
+        reply = self._submit_axis(Operation.AXIS_EVENT_RESET, k, {"event_types": list(request.event_types)})
+        response.latched_event_types = list(reply.value or [])
+        return convert.answer(response, reply)
 
     def publish_configuration(self, config, start_sample: int | None = None) -> SuiteConfiguration:
         """Publish (latched) the configuration the suite runs: ``config`` (a SuiteConfig), the
@@ -331,6 +362,8 @@ class ControllerNode(Node):
         status.hardware_id = "mpi_ros simulated controller"
         if snap.faults:
             level, message = DiagnosticStatus.ERROR, f"fault {', '.join(snap.faults)}: RESET once cleared"
+        elif not snap.amp_enabled and not axis.enabled:  # the host's choice (amp_enable_set), not a failure
+            level, message = DiagnosticStatus.WARN, "amplifier disabled by amp_enable_set: enable it to move"
         elif not snap.amp_enabled:
             level, message = DiagnosticStatus.ERROR, "amplifier disabled (ABORT): RESET to enable"
         elif abs(snap.position_error) > axis.in_position.position_coarse:
@@ -350,7 +383,7 @@ class ControllerNode(Node):
 
     # -- services -------------------------------------------------------------------------
     def _on_config_get(self, k: int, response):
-        cfg, master = self.runner.read(lambda ctl: (ctl.axes[k].in_position.copy(), ctl.axes[k].master.copy()))
+        cfg, master = self.runner.read(lambda ctl: (ctl.axes[k].in_position.copy(), ctl.axis_master_get(k)))
         convert.fill(response.in_position, rq.in_position_to_dict(cfg))
         convert.fill(response.master, rq.axis_master_to_dict(master))
         response.master_correction = master.correction

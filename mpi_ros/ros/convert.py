@@ -172,6 +172,14 @@ def answer(response, reply):
     return response
 
 
+def event_mask_answer(response, message, mask):
+    """An EventNotifyGet response (mpiMotionEventNotifyGet and mpiAxisEventNotifyGet alike)."""
+    response.event_types = mask.names()
+    response.message = message.name
+    response.code = message.code
+    return response
+
+
 _default_epoch_ns = 0  # the epoch of the suite anchored last in this process
 _EPOCHS: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()
 

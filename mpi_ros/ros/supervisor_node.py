@@ -34,7 +34,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from mpi_ros.action import MotionModify, MotionStart
 from mpi_ros.mpi.base.messages import Message
-from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
+from mpi_ros.mpi.base.outcome import MoveEnd, Outcome, Refused
 from mpi_ros.mpi.base.snapshot import MotionFeedback
 from mpi_ros.mpi.control import Controller
 from mpi_ros.msg import FrameBufferStatus as FrameBufferStatusMsg
@@ -53,6 +53,7 @@ from mpi_ros.srv import (
     MotionConfigSet,
     MotionParamsGet,
     MotionParamsSet,
+    MotionParamsValidate,
     PositionGet,
     PositionSet,
 )
@@ -140,6 +141,7 @@ class SupervisorNode(Node):
         self._service(EventNotifyGet, "event_notify_get", self._on_event_notify_get)
         self._service(EventNotifySet, "event_notify_set", self._on_event_notify_set)
         self._service(EventReset, "event_reset", self._on_event_reset)
+        self._service(MotionParamsValidate, "params_validate", self._on_params_validate)
         self._pub_status = self.create_publisher(MotionStatus, "~/status", STATUS_QOS)
         runner.add_periodic(settings.status_rate, self._collect_status)
         runner.add_periodic(settings.feedback_rate, self._collect_feedback)
@@ -466,12 +468,24 @@ class SupervisorNode(Node):
         return convert.answer(response, Reply.of(message))
 
     def _on_event_notify_get(self, _request, response):
-        message, mask = self._read_ms(lambda ms: ms.event_notify_get())
-        response.event_types = mask.names()
-        return convert.answer(response, Reply.of(message))
+        return convert.event_mask_answer(response, *self._read_ms(lambda ms: ms.event_notify_get()))
 
     def _on_event_notify_set(self, request, response):
         return convert.answer(response, self._submit("event_notify_set", {"event_types": list(request.event_types)}))
+
+    def _on_params_validate(self, request, response):
+        """meiMotionParamsValidate: read-only (nothing to record), answered under the lock."""
+        try:
+            motion = rq.motion_request({"type": request.type, "attributes": list(request.attributes),
+                                        **convert.to_dict(request.params)})
+        except Refused as exc:
+            response.detail = exc.detail
+            return convert.answer(response, Reply.of(exc.message))
+        outcome, points = self._read_ms(
+            lambda ms: ms.params_validate(motion.type, motion.attributes, motion.params, request.modify))
+        response.points = points
+        response.detail = outcome.detail
+        return convert.answer(response, Reply(outcome))
 
     def _on_event_reset(self, request, response):
         reply = self._submit("event_reset", {"event_types": list(request.event_types)})

@@ -31,6 +31,7 @@ from mpi_ros.mpi.axes.plant import Forced, Plant, PlantState, compose, servo_eff
 from mpi_ros.mpi.axes.status import AxisStatusBits, StatusMode, bits_of, column_of
 from mpi_ros.mpi.base import masters
 from mpi_ros.mpi.base.clock import ProfileClock
+from mpi_ros.mpi.base.events import EventNotify
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.params import AxisInPosition, AxisMaster, PlantConfig, check_position
 from mpi_ros.mpi.base.types import MPIState
@@ -164,7 +165,8 @@ class Axis:
         self.master = AxisMaster()  # MPIAxisConfig.master and masterCorrection (cams)
         self.plant = Plant(plant)
         self.origin = 0.0
-        self.enabled = True  # an enabled axis (MPIMessageOBJECT_NOT_ENABLED otherwise)
+        self.enabled = True  # the amplifier enable the host set (amp_enable_set; OBJECT_NOT_ENABLED when off)
+        self.events = EventNotify()  # mpiAxisEventNotifySet/Reset: no host notification until asked
         self.plan = None
         self.tau_start = 0.0
         self.rest = 0.0
@@ -714,6 +716,18 @@ class Axis:
         self.cmd_v = self.cmd_a = 0.0
         self.target = self.rest
         self.mode = CommandMode.SERVO
+
+    def amp_enable_set(self, enabled: bool, t: float, clock: ProfileClock | None, servo: bool) -> None:
+        """The host's amplifier enable (a motion that moves the axis is ABORTed first:
+        Controller.axis_amp_enable_set). Off: the amplifier goes off and the motor coasts, as
+        after an ABORT. On, with ``servo``: the amplifier is back on with the command at the
+        actual position (the motor may have moved while it coasted); without (the axis'
+        supervisor is in ERROR) RESET turns it on, as after any ABORT."""
+        self.enabled = bool(enabled)
+        if not enabled and self.amp_enabled:
+            self.disable(t, clock)
+        elif enabled and servo and not self.amp_enabled:
+            self.enable(t, command_equals_actual=True)
 
     def follow_actual(self, t: float, clock: ProfileClock | None) -> None:
         self.rebase(t, clock)

@@ -137,3 +137,28 @@ class Event:
     @property
     def type_name(self) -> str:
         return self.type.name or "NONE"
+
+
+@dataclass(slots=True)
+class EventNotify:
+    """The event mask and latched events of one object, a Motion or an Axis: the one
+    implementation of mpiMotionEventNotifyGet/Set and mpiMotionEventReset (MPI 000) and of
+    mpiAxisEventNotifyGet/Set and mpiAxisEventReset (MPI 002, "Event Methods"). ``mask``: the
+    event types whose host notification was requested; ``latched``: what happened since the
+    last reset."""
+
+    mask: MPIEventType = MPIEventType.NONE
+    latched: MPIEventType = MPIEventType.NONE
+
+    def notify_set(self, mask: MPIEventType) -> None:
+        """Notification is enabled for the types in ``mask`` and disabled for the others."""
+        self.mask = MPIEventType(mask)
+
+    def reset(self, mask: MPIEventType) -> None:
+        """The latched events in ``mask`` are cleared."""
+        self.latched &= ~MPIEventType(mask)
+
+    def latch(self, kind: MPIEventType) -> bool:
+        """``kind`` happened: latched; True if its notification was requested."""
+        self.latched |= kind
+        return bool(kind & self.mask)

@@ -447,12 +447,17 @@ class AxisMaster:
     cam on this axis follows comes from. ``number`` is the motor (MOTOR_FEEDBACK_*) or the axis
     (AXIS_*), ``address`` the I/O word (ADDRESS); the other one is "Not used" (MPI 002,
     MPIAxisMaster) and not checked. ``correction``: the axis whose command position is added
-    to the master position (masterCorrection; -1: none, docs/cams.md)."""
+    to the master position (masterCorrection; -1: none, docs/cams.md).
+    ``encoder_fault_motor_number``: MPIAxisMaster.encoderFaultMotorNumber, the motor whose
+    encoder fault aborts this axis (-1: none). Its one home is the axis' fault configuration
+    (AxisFaultConfig, which the fault monitor acts on): the controller fills it in on a get,
+    and on a set None keeps the current value (docs/decisions.md, "encoderFaultMotorNumber")."""
 
     type: AxisMasterType = AxisMasterType.AXIS_COMMANDED_POSITION
     number: int = 0
     address: int = 0
     correction: int = -1
+    encoder_fault_motor_number: int | None = None
 
     def copy(self) -> AxisMaster:
         return copy.deepcopy(self)
@@ -472,6 +477,8 @@ class AxisMaster:
         return first_refusal((
             check_integer(name, value, 0, count - 1),
             check_integer("correction", self.correction, -1, axes - 1),
+            (VALID if self.encoder_fault_motor_number is None
+             else check_integer("encoder_fault_motor_number", self.encoder_fault_motor_number, -1, motors - 1)),
         ))
 
 

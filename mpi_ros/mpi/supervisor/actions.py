@@ -225,7 +225,8 @@ class Actions:
         for axis in self._moves.axes:
             if axis.owner == self._state.number or axis.owner == -1:
                 axis.unload(t, self._moves.clock_of(axis))
-                if not axis.amp_enabled or axis.mode is CommandMode.FOLLOW_ACTUAL:
+                if axis.enabled and (not axis.amp_enabled or axis.mode is CommandMode.FOLLOW_ACTUAL):
+                    # (an axis the host disabled stays off: Controller.axis_amp_enable_set)
                     # after an ABORT or an amplifier fault the motor coasted: the command is set to the actual
                     axis.enable(t, command_equals_actual=self._state.aborted or axis.mode is CommandMode.FOLLOW_ACTUAL
                                 or axis.number in amp_faulted)

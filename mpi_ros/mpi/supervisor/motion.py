@@ -25,7 +25,7 @@ from mpi_ros.mpi.axes.axis import Axis
 from mpi_ros.mpi.axes.status import StretchStatus
 from mpi_ros.mpi.axes.trace import Stretch
 from mpi_ros.mpi.base.clock import ProfileClock
-from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.base.events import EventNotify, MPIEventType
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
 from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome, Refused
 from mpi_ros.mpi.base.params import AxisMaster, MotionConfig, MotionParams, check_position
@@ -90,12 +90,23 @@ class MotionSupervisor:
         self._transitions = Transitions(host, self._state, self._moves, self._actions)
         self.stored_params = MotionParams()
         self.stored_type = MPIMotionType.INVALID
-        self.notify_mask = host.config.event_notify
-        self.latched = MPIEventType.NONE
+        self.events = EventNotify(host.config.event_notify)  # (the Axis object has one too)
         self.log: MotionLog | None = None
         self.action_callback: ActionCallback | None = None
 
     # ================================================================= queries ====
+    @property
+    def notify_mask(self) -> MPIEventType:
+        return self.events.mask
+
+    @property
+    def latched(self) -> MPIEventType:
+        return self.events.latched
+
+    @latched.setter
+    def latched(self, latched: MPIEventType) -> None:
+        self.events.latched = latched
+
     @property
     def config(self) -> MotionConfig:
         return self._state.config
@@ -384,14 +395,14 @@ class MotionSupervisor:
             remapped = self._moves.remap()
             if not remapped.ok:
                 return remapped.message
-        self.notify_mask = MPIEventType(mask)
+        self.events.notify_set(mask)
         return OK
 
     def event_reset(self, mask: MPIEventType) -> Message:
         """mpiMotionEventReset: clear latched events."""
         if not self.valid:
             return Message.MPIMessageHANDLE_INVALID
-        self.latched &= ~MPIEventType(mask)
+        self.events.reset(mask)
         return OK
 
     def frame_buffer_status(self) -> tuple[Message, list[FrameBufferStatus]]:
@@ -492,6 +503,10 @@ class MotionSupervisor:
         self._notify_action(motion_type, "MODIFY" if modify else "START")
         if not self._axis_list.listed:
             return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes")
+        disabled = [n for n in self._axis_list.listed if not self._host.axes[n].enabled]
+        if disabled:  # MPI 000, MPIMessageOBJECT_NOT_ENABLED: "axis is not an enabled axis"
+            return Outcome(Message.MPIMessageOBJECT_NOT_ENABLED,
+                           f"axis {disabled[0]} is not enabled (its amplifier is off): enable it first")
         bits = int(attrs)
         append = bool(bits & _APPEND)
         verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21, append=append)
@@ -598,6 +613,31 @@ class MotionSupervisor:
         if admitted.auto_start:
             return Outcome(Message.MPIMotionMessageAUTO_START, "modify started a new motion (AUTO_START)")
         return VALID
+
+    def params_validate(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
+                        params: MotionParams | None = None, modify: bool = False) -> tuple[Outcome, int]:
+        """meiMotionParamsValidate (MPI 000): "validates the type-specific motion parameters
+        [...] using the coordinate system of motion", and the number of points they specify
+        (0 for a point-to-point move). The checks are a start's (a modify's, with ``modify``)
+        own: the handle, the axis count, the type, the attributes and the values against the
+        axes; whatever depends on the motion in progress (the state, a running type) is the
+        start's alone. Nothing changes (params None: the stored parameters)."""
+        if not self.valid:
+            return Outcome(Message.MPIMessageHANDLE_INVALID, "invalid motion handle"), 0
+        if not self._axis_list.listed:
+            return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes"), 0
+        params = self.stored_params if params is None else params
+        verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21,
+                                      append=MotionAttr.APPEND in attrs)
+        if verdict.ok:
+            verdict = self._check_request(motion_type, attrs, params, modify, append_to=False)
+        if motion_type in CAM_TYPES:
+            points = len(params.master_distance)  # (MPIMotionCam: pointCount segments)
+        elif motion_type in paths.STREAMED_TYPES:
+            points = paths.point_count(motion_type, params, len(self._axis_list.listed))
+        else:
+            points = 0
+        return verdict, points
 
     def _check_request(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
                        append_to: bool) -> Outcome:
