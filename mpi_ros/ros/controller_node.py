@@ -31,7 +31,6 @@ from collections.abc import Sequence
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
@@ -55,26 +54,15 @@ from mpi_ros.srv import (
     MotorFeedbackSecondarySet,
 )
 
+from .. import graph_names as gn
 from .. import requests as rq
 from ..commands import Command, Operation, Reply, io_space
 from ..config import RosSettings
 from ..joints import AxisJoint, JointStates
+from ..qos import profile
 from ..runner import ControllerRunner
 from . import convert, snapshots, wire
-from .supervisor_node import STATUS_QOS
 
-# Events are never dropped in a burst by the publisher: reliable and deep. (A subscriber
-# keeps its own history: see the README's topic table for the QoS to echo them with.)
-EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
-COMMAND_HISTORY = 1000
-# Applied commands: reliable, deep, and kept for late joiners (a recorder started after the
-# first moves still gets them; a subscriber asking for volatile durability is matched too).
-COMMANDS_QOS = QoSProfile(depth=COMMAND_HISTORY, reliability=ReliabilityPolicy.RELIABLE,
-                          history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.TRANSIENT_LOCAL)
-# The configuration: published once, latched.
-LATCHED_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
-CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE)
 _LEVELS = {
     MPIState.ERROR: DiagnosticStatus.ERROR,
     MPIState.STOPPING_ERROR: DiagnosticStatus.ERROR,
@@ -108,31 +96,36 @@ class ControllerNode(Node):
         self.epoch_ns = convert.anchor(runner.ctl) if epoch is None else epoch
         self._service_group = ReentrantCallbackGroup()
         count = len(runner.ctl.axes)
-        self._pub_axis_status = [self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS) for k in range(count)]
+        ns = settings.namespace
+        self._pub_axis_status = [self._publisher(AxisStatus, gn.AXIS_STATUS, gn.AXIS_STATUS.name(ns, k))
+                                 for k in range(count)]
         for k in range(count):
-            self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp, k=k: self._on_config_get(k, resp))
-            self._service(AxisConfigSet, f"axis{k}/config_set",
+            self._service(AxisConfigGet, gn.AXIS_CONFIG_GET.name(ns, k),
+                          lambda req, resp, k=k: self._on_config_get(k, resp))
+            self._service(AxisConfigSet, gn.AXIS_CONFIG_SET.name(ns, k),
                           lambda req, resp, k=k: self._on_config_set(k, req, resp))
-            self._service(AxisPositionSet, f"axis{k}/position_set",
+            self._service(AxisPositionSet, gn.AXIS_POSITION_SET.name(ns, k),
                           lambda req, resp, k=k: self._on_position_set(k, req, resp))
-            self._service(AxisFaultConfigGet, f"axis{k}/fault_config_get",
+            self._service(AxisFaultConfigGet, gn.FAULT_CONFIG_GET.name(ns, k),
                           lambda req, resp, k=k: self._on_fault_config_get(k, resp))
-            self._service(AxisFaultConfigSet, f"axis{k}/fault_config_set",
+            self._service(AxisFaultConfigSet, gn.FAULT_CONFIG_SET.name(ns, k),
                           lambda req, resp, k=k: self._on_fault_config_set(k, req, resp))
-            self._service(AxisFaultInject, f"axis{k}/fault_inject",
+            self._service(AxisFaultInject, gn.FAULT_INJECT.name(ns, k),
                           lambda req, resp, k=k: self._on_fault_inject(k, req, resp))
-        self._service(GateSet, "gate_set", self._on_gate_set)
-        self._service(GateGet, "gate_get", self._on_gate_get)
-        self._service(IoSet, "io_set", self._on_io_set)
-        self._service(IoGet, "io_get", self._on_io_get)
-        self._service(MotorFeedbackSecondarySet, "motor_feedback_secondary_set", self._on_secondary_set)
-        self._pub_events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
-        self._pub_joints = self.create_publisher(JointState, settings.joint_states_topic, 10)
-        self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self._pub_commands = self.create_publisher(CommandMsg, "commands", COMMANDS_QOS)
-        self._pub_configuration = self.create_publisher(SuiteConfiguration, "configuration", LATCHED_QOS)
+        self._service(GateSet, gn.GATE_SET.name(ns), self._on_gate_set)
+        self._service(GateGet, gn.GATE_GET.name(ns), self._on_gate_get)
+        self._service(IoSet, gn.IO_SET.name(ns), self._on_io_set)
+        self._service(IoGet, gn.IO_GET.name(ns), self._on_io_get)
+        self._service(MotorFeedbackSecondarySet, gn.MOTOR_FEEDBACK_SECONDARY_SET.name(ns), self._on_secondary_set)
+        self._pub_events = self._publisher(MotionEvent, gn.EVENTS, gn.EVENTS.name(ns))
+        self._pub_joints = self._publisher(JointState, gn.JOINT_STATES, gn.joint_states(ns))
+        self._pub_diagnostics = self._publisher(DiagnosticArray, gn.DIAGNOSTICS, gn.DIAGNOSTICS.name())
+        self._pub_commands = self._publisher(CommandMsg, gn.COMMANDS, gn.COMMANDS.name(ns))
+        self._pub_configuration = self._publisher(SuiteConfiguration, gn.CONFIGURATION,
+                                                  gn.CONFIGURATION.name(ns))
         if robot_description is not None:  # once, latched: robot_state_publisher's own topic and QoS
-            self._pub_description = self.create_publisher(String, "robot_description", LATCHED_QOS)
+            self._pub_description = self._publisher(String, gn.ROBOT_DESCRIPTION,
+                                                    gn.ROBOT_DESCRIPTION.name(ns))
             self._pub_description.publish(String(data=robot_description))
         self._applied: list = []  # commands applied since the last change hook, to publish after the lock
         runner.on_command(self._on_command)
@@ -142,13 +135,17 @@ class ControllerNode(Node):
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
         if settings.clock:
-            self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
+            self._pub_clock = self._publisher(Clock, gn.CLOCK, gn.CLOCK.name())
             runner.add_periodic(settings.clock_rate, self._collect_clock)
         runner.on_event(lambda event: convert.publish(
             self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns, settings.namespace)))
 
     def _service(self, srv_type, name, callback):
-        self.create_service(srv_type, name, callback, callback_group=self._service_group)
+        self.create_service(srv_type, name, callback, qos_profile=profile(gn.SERVICE_QOS),
+                            callback_group=self._service_group)
+
+    def _publisher(self, msg_type, endpoint: gn.Endpoint, name: str):
+        return self.create_publisher(msg_type, name, profile(endpoint.qos))
 
     def publish_configuration(self, config, start_sample: int | None = None) -> SuiteConfiguration:
         """Publish (latched) the configuration the suite runs: ``config`` (a SuiteConfig), the
