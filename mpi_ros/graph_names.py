@@ -114,14 +114,13 @@ class Endpoint:
 
     def name(self, namespace: str = DEFAULT_NAMESPACE, number: int | None = None) -> str:
         """The full name: ``number`` is the supervisor's or the axis' (by the owner)."""
-        if (number is None) != (self.owner in (Owner.SUITE, Owner.ROOT)):
-            raise ValueError(f"{self.leaf}: a {self.owner} endpoint {'needs' if number is None else 'takes no'} number")
-        if self.owner is Owner.ROOT:
-            return f"/{self.leaf}"
-        if self.owner is Owner.SUITE:
-            return f"{ns(namespace)}/{self.leaf}"
-        where = "ms" if self.owner is Owner.SUPERVISOR else "axis"
-        return f"{ns(namespace)}/{where}{number}/{self.leaf}"
+        numbered = self.owner in (Owner.SUPERVISOR, Owner.AXIS)
+        if numbered != (number is not None):
+            raise ValueError(f"{self.leaf}: a {self.owner} endpoint {'needs' if numbered else 'takes no'} number")
+        if number is not None:
+            prefix = supervisor_node if self.owner is Owner.SUPERVISOR else axis_prefix
+            return f"{prefix(namespace, number)}/{self.leaf}"
+        return f"/{self.leaf}" if self.owner is Owner.ROOT else f"{ns(namespace)}/{self.leaf}"
 
 
 def ns(namespace: str) -> str:
@@ -132,6 +131,11 @@ def ns(namespace: str) -> str:
 def supervisor_node(namespace: str, number: int) -> str:
     """The node of supervisor ``number``: ``<ns>/ms<n>``."""
     return f"{ns(namespace)}/ms{number}"
+
+
+def axis_prefix(namespace: str, number: int) -> str:
+    """Where axis ``number``'s endpoints are: ``<ns>/axis<k>``."""
+    return f"{ns(namespace)}/axis{number}"
 
 
 def _topic(owner: Owner, leaf: str, type_: str, qos: Qos) -> Endpoint:

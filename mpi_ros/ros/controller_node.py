@@ -212,7 +212,7 @@ class ControllerNode(Node):
     def _supervisor_diagnostic(self, ms) -> DiagnosticStatus:
         snap = ms.snapshot()
         status = DiagnosticStatus()
-        status.name = f"{self.settings.namespace.strip('/')}/ms{ms.number}"
+        status.name = convert.frame_id(self.settings.namespace, supervisor=ms.number)
         status.hardware_id = "mpi_ros simulated controller"
         status.level = _level(_LEVELS.get(snap.state, DiagnosticStatus.OK))
         status.message = f"{snap.state.name} ({snap.last_action} by {snap.action_source})"
@@ -226,7 +226,7 @@ class ControllerNode(Node):
     def _axis_diagnostic(self, ctl, axis) -> DiagnosticStatus:
         snap = ctl.axis_snapshot(axis.number)
         status = DiagnosticStatus()
-        status.name = f"{self.settings.namespace.strip('/')}/axis{axis.number}"
+        status.name = convert.frame_id(self.settings.namespace, axis=axis.number)
         status.hardware_id = "mpi_ros simulated controller"
         if snap.faults:
             level, message = DiagnosticStatus.ERROR, f"fault {', '.join(snap.faults)}: RESET once cleared"

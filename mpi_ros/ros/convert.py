@@ -27,6 +27,7 @@ from builtin_interfaces.msg import Time
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
 
+from mpi_ros import graph_names
 from mpi_ros.config import DEFAULT_NAMESPACE
 from mpi_ros.joints import AxisJoint, JointStates
 from mpi_ros.message_dicts import fill as fill  # the nodes' message <-> dict edge
@@ -99,12 +100,11 @@ def frame_id(namespace: str, supervisor: int = -1, axis: int = -1) -> str:
     (``mpi/axis<k>``) if ``axis`` >= 0, else the supervisor (``mpi/ms<n>``) if ``supervisor``
     >= 0, else the controller (``mpi/controller``); ``mpi`` being the namespace without its
     leading slash (``plant/cell_a/axis0`` in /plant/cell_a), as /diagnostics names them."""
-    prefix = namespace.strip("/")
     if axis >= 0:
-        return f"{prefix}/axis{axis}"
+        return graph_names.axis_prefix(namespace, axis).lstrip("/")
     if supervisor >= 0:
-        return f"{prefix}/ms{supervisor}"
-    return f"{prefix}/controller"
+        return graph_names.supervisor_node(namespace, supervisor).lstrip("/")
+    return f"{graph_names.ns(namespace)}/{graph_names.CONTROLLER_NODE}".lstrip("/")
 
 
 def header(sample: int, rate: float, epoch_ns: int | None, frame: str) -> Header:
