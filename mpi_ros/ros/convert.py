@@ -1,4 +1,4 @@
-"""Conversions at the ROS edge: messages <-> plain dicts, controller snapshots -> messages.
+"""Conversions at the ROS edge: controller snapshots -> messages (messages <-> plain dicts: mpi_ros/message_dicts.py).
 
 Time: every stamp is controller time anchored to the wall clock, ``epoch + sample / rate``,
 where the epoch is the wall-clock time of sample 0 (ns since the Unix epoch). The suite
