@@ -153,7 +153,7 @@ class Load:
 
     def __init__(self, node, rclpy_impl):
         from mpi_ros.action import MotionModify, MotionStart
-        from mpi_ros.ros.supervisor_node import ACTION_SERVICE_QOS
+        from mpi_ros.ros.goal_endpoints import ACTION_SERVICE_QOS
         from mpi_ros.srv import MotionAction
 
         self._rclpy = rclpy_impl

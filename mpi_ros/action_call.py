@@ -24,6 +24,8 @@ from mpi_ros.srv import MotionAction
 
 from . import discovery, errors
 from .errors import NoResponse, raise_for
+from .graph_names import DEFAULT_NAMESPACE, MOTION_ACTION, ns, supervisor_node
+from .qos import profile
 
 
 class State(StrEnum):
@@ -74,17 +76,18 @@ def action_reply(name: str, response: Any, raise_on_error: bool) -> ActionReply:
 class ActionCall:
     """``<namespace>/ms<supervisor>/action`` on a node of its own (spun only while calling)."""
 
-    def __init__(self, supervisor: int, namespace: str = "/mpi", context: Context | None = None,
+    def __init__(self, supervisor: int, namespace: str = DEFAULT_NAMESPACE, context: Context | None = None,
                  node_name: str | None = None):
         self.supervisor = supervisor
-        self.namespace = "/" + namespace.strip("/")
-        self.prefix = f"{self.namespace}/ms{supervisor}"
+        self.namespace = ns(namespace)
+        self.prefix = supervisor_node(namespace, supervisor)
         # No parameter services, /rosout or type description service: each is endpoints for
         # the suite to discover and interfaces to import before the one that matters.
         self.node = Node(node_name or f"mpi_ros_action_ms{supervisor}", context=context,
                          start_parameter_services=False, enable_rosout=False,
                          parameter_overrides=[Parameter(START_TYPE_DESCRIPTION_SERVICE_PARAM, value=False)])
-        self._service = self.node.create_client(MotionAction, f"{self.prefix}/action")
+        self._service = self.node.create_client(MotionAction, MOTION_ACTION.name(namespace, supervisor),
+                                               qos_profile=profile(MOTION_ACTION.qos))
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
 

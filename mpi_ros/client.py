@@ -30,8 +30,6 @@ safe to send from another thread while spinning). :class:`Watcher` follows the w
 from __future__ import annotations
 
 import contextlib
-import importlib
-import re
 import threading
 import time
 import uuid
@@ -49,7 +47,6 @@ from rclpy.action.client import ClientGoalHandle
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from unique_identifier_msgs.msg import UUID
 
 from mpi_ros.action import MotionModify, MotionStart
@@ -57,17 +54,16 @@ from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 from mpi_ros.srv import AxisConfigGet, AxisConfigSet, AxisFaultInject, MotionAction, MotorFeedbackSecondarySet
 
 from . import discovery, errors
+from . import graph_names as gn
 from .action_call import ActionReply, State, action_reply
 from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
+from .graph_names import DEFAULT_NAMESPACE
+from .message_dicts import fill, message_class, to_dict
+from .qos import action_qos, matching, profile
 
-# The suite serves actions with deep service queues (an E_STOP can end many goals at once);
-# a client asks for the same so no result is dropped on its side either.
-ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-ACTION_QOS = {"goal_service_qos_profile": ACTION_SERVICE_QOS, "result_service_qos_profile": ACTION_SERVICE_QOS,
-              "cancel_service_qos_profile": ACTION_SERVICE_QOS}
-STATUS_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-# Events come in bursts (6-7 in one sample at the end of a move): deep and reliable.
-EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+ACTION_QOS = action_qos(gn.ACTION_SERVICE_QOS)
+STATUS_QOS = profile(gn.STATUS_READER_QOS)
+EVENTS_QOS = profile(gn.EVENTS_QOS)
 
 _POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
 RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting for its result
@@ -250,88 +246,8 @@ def _outcome(result: Any, status: int) -> Outcome:
     return Outcome.ENDED
 
 
-# -- messages <-> plain data ------------------------------------------------------------------------
-def message_to_dict(msg: Any) -> dict[str, Any]:
-    """A ROS message as plain Python data (nested messages as dicts), in field order."""
-    return {name: _plain(getattr(msg, name)) for name in msg.get_fields_and_field_types()}
-
-
-def _plain(value: Any) -> Any:
-    if hasattr(value, "get_fields_and_field_types"):
-        return message_to_dict(value)
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, bytes):  # octet/byte fields (DiagnosticStatus.level)
-        return value[0] if len(value) == 1 else list(value)
-    if hasattr(value, "tolist"):  # array.array for sequences, numpy arrays for fixed arrays
-        return value.tolist()
-    return value
-
-
-def message_class(type_name: str) -> type:
-    """The generated class of ``pkg/msg/Type`` (or ``pkg/Type``)."""
-    parts = type_name.split("/")
-    if len(parts) == 2:
-        parts.insert(1, "msg")
-    if len(parts) != 3:
-        raise ValueError(f"{type_name!r}: not a message type name (pkg/msg/Type)")
-    return getattr(importlib.import_module(f"{parts[0]}.{parts[1]}"), parts[2])
-
-
-def fill(msg: Any, data: Mapping[str, Any], where: str = "") -> Any:
-    """Set a message's fields from a mapping (as ``ros2 action send_goal`` reads its YAML).
-
-    Names and types are checked (ValueError naming the field); numbers become float64 at
-    the edge, as the generated messages want.
-    """
-    if not isinstance(data, Mapping):
-        raise ValueError(f"{where or type(msg).__name__}: expected a mapping of fields, got {data!r}")
-    types = msg.get_fields_and_field_types()
-    for name, value in data.items():
-        path = f"{where}.{name}" if where else str(name)
-        if name not in types:
-            raise ValueError(f"{path}: no such field in {type(msg).__name__} (fields: {', '.join(types)})")
-        setattr(msg, name, _convert(types[name], value, path))
-    return msg
-
-
-_INTEGERS = {"int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "char", "octet"}
-
-
-def _convert(kind: str, value: Any, where: str) -> Any:
-    element = _element_kind(kind)
-    if element is not None:
-        if not isinstance(value, (list, tuple)):
-            raise ValueError(f"{where}: expected a list, got {value!r}")
-        return [_convert(element, v, f"{where}[{i}]") for i, v in enumerate(value)]
-    if "/" in kind:
-        return fill(message_class(kind)(), value, where)
-    if kind in ("double", "float"):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ValueError(f"{where}: expected a number, got {value!r}")
-        return float(value)
-    if kind in _INTEGERS:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
-            raise ValueError(f"{where}: expected an integer, got {value!r}")
-        return int(value)
-    if kind == "boolean":
-        if not isinstance(value, bool):
-            raise ValueError(f"{where}: expected true or false, got {value!r}")
-        return value
-    if kind.startswith(("string", "wstring")):
-        if not isinstance(value, str):
-            raise ValueError(f"{where}: expected a string, got {value!r}")
-        return str(value)  # a StrEnum member becomes its plain name
-    raise ValueError(f"{where}: fields of type {kind} cannot be set here")
-
-
-def _element_kind(kind: str) -> str | None:
-    """``double`` for ``sequence<double>``, ``sequence<double, 5>`` or ``double[3]``; None for scalars."""
-    if kind.startswith("sequence<"):
-        return kind[len("sequence<"):-1].split(",")[0].strip()
-    if kind.endswith("]") and "[" in kind:
-        return kind[:kind.index("[")]
-    return None
+# -- messages <-> plain data (mpi_ros/message_dicts.py) -----------------------------------------------
+message_to_dict = to_dict  # the client's name for it
 
 
 def _name(value: Any) -> str:
@@ -542,9 +458,10 @@ class _Endpoint:
             if now >= deadline or (first_seen is not None and now - first_seen >= _GRACE):
                 break
             pause.wait(_POLL)
-        if found:
+        if found and supervisor is not None:  # (with no supervisor asked for, any found was enough)
             runs = ", ".join(f"ms{n}" for n in found)
-            raise NoSuchSupervisor(f"no supervisor {self.namespace}/ms{supervisor}: the suite runs {runs}")
+            raise NoSuchSupervisor(f"no supervisor {gn.supervisor_node(self.namespace, supervisor)}: "
+                                   f"the suite runs {runs}")
         raise SuiteNotFound(self._not_found(timeout))
 
     def _not_found(self, timeout: float) -> str:
@@ -680,18 +597,20 @@ def _fewest_frames(status: MotionStatus | None) -> int:
 class MotionClient(_Endpoint):
     """One motion supervisor (``<namespace>/ms<supervisor>``): goals, actions and status."""
 
-    def __init__(self, supervisor: int = 0, namespace: str = "/mpi", context: Context | None = None,
+    def __init__(self, supervisor: int = 0, namespace: str = DEFAULT_NAMESPACE, context: Context | None = None,
                  timeout: float = 10.0, node_name: str | None = None):
         super().__init__(namespace, context, timeout, node_name or f"mpi_ros_client_ms{supervisor}")
         self.supervisor = supervisor
-        prefix = f"{self.namespace}/ms{supervisor}"
-        self.prefix = prefix
-        self._start = ActionClient(self.node, MotionStart, f"{prefix}/motion_start", **ACTION_QOS)
-        self._modify = ActionClient(self.node, MotionModify, f"{prefix}/motion_modify", **ACTION_QOS)
-        self._action = self.node.create_client(MotionAction, f"{prefix}/action")
+        self.prefix = gn.supervisor_node(self.namespace, supervisor)
+        ns = self.namespace
+        self._start = ActionClient(self.node, MotionStart, gn.MOTION_START.name(ns, supervisor), **ACTION_QOS)
+        self._modify = ActionClient(self.node, MotionModify, gn.MOTION_MODIFY.name(ns, supervisor), **ACTION_QOS)
+        self._action = self.node.create_client(MotionAction, gn.MOTION_ACTION.name(ns, supervisor),
+                                               qos_profile=profile(gn.MOTION_ACTION.qos))
         self._status: MotionStatus | None = None
         self._status_event = threading.Condition()
-        self.node.create_subscription(MotionStatus, f"{prefix}/status", self._on_status, STATUS_QOS)
+        self.node.create_subscription(MotionStatus, gn.MOTION_STATUS.name(ns, supervisor), self._on_status,
+                                      STATUS_QOS)
         self._events: Any = None  # <namespace>/events, subscribed by the first stream()
         self._frames_low_at = -1  # sample of this supervisor's latest FRAMES_LOW event
         self._start_spinning()
@@ -935,8 +854,8 @@ class MotionClient(_Endpoint):
     def _follow_buffer(self) -> None:
         """Subscribe (once) to <namespace>/events for this supervisor's FRAMES_LOW."""
         if self._events is None:
-            self._events = self.node.create_subscription(MotionEvent, f"{self.namespace}/events", self._on_event,
-                                                         EVENTS_QOS)
+            self._events = self.node.create_subscription(MotionEvent, gn.EVENTS.name(self.namespace),
+                                                         self._on_event, EVENTS_QOS)
 
     def _on_event(self, event: MotionEvent) -> None:
         if event.supervisor == self.supervisor and event.type == EventType.FRAMES_LOW:
@@ -980,8 +899,8 @@ class MotionClient(_Endpoint):
     def fault_inject(self, axis: int, fault: str, active: bool = True) -> FaultReply:
         """Inject a fault on an axis (AMP_FAULT, ENCODER_FAULT: a condition, cleared with
         ``active`` False; the others trip once), docs/faults.md. RESET clears it afterwards."""
-        name = f"{self.namespace}/axis{axis}/fault_inject"
-        service = self.node.create_client(AxisFaultInject, name)
+        name = gn.FAULT_INJECT.name(self.namespace, axis)
+        service = self.node.create_client(AxisFaultInject, name, qos_profile=profile(gn.FAULT_INJECT.qos))
         try:
             if not service.wait_for_service(timeout_sec=self.timeout):
                 raise NoResponse(f"the axis service {name} is not available")
@@ -1057,19 +976,22 @@ class AxisClient(_Endpoint):
             axes.config_set(1, master={"type": "AXIS_COMMANDED_POSITION", "number": 0})
     """
 
-    def __init__(self, namespace: str = "/mpi", context: Context | None = None, timeout: float = 10.0,
+    def __init__(self, namespace: str = DEFAULT_NAMESPACE, context: Context | None = None, timeout: float = 10.0,
                  node_name: str | None = None):
         super().__init__(namespace, context, timeout, node_name or "mpi_ros_axis_client")
         self._clients: dict[tuple[type, str], Any] = {}
         self._start_spinning()
 
-    def _call(self, srv_type: type, name: str, request: Any, raise_on_error: bool) -> Any:
+    def _call(self, srv_type: type, endpoint: gn.Endpoint, number: int | None, request: Any,
+              raise_on_error: bool) -> Any:
+        full = endpoint.name(self.namespace, number)
+        name = full[len(self.namespace) + 1:]  # as the answers name it: axis0/config_set
         key = (srv_type, name)
         if key not in self._clients:
-            self._clients[key] = self.node.create_client(srv_type, f"{self.namespace}/{name}")
+            self._clients[key] = self.node.create_client(srv_type, full, qos_profile=profile(endpoint.qos))
         client = self._clients[key]
         if not client.wait_for_service(timeout_sec=self.timeout):
-            raise NoResponse(f"the controller's service {self.namespace}/{name} is not available")
+            raise NoResponse(f"the controller's service {full} is not available")
         response = self._wait_future(self._on_executor(lambda: client.call_async(request)), None, name)
         if raise_on_error:
             raise_for(response.message, name, ServiceReply(response.message, response.code))
@@ -1077,7 +999,7 @@ class AxisClient(_Endpoint):
 
     def config_get(self, axis: int) -> Any:
         """mpiAxisConfigGet: the AxisConfigGet response (in_position, master, master_correction)."""
-        return self._call(AxisConfigGet, f"axis{axis}/config_get", AxisConfigGet.Request(), True)
+        return self._call(AxisConfigGet, gn.AXIS_CONFIG_GET, axis, AxisConfigGet.Request(), True)
 
     def config_set(self, axis: int, in_position: Mapping[str, Any] | None = None,
                    master: Mapping[str, Any] | None = None, master_correction: int | None = None,
@@ -1092,7 +1014,7 @@ class AxisClient(_Endpoint):
             fill(request.master, master, "master")
         if master_correction is not None:
             request.master_correction = int(master_correction)
-        response = self._call(AxisConfigSet, f"axis{axis}/config_set", request, raise_on_error)
+        response = self._call(AxisConfigSet, gn.AXIS_CONFIG_SET, axis, request, raise_on_error)
         return ServiceReply(response.message, response.code)
 
     def secondary_feedback_set(self, motor: int, position: float, velocity: float,
@@ -1100,7 +1022,8 @@ class AxisClient(_Endpoint):
         """Drive motor ``motor``'s secondary feedback input: from the next sample it reads
         ``position`` and moves at ``velocity`` counts/s (a line shaft's encoder, say)."""
         request = MotorFeedbackSecondarySet.Request(motor=motor, position=float(position), velocity=float(velocity))
-        response = self._call(MotorFeedbackSecondarySet, "motor_feedback_secondary_set", request, raise_on_error)
+        response = self._call(MotorFeedbackSecondarySet, gn.MOTOR_FEEDBACK_SECONDARY_SET, None, request,
+                              raise_on_error)
         return ServiceReply(response.message, response.code)
 
 
@@ -1114,7 +1037,7 @@ class Watcher(_Endpoint):
             statuses, axes = watch.latest()
     """
 
-    def __init__(self, namespace: str = "/mpi", context: Context | None = None, timeout: float = 10.0,
+    def __init__(self, namespace: str = DEFAULT_NAMESPACE, context: Context | None = None, timeout: float = 10.0,
                  node_name: str | None = None):
         super().__init__(namespace, context, timeout, node_name or "mpi_ros_watcher")
         self._changed = threading.Condition()
@@ -1124,9 +1047,8 @@ class Watcher(_Endpoint):
 
     def axes_on_graph(self) -> list[int]:
         """Numbers of the axes whose status topic (``<namespace>/axis<k>/status``) is on the graph."""
-        pattern = re.compile(re.escape(self.namespace) + r"/axis(\d+)/status")
-        return sorted(int(m.group(1)) for name, _ in self.node.get_topic_names_and_types()
-                      if (m := pattern.fullmatch(name)))
+        return sorted(k for name, _ in self.node.get_topic_names_and_types()
+                      if (k := gn.axis_status_number(self.namespace, name)) is not None)
 
     def topics_on_graph(self) -> dict[str, str]:
         """Topic name -> type (``pkg/msg/Type``) of every topic on the graph."""
@@ -1136,10 +1058,10 @@ class Watcher(_Endpoint):
     def follow_status(self, supervisors: Iterable[int], axes: Iterable[int]) -> None:
         """Keep the latest MotionStatus of ``supervisors`` and AxisStatus of ``axes``."""
         for n in supervisors:
-            self.node.create_subscription(MotionStatus, f"{self.namespace}/ms{n}/status",
+            self.node.create_subscription(MotionStatus, gn.MOTION_STATUS.name(self.namespace, n),
                                           partial(self._keep, self._supervisors, n), STATUS_QOS)
         for k in axes:
-            self.node.create_subscription(AxisStatus, f"{self.namespace}/axis{k}/status",
+            self.node.create_subscription(AxisStatus, gn.AXIS_STATUS.name(self.namespace, k),
                                           partial(self._keep, self._axes, k), STATUS_QOS)
 
     def _keep(self, table: dict[int, Any], key: int, msg: Any) -> None:
@@ -1163,15 +1085,15 @@ class Watcher(_Endpoint):
 
         with self._changed:
             if not self._changed.wait_for(complete, self.timeout if timeout is None else timeout):
-                missing = [f"{self.namespace}/ms{n}/status" for n in wanted_ms if n not in self._supervisors]
-                missing += [f"{self.namespace}/axis{k}/status" for k in wanted_axes if k not in self._axes]
+                missing = [gn.MOTION_STATUS.name(self.namespace, n) for n in wanted_ms if n not in self._supervisors]
+                missing += [gn.AXIS_STATUS.name(self.namespace, k) for k in wanted_axes if k not in self._axes]
                 raise NoResponse(f"no status from {', '.join(missing) or 'the suite'} within the timeout")
             return dict(self._supervisors), dict(self._axes)
 
     # -- events and other topics ----------------------------------------------------------------------
     def follow_events(self, callback: Callable[[MotionEvent], None]) -> Any:
         """Call ``callback`` (on the watcher's thread) with every MotionEvent; returns the subscription."""
-        return self.node.create_subscription(MotionEvent, f"{self.namespace}/events", callback, EVENTS_QOS)
+        return self.node.create_subscription(MotionEvent, gn.EVENTS.name(self.namespace), callback, EVENTS_QOS)
 
     def follow_topic(self, topic: str, callback: Callable[[Any], None], depth: int = 100) -> tuple[Any, str]:
         """Subscribe to any topic on the graph, with a QoS its publishers accept.
@@ -1182,13 +1104,7 @@ class Watcher(_Endpoint):
         types = self.topics_on_graph()
         if topic not in types:
             raise LookupError(topic)
-        publishers = self.node.get_publishers_info_by_topic(topic)
-        best_effort = any(p.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT for p in publishers)
-        latched = bool(publishers) and all(
-            p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers)
-        qos = QoSProfile(depth=depth,
-                         reliability=ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+        qos = matching(self.node.get_publishers_info_by_topic(topic), depth)
         return self.node.create_subscription(message_class(types[topic]), topic, callback, qos), types[topic]
 
     def wait_matched(self, subscription: Any, timeout: float | None = None) -> None:

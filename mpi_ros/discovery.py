@@ -7,15 +7,14 @@ verb does not pay for rclpy.action and numpy before its first command.
 
 from __future__ import annotations
 
-import re
 import threading
 import time
 from collections.abc import Callable
 from typing import Any
 
 from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound
+from .graph_names import DEFAULT_NAMESPACE, SUPERVISOR_NODE, supervisor_node
 
-SUPERVISOR_NODE = re.compile(r"ms(\d+)")
 READY_POLL = 0.005  # s between looks at the endpoints (rclpy's wait_for_service looks every 0.25 s)
 GRAPH_POLL = 0.05  # s between looks at the graph's nodes (to tell a wrong --supervisor early)
 # Every node of a process is announced together (one DDS participant per context), but give
@@ -31,7 +30,7 @@ def supervisors_on_graph(node: Any, namespace: str) -> list[int]:
 
 def not_found(node: Any, namespace: str, timeout: float) -> str:
     """Why no suite was found under ``namespace``, with where supervisors were seen instead."""
-    where = "" if namespace == "/mpi" else f" under {namespace}"
+    where = "" if namespace == DEFAULT_NAMESPACE else f" under {namespace}"
     elsewhere = sorted({ns for name, ns in node.get_node_names_and_namespaces()
                         if SUPERVISOR_NODE.fullmatch(name) and ns != namespace})
     hint = f" (supervisors found under {', '.join(elsewhere)})" if elsewhere else ""
@@ -57,10 +56,10 @@ def wait_for_endpoints(node: Any, namespace: str, supervisor: int, ready: Callab
             suite_seen = suite_seen if suite_seen is not None or not found else now
             if suite_seen is not None and supervisor not in found and now - suite_seen >= GRACE:
                 runs = ", ".join(f"ms{n}" for n in found)
-                raise NoSuchSupervisor(f"no supervisor {namespace}/ms{supervisor}: the suite runs {runs}")
+                raise NoSuchSupervisor(f"no supervisor {supervisor_node(namespace, supervisor)}: the suite runs {runs}")
         if now - start >= timeout:
             if supervisor in supervisors_on_graph(node, namespace):
-                raise NoResponse(f"{namespace}/ms{supervisor} is on the graph but {what} did not appear within "
-                                 f"{timeout:g} s: is the suite shutting down?")
+                raise NoResponse(f"{supervisor_node(namespace, supervisor)} is on the graph but {what} did not "
+                                 f"appear within {timeout:g} s: is the suite shutting down?")
             raise SuiteNotFound(not_found(node, namespace, timeout))
         pause.wait(READY_POLL)

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from mpi_ros.graph_names import DEFAULT_NAMESPACE, joint_states
 from mpi_ros.mpi.base.params import SAMPLE_RATE_MAX, SAMPLE_RATE_MIN, ControllerConfig, shown
 
 _SETTING = "mpi_ros.setting"  # the key of a field's schema in its dataclass metadata
@@ -102,7 +103,6 @@ def schema(cls: type, section: str) -> tuple[Setting, ...]:
                  for f in fields(cls))
 
 
-DEFAULT_NAMESPACE = "/mpi"
 DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")  # ROS_AUTOMATIC_DISCOVERY_RANGE
 ACTION_SERVERS = ("batched", "rclpy")
 LOST_CLIENT_TIMEOUT = 2.0  # s: the lost-client watchdog's default
@@ -166,7 +166,7 @@ class RosSettings:
     def joint_states_topic(self) -> str:
         """/joint_states for the default namespace (the contract); <namespace>/joint_states
         for any other, so that suites of a cell neither collide nor interleave there."""
-        return "/joint_states" if self.namespace == DEFAULT_NAMESPACE else f"{self.namespace.rstrip('/')}/joint_states"
+        return joint_states(self.namespace)
 
     @property
     def joint_prefix(self) -> str:

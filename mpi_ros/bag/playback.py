@@ -9,8 +9,9 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 
+from .. import graph_names
+from ..qos import profile
 from . import schema
 from .reader import BagReader
 
@@ -28,7 +29,7 @@ def play(node: Node, path: str | Path, rate: float = 1.0, topics: Iterable[str] 
     reader = BagReader(path)
     wanted = set(topics) if topics is not None else None
     kinds = {t: k for t, k in reader.topics().items() if wanted is None or t in wanted}
-    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    qos = profile(graph_names.PLAYBACK_QOS)
     publishers = {t: node.create_publisher(schema.message_class(k), t, qos) for t, k in kinds.items()}
     stop = stop or threading.Event()
     deadline = time.monotonic() + timeout

@@ -26,6 +26,7 @@ from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.control import Controller
 
 from .. import __version__
+from .. import graph_names as gn
 from ..commands import Command as ControllerCommand
 from ..commands import Reply
 from ..config import SuiteConfig
@@ -34,20 +35,24 @@ from ..ros import convert
 from ..runner import ControllerRunner, Output
 from .writer import BagWriter, TopicQos
 
-COMMANDS_TOPIC = "/mpi/commands"  # with the default namespace; in general <namespace>/commands
+COMMANDS_TOPIC = gn.COMMANDS.name()  # with the default namespace; in general commands_topic(namespace)
 METADATA_NAME = "mpi_ros"
-COMMAND_TYPE = "mpi_ros/msg/Command"
-CONFIGURATION_TYPE = "mpi_ros/msg/SuiteConfiguration"
-COMMANDS_QOS = TopicQos(depth=1000, transient_local=True)  # as the controller node offers them
-LATCHED_QOS = TopicQos(depth=1, transient_local=True)
+COMMAND_TYPE = gn.COMMANDS.type
+CONFIGURATION_TYPE = gn.CONFIGURATION.type
 
 
 def commands_topic(namespace: str) -> str:
-    return f"{namespace.rstrip('/')}/commands"
+    return gn.COMMANDS.name(namespace)
 
 
 def configuration_topic(namespace: str) -> str:
-    return f"{namespace.rstrip('/')}/configuration"
+    return gn.CONFIGURATION.name(namespace)
+
+
+def offered(qos: gn.Qos) -> TopicQos:
+    """The QoS a bag says a topic was offered with: the suite's (mpi_ros/graph_names.py)."""
+    return TopicQos(reliable=qos.reliability is gn.Reliability.RELIABLE, depth=qos.depth,
+                    transient_local=qos.durability is gn.Durability.TRANSIENT_LOCAL)
 
 
 class Recorder:
@@ -65,17 +70,17 @@ class Recorder:
             epoch_ns = time.time_ns() - convert.sample_ns(ctl.sample, self.rate)
         self.epoch = int(epoch_ns)
         self.writer = BagWriter(directory, compress=compress)
-        status, deep = TopicQos(depth=10), TopicQos(depth=1000)
         self.commands_topic = commands_topic(ns)
-        self.writer.add_topic(self.commands_topic, COMMAND_TYPE, COMMANDS_QOS)
-        self.writer.add_topic(configuration_topic(ns), CONFIGURATION_TYPE, LATCHED_QOS)
-        self.writer.add_topic(f"{ns}/events", "mpi_ros/msg/MotionEvent", deep)
+        self.events_topic = gn.EVENTS.name(ns)
+        self._add(self.commands_topic, gn.COMMANDS)
+        self._add(configuration_topic(ns), gn.CONFIGURATION)
+        self._add(self.events_topic, gn.EVENTS)
         for spec in config.supervisors:
-            self.writer.add_topic(f"{ns}/ms{spec.number}/status", "mpi_ros/msg/MotionStatus", status)
+            self._add(gn.MOTION_STATUS.name(ns, spec.number), gn.MOTION_STATUS)
         for axis in ctl.axes:
-            self.writer.add_topic(f"{ns}/axis{axis.number}/status", "mpi_ros/msg/AxisStatus", status)
-        self.joint_states_topic, self.joints = config.ros.joint_states_topic, JointStates(config.axis_joints())
-        self.writer.add_topic(self.joint_states_topic, "sensor_msgs/msg/JointState", status)
+            self._add(gn.AXIS_STATUS.name(ns, axis.number), gn.AXIS_STATUS)
+        self.joint_states_topic, self.joints = gn.joint_states(ns), JointStates(config.axis_joints())
+        self._add(self.joint_states_topic, gn.JOINT_STATES)
         self.writer.add_metadata(METADATA_NAME, {
             "config": yaml.safe_dump(config.raw, sort_keys=False),
             "sample_rate": repr(self.rate),
@@ -92,6 +97,9 @@ class Recorder:
         runner.on_event(self._on_event)
         runner.on_command(self._on_command)
 
+    def _add(self, topic: str, endpoint: gn.Endpoint) -> None:
+        self.writer.add_topic(topic, endpoint.type, offered(endpoint.qos))
+
     def log_time(self, sample: int) -> int:
         return convert.stamp_ns(sample, self.rate, self.epoch)
 
@@ -100,11 +108,11 @@ class Recorder:
         t = self.log_time(ctl.sample)
         motions, axes = ctl.motion_snapshots()  # every axis read once for both kinds of topic
         messages: list[tuple[str, object]] = [
-            (f"{self.ns}/ms{number}/status", convert.motion_status(snap, ctl.rate, self.epoch, self.namespace))
+            (gn.MOTION_STATUS.name(self.ns, number), convert.motion_status(snap, ctl.rate, self.epoch, self.namespace))
             for number, snap in motions.items()
         ]
         messages += [
-            (f"{self.ns}/axis{snap.number}/status", convert.axis_status(snap, ctl.rate, self.epoch, self.namespace))
+            (gn.AXIS_STATUS.name(self.ns, snap.number), convert.axis_status(snap, ctl.rate, self.epoch, self.namespace))
             for snap in axes
         ]
 
@@ -120,7 +128,7 @@ class Recorder:
         return lambda: self.writer.write(self.joint_states_topic, msg, t)
 
     def _on_event(self, event) -> None:
-        self.writer.write(f"{self.ns}/events", convert.motion_event(event, self.rate, self.epoch, self.namespace),
+        self.writer.write(self.events_topic, convert.motion_event(event, self.rate, self.epoch, self.namespace),
                           self.log_time(event.sample))
 
     def _on_command(self, sample: int, command: ControllerCommand, reply: Reply) -> None:

@@ -25,6 +25,7 @@ import yaml
 from mcap.exceptions import McapError
 
 from .. import config as suite_config
+from .. import graph_names as gn
 from ..commands import Command, apply
 from ..ros import convert
 from .reader import BagReader
@@ -32,7 +33,7 @@ from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA
 
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
 _OLDER_STAMP = "header.stamp"  # where a bag recorded before the headers has its bare `stamp` compared
-STATUS_TYPES = ("mpi_ros/msg/MotionStatus", "mpi_ros/msg/AxisStatus")
+STATUS_TYPES = gn.STATUS_TYPES
 
 
 @dataclass(frozen=True, slots=True)
@@ -171,7 +172,8 @@ def inspect(reader: BagReader, namespace: str | None = None) -> Recording:
         missing.append(f"the configuration ({where})")
     raw, source, start, epoch, namespace = setup or ({}, "", 0, None, None)
     if namespace is None:
-        namespace = ((raw.get("ros") or {}).get("namespace") if isinstance(raw, dict) else None) or "/mpi"
+        namespace = (((raw.get("ros") or {}).get("namespace") if isinstance(raw, dict) else None)
+                     or gn.DEFAULT_NAMESPACE)
     ns = namespace.rstrip("/")
     commands = [t for t, k in topics.items() if k == COMMAND_TYPE and t in (commands_topic(ns), COMMANDS_TOPIC)]
     if not commands:
@@ -186,14 +188,14 @@ def inspect(reader: BagReader, namespace: str | None = None) -> Recording:
     if start != 0:
         raise ValueError(f"{reader.path}: the suite did not start at sample 0 (it started at {start}); "
                          "it cannot be replayed")
-    events = f"{ns}/events" if topics.get(f"{ns}/events") == "mpi_ros/msg/MotionEvent" else None
+    events = gn.EVENTS.name(ns) if topics.get(gn.EVENTS.name(ns)) == gn.EVENTS.type else None
     return Recording(raw, source, start, epoch, namespace, commands, events, statuses, source != "metadata")
 
 
 def _chosen(reader: BagReader, config_topics: list[str], namespace: str | None) -> list[str]:
     """The configuration topic of the suite in ``namespace`` (or the only one)."""
     if namespace is not None:
-        wanted = f"{namespace.rstrip('/')}/configuration"
+        wanted = gn.CONFIGURATION.name(namespace)
         if wanted not in config_topics:
             raise MissingInput(f"{reader.path}: no suite in {namespace} (no topic {wanted}; "
                                f"the bag has {', '.join(config_topics)})")
@@ -281,7 +283,7 @@ def _step_to(ctl, sample: int) -> None:
 
 
 def _replayed_status(ctl, msg_type: str, number: int, epoch: int | None, namespace: str):
-    if msg_type == "mpi_ros/msg/MotionStatus":
+    if msg_type == gn.MOTION_STATUS.type:
         return convert.motion_status(ctl.supervisor(number).snapshot(), ctl.rate, epoch or 0, namespace)
     return convert.axis_status(ctl.axis_snapshot(number), ctl.rate, epoch or 0, namespace)
 

@@ -25,9 +25,11 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from .. import graph_names
+
 MIN_SAMPLES = 50  # fewer say too little about a loop of two states and four parameters
-AXIS_STATUS_TYPE = "mpi_ros/msg/AxisStatus"
-CONFIGURATION_TYPE = "mpi_ros/msg/SuiteConfiguration"
+AXIS_STATUS_TYPE = graph_names.AXIS_STATUS.type
+CONFIGURATION_TYPE = graph_names.CONFIGURATION.type
 _AXIS_COLUMN = re.compile(r"^axis(\d+)_(command_position|actual_position)$")
 
 

@@ -15,8 +15,9 @@ import re
 import sys
 from typing import Any, Self, TextIO
 
+from ..graph_names import DEFAULT_NAMESPACE
+
 OK, REFUSED, USAGE = 0, 1, 2
-DEFAULT_NAMESPACE = "/mpi"
 DEFAULT_TIMEOUT = 5.0
 
 # What to do next when the supervisor's state refused a command.

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO, TypedDict
 
-from .console import OK, REFUSED, USAGE, UsageError, fail, positions
+from .console import DEFAULT_NAMESPACE, OK, REFUSED, USAGE, UsageError, fail, positions
 
 # s to let an already running suite show itself on the graph: DDS discovery between processes
 # on one host takes up to about 3 s here (a missed first announcement waits for the next).
@@ -68,7 +68,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--time-scale", type=float, default=1.0, metavar="X",
                         help="1 real time (default), larger faster; the tour needs X > 0")
     parser.add_argument("--config", help="suite configuration (YAML); default: config/default.yaml")
-    parser.add_argument("--namespace", default="/mpi", metavar="NS",
+    parser.add_argument("--namespace", default=DEFAULT_NAMESPACE, metavar="NS",
                         help="the suite's namespace (default /mpi; another one if a suite already runs there)")
 
 

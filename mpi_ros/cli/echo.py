@@ -17,9 +17,10 @@ import sys
 import threading
 import time
 
+from .. import graph_names as gn
 from .console import OK, UsageError, add_target_options, fail, run_verb
 
-ROOT_TOPICS = ("/joint_states", "/diagnostics", "/clock")
+ROOT_TOPICS = tuple(endpoint.name() for endpoint in gn.ENDPOINTS if endpoint.owner is gn.Owner.ROOT)
 TOPIC_WAIT = 1.0  # s for a topic to appear once the suite is there (its endpoints come after its nodes)
 
 
@@ -62,7 +63,7 @@ def _find(watcher, args: argparse.Namespace) -> str:
 def suite_topics(topics, namespace: str) -> list[str]:
     """The suite's own topics among ``topics`` (the actions' internal topics left out)."""
     return sorted(t for t in topics if (t.startswith(namespace.rstrip("/") + "/") or t in ROOT_TOPICS)
-                  and "/_action/" not in t)
+                  and not gn.is_action_internal(t))
 
 
 def _echo(session, args: argparse.Namespace) -> int:

@@ -34,6 +34,7 @@ import numpy as np
 from ..bag import schema
 from ..bag.fields import Unreadable, field_reader
 from ..bag.reader import BagReader, Recorded
+from ..graph_names import AXIS_STATUS, EVENTS, MOTION_STATUS
 
 STATE_COLOURS = {
     "IDLE": "#e8f5e9", "MOVING": "#bbdefb", "STOPPING": "#ffe0b2", "STOPPED": "#fff9c4",
@@ -62,9 +63,9 @@ class Recording:
 
 
 # -- reading ----------------------------------------------------------------------------------------
-FIELDS = {"mpi_ros/msg/AxisStatus": ("number", *AXIS_FIELDS),
-          "mpi_ros/msg/MotionStatus": ("number", "state_name", "axis_numbers"),
-          "mpi_ros/msg/MotionEvent": ("type", "supervisor")}
+FIELDS = {AXIS_STATUS.type: ("number", *AXIS_FIELDS),
+          MOTION_STATUS.type: ("number", "state_name", "axis_numbers"),
+          EVENTS.type: ("type", "supervisor")}
 
 
 def _rows(reader: BagReader) -> Iterator[tuple[str, tuple]]:
@@ -107,9 +108,9 @@ def read_recording(path: str | Path) -> Recording:
     raw_states: dict[int, list[tuple[int, str]]] = defaultdict(list)
     raw_events: list[tuple[int, str, int]] = []
     for type_name, row in _rows(reader):
-        if type_name == "mpi_ros/msg/AxisStatus":
+        if type_name == AXIS_STATUS.type:
             raw_axes[row[1]].append((row[0], *row[2:]))
-        elif type_name == "mpi_ros/msg/MotionStatus":
+        elif type_name == MOTION_STATUS.type:
             ns, number, state, axes = row
             history = raw_states[number]
             if not history or history[-1][1] != state:

@@ -34,7 +34,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
@@ -71,26 +70,15 @@ from mpi_ros.srv import (
 )
 
 from .. import flash as flash_file
+from .. import graph_names as gn
 from .. import requests as rq
 from ..commands import Command, Operation, Reply, io_space
 from ..config import RosSettings
 from ..joints import AxisJoint, JointStates
+from ..qos import profile
 from ..runner import ControllerRunner
 from . import convert, snapshots, wire
-from .supervisor_node import STATUS_QOS
 
-# Events are never dropped in a burst by the publisher: reliable and deep. (A subscriber
-# keeps its own history: see the README's topic table for the QoS to echo them with.)
-EVENTS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
-COMMAND_HISTORY = 1000
-# Applied commands: reliable, deep, and kept for late joiners (a recorder started after the
-# first moves still gets them; a subscriber asking for volatile durability is matched too).
-COMMANDS_QOS = QoSProfile(depth=COMMAND_HISTORY, reliability=ReliabilityPolicy.RELIABLE,
-                          history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.TRANSIENT_LOCAL)
-# The configuration: published once, latched.
-LATCHED_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
-CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE)
 _LEVELS = {
     MPIState.ERROR: DiagnosticStatus.ERROR,
     MPIState.STOPPING_ERROR: DiagnosticStatus.ERROR,
@@ -127,6 +115,8 @@ class ControllerNode(Node):
         epoch = convert.epoch_of(runner.ctl)
         self.epoch_ns = convert.anchor(runner.ctl) if epoch is None else epoch
         self._service_group = ReentrantCallbackGroup()
+        ns = settings.namespace
+        self._ns = ns
         self._flash = flash_file.Flash(flash) if flash is not None else None
         # what the next start loads where the flash holds nothing: the configuration, as it started
         self._started = runner.read(_started_configs)
@@ -138,28 +128,30 @@ class ControllerNode(Node):
         self._axes_changed = False  # an axis was created or deleted since the last change hook
         self._axes_synced = threading.Condition()
         self._sync_axes(tuple(runner.ctl.valid_axes()))
-        self._service(AxisCreate, "axis_create", lambda req, resp: self._on_axis_object(
+        self._service(AxisCreate, gn.AXIS_CREATE.name(ns), lambda req, resp: self._on_axis_object(
             Command(Operation.AXIS_CREATE, axis=req.number), True, resp))
-        self._service(AxisDelete, "axis_delete", lambda req, resp: self._on_axis_object(
+        self._service(AxisDelete, gn.AXIS_DELETE.name(ns), lambda req, resp: self._on_axis_object(
             Command(Operation.AXIS_DELETE, axis=req.number), False, resp))
-        self._service(AxisValidate, "axis_validate", self._on_axis_validate)
+        self._service(AxisValidate, gn.AXIS_VALIDATE.name(ns), self._on_axis_validate)
         for n in self._started["supervisors"]:
-            self._service(MotionFlashConfigGet, f"ms{n}/flash_config_get",
+            self._service(MotionFlashConfigGet, gn.MOTION_FLASH_CONFIG_GET.name(ns, n),
                           lambda req, resp, n=n: self._on_motion_flash_get(n, resp))
-            self._service(MotionFlashConfigSet, f"ms{n}/flash_config_set",
+            self._service(MotionFlashConfigSet, gn.MOTION_FLASH_CONFIG_SET.name(ns, n),
                           lambda req, resp, n=n: self._on_motion_flash_set(n, req, resp))
-        self._service(GateSet, "gate_set", self._on_gate_set)
-        self._service(GateGet, "gate_get", self._on_gate_get)
-        self._service(IoSet, "io_set", self._on_io_set)
-        self._service(IoGet, "io_get", self._on_io_get)
-        self._service(MotorFeedbackSecondarySet, "motor_feedback_secondary_set", self._on_secondary_set)
-        self._pub_events = self.create_publisher(MotionEvent, "events", EVENTS_QOS)
-        self._pub_joints = self.create_publisher(JointState, settings.joint_states_topic, 10)
-        self._pub_diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self._pub_commands = self.create_publisher(CommandMsg, "commands", COMMANDS_QOS)
-        self._pub_configuration = self.create_publisher(SuiteConfiguration, "configuration", LATCHED_QOS)
+        self._service(GateSet, gn.GATE_SET.name(ns), self._on_gate_set)
+        self._service(GateGet, gn.GATE_GET.name(ns), self._on_gate_get)
+        self._service(IoSet, gn.IO_SET.name(ns), self._on_io_set)
+        self._service(IoGet, gn.IO_GET.name(ns), self._on_io_get)
+        self._service(MotorFeedbackSecondarySet, gn.MOTOR_FEEDBACK_SECONDARY_SET.name(ns), self._on_secondary_set)
+        self._pub_events = self._publisher(MotionEvent, gn.EVENTS, gn.EVENTS.name(ns))
+        self._pub_joints = self._publisher(JointState, gn.JOINT_STATES, gn.joint_states(ns))
+        self._pub_diagnostics = self._publisher(DiagnosticArray, gn.DIAGNOSTICS, gn.DIAGNOSTICS.name())
+        self._pub_commands = self._publisher(CommandMsg, gn.COMMANDS, gn.COMMANDS.name(ns))
+        self._pub_configuration = self._publisher(SuiteConfiguration, gn.CONFIGURATION,
+                                                  gn.CONFIGURATION.name(ns))
         if robot_description is not None:  # once, latched: robot_state_publisher's own topic and QoS
-            self._pub_description = self.create_publisher(String, "robot_description", LATCHED_QOS)
+            self._pub_description = self._publisher(String, gn.ROBOT_DESCRIPTION,
+                                                    gn.ROBOT_DESCRIPTION.name(ns))
             self._pub_description.publish(String(data=robot_description))
         self._applied: list = []  # commands applied since the last change hook, to publish after the lock
         runner.on_command(self._on_command)
@@ -170,33 +162,40 @@ class ControllerNode(Node):
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
         if settings.clock:
-            self._pub_clock = self.create_publisher(Clock, "/clock", CLOCK_QOS)
+            self._pub_clock = self._publisher(Clock, gn.CLOCK, gn.CLOCK.name())
             runner.add_periodic(settings.clock_rate, self._collect_clock)
         runner.on_event(lambda event: convert.publish(
             self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns, settings.namespace)))
 
     def _service(self, srv_type, name, callback):
-        return self.create_service(srv_type, name, callback, callback_group=self._service_group)
+        return self.create_service(srv_type, name, callback, qos_profile=profile(gn.SERVICE_QOS),
+                                   callback_group=self._service_group)
+
+    def _publisher(self, msg_type, endpoint: gn.Endpoint, name: str):
+        return self.create_publisher(msg_type, name, profile(endpoint.qos))
 
     # -- axis objects (mpiAxisCreate / mpiAxisDelete: docs/decisions.md, "Axis objects") ----
     def _axis_services(self, k: int) -> list:
-        return [
-            self._service(AxisConfigGet, f"axis{k}/config_get", lambda req, resp: self._on_config_get(k, resp)),
-            self._service(AxisConfigSet, f"axis{k}/config_set", lambda req, resp: self._on_config_set(k, req, resp)),
-            self._service(AxisPositionSet, f"axis{k}/position_set",
-                          lambda req, resp: self._on_position_set(k, req, resp)),
-            self._service(AxisFaultConfigGet, f"axis{k}/fault_config_get",
-                          lambda req, resp: self._on_fault_config_get(k, resp)),
-            self._service(AxisFaultConfigSet, f"axis{k}/fault_config_set",
-                          lambda req, resp: self._on_fault_config_set(k, req, resp)),
-            self._service(AxisFaultInject, f"axis{k}/fault_inject",
-                          lambda req, resp: self._on_fault_inject(k, req, resp)),
-            self._service(AxisFlashConfigGet, f"axis{k}/flash_config_get",
-                          lambda req, resp: self._on_axis_flash_get(k, resp)),
-            self._service(AxisFlashConfigSet, f"axis{k}/flash_config_set",
-                          lambda req, resp: self._on_axis_flash_set(k, req, resp)),
-            *self._axis_event_services(k),
+        """Axis ``k``'s services: (type, endpoint, callback(request, response)) each."""
+        services = [
+            (AxisConfigGet, gn.AXIS_CONFIG_GET, lambda req, resp: self._on_config_get(k, resp)),
+            (AxisConfigSet, gn.AXIS_CONFIG_SET, lambda req, resp: self._on_config_set(k, req, resp)),
+            (AxisPositionSet, gn.AXIS_POSITION_SET, lambda req, resp: self._on_position_set(k, req, resp)),
+            (AxisFaultConfigGet, gn.FAULT_CONFIG_GET, lambda req, resp: self._on_fault_config_get(k, resp)),
+            (AxisFaultConfigSet, gn.FAULT_CONFIG_SET, lambda req, resp: self._on_fault_config_set(k, req, resp)),
+            (AxisFaultInject, gn.FAULT_INJECT, lambda req, resp: self._on_fault_inject(k, req, resp)),
+            (AxisFlashConfigGet, gn.AXIS_FLASH_CONFIG_GET, lambda req, resp: self._on_axis_flash_get(k, resp)),
+            (AxisFlashConfigSet, gn.AXIS_FLASH_CONFIG_SET, lambda req, resp: self._on_axis_flash_set(k, req, resp)),
+            # amplifier enable and the axis' events (MPI 002, "Event Methods"): the motion's srv types
+            (AmpEnableSet, gn.AMP_ENABLE_SET, lambda req, resp: self._on_amp_enable(k, req, resp)),
+            (EventNotifyGet, gn.AXIS_EVENT_NOTIFY_GET, lambda req, resp: convert.event_mask_answer(
+                resp, *self.runner.read(lambda ctl: ctl.axis_event_notify_get(k)))),
+            (EventNotifySet, gn.AXIS_EVENT_NOTIFY_SET, lambda req, resp: convert.answer(
+                resp, self._submit_axis(Operation.AXIS_EVENT_NOTIFY_SET, k, {"event_types": list(req.event_types)}))),
+            (EventReset, gn.AXIS_EVENT_RESET, lambda req, resp: self._on_event_reset(k, req, resp)),
         ]
+        return [self._service(srv_type, endpoint.name(self._ns, k), callback)
+                for srv_type, endpoint, callback in services]
 
     def _sync_axes(self, valid: tuple[int, ...]) -> None:
         """Give each axis in ``valid`` its endpoints and take them from every other one."""
@@ -207,7 +206,8 @@ class ControllerNode(Node):
                     self.destroy_service(service)
             for k in valid:
                 if k not in self._axis_endpoints:
-                    self._pub_axis_status[k] = self.create_publisher(AxisStatus, f"axis{k}/status", STATUS_QOS)
+                    status = gn.AXIS_STATUS
+                    self._pub_axis_status[k] = self._publisher(AxisStatus, status, status.name(self._ns, k))
                     self._axis_endpoints[k] = self._axis_services(k)
             self._axes_synced.notify_all()
 
@@ -232,17 +232,6 @@ class ControllerNode(Node):
         outcome = self.runner.read(lambda ctl: ctl.axis_validate(request.number))
         response.detail = outcome.detail
         return convert.answer(response, Reply(outcome))
-
-    def _axis_event_services(self, k: int) -> list:
-        """Amplifier enable and the axis' events (MPI 002, "Event Methods"): the motion's srv types."""
-        return [
-            self._service(AmpEnableSet, f"axis{k}/amp_enable_set", lambda req, resp: self._on_amp_enable(k, req, resp)),
-            self._service(EventNotifyGet, f"axis{k}/event_notify_get", lambda req, resp: convert.event_mask_answer(
-                resp, *self.runner.read(lambda ctl: ctl.axis_event_notify_get(k)))),
-            self._service(EventNotifySet, f"axis{k}/event_notify_set", lambda req, resp: convert.answer(
-                resp, self._submit_axis(Operation.AXIS_EVENT_NOTIFY_SET, k, {"event_types": list(req.event_types)}))),
-            self._service(EventReset, f"axis{k}/event_reset", lambda req, resp: self._on_event_reset(k, req, resp)),
-        ]
 
     def _submit_axis(self, operation: str, k: int, request: dict) -> Reply:
         reply, _ = self.runner.submit(Command(operation, axis=k, request=request))
@@ -344,7 +333,7 @@ class ControllerNode(Node):
     def _supervisor_diagnostic(self, ms) -> DiagnosticStatus:
         snap = ms.snapshot()
         status = DiagnosticStatus()
-        status.name = f"{self.settings.namespace.strip('/')}/ms{ms.number}"
+        status.name = convert.frame_id(self.settings.namespace, supervisor=ms.number)
         status.hardware_id = "mpi_ros simulated controller"
         status.level = _level(_LEVELS.get(snap.state, DiagnosticStatus.OK))
         status.message = f"{snap.state.name} ({snap.last_action} by {snap.action_source})"
@@ -358,7 +347,7 @@ class ControllerNode(Node):
     def _axis_diagnostic(self, ctl, axis) -> DiagnosticStatus:
         snap = ctl.axis_snapshot(axis.number)
         status = DiagnosticStatus()
-        status.name = f"{self.settings.namespace.strip('/')}/axis{axis.number}"
+        status.name = convert.frame_id(self.settings.namespace, axis=axis.number)
         status.hardware_id = "mpi_ros simulated controller"
         if snap.faults:
             level, message = DiagnosticStatus.ERROR, f"fault {', '.join(snap.faults)}: RESET once cleared"

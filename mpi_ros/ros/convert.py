@@ -1,4 +1,4 @@
-"""Conversions at the ROS edge: messages <-> plain dicts, controller snapshots -> messages.
+"""Conversions at the ROS edge: controller snapshots -> messages (messages <-> plain dicts: mpi_ros/message_dicts.py).
 
 Time: every stamp is controller time anchored to the wall clock, ``epoch + sample / rate``,
 where the epoch is the wall-clock time of sample 0 (ns since the Unix epoch). The suite
@@ -17,152 +17,27 @@ leading slash, as /diagnostics names them (:func:`frame_id`: ``mpi/axis0``, ``mp
 
 from __future__ import annotations
 
-import array
 import math
-import operator
 import time
 import weakref
-from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
 from typing import Any
 
-import numpy as np
 from builtin_interfaces.msg import Time
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
 
+from mpi_ros import graph_names
 from mpi_ros.config import DEFAULT_NAMESPACE
 from mpi_ros.joints import AxisJoint, JointStates
+from mpi_ros.message_dicts import fill as fill  # the nodes' message <-> dict edge
+from mpi_ros.message_dicts import to_dict as to_dict
 from mpi_ros.mpi.base.events import Event
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.msg import AxisStatus, MotionEvent, MotionStatus
 from mpi_ros.msg import Command as CommandMsg
 
 from . import rcl
-
-
-def to_dict(msg) -> dict[str, Any]:
-    """A ROS message as a dict of plain Python values (nested messages as dicts); also a
-    message read from a bag by the definition the bag stores (its fields are its slots)."""
-    plan = _reading(type(msg))
-    if plan is None:
-        return {name: _plain(getattr(msg, name)) for name in _fields(msg)}
-    values = dict(zip(plan.names, plan.read_all(msg), strict=True))
-    for name, read in plan.converted:
-        values[name] = read(values[name])
-    return values
-
-
-@dataclass(frozen=True, slots=True)
-class _Reading:
-    """How a generated message class becomes a dict, decided once from its declared types: a
-    goal has some thirty fields and arrives hundreds of times a second."""
-
-    names: tuple[str, ...]
-    read_all: Callable[[Any], tuple[Any, ...]]  # every field's value at once (its slot, not its property)
-    converted: tuple[tuple[str, Callable[[Any], Any]], ...]  # the fields not plain already, and how
-
-
-_READINGS: dict[type, _Reading] = {}  # generated classes only: a bag's message classes come and go
-
-
-def _reading(cls: type) -> _Reading | None:
-    plan = _READINGS.get(cls)
-    if plan is None:
-        plan = _plan(cls)
-        if plan is not None:
-            _READINGS[cls] = plan
-    return plan
-
-
-def _plan(cls: type) -> _Reading | None:
-    """None for classes other than generated ones (those are read by value). A generated
-    class keeps field ``x`` in slot ``_x`` behind a property; reading the slots directly
-    takes a third of the time (the properties are Python functions)."""
-    slot_types = getattr(cls, "SLOT_TYPES", None)
-    if slot_types is None or not hasattr(cls, "get_fields_and_field_types"):
-        return None
-    names = tuple(cls.get_fields_and_field_types())
-    slots = set(getattr(cls, "__slots__", ()))
-    attributes = [f"_{name}" if f"_{name}" in slots else name for name in names]
-    getter = operator.attrgetter(*attributes)
-    read_all = getter if len(names) > 1 else (lambda msg: (getter(msg),))
-    readers = ((name, _reader(slot_type)) for name, slot_type in zip(names, slot_types, strict=True))
-    return _Reading(names, read_all, tuple((name, read) for name, read in readers if read is not None))
-
-
-def _reader(slot_type) -> Callable[[Any], Any] | None:
-    """How a field's value becomes plain; None when it is plain already."""
-    from rosidl_parser import definition
-
-    if isinstance(slot_type, definition.NamespacedType):
-        return to_dict
-    if isinstance(slot_type, definition.AbstractNestedType):
-        value_type = slot_type.value_type
-        if isinstance(value_type, definition.NamespacedType):
-            return _dicts
-        if isinstance(value_type, definition.BasicType) and value_type.typename in _NUMBERS:
-            return _numbers  # array.array (sequences) or numpy (fixed arrays)
-        return _plain  # strings, booleans, bytes: plain lists
-    return None
-
-
-# element types rosidl keeps in array.array or numpy arrays (both have tolist)
-_NUMBERS = frozenset({"float", "double", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64"})
-
-
-def _numbers(value) -> list:
-    return value.tolist()  # Python numbers
-
-
-def _dicts(messages) -> list[dict[str, Any]]:
-    return [to_dict(m) for m in messages]
-
-
-def _fields(msg) -> list[str]:
-    if hasattr(msg, "get_fields_and_field_types"):
-        return list(msg.get_fields_and_field_types())
-    return [name for name in msg.__slots__ if not name.startswith("_")]
-
-
-def _plain(value):
-    if hasattr(value, "get_fields_and_field_types") or (hasattr(value, "__slots__") and hasattr(value, "_type")):
-        return to_dict(value)
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, (array.array, np.ndarray)):
-        return value.tolist()  # Python numbers
-    return value
-
-
-def fill(msg, data: dict[str, Any]):
-    """Set a message's fields from a dict (floats converted at the edge)."""
-    types = msg.get_fields_and_field_types()
-    for name, value in data.items():
-        if name not in types:
-            continue
-        current = getattr(msg, name)
-        kind = types[name]
-        if hasattr(current, "get_fields_and_field_types"):
-            fill(current, value)
-        elif kind.startswith("sequence<") and "/" in kind:
-            element = type(msg).SLOT_TYPES[list(types).index(name)].value_type
-            cls = _message_class(element)
-            setattr(msg, name, [fill(cls(), v) for v in value])
-        elif "float" in kind or "double" in kind:
-            setattr(msg, name, [float(v) for v in value] if kind.startswith("sequence") else float(value))
-        elif kind.startswith("sequence<int") or kind.startswith("sequence<uint"):
-            setattr(msg, name, [int(v) for v in value])
-        else:
-            setattr(msg, name, value)
-    return msg
-
-
-def _message_class(namespaced_type):
-    import importlib
-
-    module = importlib.import_module(".".join(namespaced_type.namespaces))
-    return getattr(module, namespaced_type.name)
 
 
 def answer(response, reply):
@@ -233,12 +108,11 @@ def frame_id(namespace: str, supervisor: int = -1, axis: int = -1) -> str:
     (``mpi/axis<k>``) if ``axis`` >= 0, else the supervisor (``mpi/ms<n>``) if ``supervisor``
     >= 0, else the controller (``mpi/controller``); ``mpi`` being the namespace without its
     leading slash (``plant/cell_a/axis0`` in /plant/cell_a), as /diagnostics names them."""
-    prefix = namespace.strip("/")
     if axis >= 0:
-        return f"{prefix}/axis{axis}"
+        return graph_names.axis_prefix(namespace, axis).lstrip("/")
     if supervisor >= 0:
-        return f"{prefix}/ms{supervisor}"
-    return f"{prefix}/controller"
+        return graph_names.supervisor_node(namespace, supervisor).lstrip("/")
+    return f"{graph_names.ns(namespace)}/{graph_names.CONTROLLER_NODE}".lstrip("/")
 
 
 def header(sample: int, rate: float, epoch_ns: int | None, frame: str) -> Header:

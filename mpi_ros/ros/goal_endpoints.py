@@ -30,16 +30,16 @@ import threading
 from typing import Any, Protocol
 
 from action_msgs.msg import GoalInfo
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.type_support import check_for_type_support
 
+from .. import graph_names
+from ..qos import profile
 from . import convert, rcl
 
 KINDS = ("goal", "cancel", "result")  # the action's services, in the order each round serves them
-SERVICE_NAMES = {"goal": "send_goal", "cancel": "cancel_goal", "result": "get_result"}
 # The action's services default to a history of 10: an E_STOP that ends more goals than
 # that at once would drop results. Deep enough for every goal a frame buffer can queue.
-ACTION_SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+ACTION_SERVICE_QOS = profile(graph_names.ACTION_SERVICE_QOS)
 
 _log = logging.getLogger("mpi_ros.goal_front")
 
@@ -101,7 +101,7 @@ def create_services(node_handle, action_type, name: str, qos) -> dict[str, Any]:
     with node_handle:
         for kind in KINDS:
             check_for_type_support(types[kind])  # loads the C type support the service needs
-            services[kind] = rcl.service(node_handle, types[kind], f"{name}/_action/{SERVICE_NAMES[kind]}", qos)
+            services[kind] = rcl.service(node_handle, types[kind], graph_names.action_service(name, kind), qos)
     return services
 
 

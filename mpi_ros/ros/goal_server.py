@@ -43,8 +43,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from action_msgs.msg import GoalStatusArray
-from rclpy.qos import qos_profile_action_status_default
 
+from .. import graph_names
+from ..qos import profile
 from . import goal_table
 from .goal_endpoints import Endpoints
 from .goal_table import GoalTable
@@ -83,8 +84,8 @@ class GoalServer:
         self.endpoints = endpoints  # the action's services: here (LocalEndpoints) or in the goal front
         self._lock = threading.RLock()  # the goals and the responses (a finished goal's result
         # is sent from whichever thread ran the controller's outputs)
-        self._status_publisher = node.create_publisher(GoalStatusArray, f"{name}/_action/status",
-                                                       qos_profile_action_status_default)
+        self._status_publisher = node.create_publisher(GoalStatusArray, graph_names.action_status(name),
+                                                       profile(graph_names.ACTION_STATUS_QOS))
         self._goals = GoalTable(result_timeout)
         self._expiring = False  # an expiry is queued with the requests taken (one at a time)
         self._taken: deque[dict[str, list]] = deque()

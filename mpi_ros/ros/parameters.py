@@ -25,6 +25,7 @@ from rclpy.context import Context
 from rclpy.node import Node
 
 from .. import config as suite_config
+from ..graph_names import DEFAULT_NAMESPACE
 from ..settings import PARAMETERS, Setting
 
 # the parameters of the ros section, by name
@@ -63,7 +64,7 @@ def _namespace(path: str | None) -> str:
     try:
         return suite_config.load(path).ros.namespace
     except suite_config.ConfigError:
-        return "/mpi"
+        return DEFAULT_NAMESPACE
 
 
 def _typed(name: str, value: Any) -> Any:

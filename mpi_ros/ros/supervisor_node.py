@@ -27,7 +27,6 @@ from action_msgs.msg import GoalStatus
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import serialize_message
 from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
@@ -58,14 +57,15 @@ from mpi_ros.srv import (
     PositionSet,
 )
 
+from .. import graph_names as gn
 from .. import requests as rq
 from ..commands import Command, Operation, Reply
 from ..config import RosSettings
 from ..joints import AxisJoint
+from ..qos import profile
 from ..runner import ControllerRunner, Output
 from ..trajectory_feed import TrajectoryFeed
 from . import convert, snapshots, wire
-from .goal_endpoints import ACTION_SERVICE_QOS
 from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
 from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
@@ -73,17 +73,6 @@ from .goal_tracker import GoalBook, TrackedGoal
 from .stock_goal_server import StockGoalServer
 from .watchdog import LostClientWatchdog
 
-# The status writers keep 1000 samples for their readers: a suite catching up after a stall
-# publishes many status points of a topic at once, and a reliable writer keeping fewer drops
-# the oldest of a burst before a reader has them (gaps in the soak: with 10, and with 100 in a
-# 10-minute soak that fell 2.4 s behind, 235 points of each topic at once). 1000 rides out 10 s
-# at 100 Hz, 1 s at 1 kHz. Depth is not part of QoS matching, so readers keep whatever history
-# they ask for.
-STATUS_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-FEEDBACK_QOS = QoSProfile(depth=10)  # rclpy's ActionServer default for its feedback publisher
-# As joint_trajectory_controller's ~/joint_trajectory subscription: reliable, depth 10.
-TRAJECTORY_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-TRIGGER_ACTIONS = {"stop": "STOP", "e_stop": "E_STOP", "abort": "ABORT", "reset": "RESET", "resume": "RESUME"}
 # A goal whose cancel was accepted is still in one of these until its GoalServer has moved it
 # to CANCELING (right after our cancel callback returns); only then may it end CANCELED.
 _NOT_YET_CANCELING = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING)
@@ -111,11 +100,11 @@ class SupervisorNode(Node):
         self._closing = threading.Condition()
         self._goal_loop = goal_loop
         self._unfinished = 0  # goals ended whose result has not been handed to their server yet
-        actions = ((MotionStart, "motion_start", Operation.MOTION_START),
-                   (MotionModify, "motion_modify", Operation.MOTION_MODIFY))
+        ns = settings.namespace
+        actions = ((MotionStart, gn.MOTION_START.name(ns, number), Operation.MOTION_START),
+                   (MotionModify, gn.MOTION_MODIFY.name(ns, number), Operation.MOTION_MODIFY))
         # each action's feedback topic: its clients subscribe there (the watchdog looks for them)
-        self._feedback_topics = {action_type: f"{self.get_fully_qualified_name()}/{name}/_action/feedback"
-                                 for action_type, name, _ in actions}
+        self._feedback_topics = {action_type: gn.action_feedback(name) for action_type, name, _ in actions}
         self._servers = {action_type: self._action_server(action_type, name, operation)
                          for action_type, name, operation in actions}
         for server in self._servers.values():
@@ -123,33 +112,35 @@ class SupervisorNode(Node):
                 goal_loop.add(server)
         # Feedback goes out pre-serialized on the actions' own feedback topics (see _collect_feedback).
         self._feedback_pubs = {action_type: self.create_publisher(action_type.Impl.FeedbackMessage,
-                                                                  f"~/{name}/_action/feedback", FEEDBACK_QOS)
+                                                                  gn.action_feedback(name), profile(gn.FEEDBACK_QOS))
                                for action_type, name, _ in actions}
-        self._service(MotionAction, "action", self._on_action)
-        for name, action in TRIGGER_ACTIONS.items():
-            self._service(Trigger, name, lambda req, resp, a=action: self._on_trigger(a, resp))
-        self._service(MotionConfigGet, "config_get", self._on_config_get)
-        self._service(MotionConfigSet, "config_set", self._on_config_set)
-        self._service(MotionParamsGet, "params_get", self._on_params_get)
-        self._service(MotionParamsSet, "params_set", self._on_params_set)
-        self._service(AxisListGet, "axis_list_get", self._on_axis_list_get)
-        self._service(AxisListSet, "axis_list_set", self._on_axis_list_set)
-        self._service(AxisListEdit, "axis_list_edit", self._on_axis_list_edit)
-        self._service(PositionGet, "position_get", self._on_position_get)
-        self._service(PositionSet, "position_set", self._on_position_set)
-        self._service(FrameBufferStatusGet, "frame_buffer_status", self._on_frame_buffer_status)
-        self._service(EventNotifyGet, "event_notify_get", self._on_event_notify_get)
-        self._service(EventNotifySet, "event_notify_set", self._on_event_notify_set)
-        self._service(EventReset, "event_reset", self._on_event_reset)
-        self._service(MotionParamsValidate, "params_validate", self._on_params_validate)
-        self._pub_status = self.create_publisher(MotionStatus, "~/status", STATUS_QOS)
+        self._service(MotionAction, gn.MOTION_ACTION, self._on_action)
+        for endpoint, action in gn.TRIGGERS.values():
+            self._service(Trigger, endpoint, lambda req, resp, a=action: self._on_trigger(a, resp))
+        self._service(MotionConfigGet, gn.MOTION_CONFIG_GET, self._on_config_get)
+        self._service(MotionConfigSet, gn.MOTION_CONFIG_SET, self._on_config_set)
+        self._service(MotionParamsGet, gn.PARAMS_GET, self._on_params_get)
+        self._service(MotionParamsSet, gn.PARAMS_SET, self._on_params_set)
+        self._service(AxisListGet, gn.AXIS_LIST_GET, self._on_axis_list_get)
+        self._service(AxisListSet, gn.AXIS_LIST_SET, self._on_axis_list_set)
+        self._service(AxisListEdit, gn.AXIS_LIST_EDIT, self._on_axis_list_edit)
+        self._service(PositionGet, gn.POSITION_GET, self._on_position_get)
+        self._service(PositionSet, gn.POSITION_SET, self._on_position_set)
+        self._service(FrameBufferStatusGet, gn.FRAME_BUFFER_STATUS, self._on_frame_buffer_status)
+        self._service(EventNotifyGet, gn.EVENT_NOTIFY_GET, self._on_event_notify_get)
+        self._service(EventNotifySet, gn.EVENT_NOTIFY_SET, self._on_event_notify_set)
+        self._service(EventReset, gn.EVENT_RESET, self._on_event_reset)
+        self._service(MotionParamsValidate, gn.PARAMS_VALIDATE, self._on_params_validate)
+        self._pub_status = self.create_publisher(MotionStatus, gn.MOTION_STATUS.name(ns, number),
+                                                 profile(gn.MOTION_STATUS.qos))
         runner.add_periodic(settings.status_rate, self._collect_status)
         runner.add_periodic(settings.feedback_rate, self._collect_feedback)
         runner.on_change(self._review)
         # JointTrajectory commands in SI units (trajectory_feed.py, docs/trajectories.md)
         self.trajectories = TrajectoryFeed(runner, number, joints or [], convert.epoch_of(runner.ctl) or 0,
                                            self.get_logger().warning)
-        self.create_subscription(JointTrajectory, "~/joint_trajectory", self._on_trajectory, TRAJECTORY_QOS,
+        self.create_subscription(JointTrajectory, gn.JOINT_TRAJECTORY.name(ns, number), self._on_trajectory,
+                                 profile(gn.JOINT_TRAJECTORY.qos),
                                  callback_group=self._service_group)
         self.watchdog = (LostClientWatchdog(self, lost_client_timeout, self._running, self._client_lost,
                                             self._service_group) if lost_client_timeout > 0 else None)
@@ -166,15 +157,16 @@ class SupervisorNode(Node):
                               apply=partial(self._on_goals, action_type, operation), cancel=self._on_cancel,
                               cancelled=lambda: self.runner.update(self._review))
         if self.settings.action_server == "rclpy":
-            return StockGoalServer(self, action_type, f"~/{name}", callbacks, ACTION_SERVICE_QOS,
+            return StockGoalServer(self, action_type, name, callbacks, profile(gn.ACTION_SERVICE_QOS),
                                    result_timeout=self.settings.result_timeout)
-        endpoints = self._goal_loop.endpoints(self, action_type, f"~/{name}", ACTION_SERVICE_QOS)
-        return GoalServer(self, action_type, f"~/{name}", callbacks, endpoints,
+        endpoints = self._goal_loop.endpoints(self, action_type, name, profile(gn.ACTION_SERVICE_QOS))
+        return GoalServer(self, action_type, name, callbacks, endpoints,
                           result_timeout=self.settings.result_timeout)
 
-    def _service(self, srv_type, name, callback):
-        """A service of this supervisor: /<ns>/ms<n>/<name>."""
-        self.create_service(srv_type, f"~/{name}", callback, callback_group=self._service_group)
+    def _service(self, srv_type, endpoint: gn.Endpoint, callback):
+        """A service of this supervisor: /<ns>/ms<n>/<leaf>."""
+        self.create_service(srv_type, endpoint.name(self.settings.namespace, self.number), callback,
+                            qos_profile=profile(endpoint.qos), callback_group=self._service_group)
 
     def shutdown(self, timeout: float = 2.0) -> None:
         """Reject new goals and end the pending ones with MPIMotionMessageSTOPPED ("the suite
@@ -214,7 +206,7 @@ class SupervisorNode(Node):
         (per MPI message) and interrupted, and the last refusal with its reason."""
         counts = self.trajectories.snapshot()
         status = DiagnosticStatus()
-        status.name = f"{self.settings.namespace.strip('/')}/ms{self.number}/joint_trajectory"
+        status.name = gn.JOINT_TRAJECTORY.name(self.settings.namespace, self.number).lstrip("/")
         status.hardware_id = "mpi_ros simulated controller"
         level = DiagnosticStatus.WARN if counts.refused_total or counts.interrupted else DiagnosticStatus.OK
         status.level = bytes([level]) if isinstance(level, int) else level

@@ -64,10 +64,10 @@ def test_a_disagreement_is_an_event_and_a_diagnostic(crosscheck_suite, probe, mo
 
     from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
+    from mpi_ros.client import EVENTS_QOS
     from mpi_ros.commands import Command
     from mpi_ros.mpi.supervisor import motion as motion_module
     from mpi_ros.msg import MotionEvent
-    from mpi_ros.ros.controller_node import EVENTS_QOS
 
     suite = crosscheck_suite
     events = Collector(probe, MotionEvent, "/mpi/events", EVENTS_QOS, lambda m: m.type == "CROSSCHECK")

@@ -184,8 +184,9 @@ def test_axis_list_set_and_map_is_all_or_nothing(harness):
 def _collect_commands(node):
     """Subscribe to /mpi/commands as a recorder joining late would (transient local, 1000
     deep): the messages received, and a condition notified on each."""
+    from mpi_ros import graph_names
     from mpi_ros.msg import Command as CommandMsg
-    from mpi_ros.ros.controller_node import COMMANDS_QOS
+    from mpi_ros.qos import profile
 
     received: list = []
     arrived = threading.Condition()
@@ -195,7 +196,8 @@ def _collect_commands(node):
             received.append(msg)
             arrived.notify_all()
 
-    subscription = node.create_subscription(CommandMsg, "/mpi/commands", on_command, COMMANDS_QOS)
+    subscription = node.create_subscription(CommandMsg, graph_names.COMMANDS.name(), on_command,
+                                            profile(graph_names.COMMANDS_QOS))
     return subscription, received, arrived
 
 

@@ -66,8 +66,9 @@ class StatusCheck:
     statuses that broke a rule (at most a few kept, with the count)."""
 
     def __init__(self, node):
+        from mpi_ros.graph_names import STATUS_QOS
         from mpi_ros.msg import MotionStatus
-        from mpi_ros.ros.supervisor_node import STATUS_QOS
+        from mpi_ros.qos import profile
 
         self.states: Counter = Counter()
         self.broken: list[str] = []
@@ -75,7 +76,7 @@ class StatusCheck:
         self._last: dict[int, int] = {}
         self._lock = threading.Lock()
         for n in SUPERVISORS:
-            node.create_subscription(MotionStatus, f"/mpi/ms{n}/status", self._check, STATUS_QOS)
+            node.create_subscription(MotionStatus, f"/mpi/ms{n}/status", self._check, profile(STATUS_QOS))
 
     def _check(self, msg) -> None:
         with self._lock:
