@@ -130,10 +130,6 @@ class Family:
         """May points be added to it (APPEND among its allowed attributes)?"""
         return self.allowed is not None and bool(self.allowed & A.APPEND)
 
-    @property
-    def cam_attributes(self) -> MotionAttr:
-        return CAM_ATTRS if self.kind is Kind.CAM else A.NONE
-
 
 def index(families: Iterable[Family], types: Iterable[MPIMotionType]) -> Mapping[MPIMotionType, Family]:
     """The records by type: exactly one for each of ``types`` but INVALID. A type without a

@@ -1,8 +1,9 @@
 """Validation of a start/modify request, before any calculation.
 
 Implements MPI 000, "Returns for mpiMotionStart and mpiMotionModify" and the "possible
-causes for receiving an MPIMotionMessageATTRIBUTE_INVALID" lists, plus the array-length rules
-of docs/decisions.md, "The ROS contract: names, numbers, arrays". Each check answers the
+causes for receiving an MPIMotionMessageATTRIBUTE_INVALID" lists (each type's list is its
+record in families.py), plus the array-length rules of docs/decisions.md, "The ROS contract:
+names, numbers, arrays". Each check answers the
 reference's message; the first failing check wins and nothing is changed.
 """
 
