@@ -140,9 +140,10 @@ class Planner:
 
     @classmethod
     def of(cls, name: str, package: str) -> Planner:
-        planner = importlib.import_module(f"{package}.mpi.planner")
-        params = importlib.import_module(f"{package}.mpi.params")
-        types = importlib.import_module(f"{package}.mpi.types")
+        # (the layout of mpi_ros.mpi's subpackages: the baseline must have it too)
+        planner = importlib.import_module(f"{package}.mpi.planning.planner")
+        params = importlib.import_module(f"{package}.mpi.base.params")
+        types = importlib.import_module(f"{package}.mpi.base.types")
         return cls(name, planner.compile_move, params.MotionParams, params.Trajectory, planner.AxisStart,
                    types.MotionAttr.NONE, types.MPIMotionType.S_CURVE)
 

@@ -149,6 +149,15 @@ def test_motion_result_outcome(message, sample, end, status, outcome):
     assert result.actual_position == (1.0,)
 
 
+def test_client_motion_types_are_the_family_records():
+    # The client imports nothing of the controller (below), so its MotionType is checked
+    # against the one table of motion types here (mpi_ros/mpi/planning/families.py)
+    from mpi_ros.client import MotionType
+    from mpi_ros.mpi.planning.families import FAMILIES
+
+    assert [t.value for t in MotionType] == [t.name for t in FAMILIES]
+
+
 def test_client_and_errors_import_nothing_of_the_simulated_controller():
     code = ("import sys, mpi_ros.client, mpi_ros.errors;"
             "print(sorted(m for m in sys.modules if m.startswith(('mpi_ros.mpi', 'mpi_ros.ros', 'mpi_ros.runner'))))")

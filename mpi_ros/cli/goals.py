@@ -14,6 +14,7 @@ from typing import Any, TextIO
 from .console import OK, USAGE, UsageError, add_target_options, print_result, run_verb
 
 TRAJECTORY_FLAGS = ("velocity", "acceleration", "deceleration", "jerk_percent")
+GOAL_FLAGS = frozenset({"position", *TRAJECTORY_FLAGS})  # the goal fields a flag sets
 BAR_WIDTH = 30
 CANCEL_WAIT = 30.0  # s: how long a cancelled goal may take to stop before the command gives up
 
@@ -90,16 +91,23 @@ def goal_from_args(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _check_complete(goal: dict[str, Any]) -> None:
-    """Flags alone must make a whole move: say which is missing rather than let it be refused.
-    A point-to-point move needs its deceleration (MPI 000, MPIMotionTrapezoidal, MPIMotionSCurve:
-    the profile is specified by velocity, acceleration and deceleration); VELOCITY ignores it."""
-    needed = ["velocity", "acceleration"]
-    if goal["type"] not in ("VELOCITY", "VELOCITY_JERK"):
-        needed = ["position", *needed, "deceleration"]
+    """Flags alone must make a whole move: say which field is missing rather than let it be
+    refused. What each type needs is its family record's (mpi_ros/mpi/planning/families.py:
+    MPI 000, MPIMotionTrapezoidal and MPIMotionSCurve need velocity, acceleration and
+    deceleration, MPIMotionVelocity velocity and acceleration, a path its points and times).
+    A type without a record is left to the controller, which answers TYPE_INVALID."""
+    from mpi_ros.mpi.base.types import MPIMotionType  # (the core, only for a goal made of flags)
+    from mpi_ros.mpi.planning.families import family_of
+
+    motion_type = MPIMotionType.__members__.get(str(goal["type"]))
+    family = family_of(motion_type) if motion_type is not None else None
+    if family is None:
+        return
     have = set(goal) | set((goal.get("trajectory") or [{}])[0])
-    missing = [f"--{name.replace('_', '-')}" for name in needed if name not in have]
+    missing = [name for name in (*family.fields, *family.trajectory) if name not in have]
     if missing:
-        raise UsageError(f"{' and '.join(missing)} needed for a {goal['type']} move "
+        named = [f"--{name.replace('_', '-')}" if name in GOAL_FLAGS else name for name in missing]
+        raise UsageError(f"{' and '.join(named)} needed for a {goal['type']} move "
                          "(or give the whole goal with --goal YAML)")
 
 

@@ -20,6 +20,8 @@ layers, each importing only the ones above it in this list (test/mpi/test_archit
 | mpiMotionStatus / mpiAxisStatus / frame buffer status     | base/snapshot.py |
 | 32-bit position wrap                                      | base/wrap.py |
 | **planning/**: from a request to a plan                   |   |
+| one record per motion type: family, fields, attributes,   | planning/families.py |
+|   modifiable, option 21, line and stop ramps              |   |
 | the start/modify return table, ATTRIBUTE_INVALID lists    | planning/validate.py |
 | trapezoid (TRAPEZOIDAL), S-curve reshaping (S_CURVE)      | planning/profiles/ramps.py, scurve.py |
 | VELOCITY, point-to-point from (p, v) incl. reversal       | planning/profiles/point_to_point.py |

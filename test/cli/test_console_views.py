@@ -239,6 +239,8 @@ def test_goal_from_flags():
     velocity = goal_from_args(_args("--type", "velocity", "-v", "-300", "-a", "2000"))
     assert velocity["type"] == "VELOCITY"
     assert "position" not in velocity
+    # a type the controller does not know is the controller's to refuse (TYPE_INVALID)
+    assert goal_from_args(_args("--type", "invalid"))["type"] == "INVALID"
 
 
 def test_goal_yaml_with_flags_overriding_its_fields():
@@ -258,6 +260,12 @@ def test_goal_yaml_with_flags_overriding_its_fields():
     (["-p", "1", "2", "-a", "5"], "--velocity and --deceleration needed for a S_CURVE move"),
     (["-p", "1", "2", "-v", "1", "-a", "5"], "--deceleration needed for a S_CURVE move"),
     (["--type", "VELOCITY"], "--velocity and --acceleration needed for a VELOCITY move"),
+    # what each type needs is its family record's (mpi_ros/mpi/planning/families.py); fields
+    # without a flag are named as the goal's fields
+    (["--type", "S_CURVE_JERK", "-p", "1", "2", "-v", "1", "-a", "5", "-d", "5"],
+     "acceleration_jerk and deceleration_jerk needed for a S_CURVE_JERK move"),
+    (["--type", "PVT", "-p", "1", "2"], "point_velocity and time needed for a PVT move"),
+    (["--type", "CAM_LINEAR"], "master_distance and slave_position needed for a CAM_LINEAR move"),
     (["--goal", "{type: [unclosed"], "--goal: not valid YAML"),
     (["--goal", "- 1"], "--goal: expected a mapping of goal fields"),
     (["--goal", "{trajectory: 5}", "-v", "1"], "--goal: trajectory must be a list of mappings"),

@@ -26,12 +26,9 @@ from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import VALID, Outcome
 from mpi_ros.mpi.base.types import (
     HOLD_ATTRS,
-    POINT_TO_POINT_TYPES,
-    VELOCITY_TYPES,
     AxisMasterType,
     HoldType,
     MotionAttr,
-    MPIMotionType,
     OutputType,
 )
 
@@ -302,13 +299,13 @@ class MotionParams:
         holds fewer than 0 points, so the trigger could never fire anyway)."""
         return self.empty_count <= 0
 
-    def validate(self, motion_type: MPIMotionType | None = None, attributes: MotionAttr | None = None) -> Outcome:
-        """The values a move of ``motion_type`` with ``attributes`` uses (None: every value,
-        as mpiMotionParamsSet stores them for any later start). Values a move ignores are
-        not read (MPI 000 MPIMotionSCurve, position: VELOCITY "will ignore these values";
-        an attribute's array is read only with the attribute). Lengths are checked with
-        the move."""
-        every = motion_type is None
+    def validate(self, attributes: MotionAttr | None = None, position: bool = True, path_data: bool = True) -> Outcome:
+        """The values a move with ``attributes`` uses (None: every value, as mpiMotionParamsSet
+        stores them for any later start). Values a move ignores are not read: ``position``
+        and ``path_data`` (times, point velocities, feedforward, cam tables, frames) only if
+        its family reads them (planning/families.py; MPI 000 MPIMotionSCurve, position:
+        VELOCITY "will ignore these values"), an attribute's array only with the attribute.
+        Lengths are checked with the move."""
 
         bits = None if attributes is None else attributes.value  # (int masks: a Flag's & costs a new member)
 
@@ -316,7 +313,7 @@ class MotionParams:
             return bits is None or bool(bits & attr.value)
 
         checks: list[Iterable[Outcome]] = [
-            _each("position", self.position if every or motion_type not in VELOCITY_TYPES else (), check_position),
+            _each("position", self.position if position else (), check_position),
             _each_struct("trajectory", self.trajectory),
             (check_bool("final", self.final),
              check_bool("retain", self.retain),
@@ -338,7 +335,7 @@ class MotionParams:
             checks.append(_each_struct("hold", self.hold))
         if uses(MotionAttr.OUTPUT):
             checks.append(_each_struct("output", self.output))
-        if every or motion_type not in POINT_TO_POINT_TYPES | VELOCITY_TYPES:
+        if path_data:
             checks += self._path_checks()
         return first_refusal(itertools.chain.from_iterable(checks))
 

@@ -74,38 +74,8 @@ class MPIMotionType(IntEnum):
     FRAME = 16  # MEIMotionTypeFRAME
 
 
-POINT_TO_POINT_TYPES = frozenset(
-    {MPIMotionType.S_CURVE, MPIMotionType.TRAPEZOIDAL, MPIMotionType.S_CURVE_JERK}
-)
-VELOCITY_TYPES = frozenset({MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK})
-JERK_TYPES = frozenset({MPIMotionType.S_CURVE_JERK, MPIMotionType.VELOCITY_JERK})
-PATH_TYPES = frozenset(
-    {
-        MPIMotionType.PT,
-        MPIMotionType.PTF,
-        MPIMotionType.PVT,
-        MPIMotionType.PVTF,
-        MPIMotionType.SPLINE,
-        MPIMotionType.BESSEL,
-        MPIMotionType.BSPLINE,
-        MPIMotionType.BSPLINE2,
-    }
-)
-CAM_TYPES = frozenset({MPIMotionType.CAM_LINEAR, MPIMotionType.CAM_CUBIC})
-# MPI 000 mpiMotionModify: "The types of motion whose parameters can be modified while
-# moving are TRAPEZOIDAL, S_CURVE, VELOCITY, PT and PVT." The jerk types replace the
-# trapezoidal/S-curve/velocity algorithm in firmware option 21, so they modify alike.
-MODIFIABLE_TYPES = frozenset(
-    {
-        MPIMotionType.TRAPEZOIDAL,
-        MPIMotionType.S_CURVE,
-        MPIMotionType.VELOCITY,
-        MPIMotionType.PT,
-        MPIMotionType.PVT,
-        MPIMotionType.S_CURVE_JERK,
-        MPIMotionType.VELOCITY_JERK,
-    }
-)
+# Which types are point-to-point, paths, cams ..., what each may carry and how it is planned:
+# one record per type in planning/families.py.
 
 
 class MotionAttr(IntFlag):

@@ -19,7 +19,8 @@ from __future__ import annotations
 import math
 
 from mpi_ros.mpi.base.params import Trajectory
-from mpi_ros.mpi.base.types import POINT_TO_POINT_TYPES, MotionAttr
+from mpi_ros.mpi.base.types import MotionAttr
+from mpi_ros.mpi.planning.families import FAMILIES, Kind
 from mpi_ros.mpi.planning.frames import AxisPlan, BlendParts, Move
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
@@ -48,7 +49,7 @@ def overlap(previous: Move, move: Move, blend_limit: float) -> float:
 
 def _eligible(previous: Move, move: Move) -> bool:
     """Point-to-point moves on the same axes, the first ending at rest, the second not waiting."""
-    return (previous.type in POINT_TO_POINT_TYPES and move.type in POINT_TO_POINT_TYPES
+    return (FAMILIES[previous.type].kind is Kind.POINT_TO_POINT and FAMILIES[move.type].kind is Kind.POINT_TO_POINT
             and previous.stream is None and not previous.ends_moving and not move.attributes & _WAITS
             and previous.plan_axes == move.plan_axes and all(p.hold is None for p in move.plans))
 

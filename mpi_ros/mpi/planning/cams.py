@@ -31,6 +31,7 @@ from mpi_ros.mpi.base.masters import reads
 from mpi_ros.mpi.base.params import AxisMaster, MotionParams
 from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
 from mpi_ros.mpi.planning.cam_follow import Backtrack, CamFollow, CamState
+from mpi_ros.mpi.planning.families import FAMILIES
 from mpi_ros.mpi.planning.frames import AxisPlan
 from mpi_ros.mpi.planning.profiles.cam import CamTable
 from mpi_ros.mpi.planning.start import AxisStart
@@ -47,7 +48,7 @@ def cam_plans(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParam
     direction = 1.0 if params.master_distance[0] > 0.0 else -1.0
     distances = [abs(float(d)) for d in params.master_distance]
     repeat_from = int(params.repeat_from) if MotionAttr.REPEAT in attrs else None
-    cubic = motion_type is MPIMotionType.CAM_CUBIC
+    cubic = "gear_ratio" in FAMILIES[motion_type].fields  # (MPIMotionCam: the linear cam ignores them)
     plans = []
     for j, (start, (master, now, frame)) in enumerate(zip(starts, masters, strict=True)):
         ratios = [direction * float(g) for g in params.gear_ratio[j::count]] if cubic else None

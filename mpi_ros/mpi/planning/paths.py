@@ -29,24 +29,26 @@ from mpi_ros.mpi.base.outcome import Refused
 from mpi_ros.mpi.base.params import MotionParams, Output
 from mpi_ros.mpi.base.types import HOLD_ATTRS, MotionAttr, MPIMotionType
 from mpi_ros.mpi.base.wrap import WRAP
+from mpi_ros.mpi.planning.families import FAMILIES, Kind
 from mpi_ros.mpi.planning.frames import AxisPlan, reached
 from mpi_ros.mpi.planning.profiles.path import PathKind, SplineHistory, path_segments, peaks
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 A = MotionAttr
 
-KINDS: dict[MPIMotionType, PathKind] = {
-    MPIMotionType.PT: PathKind.PT,
-    MPIMotionType.PTF: PathKind.PT,
-    MPIMotionType.PVT: PathKind.PVT,
-    MPIMotionType.PVTF: PathKind.PVT,
-    MPIMotionType.SPLINE: PathKind.SPLINE,
-    MPIMotionType.BESSEL: PathKind.BESSEL,
-    MPIMotionType.BSPLINE: PathKind.BSPLINE,
-    MPIMotionType.BSPLINE2: PathKind.BSPLINE2,
-}
-STREAMED_TYPES = frozenset(KINDS) | {MPIMotionType.FRAME}
-FEEDFORWARD_TYPES = frozenset({MPIMotionType.PTF, MPIMotionType.PVTF})
+
+def _path_kind(motion_type: MPIMotionType) -> PathKind:
+    """The path kind a path type is planned as (its family record)."""
+    kind = FAMILIES[motion_type].path
+    if kind is None:
+        raise ValueError(f"{motion_type.name} is not a path type")
+    return kind
+
+
+def _is_frame(motion_type: MPIMotionType) -> bool:
+    return FAMILIES[motion_type].kind is Kind.FRAME
+
+
 # How closely a frame must begin where the axis is (counts, counts/s): the user computes each
 # frame's start from the one before it in floating point, which rounds far below a count.
 FRAME_JOIN_ABS = 1e-6
@@ -66,7 +68,7 @@ class PathStart:
 
 def point_count(motion_type: MPIMotionType, params: MotionParams, axes: int) -> int:
     """pointCount of a request: frames per axis for FRAME, else one per time."""
-    if motion_type is MPIMotionType.FRAME:
+    if _is_frame(motion_type):
         return len(params.frames) // axes if axes else 0
     return len(params.time)
 
@@ -76,17 +78,19 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
     """Per-axis plans of a (validated) path request starting at ``starts``, and each axis'
     peak velocity and acceleration. Times in the plans are profile time from the start."""
     axes = len(starts)
-    if motion_type is MPIMotionType.FRAME:
+    frame_type = _is_frame(motion_type)
+    if frame_type:
         per_axis = _frame_segments(params, starts)
         times = [[f.time for f in params.frames[k::axes]] for k in range(axes)]
         ends = [segments[-1].end_state()[0] if segments else start.position
                 for segments, start in zip(per_axis, starts, strict=True)]
     else:
         points = _points(params, starts, relative)
+        path_kind = _path_kind(motion_type)
         velocities = np.asarray(params.point_velocity, dtype=float).reshape(-1, axes) if \
-            KINDS[motion_type] is PathKind.PVT else None
+            path_kind is PathKind.PVT else None
         per_axis = [
-            path_segments(KINDS[motion_type], start.position, start.velocity, points[:, k], params.time,
+            path_segments(path_kind, start.position, start.velocity, points[:, k], params.time,
                           None if velocities is None else velocities[:, k])
             for k, start in enumerate(starts)
         ]
@@ -94,7 +98,7 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
         # Every kind ends exactly on its last point (the segments reach it within rounding;
         # the command is put on it when the path is done, AxisPlan.evaluate).
         ends = [float(points[-1, k]) for k in range(axes)]
-        histories = [_history(motion_type, start, points[:, k], params.time) for k, start in enumerate(starts)]
+        histories = [_history(path_kind, start, points[:, k], params.time) for k, start in enumerate(starts)]
         if not params.final and histories[0] is not None:
             # An open B-spline runs only as far as its points settle it (docs/paths.md).
             per_axis = [history.pieces(0.0, final=False) for history in histories if history is not None]
@@ -112,15 +116,14 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
             timed_outputs=[(when, out) for when, out in timed if when > 0.0],
             hold=params.hold[k] if attrs & HOLD_ATTRS else None,
             feedforward=None if feedforward is None else _knots(0.0, math.nan, point_times, feedforward[:, k]),
-            spline=None if motion_type is MPIMotionType.FRAME else histories[k],
+            spline=None if frame_type else histories[k],
         ))
     return plans, [peaks(plan.segments) for plan in plans]
 
 
-def _history(motion_type: MPIMotionType, start: PathStart, points: np.ndarray,
+def _history(kind: PathKind, start: PathStart, points: np.ndarray,
              dts: list[float]) -> SplineHistory | None:
     """A B-spline's control points and dts (None for the other kinds)."""
-    kind = KINDS[motion_type]
     if kind not in (PathKind.BSPLINE, PathKind.BSPLINE2):
         return None
     values = (float(start.position), *(float(x) for x in points))
@@ -188,7 +191,7 @@ def _continued(plan: AxisPlan, old: SplineHistory, values: tuple[float, ...], dt
 
 def _feedforward(motion_type: MPIMotionType, params: MotionParams, axes: int) -> np.ndarray | None:
     """PTF/PVTF: (points, axes) feedforward values (raw DAC counts), else None."""
-    if motion_type not in FEEDFORWARD_TYPES:
+    if "feedforward" not in FAMILIES[motion_type].fields:
         return None
     return np.asarray(params.feedforward, dtype=float).reshape(-1, axes)
 

@@ -36,10 +36,11 @@ from mpi_ros.mpi.base.params import (
     Output,
     Trajectory,
 )
-from mpi_ros.mpi.base.types import CAM_TYPES, HOLD_ATTRS, MotionAttr, MPIMotionType
+from mpi_ros.mpi.base.types import HOLD_ATTRS, MotionAttr, MPIMotionType
 from mpi_ros.mpi.planning import cams
+from mpi_ros.mpi.planning.families import FAMILIES, Kind
 from mpi_ros.mpi.planning.frames import AxisPlan, Move, RowAxisPlan, ScaledAxisPlan, Stream
-from mpi_ros.mpi.planning.paths import STREAMED_TYPES, PathStart, compile_path
+from mpi_ros.mpi.planning.paths import PathStart, compile_path
 from mpi_ros.mpi.planning.profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from mpi_ros.mpi.planning.profiles.point_to_point import reverses, velocity_move
 from mpi_ros.mpi.planning.profiles.ramps import ProfileError, ramp_rows, trapezoid_rows
@@ -70,13 +71,12 @@ _HOLD_OR_OUTPUT = _HOLDS | _OUTPUT
 # The attributes that change a point-to-point axis' plan: without them one axis is planned by
 # _lone_axis_plan, the general path's lists and tests left out
 _GENERAL = _RELATIVE | _FINAL_VEL | _SYNC | _DELAY | _NO_REVERSAL | _HOLD_OR_OUTPUT
-# The motion types planning tells apart, looked up once: an enum member is a class attribute
-# lookup of ~0.1 us each time.
-_S_CURVE, _S_CURVE_JERK = MPIMotionType.S_CURVE, MPIMotionType.S_CURVE_JERK
-_VELOCITY_TYPES = frozenset((MPIMotionType.VELOCITY, MPIMotionType.VELOCITY_JERK))
-# The types not planned as point-to-point moves: one test for the point-to-point types (the
-# starts and modifies a command waits for), a set lookup each for the others
-_NOT_POINT_TO_POINT = CAM_TYPES | STREAMED_TYPES | _VELOCITY_TYPES
+# Each type's family and ramps (families.py), looked up once: an enum member is a class
+# attribute lookup of ~0.1 us each time, a record's field another.
+_KIND = {t: family.kind for t, family in FAMILIES.items()}
+_LINE = {t: family.line for t, family in FAMILIES.items() if family.line is not None}
+_STOP = {t: family.stop for t, family in FAMILIES.items() if family.stop is not None}
+_POINT_TO_POINT, _VELOCITY, _CAM = Kind.POINT_TO_POINT, Kind.VELOCITY, Kind.CAM
 _NO_EVENTS = MPIEventType.NONE
 
 
@@ -295,12 +295,13 @@ def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, t
                   traj: Trajectory, rows: bool = False) -> Line | RowLine:
     """The 1-D profile of a point-to-point type from (p0, v0, a0); a0 is read by the jerk types
     only. ``rows``: reshape's segments as Rows (scurve.reshaped; a jerk type's are Segments)."""
-    if motion_type is _S_CURVE_JERK:
+    line = _LINE[motion_type]
+    if line.jerk_limited:
         segments = point_to_point_jerk(
             p0, v0, a0, target, v_final, traj.velocity,
             (traj.acceleration, traj.acceleration_jerk), (traj.deceleration, traj.deceleration_jerk))
         return segments, _end_position(segments[-1]) if segments else p0, end_time(segments)
-    jerk_percent = traj.jerk_percent if motion_type is _S_CURVE else 0.0
+    jerk_percent = traj.jerk_percent if line.reads_jerk_percent else 0.0
     # point_to_point's two steps, without its call (a modify is planned while its command waits)
     plan = trapezoid_rows(target - p0, v0, v_final, traj.velocity, traj.acceleration, traj.deceleration)
     return reshaped(plan, p0, jerk_percent, True) if rows else reshaped(plan, p0, jerk_percent)
@@ -391,7 +392,8 @@ def _vector_profiles(motion_type, starts, targets, finals,
         raise Refused(Message.MPIMessagePARAM_INVALID, "final velocities of a vector move must lie along the move")
     if not parallel:
         return _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj)
-    accel = _accel_along(starts, unit) if motion_type is _S_CURVE_JERK else 0.0  # (the others plan from a = 0)
+    # (only a jerk-limited profile plans from the current acceleration; the others from a = 0)
+    accel = _accel_along(starts, unit) if _LINE[motion_type].jerk_limited else 0.0
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj, True)
     segments = line[0]
     profiles: list[Profile] = []
@@ -422,10 +424,12 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
 
 
 def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) -> list[Segment]:
-    """1-D: from ``speed`` to rest with the trajectory's deceleration (and its jerk)."""
-    if motion_type is MPIMotionType.S_CURVE_JERK:
+    """1-D: from ``speed`` to rest with the trajectory's deceleration (and its jerk), as the
+    family's stop profile ramps."""
+    stop = _STOP[motion_type]
+    if stop.jerk_limited:
         return chain(0.0, speed, 0.0, velocity_change(speed, 0.0, 0.0, traj.deceleration, traj.deceleration_jerk))
-    jerk_percent = traj.jerk_percent if motion_type is MPIMotionType.S_CURVE else 0.0
+    jerk_percent = traj.jerk_percent if stop.reads_jerk_percent else 0.0
     return reshape(ramp_rows(speed, 0.0, traj.acceleration, traj.deceleration), 0.0, jerk_percent)
 
 
@@ -470,18 +474,20 @@ def compile_move(
             raise Refused(Message.MPIMotionMessageATTRIBUTE_INVALID, "a move that starts in motion cannot be held")
     stream = None
     try:
-        if motion_type not in _NOT_POINT_TO_POINT:
+        kind = _KIND[motion_type]
+        if kind is _POINT_TO_POINT:
             if len(starts) == 1 and not bits & _GENERAL:  # (the usual start or modify of an axis)
                 plans = [_lone_axis_plan(motion_type, params, starts[0], sample_rate, notes)]
             else:
                 plans = _point_to_point_plans(motion_type, params, bits, starts, sample_rate, notes)
-        elif motion_type in CAM_TYPES:
+        elif kind is _VELOCITY:
+            plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
+        elif kind is _CAM:
             assert cam_masters is not None  # (the supervisor reads each slave's master)
             plans = cams.cam_plans(motion_type, attrs, params, starts, cam_masters)
-        elif motion_type in STREAMED_TYPES:
+        else:  # (the streamed kinds, PATH and FRAME: paths.py tells them apart)
+            assert kind.streamed, kind
             plans, stream = _path_plans(motion_type, params, attrs, starts)
-        else:
-            plans = _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
     # (positional: keywords are matched at a cost; serial is the supervisor's to give)
@@ -545,8 +551,8 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
     # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
-    # reshape's profiles (_profile_from: all but the jerk types'), not padded, delayed or composite
-    chained = motion_type is not _S_CURVE_JERK and not bits & _PADDED and not composite
+    # reshape's profiles (_profile_from: all but a jerk-limited line's), not padded, delayed or composite
+    chained = not _LINE[motion_type].jerk_limited and not bits & _PADDED and not composite
     # ``shared`` only for a vector's shares (every profile a ScaledProfile) whose 1-D profile
     # passed its checks; every ScaledAxisPlan's duration is then the 1-D profile's.
     first = profiles[0] if profiles else None
@@ -592,8 +598,8 @@ def _lone_axis_plan(motion_type: MPIMotionType, params: MotionParams, start: Axi
     line = _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, 0.0, traj, True)
     segments, end, duration = line
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
-    # (chained: reshape's profile unless a jerk type's; one axis is neither padded nor composite)
-    chained = motion_type is not _S_CURVE_JERK
+    # (chained: reshape's profile unless a jerk-limited line's; one axis is neither padded nor composite)
+    chained = not _LINE[motion_type].jerk_limited
     if chained and duration <= limit and _on_target(end, start, target):
         # _checked's first answer, the usual one: on target, and no segment lasts longer than the
         # limit (_within), so finite (_finite_if_it_ends): the plan as _checked_plan makes it
@@ -625,12 +631,13 @@ def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: A
 
 def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
+    jerk_limited = _LINE[motion_type].jerk_limited
     trajs = params.trajectory if len(params.trajectory) == len(starts) else params.trajectory * len(starts)
     plans = []
     for i, (start, traj) in enumerate(zip(starts, trajs, strict=True)):
         delay = params.delay[i] if A.DELAY in attrs else 0.0
         cruise = limit if traj.velocity != 0.0 else 0.0
-        if motion_type is MPIMotionType.VELOCITY_JERK:
+        if jerk_limited:
             prof, ramp_time = velocity_jerk(start.position, start.velocity, start.acceleration, traj.velocity,
                                             traj.acceleration, traj.acceleration_jerk, traj.deceleration_jerk,
                                             cruise)

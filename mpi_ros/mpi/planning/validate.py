@@ -1,8 +1,9 @@
 """Validation of a start/modify request, before any calculation.
 
 Implements MPI 000, "Returns for mpiMotionStart and mpiMotionModify" and the "possible
-causes for receiving an MPIMotionMessageATTRIBUTE_INVALID" lists, plus the array-length rules
-of docs/decisions.md, "The ROS contract: names, numbers, arrays". Each check answers the
+causes for receiving an MPIMotionMessageATTRIBUTE_INVALID" lists (each type's list is its
+record in families.py), plus the array-length rules of docs/decisions.md, "The ROS contract:
+names, numbers, arrays". Each check answers the
 reference's message; the first failing check wins and nothing is changed.
 """
 
@@ -13,66 +14,31 @@ from dataclasses import replace
 
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Outcome
-from mpi_ros.mpi.base.params import MAX_COORD_AXES, MAX_GATES, MAX_REQUEST_VALUES, Hold, MotionParams, Output
-from mpi_ros.mpi.base.types import (
-    CAM_ATTRS,
-    CAM_TYPES,
-    HOLD_ATTRS,
-    JERK_TYPES,
-    MODIFIABLE_TYPES,
-    PATH_ATTRS,
-    PATH_TYPES,
-    POINT_TO_POINT_TYPES,
-    VELOCITY_TYPES,
-    HoldType,
-    MotionAttr,
-    MPIMotionType,
-    OutputType,
+from mpi_ros.mpi.base.params import (
+    MAX_COORD_AXES,
+    MAX_GATES,
+    MAX_REQUEST_VALUES,
+    Hold,
+    MotionParams,
+    Output,
+    Trajectory,
 )
+from mpi_ros.mpi.base.types import CAM_ATTRS, HOLD_ATTRS, PATH_ATTRS, HoldType, MotionAttr, MPIMotionType, OutputType
+from mpi_ros.mpi.planning.families import FAMILIES, POINT_ARRAYS, Family, Kind
 
 A = MotionAttr
-# MPI 000, ATTRIBUTE_INVALID lists for the point types, and the path attributes of MPI 001
-# (MPIMotionPathAttrMask, the attributes of path motion: docs/paths.md).
-_PATH_ALLOWED = A.APPEND | A.RELATIVE | A.ID | A.ELEMENT_ID | HOLD_ATTRS | A.OUTPUT | PATH_ATTRS
-# MPI 000: which attributes each type may carry.
-ALLOWED_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
-    MPIMotionType.PT: _PATH_ALLOWED,
-    MPIMotionType.PTF: _PATH_ALLOWED,
-    MPIMotionType.PVT: _PATH_ALLOWED,
-    MPIMotionType.PVTF: _PATH_ALLOWED,
-    MPIMotionType.SPLINE: _PATH_ALLOWED & ~A.APPEND,
-    MPIMotionType.BESSEL: _PATH_ALLOWED,
-    MPIMotionType.BSPLINE: _PATH_ALLOWED,
-    MPIMotionType.BSPLINE2: _PATH_ALLOWED,
-    MPIMotionType.FRAME: A.APPEND | A.ID,
-    # The reference has no ATTRIBUTE_INVALID list for the cams: they take their own attributes
-    # (MPIMotionAttrMask: REPEAT, MASTER_START, NO_BACKTRACK, NO_BACKTRACK_HOLD), ID and EVENT,
-    # which every move may carry. A cam's slave distances are relative by definition
-    # (MPIMotionCam), and its start is MASTER_START, not a time (DELAY) or a HOLD (docs/cams.md).
-    MPIMotionType.CAM_LINEAR: CAM_ATTRS | A.ID | A.EVENT,
-    MPIMotionType.CAM_CUBIC: CAM_ATTRS | A.ID | A.EVENT,
-}
-# MPI 000: "VELOCITY, VELOCITY_JERK Moves are not permitted to have the following".
-FORBIDDEN_ATTRIBUTES: dict[MPIMotionType, MotionAttr] = {
-    MPIMotionType.VELOCITY: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,
-    MPIMotionType.VELOCITY_JERK: A.SYNC_END | A.SYNC_START | A.FINAL_VEL | A.NO_REVERSAL,
-}
-# The same masks as plain ints, for the checks every start and modify runs: an IntFlag's & and
-# ``in`` are Python calls (about a microsecond each in Python 3.11), an int's cost nothing.
-_DISALLOWED_BITS = {motion_type: int(~allowed) for motion_type, allowed in ALLOWED_ATTRIBUTES.items()}
-_FORBIDDEN_BITS = {motion_type: int(forbidden) for motion_type, forbidden in FORBIDDEN_ATTRIBUTES.items()}
+# The attribute masks of each type's record as plain ints, for the checks every start and
+# modify runs: an IntFlag's & and ``in`` are Python calls (about a microsecond each in Python
+# 3.11), an int's cost nothing. (Types whose record has no list of the reference have none.)
+_DISALLOWED_BITS = {t: int(~f.allowed) for t, f in FAMILIES.items() if f.allowed is not None}
+_FORBIDDEN_BITS = {t: int(f.forbidden) for t, f in FAMILIES.items() if f.forbidden}
 _PATH_BITS, _CAM_BITS, _HOLD_BITS = int(PATH_ATTRS), int(CAM_ATTRS), int(HOLD_ATTRS)
 _SYNC_BITS = int(A.SYNC_START | A.SYNC_END)
 _DELAY, _FINAL_VEL, _OUTPUT, _ELEMENT_ID = int(A.DELAY), int(A.FINAL_VEL), int(A.OUTPUT), int(A.ELEMENT_ID)
 _NO_BACKTRACK, _NO_BACKTRACK_HOLD = int(A.NO_BACKTRACK), int(A.NO_BACKTRACK_HOLD)
 _HOLD_LESS, _HOLD_GREATER = int(A.HOLD_LESS), int(A.HOLD_GREATER)
-# Every documented type is supported by the controller. (The list under MPI 000,
-# mpiMotionStart is visibly incomplete: it leaves out VELOCITY and FRAME, which the same
-# reference documents as supported, so it does not exclude the cams either.)
-SUPPORTED_TYPES = frozenset(MPIMotionType) - {MPIMotionType.INVALID}
-# Types this simulator executes: all of them.
-STREAMED_TYPES = PATH_TYPES | {MPIMotionType.FRAME}
-EXECUTED_TYPES = POINT_TO_POINT_TYPES | VELOCITY_TYPES | STREAMED_TYPES | CAM_TYPES
+# The arrays of pointCount x axes values each path type reads (MPIMotionPT .. MPIMotionPVTF)
+_POINT_ARRAYS = {t: tuple(name for name in POINT_ARRAYS if name in f.fields) for t, f in FAMILIES.items()}
 # The most values one path request may carry (positions, or frames, over all its axes): a
 # bound on the memory and planning time a single request can claim (1 << 20 took 5 s to
 # plan, holding the controller). A longer path is streamed in requests (APPEND), as the
@@ -95,20 +61,18 @@ def check_type(
     points to a path and changes nothing of the motion in progress, so it is open to every
     type that may carry APPEND (docs/paths.md), not only to the types MPI 000, mpiMotionModify
     lists as modifiable."""
-    if motion_type is MPIMotionType.INVALID:
-        return _bad(Message.MPIMotionMessageTYPE_INVALID, "motion type INVALID")
-    if motion_type in JERK_TYPES and not firmware_option_21:
+    family = FAMILIES.get(motion_type)
+    if family is None:  # (INVALID: every other type has a record, families.index)
+        return _bad(Message.MPIMotionMessageTYPE_INVALID, f"motion type {motion_type.name}")
+    if family.option_21 and not firmware_option_21:
         return _bad(
             Message.MPIMotionMessagePROFILE_NOT_SUPPORTED,
             f"{motion_type.name} needs firmware option 21 (controller.firmware_option_21)",
         )
-    if motion_type not in SUPPORTED_TYPES:
-        return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} is not supported by the controller")
-    appendable = append and A.APPEND & ALLOWED_ATTRIBUTES.get(motion_type, A.NONE)
-    if modify and motion_type not in MODIFIABLE_TYPES and not appendable:
+    # (Every documented type is supported: the list under MPI 000, mpiMotionStart is visibly
+    # incomplete, leaving out VELOCITY and FRAME, which the same reference documents.)
+    if modify and not family.modifiable and not (append and family.appendable):
         return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} moves cannot be modified")
-    if motion_type not in EXECUTED_TYPES:
-        return _bad(Message.MPIMessageUNSUPPORTED, f"{motion_type.name} motion is not simulated yet")
     return OK
 
 
@@ -117,7 +81,8 @@ def check_running_type(running: MPIMotionType) -> Outcome:
     motion whose parameters can be modified while moving are ..." -- the running motion's
     type decides, whatever type the modify itself carries (a TRAPEZOIDAL modify may not
     replace a SPLINE or a cam)."""
-    if running not in MODIFIABLE_TYPES:
+    family = FAMILIES.get(running)
+    if family is None or not family.modifiable:
         return _bad(Message.MPIMessageUNSUPPORTED, f"the {running.name} motion in progress cannot be modified")
     return OK
 
@@ -127,13 +92,13 @@ def check_attributes(
 ) -> Outcome:
     bad = Message.MPIMotionMessageATTRIBUTE_INVALID
     bits = int(attrs)
-    if bits & _DISALLOWED_BITS.get(motion_type, 0):
-        return _bad(bad, f"{motion_type.name} moves may not have {(attrs & ~ALLOWED_ATTRIBUTES[motion_type]).names()}")
-    if bits & _FORBIDDEN_BITS.get(motion_type, 0):
-        return _bad(bad, f"{motion_type.name} moves may not have {(attrs & FORBIDDEN_ATTRIBUTES[motion_type]).names()}")
-    if motion_type not in PATH_TYPES and bits & _PATH_BITS:
+    disallowed = bits & (_DISALLOWED_BITS.get(motion_type, 0) | _FORBIDDEN_BITS.get(motion_type, 0))
+    if disallowed:
+        return _bad(bad, f"{motion_type.name} moves may not have {MotionAttr(disallowed).names()}")
+    kind = FAMILIES[motion_type].kind
+    if kind is not Kind.PATH and bits & _PATH_BITS:
         return _bad(bad, f"{(attrs & PATH_ATTRS).names()} are path attributes (MPI 001, MPIMotionPathAttrMask)")
-    if motion_type not in CAM_TYPES and bits & _CAM_BITS:
+    if kind is not Kind.CAM and bits & _CAM_BITS:
         return _bad(bad, f"{(attrs & CAM_ATTRS).names()} are cam attributes")
     if bits & _NO_BACKTRACK and bits & _NO_BACKTRACK_HOLD:
         return _bad(bad, "NO_BACKTRACK and NO_BACKTRACK_HOLD exclude each other")
@@ -171,14 +136,16 @@ def check_params(
     bad = Message.MPIMessagePARAM_INVALID
     if axis_count > MAX_COORD_AXES:
         return _bad(Message.MPIMessageARG_INVALID, f"{axis_count} axes exceed MEIXmpMAX_COORD_AXES ({MAX_COORD_AXES})")
-    if motion_type in CAM_TYPES:
-        return _check_cam(motion_type, attrs, params, axis_count)
-    if motion_type in STREAMED_TYPES:
+    family = FAMILIES[motion_type]
+    kind = family.kind
+    if kind is Kind.CAM:
+        return _check_cam(family, attrs, params, axis_count)
+    if kind.streamed:
         verdict = _check_path_attributes(attrs, params, axis_count, frame_buffer_size)
         if not verdict.ok:
             return verdict
-        return _check_path(motion_type, attrs, params, axis_count, io_words, motors, axes, sample_rate, append_to)
-    velocity_type = motion_type in VELOCITY_TYPES
+        return _check_path(family, attrs, params, axis_count, io_words, motors, axes, sample_rate, append_to)
+    velocity_type = kind is Kind.VELOCITY
     per_axis = bool(int(attrs) & _SYNC_BITS)
     counts = {axis_count} if per_axis else ({1, axis_count} if velocity_type else {1})
     if len(params.trajectory) not in counts:
@@ -187,11 +154,11 @@ def check_params(
     if not velocity_type and len(params.position) != axis_count:
         return _bad(bad, f"position needs {axis_count} value(s) (one per axis), got {len(params.position)}")
     # Ranges of every value the move reads (emptyCount <= 0 included: it disables, 000/001).
-    verdict = params.validate(motion_type, attrs)
+    verdict = params.validate(attrs, position=kind.reads_position, path_data=kind.reads_path_data)
     if not verdict.ok:
         return verdict
     for traj in params.trajectory:
-        verdict = _check_trajectory(motion_type, traj)
+        verdict = _check_trajectory(family, traj)
         if not verdict.ok:
             return verdict
     return _check_attribute_data(attrs, params, axis_count, io_words, motors, axes, points=1)
@@ -230,7 +197,7 @@ def _check_attribute_data(attrs: MotionAttr, params: MotionParams, axis_count: i
     return OK
 
 
-def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, axis_count: int,
+def _check_path(family: Family, attrs: MotionAttr, params: MotionParams, axis_count: int,
                 io_words: int, motors: int, axes: int, sample_rate: float, append_to: bool) -> Outcome:
     """A path or FRAME request (MPI 000, MPIMotionPT .. MEIMotionFrame, MPIMotionPoint).
 
@@ -240,16 +207,16 @@ def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPar
     array must be equal to pointCount multiplied by the number of axes"), then the path
     itself (MPIMotionMessagePATH_ERROR: "when the final point is not specified or the time
     slice is less than one controller sample")."""
-    if not _finite_path_data(motion_type, params):
+    if not _finite_path_data(params):
         return _bad(Message.MEIMotionMessageBAD_PATH_DATA, "a path value is infinite or NaN")
     bad = Message.MPIMessagePARAM_INVALID
-    frame_type = motion_type is MPIMotionType.FRAME
+    frame_type = family.kind is Kind.FRAME
     values = len(params.frames) if frame_type else len(params.position)
     if values > MAX_PATH_VALUES:
         return _bad(bad, f"{values} values in one request: at most {MAX_PATH_VALUES}; stream longer paths "
                          "with APPEND")
     points = len(params.frames) // axis_count if frame_type else len(params.time)
-    verdict = _path_lengths(motion_type, params, axis_count, points)
+    verdict = _path_lengths(family, params, axis_count, points)
     if not verdict.ok:
         return verdict
     if points == 0 and not append_to:
@@ -260,7 +227,7 @@ def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPar
         # could never be used. Refused rather than accepted and ignored (docs/paths.md).
         return _bad(Message.MPIMessageUNSUPPORTED, "retain: the MPI names no way to back up along a path, so "
                                                    "executed points are not kept; give retain false")
-    verdict = params.validate(motion_type, attrs)
+    verdict = params.validate(attrs)
     if not verdict.ok:
         return verdict
     verdict = _check_attribute_data(attrs, params, axis_count, io_words, motors, axes, points)
@@ -268,10 +235,10 @@ def _check_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPar
         return verdict
     if A.ELEMENT_ID in attrs and len(params.element_id) not in (1, points):
         return _bad(bad, f"element_id needs 1 or {points} value(s) (one per point), got {len(params.element_id)}")
-    return _check_path_shape(motion_type, params, sample_rate)
+    return _check_path_shape(family, params, sample_rate)
 
 
-def _check_cam(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, axis_count: int) -> Outcome:
+def _check_cam(family: Family, attrs: MotionAttr, params: MotionParams, axis_count: int) -> Outcome:
     """A cam (MPI 000, MPIMotionCam): pointCount segments, each with a master distance
     (masterDistance: pointCount elements), a slave distance per axis (slavePosition) and, for
     CAM_CUBIC, a gear ratio per axis at its end (gearRatio; a linear cam ignores it). The
@@ -286,16 +253,15 @@ def _check_cam(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPara
         return _bad(bad, "master_distance: a cam needs at least one segment (pointCount >= 1)")
     if points * axis_count > MAX_PATH_VALUES:
         return _bad(bad, f"{points} segments x {axis_count} axes: at most {MAX_PATH_VALUES} values in one request")
-    arrays = [("slave_position", params.slave_position)]
-    if motion_type is MPIMotionType.CAM_CUBIC:
-        arrays.append(("gear_ratio", params.gear_ratio))
-    for name, values in arrays:
+    cubic = "gear_ratio" in family.fields
+    for name in family.fields[1:]:  # (after master_distance, which gives pointCount)
+        values = getattr(params, name)
         if len(values) != points * axis_count:
             return _bad(bad, f"{name} needs pointCount x axes = {points} x {axis_count} value(s) (interleaved by "
                              f"axis), got {len(values)}")
     # "with linear cams this field is completely ignored" (MPIMotionCam, gearRatio): not read
-    read = params if motion_type is MPIMotionType.CAM_CUBIC else replace(params, gear_ratio=[])
-    verdict = read.validate(motion_type, attrs)
+    read = params if cubic else replace(params, gear_ratio=[])
+    verdict = read.validate(attrs)
     if not verdict.ok:
         return verdict
     if any(d == 0.0 for d in params.master_distance):
@@ -326,7 +292,7 @@ def _check_path_attributes(attrs: MotionAttr, params: MotionParams, axis_count: 
     return OK
 
 
-def _finite_path_data(motion_type: MPIMotionType, params: MotionParams) -> bool:
+def _finite_path_data(params: MotionParams) -> bool:
     arrays = [params.position, params.time, params.point_velocity, params.feedforward]
     arrays += [[f.position, f.velocity, f.acceleration, f.jerk, f.time] for f in params.frames]
     return all(_finite(x) for values in arrays for x in values)
@@ -339,53 +305,47 @@ def _finite(value: object) -> bool:
         return True  # not a number at all: the range checks answer it (PARAM_INVALID)
 
 
-def _path_lengths(motion_type: MPIMotionType, params: MotionParams, axis_count: int, points: int) -> Outcome:
+def _path_lengths(family: Family, params: MotionParams, axis_count: int, points: int) -> Outcome:
     bad = Message.MPIMessagePARAM_INVALID
-    if motion_type is MPIMotionType.FRAME:
+    if family.kind is Kind.FRAME:
         if len(params.frames) % axis_count:
             return _bad(bad, f"frames needs a multiple of {axis_count} (frames per axis, interleaved by axis), "
                              f"got {len(params.frames)}")
         return OK
-    arrays = [("position", params.position)]
-    if motion_type in (MPIMotionType.PVT, MPIMotionType.PVTF):
-        arrays.append(("point_velocity", params.point_velocity))
-    if motion_type in (MPIMotionType.PTF, MPIMotionType.PVTF):
-        arrays.append(("feedforward", params.feedforward))
-    for name, values in arrays:
+    for name in _POINT_ARRAYS[family.type]:
+        values = getattr(params, name)
         if len(values) != points * axis_count:
             return _bad(bad, f"{name} needs pointCount x axes = {points} x {axis_count} value(s) (one time per "
                              f"point), got {len(values)}")
     return OK
 
 
-def _check_path_shape(motion_type: MPIMotionType, params: MotionParams, sample_rate: float) -> Outcome:
+def _check_path_shape(family: Family, params: MotionParams, sample_rate: float) -> Outcome:
     bad = Message.MPIMotionMessagePATH_ERROR
-    if not params.final and not A.APPEND & ALLOWED_ATTRIBUTES[motion_type]:
-        return _bad(bad, f"final is false, but no points can be appended to a {motion_type.name} path "
+    if not params.final and not family.appendable:
+        return _bad(bad, f"final is false, but no points can be appended to a {family.type.name} path "
                          "(it may not carry APPEND): give the final point")
-    slices = [f.time for f in params.frames] if motion_type is MPIMotionType.FRAME else list(params.time)
+    slices = [f.time for f in params.frames] if family.kind is Kind.FRAME else list(params.time)
     if sample_rate > 0.0 and slices and min(slices) < (1.0 - 1e-9) / sample_rate:
         return _bad(bad, f"a time slice of {min(slices)!r} s is less than one controller sample "
                          f"({1.0 / sample_rate!r} s)")
     return OK
 
 
-def _check_trajectory(motion_type: MPIMotionType, traj) -> Outcome:
+def _check_trajectory(family: Family, traj: Trajectory) -> Outcome:
+    """The limits the family's profile divides by must be > 0 (MPI 000, MPITrajectory)."""
     bad = Message.MPIMessagePARAM_INVALID
-    if motion_type in VELOCITY_TYPES:
-        if traj.acceleration <= 0.0:
-            return _bad(bad, "acceleration must be > 0")
-    else:
-        if traj.velocity <= 0.0 or traj.acceleration <= 0.0 or traj.deceleration <= 0.0:
-            return _bad(bad, "velocity, acceleration and deceleration must be > 0")
-    if motion_type in JERK_TYPES:
-        if traj.acceleration_jerk <= 0.0 or (
-            motion_type is MPIMotionType.S_CURVE_JERK and traj.deceleration_jerk <= 0.0
-        ):
-            return _bad(bad, "acceleration_jerk and deceleration_jerk must be > 0")
-    elif not 0.0 <= traj.jerk_percent <= 100.0:
+    for names in (family.limits, family.jerk_limits):
+        if any(getattr(traj, name) <= 0.0 for name in names):
+            return _bad(bad, f"{_listed(names)} must be > 0")
+    if not family.jerk_limits and not 0.0 <= traj.jerk_percent <= 100.0:
         return _bad(bad, "jerk_percent must be within 0..100")
     return OK
+
+
+def _listed(names: tuple[str, ...]) -> str:
+    """"a", "a and b", "a, b and c"."""
+    return " and ".join(filter(None, (", ".join(names[:-1]), names[-1])))
 
 
 def _check_hold(hold: Hold, attrs: MotionAttr, io_words: int, motors: int, axes: int) -> Outcome:

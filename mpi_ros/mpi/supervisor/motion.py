@@ -31,7 +31,6 @@ from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome, Refused
 from mpi_ros.mpi.base.params import AxisMaster, MotionConfig, MotionParams, check_position
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, FrameBufferStatus, MotionSnapshot
 from mpi_ros.mpi.base.types import (
-    CAM_TYPES,
     HOLD_ATTRS,
     ActionSource,
     MotionAttr,
@@ -41,6 +40,7 @@ from mpi_ros.mpi.base.types import (
 )
 from mpi_ros.mpi.host import SupervisorHost
 from mpi_ros.mpi.planning import blend, cams, paths, validate
+from mpi_ros.mpi.planning.families import FAMILIES, Kind
 from mpi_ros.mpi.planning.frames import AxisPlan, Move, frames_needed
 from mpi_ros.mpi.planning.planner import PlanNotes, compile_move
 from mpi_ros.mpi.planning.start import AxisStart
@@ -547,7 +547,8 @@ class MotionSupervisor:
     def _check(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool,
                admitted: _Admitted) -> Outcome:
         """The request itself, and against the motion it would join or replace."""
-        if admitted.open_path is not None and motion_type not in paths.STREAMED_TYPES:
+        # (the type is known here: _admit checked it, validate.check_type)
+        if admitted.open_path is not None and not FAMILIES[motion_type].kind.streamed:
             return Outcome(Message.MPIMotionMessagePATH_ERROR, "the path in progress is open (final false): append "
                                                                "its points, or close it with final true, first")
         replaces = modify and not admitted.auto_start
@@ -571,7 +572,7 @@ class MotionSupervisor:
         starts = self._starts(admitted.queued, admitted.state, modify and not admitted.auto_start)
         try:
             # (a cam also needs each slave's master; other moves are planned from the starts alone)
-            cams_of = (self._cam_masters(),) if motion_type in CAM_TYPES else ()
+            cams_of = (self._cam_masters(),) if FAMILIES[motion_type].kind is Kind.CAM else ()
             move, notes = compile_move(self.number, motion_type, attrs, params, starts, self._host.rate, *cams_of)
         except Refused as exc:
             return exc.outcome
@@ -631,9 +632,10 @@ class MotionSupervisor:
                                       append=MotionAttr.APPEND in attrs)
         if verdict.ok:
             verdict = self._check_request(motion_type, attrs, params, modify, append_to=False)
-        if motion_type in CAM_TYPES:
+        kind = FAMILIES[motion_type].kind if motion_type in FAMILIES else None  # an unknown type: refused above
+        if kind is Kind.CAM:
             points = len(params.master_distance)  # (MPIMotionCam: pointCount segments)
-        elif motion_type in paths.STREAMED_TYPES:
+        elif kind in (Kind.PATH, Kind.FRAME):
             points = paths.point_count(motion_type, params, len(self._axis_list.listed))
         else:
             points = 0

@@ -239,9 +239,10 @@ def test_params_check_only_what_the_move_reads():
     # positions and will ignore these values"; an attribute's array is read only with the
     # attribute (MPIMotionAttributes)
     params = MotionParams(trajectory=[Trajectory(100.0, 1e4, 0.0)], position=[1e300], delay=[-1.0])
-    assert params.validate(MPIMotionType.VELOCITY, MotionAttr.NONE).ok
-    assert refused(params.validate(MPIMotionType.VELOCITY, MotionAttr.DELAY), "delay[0]")
-    assert refused(params.validate(MPIMotionType.TRAPEZOIDAL, MotionAttr.NONE), "position[0]")
+    # (what a family reads is its record's: planning/families.py, Kind.reads_position)
+    assert params.validate(MotionAttr.NONE, position=False).ok
+    assert refused(params.validate(MotionAttr.DELAY, position=False), "delay[0]")
+    assert refused(params.validate(MotionAttr.NONE), "position[0]")
     # mpiMotionParamsSet stores the parameters for any later start: every value is checked
     assert refused(params.validate(), "position[0]")
 

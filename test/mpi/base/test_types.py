@@ -2,11 +2,7 @@
 
 from __future__ import annotations
 
-import pytest
-
 from mpi_ros.mpi.base.types import (
-    JERK_TYPES,
-    MODIFIABLE_TYPES,
     HoldType,
     MotionAttr,
     MPIAction,
@@ -65,17 +61,3 @@ def test_hold_and_output_types_in_spec_order():
         "INVALID", "NONE", "GATE", "INPUT", "MOTOR_GENERAL_IO", "MOTOR_DEDICATED_IO",
         "AXIS_POSITION_ACTUAL", "AXIS_POSITION_COMMAND", "USER_ADDRESS"]
     assert [t.name for t in OutputType] == ["INVALID", "NONE", "MOTOR", "OUTPUT"]
-
-
-@pytest.mark.parametrize("kind", ["TRAPEZOIDAL", "S_CURVE", "VELOCITY", "PT", "PVT"])
-def test_modifiable_types_are_the_spec_list(kind):
-    # MPI 000, mpiMotionModify "types of motion whose parameters can be modified while moving are
-    # TRAPEZOIDAL, S_CURVE, VELOCITY, PT and PVT"
-    assert MPIMotionType[kind] in MODIFIABLE_TYPES
-
-
-def test_jerk_types_are_the_firmware_option_types():
-    # MPI 000, MPIMotionType S_CURVE_JERK and VELOCITY_JERK are only available with firmware option 21
-    assert {MPIMotionType.S_CURVE_JERK, MPIMotionType.VELOCITY_JERK} == JERK_TYPES
-    for kind in (MPIMotionType.PTF, MPIMotionType.SPLINE, MPIMotionType.FRAME, MPIMotionType.CAM_LINEAR):
-        assert kind not in MODIFIABLE_TYPES
