@@ -1,12 +1,12 @@
 """The Python client of the suite: commands, status and events over ROS, nothing else.
 
-    from mpi_ros.client import MotionClient, MotionType, Outcome
+    from mpi_ros.client import MotionClient, MotionType, GoalOutcome
     with MotionClient(supervisor=0) as ms0:
         result = ms0.move([1000.0, 0.0], velocity=500.0, acceleration=5000.0, deceleration=5000.0, jerk_percent=50.0)
         print(result.outcome, result.message, result.actual_position)   # waits until DONE
         goal = ms0.start({"type": "VELOCITY", "trajectory": [{"velocity": 200.0, "acceleration": 1000.0}]})
         ms0.stop()
-        goal.wait(raise_on_error=False).outcome                        # Outcome.ENDED
+        goal.wait(raise_on_error=False).outcome                        # GoalOutcome.ENDED
         ms0.reset()
         print(ms0.status().state_name)
 
@@ -181,7 +181,7 @@ class EventType(StrEnum):
     FRAME_UNDERFLOW = "FRAME_UNDERFLOW"
 
 
-class Outcome(StrEnum):
+class GoalOutcome(StrEnum):
     """How a MotionStart/MotionModify goal ended."""
 
     DONE = "DONE"          # MPIMessageOK: the move is done (a VELOCITY move: at velocity)
@@ -217,7 +217,7 @@ class MotionResult:
     sample: int      # the sample at which the command took effect
     end_sample: int  # the sample at which the goal ended
     detail: str
-    outcome: Outcome
+    outcome: GoalOutcome
     raw: Any = field(default=None, repr=False, compare=False)  # the action's Result message
 
     @property
@@ -235,15 +235,15 @@ class MotionResult:
                    result.detail, _outcome(result, status), result)
 
 
-def _outcome(result: Any, status: int) -> Outcome:
+def _outcome(result: Any, status: int) -> GoalOutcome:
     if status == GoalStatus.STATUS_CANCELED:
-        return Outcome.CANCELED
+        return GoalOutcome.CANCELED
     if result.message == errors.OK:
-        return Outcome.DONE
+        return GoalOutcome.DONE
     # A refused command is answered at the sample it arrived; a move that ran ends later.
     if result.end_sample == result.sample:
-        return Outcome.REFUSED
-    return Outcome.ENDED
+        return GoalOutcome.REFUSED
+    return GoalOutcome.ENDED
 
 
 # -- messages <-> plain data (mpi_ros/message_dicts.py) -----------------------------------------------

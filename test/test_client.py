@@ -22,10 +22,10 @@ from mpi_ros.client import (
     Action,
     EventType,
     Goal,
+    GoalOutcome,
     MotionClient,
     MotionResult,
     MotionType,
-    Outcome,
     State,
     fill,
     message_class,
@@ -134,10 +134,10 @@ def test_message_to_dict_and_message_class():
 
 
 @pytest.mark.parametrize(("message", "sample", "end", "status", "outcome"), [
-    ("MPIMessageOK", 10, 500, 4, Outcome.DONE),
-    ("MPIMessagePARAM_INVALID", 10, 10, 6, Outcome.REFUSED),
-    ("MPIMotionMessageERROR", 10, 900, 6, Outcome.ENDED),
-    ("MPIMotionMessageSTOPPED", 10, 900, 5, Outcome.CANCELED),
+    ("MPIMessageOK", 10, 500, 4, GoalOutcome.DONE),
+    ("MPIMessagePARAM_INVALID", 10, 10, 6, GoalOutcome.REFUSED),
+    ("MPIMotionMessageERROR", 10, 900, 6, GoalOutcome.ENDED),
+    ("MPIMotionMessageSTOPPED", 10, 900, 5, GoalOutcome.CANCELED),
 ])
 def test_motion_result_outcome(message, sample, end, status, outcome):
     raw = SimpleNamespace(message=message, code=0, state_name="IDLE", actual_position=[1.0], command_position=[1.0],
