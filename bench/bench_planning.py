@@ -31,6 +31,7 @@ import importlib
 import importlib.util
 import math
 import random
+import re
 import statistics
 import subprocess
 import sys
@@ -160,8 +161,8 @@ class Planner:
 
 
 def baseline_planner(revision: str, scratch: Path) -> Planner | None:
-    """compile_move of ``revision``, imported beside ours as the package ``baseline_mpi_ros``
-    (the package imports itself relatively), or None where there is no git history."""
+    """compile_move of ``revision``, imported beside ours as the package ``baseline_mpi_ros``,
+    or None where there is no git history."""
     try:
         archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros"],
                                  check=True, capture_output=True).stdout
@@ -171,6 +172,12 @@ def baseline_planner(revision: str, scratch: Path) -> Planner | None:
     with tarfile.open(scratch / "tree.tar") as tar:
         tar.extractall(scratch / "tree", filter="data")
     root = scratch / "tree" / "mpi_ros"
+    # The core imports itself absolutely (from mpi_ros.mpi...): point those imports at the copy,
+    # or the baseline would run our modules under its name.
+    for source in root.rglob("*.py"):
+        text = source.read_text()
+        source.write_text(re.sub(r"^(\s*)(from|import) mpi_ros([. ])", r"\1\2 baseline_mpi_ros\3", text,
+                                 flags=re.MULTILINE))
     spec = importlib.util.spec_from_file_location("baseline_mpi_ros", root / "__init__.py",
                                                   submodule_search_locations=[str(root)])
     module: ModuleType = importlib.util.module_from_spec(spec)
