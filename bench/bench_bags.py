@@ -85,6 +85,47 @@ def _env() -> dict:
     return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)}
 
 
+# -- a long recording -------------------------------------------------------------------------------
+def cycle_commands(samples: int, rate: float = 2000.0) -> list:
+    """Both supervisors of the default configuration busy for ``samples``: S-curve moves
+    back and forth (one every 1.5 s each, the two out of phase), and in turn a STOP and
+    RESUME, an E_STOP and RESET, and a modify of a move in progress; what bench_plot.py's
+    recording does through ROS, here at fixed samples so that the bag is the same every time."""
+    from mpi_ros.bag.scenario import Step
+    from mpi_ros.commands import Command
+
+    period = int(1.5 * rate)
+    steps = []
+    for k, at in enumerate(range(5, samples - period, period // 2)):
+        ms = k % 2
+        sign = (-1) ** (k // 2)
+        move = {"type": "S_CURVE", "position": [sign * 20000.0, sign * 5000.0],
+                "trajectory": [{"velocity": 20000.0, "acceleration": 100000.0, "deceleration": 100000.0,
+                                "jerk_percent": 50.0}]}
+        steps.append(Step(at, Command("motion_start", ms, -1, move)))
+        later = at + period // 5
+        if k % 3 == 1:
+            steps += [Step(later, Command("action", ms, -1, {"action": "STOP"})),
+                      Step(later + 400, Command("action", ms, -1, {"action": "RESUME"}))]
+        elif k % 5 == 2:
+            steps += [Step(later, Command("action", ms, -1, {"action": "E_STOP"})),
+                      Step(later + 300, Command("action", ms, -1, {"action": "RESET"}))]
+        elif k % 7 == 4:
+            modified = {**move, "position": [sign * 15000.0, sign * 3000.0]}
+            steps.append(Step(later, Command("motion_modify", ms, -1, modified)))
+    return sorted(steps, key=lambda step: step.at)
+
+
+def three_minutes(directory: Path, seconds: float = 180.0) -> Path:
+    """A recording of the default configuration (status and joint states at 100 Hz) of
+    ``seconds`` of controller time, made headless (mpi_ros.bag.scenario, as the fixtures
+    are): the same bag every time."""
+    from mpi_ros.bag import scenario
+
+    samples = int(seconds * 2000)
+    return scenario.record(scenario.Scenario("three_minutes", samples, {}, cycle_commands(samples)), directory)
+
+
 # -- write and read ----------------------------------------------------------------------------------
 def recording(count: int) -> list[tuple[str, object, int]]:
     """``count`` (topic, message, log time) as the recorder makes them: every status and the
