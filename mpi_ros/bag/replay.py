@@ -260,8 +260,9 @@ _STATUS_KEYS = {name: fields.field_reader(schema.message_class(name), ("sample",
 
 def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], list, int | None]:
     """What replay does in order: (controller sample, 0 status / 1 command, order, topic,
-    recorded, message) sorted; the recorded events in the order they were written; the first
-    sample the recording saw (a graph recording may start late).
+    recorded (for a status with its number), message) sorted; the recorded events in the
+    order they were written; the first sample the recording saw (a graph recording may
+    start late).
 
     Statuses are most of a recording: their sample and number are read from the CDR and the
     message is decoded only if the replayed bytes differ (None until then). The messages
@@ -285,10 +286,10 @@ def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], lis
                 recorded_events.append((key, msg))
             continue
         msg = item.decode() if item.older else None
-        sample = msg.sample if msg is not None else _STATUS_KEYS[item.type](item.data)[0]
+        sample, number = (msg.sample, msg.number) if msg is not None else _STATUS_KEYS[item.type](item.data)
         first_recorded = sample if first_recorded is None else min(first_recorded, sample)
         # statuses at a sample were taken before commands given at that sample
-        timeline.append((sample, 0, key, item.topic, item, msg))
+        timeline.append((sample, 0, key, item.topic, (item, number), msg))
     timeline.sort(key=lambda entry: entry[:3])
     # the order they were written in, which ties in log time may not keep
     return timeline, [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0])], first_recorded
@@ -312,12 +313,14 @@ class _Statuses:
         self.snapshots: tuple[dict, list] = ({}, [])
         self.leaves: dict[tuple[str, int], int] = {}  # (type, axes) -> values a status compares
 
-    def compare(self, report: ReplayReport, sample: int, item, msg) -> None:
+    def compare(self, report: ReplayReport, sample: int, recorded: tuple, msg) -> None:
+        """``recorded``: (the Recorded, its supervisor's or axis' number); ``msg``: the
+        message decoded, or None."""
         ctl = self.ctl
         if ctl.sample != self.sample:
             self.snapshots, self.sample = ctl.motion_snapshots(), ctl.sample
         motions, axes = self.snapshots
-        number = msg.number if msg is not None else _STATUS_KEYS[item.type](item.data)[1]
+        item, number = recorded
         motion = item.type == STATUS_TYPES[0]
         snap = motions.get(number) if motion else (axes[number] if 0 <= number < len(axes) else None)
         if snap is None:  # what the controller answers for a supervisor or axis it does not have
