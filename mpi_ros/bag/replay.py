@@ -269,7 +269,7 @@ def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], lis
     are read in the order they are stored (the order they were written in), several times
     faster than in log-time order; ``order`` sorts them as log-time order did."""
     recorded_events = []
-    timeline = []
+    timeline: list[tuple] = []
     first_recorded = None
     wanted = [*recording.commands, *recording.statuses] + ([recording.events] if recording.events else [])
     for position, item in enumerate(reader.stored(wanted)):
