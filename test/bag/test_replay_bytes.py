@@ -49,3 +49,4 @@ def test_bytes_that_differ_within_the_tolerance_are_the_same(monkeypatch: pytest
     assert report.first.topic.startswith("event"), report.summary()
     _fields_only(monkeypatch)
     assert _figures(report) == _figures(replay(BAGS / "p2p_modify", overrides=CHANGED_PLANT, tolerance=1e9))
+
