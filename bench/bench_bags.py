@@ -1,10 +1,13 @@
 """Bags (issue 10): how fast the fixtures replay, and how fast bags are written and read.
 
-- replay: each fixture of test/fixtures/bags through mpi_ros.bag.replay.replay (what
-  ``mpi-ros replay`` runs, less the interpreter's start): the recorded controller time
-  (its last sample / the sample rate) over the wall time of the replay, as a multiple of
-  real time, best of ``--rounds``; every replay must be exact (zero differences). Also
-  the whole ``mpi-ros replay BAG`` command once, interpreter start included.
+- replay: each fixture of test/fixtures/bags and a recording of ``--seconds`` (3 minutes)
+  of the default configuration, made by this bench (:func:`three_minutes`, headless and
+  the same every time), through mpi_ros.bag.replay.replay (what ``mpi-ros replay`` runs,
+  less the interpreter's start), each in a fresh process, with this tree and with
+  ``--baseline`` alternating: the recorded controller time (its last sample / the sample
+  rate) over the replay's thread CPU time (and wall time), as a multiple of real time,
+  best of ``--rounds``; every replay must be exact (zero differences). Also the whole
+  ``mpi-ros replay BAG`` command on the long recording once, interpreter start included.
 - write: what a recording holds, MotionStatus, AxisStatus and JointState of a moving
   controller (2 supervisors of 2 axes, the default configuration), through
   mpi_ros.bag.writer.BagWriter: ``write`` (message -> canonical CDR -> MCAP) and
@@ -15,12 +18,14 @@
 
 Load figures of the machine are printed with each table (the machine is shared).
 
-    python -P bench/bench_bags.py [--rounds 3] [--messages 60000]
+    python -P bench/bench_bags.py [--rounds 3] [--messages 60000] [--seconds 180] [--baseline REV]
+                                  [--only replay|write]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -32,6 +37,8 @@ from pathlib import Path
 # generated interfaces: mpi_ros/__init__.py).
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "bench"))  # run with -P: the sibling bench_controller
+from bench_controller import compared_trees  # noqa: E402 - after the path it is found on
 
 FIXTURES = REPO / "test" / "fixtures" / "bags"
 EPOCH = 1_700_000_000_000_000_000
@@ -52,37 +59,109 @@ def _best(run, rounds: int) -> tuple[float, object]:
 
 
 # -- replay ----------------------------------------------------------------------------------------
-def replay_rows(rounds: int) -> list[str]:
-    from mpi_ros.bag.replay import replay
+_MEASURE = """
+import json, sys, time
+sys.path.insert(0, sys.argv[1])
+from mpi_ros.bag.replay import replay
+wall, cpu = time.perf_counter(), time.thread_time()
+report = replay(sys.argv[2])
+wall, cpu = time.perf_counter() - wall, time.thread_time() - cpu
+print(json.dumps({"wall": wall, "cpu": cpu, "identical": report.identical, "summary": report.summary(),
+                  "last_sample": report.last_sample, "statuses": report.statuses, "values": report.values}))
+"""
 
-    rows = ["| fixture | controller time | statuses compared | replay (wall, best of "
-            f"{rounds}) | x real time | `mpi-ros replay` (wall, with start-up) |",
-            "| --- | --- | --- | --- | --- | --- |"]
-    total_recorded = total_wall = 0.0
-    for bag in sorted(p for p in FIXTURES.iterdir() if p.is_dir()):
-        wall, report = _best(lambda bag=bag: replay(bag), rounds)
-        assert report.identical, report.summary()
-        recorded = report.last_sample / 2000.0  # the fixtures run at the default sample rate
-        command = _command_wall(bag)
-        total_recorded, total_wall = total_recorded + recorded, total_wall + wall
-        rows.append(f"| {bag.name} | {recorded:.2f} s | {report.statuses} ({report.values} values) | "
-                    f"{wall * 1e3:.0f} ms | {recorded / wall:.1f} | {command:.2f} s |")
-    rows.append(f"| all {len(rows) - 2} | {total_recorded:.2f} s | | {total_wall * 1e3:.0f} ms | "
-                f"{total_recorded / total_wall:.1f} | |")
+
+def replay_in(tree: Path, bag: Path) -> dict:
+    """Replay ``bag`` with the package in ``tree``, in a fresh process: wall and thread CPU
+    time of the replay alone (imports and start-up left out), and its report."""
+    done = subprocess.run([sys.executable, "-P", "-c", _MEASURE, str(tree), str(bag)], check=True,
+                          capture_output=True, text=True, env=_env())
+    result = json.loads(done.stdout.splitlines()[-1])
+    assert result["identical"], result["summary"]
+    return result
+
+
+def replay_rows(bags: list[Path], trees: list[tuple[Path, str]], rounds: int) -> list[str]:
+    """Each bag replayed by each tree, the trees alternating ``rounds`` times, best kept;
+    "x real time" is the controller time over the replay's thread CPU time (wall in brackets)."""
+    names = [name for _, name in trees]
+    rows = ["| bag | controller time | statuses compared | " + " | ".join(
+                f"{name}: CPU (wall), best of {rounds} | {name}: x real time, CPU (wall)" for name in names)
+            + (f" | speed-up (CPU) over {names[1]} |" if len(trees) > 1 else " |"),
+            "| --- | --- | --- |" + " --- | --- |" * len(trees) + (" --- |" if len(trees) > 1 else "")]
+    for bag in bags:
+        best: dict[str, dict] = {}
+        for _ in range(rounds):
+            for tree, name in trees:  # alternate, so both see the same load
+                run = replay_in(tree, bag)
+                if name not in best or run["cpu"] < best[name]["cpu"]:
+                    best[name] = run
+        first = best[names[0]]
+        recorded = first["last_sample"] / 2000.0  # the default sample rate
+        row = f"| {bag.name} | {recorded:.1f} s | {first['statuses']} ({first['values']} values) |"
+        for name in names:
+            run = best[name]
+            row += (f" {run['cpu'] * 1e3:,.0f} ms ({run['wall'] * 1e3:,.0f} ms) | "
+                    f"{recorded / run['cpu']:.1f} ({recorded / run['wall']:.1f}) |")
+        if len(trees) > 1:
+            row += f" {best[names[1]]['cpu'] / first['cpu']:.2f}x |"
+        rows.append(row)
     return rows
 
 
-def _command_wall(bag: Path) -> float:
+def command_row(bag: Path) -> str:
+    """The whole ``mpi-ros replay BAG`` command once, interpreter start and imports included."""
     start = time.perf_counter()
     done = subprocess.run([sys.executable, "-P", "-m", "mpi_ros.cli", "replay", str(bag)], capture_output=True,
                           text=True, env=_env())
     wall = time.perf_counter() - start
     assert done.returncode == 0 and "zero differences" in done.stdout, done.stdout + done.stderr
-    return wall
+    return f"`mpi-ros replay {bag.name}` (this tree, start-up included): {wall:.2f} s wall"
 
 
 def _env() -> dict:
     return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)}
+
+
+# -- a long recording -------------------------------------------------------------------------------
+def cycle_commands(samples: int, rate: float = 2000.0) -> list:
+    """Both supervisors of the default configuration busy for ``samples``: S-curve moves
+    back and forth (one every 1.5 s each, the two out of phase), and in turn a STOP and
+    RESUME, an E_STOP and RESET, and a modify of a move in progress; what bench_plot.py's
+    recording does through ROS, here at fixed samples so that the bag is the same every time."""
+    from mpi_ros.bag.scenario import Step
+    from mpi_ros.commands import Command
+
+    period = int(1.5 * rate)
+    steps = []
+    for k, at in enumerate(range(5, samples - period, period // 2)):
+        ms = k % 2
+        sign = (-1) ** (k // 2)
+        move = {"type": "S_CURVE", "position": [sign * 20000.0, sign * 5000.0],
+                "trajectory": [{"velocity": 20000.0, "acceleration": 100000.0, "deceleration": 100000.0,
+                                "jerk_percent": 50.0}]}
+        steps.append(Step(at, Command("motion_start", ms, -1, move)))
+        later = at + period // 5
+        if k % 3 == 1:
+            steps += [Step(later, Command("action", ms, -1, {"action": "STOP"})),
+                      Step(later + 400, Command("action", ms, -1, {"action": "RESUME"}))]
+        elif k % 5 == 2:
+            steps += [Step(later, Command("action", ms, -1, {"action": "E_STOP"})),
+                      Step(later + 300, Command("action", ms, -1, {"action": "RESET"}))]
+        elif k % 7 == 4:
+            modified = {**move, "position": [sign * 15000.0, sign * 3000.0]}
+            steps.append(Step(later, Command("motion_modify", ms, -1, modified)))
+    return sorted(steps, key=lambda step: step.at)
+
+
+def three_minutes(directory: Path, seconds: float = 180.0) -> Path:
+    """A recording of the default configuration (status and joint states at 100 Hz) of
+    ``seconds`` of controller time, made headless (mpi_ros.bag.scenario, as the fixtures
+    are): the same bag every time."""
+    from mpi_ros.bag import scenario
+
+    samples = int(seconds * 2000)
+    return scenario.record(scenario.Scenario("three_minutes", samples, {}, cycle_commands(samples)), directory)
 
 
 # -- write and read ----------------------------------------------------------------------------------
@@ -158,12 +237,23 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--messages", type=int, default=60_000)
+    parser.add_argument("--seconds", type=float, default=180.0, help="the long recording's controller time")
+    parser.add_argument("--baseline", default="none", help="a revision to replay with side by side (git archive)")
+    parser.add_argument("--only", choices=("replay", "write"), help="one part only")
     args = parser.parse_args()
     print(f"Load before: {load_average()}")
-    print()
-    print("\n".join(replay_rows(args.rounds)))
-    print()
-    print("\n".join(write_read_rows(args.messages, args.rounds)))
+    with tempfile.TemporaryDirectory(prefix="bench_bags_") as tmp:
+        if args.only != "write":
+            trees = compared_trees(args.baseline, Path(tmp))
+            long = three_minutes(Path(tmp) / f"recording_{args.seconds:.0f}s", args.seconds)
+            fixtures = sorted(p for p in FIXTURES.iterdir() if p.is_dir())
+            print()
+            print("\n".join(replay_rows([*fixtures, long], trees, args.rounds)))
+            print()
+            print(command_row(long))
+        if args.only != "replay":
+            print()
+            print("\n".join(write_read_rows(args.messages, args.rounds)))
     print()
     print(f"Load after: {load_average()}")
 

@@ -30,9 +30,9 @@ import bench_controller as b
 case, watched = json.loads(sys.argv[3]), sys.argv[4] == "1"
 if watched:
     make = b._controller
-    def _controller(axes, supervisors):
+    def _controller(axes, supervisors, rate=2000.0):
         from mpi_ros.mpi.base.params import AxisFaultConfig
-        ctl = make(axes, supervisors)
+        ctl = make(axes, supervisors, rate)
         for n in range(axes):
             assert ctl.axis_fault_config_set(n, AxisFaultConfig(
                 following_error_limit=1e6, software_limit_positive_enabled=True, software_limit_positive=1e9,

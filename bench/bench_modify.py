@@ -15,7 +15,13 @@ and the package at ``--baseline`` (git archive), best of ``--rounds`` per figure
 must give the same bits: each run digests every axis' values after every step (outside the
 timed calls) and the table says whether the digests agree.
 
+``--ruckig N`` (issue 35) times instead N modifies of a moving one-axis S-curve through the
+controller's public API (MotionSupervisor.modify: validation, planning, loading), each beside
+ruckig's calculate() for the same problem (the cross-check's mapping of the plan the modify
+loaded, bench_planning.ruckig_input), in one process, the two calls alternating.
+
     python -P bench/bench_modify.py [--baseline b39be10] [--rounds 3] [--batches 1 2 5 20]
+    python -P bench/bench_modify.py --ruckig 2000
 """
 
 from __future__ import annotations
@@ -82,6 +88,51 @@ def measure(batch: int, every: int, samples: int, modify: bool) -> dict:
     return {"stepping": stepping, "applying": applying, "mods": mods, "digest": digest.hexdigest()}
 
 
+# -- beside ruckig ---------------------------------------------------------------------------------
+def beside_ruckig(count: int) -> list[str]:
+    """Median and p90 of ``count`` modifies (MotionSupervisor.modify) and of ruckig's
+    calculate() on each one's problem, microseconds, and the ratio of the medians."""
+    import statistics
+
+    from bench_planning import ruckig_input, ruckig_limits
+    from ruckig import Result, Ruckig
+    from ruckig import Trajectory as RuckigTrajectory
+
+    from mpi_ros.mpi import Controller, ControllerConfig, MotionAttr, MotionParams, MPIMotionType, Trajectory
+
+    ctl = Controller(ControllerConfig(axis_count=1, supervisor_count=1))
+    _, ms = ctl.create_motion(0)
+    ms.axis_list_set([0])
+    trajectory = [Trajectory(5000.0, 100000.0, 100000.0, 50.0)]
+    assert ms.start(MPIMotionType.S_CURVE, MotionAttr.NONE, MotionParams(trajectory=trajectory, position=[2000.0])).ok
+    otg, solved = Ruckig(1), RuckigTrajectory(1)
+    ours, theirs, clock = [], [], time.perf_counter
+    for i in range(count):
+        ctl.step(20)  # moving: each modify starts from the velocity and acceleration of the last one
+        params = MotionParams(trajectory=trajectory, position=[2000.0 if i % 2 else -2000.0])
+        t0 = clock()
+        done = ms.modify(MPIMotionType.S_CURVE, MotionAttr.NONE, params)
+        ours.append(clock() - t0)
+        assert done.ok, done
+        plan = ctl.axes[0].plan
+        assert plan is not None
+        inp, _ = ruckig_input(ruckig_limits([plan])[0])
+        t0 = clock()
+        result = otg.calculate(inp, solved)
+        theirs.append(clock() - t0)
+        assert result in (Result.Working, Result.Finished), result
+
+    def figures(times: list[float]) -> tuple[float, float]:
+        return statistics.median(times) * 1e6, statistics.quantiles(times, n=10)[-1] * 1e6
+
+    (ours_median, ours_p90), (ruckig_median, ruckig_p90) = figures(ours), figures(theirs)
+    return ["| modifies | modify median us | modify p90 us | ruckig median us | ruckig p90 us | "
+            "modify / ruckig (medians) |",
+            "| --- | --- | --- | --- | --- | --- |",
+            f"| {count} | {ours_median:.1f} | {ours_p90:.1f} | {ruckig_median:.2f} | {ruckig_p90:.2f} | "
+            f"{ours_median / ruckig_median:.1f}x |"]
+
+
 # -- the table ------------------------------------------------------------------------------
 def per_modify(source: Path, batch: int, every: int, samples: int, rounds: int) -> dict:
     """Microseconds per modify (apply, stepping extra, sum; the least of ``rounds`` runs
@@ -139,5 +190,9 @@ if __name__ == "__main__":
     parser.add_argument("--batches", type=int, nargs="+", default=[1, 2, 5, 20], help="samples stepped at a time")
     parser.add_argument("--every", type=int, default=20, help="samples between modifies of each supervisor")
     parser.add_argument("--seconds", type=float, default=3.0, help="simulated seconds per run")
+    parser.add_argument("--ruckig", type=int, metavar="N", help="time N modifies beside ruckig instead")
     options = parser.parse_args()
+    if options.ruckig:
+        print("\n".join(beside_ruckig(options.ruckig)))
+        sys.exit()
     print("\n".join(main(options.baseline, options.rounds, options.batches, options.every, options.seconds)))
