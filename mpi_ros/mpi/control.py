@@ -42,7 +42,7 @@ from mpi_ros.mpi.base.events import Event, MPIEventType
 from mpi_ros.mpi.base.io import IoImage
 from mpi_ros.mpi.base.masters import SecondaryInputs, Sources
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
-from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
+from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome
 from mpi_ros.mpi.base.params import (
     AxisFaultConfig,
     AxisInPosition,
@@ -59,7 +59,7 @@ from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
 from mpi_ros.mpi.base.wrap import wrap_position, wrap_positions
 from mpi_ros.mpi.faults.monitor import FaultMonitor
 from mpi_ros.mpi.move_log import MoveLog
-from mpi_ros.mpi.supervisor.motion import MotionSupervisor
+from mpi_ros.mpi.supervisor.motion import HANDLE_INVALID, MotionSupervisor
 
 MAX_STRETCH = 4096  # samples computed at once
 EVENTS_KEPT = 10_000  # events Controller.events keeps for a caller that drains them
@@ -135,28 +135,30 @@ class Controller:
             return Message.MPIMotionMessageMOTION_INVALID, None
         ms = MotionSupervisor(self, number, self.motion_defaults)
         if axis is not None:
-            message = ms.axis_append(axis)
-            if not message.ok:
-                return message, None
+            appended = ms.axis_append(axis)
+            if not appended.ok:
+                return appended.message, None
         self._supervisors[number] = ms
         return Message.MPIMessageOK, ms
 
-    def delete_motion(self, ms: MotionSupervisor) -> Message:
+    def delete_motion(self, ms: MotionSupervisor) -> Outcome:
         """mpiMotionDelete (the axes are not deleted)."""
         if not ms.valid or self._supervisors.get(ms.number) is not ms:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
         unmapped = [n for n in ms.axis_list if n not in ms.mapped]
         if unmapped:
-            return Message.MPIAxisMessageNOT_MAPPED_TO_MS
+            return Outcome(Message.MPIAxisMessageNOT_MAPPED_TO_MS,
+                           f"axis_list: axes {unmapped} are listed but not mapped (MAP them or remove them first)")
         if ms.own_state not in (MPIState.IDLE, MPIState.ERROR):
-            return STATE_MESSAGES[ms.own_state.name]
+            return Outcome(STATE_MESSAGES[ms.own_state.name],
+                           f"state: supervisor {ms.number} is {ms.own_state.name} (IDLE or ERROR only)")
         for axis in self.axes:
             if axis.owner == ms.number:
                 axis.unload(self.time, ms.clock)
                 axis.owner = -1
         ms.valid = False
         del self._supervisors[ms.number]
-        return Message.MPIMessageOK
+        return VALID
 
     def supervisor(self, number: int) -> MotionSupervisor | None:
         return self._supervisors.get(number)
@@ -186,7 +188,7 @@ class Controller:
         ms = self._supervisors.get(supervisor)
         if ms is None:
             return Outcome(Message.MPIMotionMessageMOTION_INVALID, f"no supervisor {supervisor}")
-        return ms.action_detail(action, source)
+        return ms.action(action, source)
 
     def responsible_for(self, axis: int) -> list[int]:
         """The supervisors that act on a fault of ``axis``: the one commanding it (if the
@@ -251,75 +253,77 @@ class Controller:
         return self.axes[number]
 
     # -- axis calls ---------------------------------------------------------------------
-    def axis_command_position_set(self, number: int, position: float) -> Message:
+    def axis_command_position_set(self, number: int, position: float) -> Outcome:
         """mpiAxisCommandPositionSet under the rule of MPI 002 (Axis.can_set_command, which
         mpiMotionPositionSet applies too): MPIAxisMessageCOMMAND_NOT_SET while it moves."""
         if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+            return _no_axis(number)
         axis = self.axes[number]
         verdict = check_position("position", position)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         owner = self.supervisor(axis.owner)  # an axis is in its owner's state (IDLE without one)
-        if not axis.can_set_command(owner.own_state if owner is not None else MPIState.IDLE):
-            return Message.MPIAxisMessageCOMMAND_NOT_SET
+        state = owner.own_state if owner is not None else MPIState.IDLE
+        if not axis.can_set_command(state):
+            return Outcome(Message.MPIAxisMessageCOMMAND_NOT_SET,
+                           f"axis: axis {number} cannot take a command position while {state.name}")
         axis.set_command_position(float(position), self.time, owner.clock if owner is not None else None)
-        return Message.MPIMessageOK
+        return VALID
 
-    def axis_actual_position_set(self, number: int, position: float) -> Message:
+    def axis_actual_position_set(self, number: int, position: float) -> Outcome:
         """mpiAxisActualPositionSet (the axis checks the range), at any time: the plant is
         re-anchored along the move the axis follows (its owner's clock)."""
         if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+            return _no_axis(number)
         axis = self.axes[number]
         owner = self.supervisor(axis.owner)
         return axis.set_actual_position(position, self.time, owner.clock if owner is not None else None)
 
-    def axis_origin_set(self, number: int, origin: float) -> Message:
+    def axis_origin_set(self, number: int, origin: float) -> Outcome:
         """mpiAxisOriginSet (the axis checks the range)."""
         if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+            return _no_axis(number)
         return self.axes[number].set_origin(origin)
 
-    def axis_in_position_set(self, number: int, in_position: AxisInPosition) -> Message:
+    def axis_in_position_set(self, number: int, in_position: AxisInPosition) -> Outcome:
         """mpiAxisConfigSet (inPosition), checked by the one AxisInPosition validator (the
         YAML loader and the service use it too) and against the axis' encoder."""
         if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+            return _no_axis(number)
         axis = self.axes[number]
         verdict = in_position.validate()
         if verdict.ok:
             verdict = check_settling_reachable(in_position, axis.plant.config)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         axis.in_position = in_position.copy()
-        return Message.MPIMessageOK
+        return VALID
 
     def axis_master_check(self, number: int, master: AxisMaster) -> Outcome:
         """The one AxisMaster validator, against this controller's axes, motors and I/O words."""
         if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"no axis {number}")
+            return _no_axis(number)
         return master.validate(len(self.axes), self.config.motors, self.config.io_words)
 
-    def axis_master_set(self, number: int, master: AxisMaster) -> Message:
+    def axis_master_set(self, number: int, master: AxisMaster) -> Outcome:
         """mpiAxisConfigSet (master, masterCorrection): used by the next cam the axis runs (a
         running cam keeps the master it started with: docs/cams.md)."""
         verdict = self.axis_master_check(number, master)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         self.axes[number].master = master.copy()
-        return Message.MPIMessageOK
+        return VALID
 
-    def secondary_feedback_set(self, motor: int, feedback: SecondaryFeedback) -> Message:
+    def secondary_feedback_set(self, motor: int, feedback: SecondaryFeedback) -> Outcome:
         """Drive a motor's secondary feedback input (MOTOR_FEEDBACK_SECONDARY masters): from the
         next sample it reads ``feedback.position`` and moves at ``feedback.velocity``."""
         if not 0 <= motor < len(self.secondary):
-            return Message.MPIMessagePARAM_INVALID
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"motor: no motor {motor} ({len(self.secondary)} motors)")
         verdict = feedback.validate()  # the one SecondaryFeedback validator (the YAML's too)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         self.secondary.set(motor, feedback, self.sample)
-        return Message.MPIMessageOK
+        return VALID
 
     def master_sources(self, stretch: Stretch | None = None) -> Sources:
         """Where master positions are read: over ``stretch`` (as far as it is traced), or now."""
@@ -343,7 +347,7 @@ class Controller:
         """The fault limits and actions of an axis (docs/faults.md), checked by the one
         AxisFaultConfig validator (the YAML loader and the service use it too)."""
         if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
+            return _no_axis(number)
         return self.faults.config_set(number, config)
 
     def axis_fault_config_get(self, number: int) -> tuple[Message, AxisFaultConfig]:
@@ -354,7 +358,7 @@ class Controller:
     def axis_fault_inject(self, number: int, fault: object, active: bool = True) -> Outcome:
         """Inject a fault on an axis (faults.FaultMonitor.inject): it acts at once."""
         if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
+            return _no_axis(number)
         return self.faults.inject(number, fault, active)
 
     def frame_count(self, number: int) -> int:
@@ -442,21 +446,21 @@ class Controller:
         )
 
     # -- gates and I/O -------------------------------------------------------------------
-    def gate_set(self, gate: int, closed: bool) -> Message:
+    def gate_set(self, gate: int, closed: bool) -> Outcome:
         """meiControlGateSet: opening a gate releases the moves held on it."""
-        message = self.io.gate_set(gate, closed)
-        if message.ok:
+        outcome = self.io.gate_set(gate, closed)
+        if outcome.ok:
             self._io_changed()
-        return message
+        return outcome
 
     def gate_get(self, gate: int) -> tuple[Message, bool]:
         return self.io.gate_get(gate)
 
-    def io_set(self, space: IoSpace, index: int, value: int, mask: int = -1) -> Message:
-        message = self.io.set(space, index, value, mask)
-        if message.ok:
+    def io_set(self, space: IoSpace, index: int, value: int, mask: int = -1) -> Outcome:
+        outcome = self.io.set(space, index, value, mask)
+        if outcome.ok:
             self._io_changed()
-        return message
+        return outcome
 
     def io_get(self, space: IoSpace, index: int) -> tuple[Message, int]:
         return self.io.get(space, index)
@@ -605,3 +609,8 @@ class Controller:
             found.append((int(np.argmax(reached[i])), int(rows[i]), -1, MPIEventType.FRAME_TIME_LIMIT,
                           "a frame reached 16,384,000 samples: the axis stopped abruptly"))
         return found
+
+
+def _no_axis(number: int) -> Outcome:
+    """MPIAxisMessageAXIS_INVALID for an axis number this controller does not have."""
+    return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")

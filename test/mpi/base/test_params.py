@@ -320,7 +320,7 @@ def test_config_set_refuses_a_feedrate_it_cannot_run(feedrate):
     ctl = Controller()
     ms = _mapped(ctl)
     before = ms.config.copy()
-    assert ms.config_set(MotionConfig(normal_feedrate=feedrate)) is M.MPIMessagePARAM_INVALID
+    assert ms.config_set(MotionConfig(normal_feedrate=feedrate)).message is M.MPIMessagePARAM_INVALID
     assert ms.config == before
     _move_runs_to_idle(ctl, ms)
 
@@ -331,7 +331,7 @@ def test_axis_config_set_refuses_a_settling_time_past_the_sample_counter():
     ctl = Controller()
     ms = _mapped(ctl)
     before = ctl.axes[0].in_position.copy()
-    assert ctl.axis_in_position_set(0, AxisInPosition(settling_time=1e308)) is M.MPIMessagePARAM_INVALID
+    assert ctl.axis_in_position_set(0, AxisInPosition(settling_time=1e308)).message is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].in_position == before
     assert ctl.axis_in_position_set(0, AxisInPosition(settling_time=MAX_DURATION)).ok  # the longest it holds
     ctl.step(5000)
@@ -349,8 +349,8 @@ def test_axis_positions_past_what_a_controller_holds_are_refused(setter):
     # PARAM_INVALID and nothing changes.
     ctl = Controller()
     before = [(a.cmd_p, a.act_p, a.origin) for a in ctl.axes]
-    assert getattr(ctl, setter)(0, 1e308) is M.MPIMessagePARAM_INVALID
-    assert getattr(ctl, setter)(0, -MAX_POSITION * 2) is M.MPIMessagePARAM_INVALID
+    assert getattr(ctl, setter)(0, 1e308).message is M.MPIMessagePARAM_INVALID
+    assert getattr(ctl, setter)(0, -MAX_POSITION * 2).message is M.MPIMessagePARAM_INVALID
     ctl.step(10)
     assert [(a.cmd_p, a.act_p, a.origin) for a in ctl.axes] == before
     assert getattr(ctl, setter)(0, MAX_POSITION).ok

@@ -209,7 +209,7 @@ def test_an_axis_of_another_frame_buffer_size_is_refused_and_nothing_changes(edi
     assert ms.axis_list_get() == (Message.MPIMessageOK, [0, 1])
     assert ms.mapped == [0, 1]
     assert ms.axis_list_set([2, 3]).ok
-    assert ms.axis_append(1) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_append(1).message is Message.MPIMotionMessageAXIS_FRAME_COUNT
 
 
 def test_an_empty_list_takes_any_size_and_same_sizes_mix():
@@ -218,7 +218,7 @@ def test_an_empty_list_takes_any_size_and_same_sizes_mix():
     assert ms.axis_append(1).ok
     assert ms.axis_append(3).ok
     assert ms.axis_append(2).ok
-    assert ms.axis_append(0) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_append(0).message is Message.MPIMotionMessageAXIS_FRAME_COUNT
     assert ms.axis_list_set([0]).ok
     assert ms.frame_buffer_size == 512
 

@@ -74,7 +74,7 @@ def test_config_set_refuses_bad_values(ms, change):
     # -1.0 to 1.0; the times are durations and the feedrates fractions (docs/quality.md, "Robust")
     config = ms.config_get()[1]
     change(config)
-    assert ms.config_set(config) is M.MPIMessagePARAM_INVALID
+    assert ms.config_set(config).message is M.MPIMessagePARAM_INVALID
     assert ms.config_get()[1] == MotionConfig(axis_numbers=[0, 1])
 
 
@@ -205,7 +205,7 @@ def test_params_set_while_moving_that_the_move_refuses_changes_nothing(ctl, ms, 
     assert ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0))).ok
     ctl.step(300)
     before = ms.params_get()[1]
-    assert ms.params_set(params((1.0,))) is M.MPIMessagePARAM_INVALID  # one position for two axes
+    assert ms.params_set(params((1.0,))).message is M.MPIMessagePARAM_INVALID  # one position for two axes
     assert ms.params_get()[1].position == before.position
     assert ms.current.plans[0].target == 100_000.0
 
@@ -257,5 +257,5 @@ def test_action_callback_runs_on_every_call_even_refused(ms):
     # will be executed"
     calls = []
     ms.action_function(lambda motion, kind, action: calls.append(action))
-    assert ms.action(MPIAction.STOP) is M.MPIMotionMessageIDLE
+    assert ms.action(MPIAction.STOP).message is M.MPIMotionMessageIDLE
     assert calls == ["STOP"]

@@ -308,7 +308,7 @@ def test_actions_without_axes_answer_no_axes_mapped(action):
     # mpiMotionAction if there are no axes mapped to the motion object"
     ctl = Controller()
     _, ms = ctl.create_motion(0)
-    assert ms.action(MPIAction[action]) is Message.MEIMotionMessageNO_AXES_MAPPED
+    assert ms.action(MPIAction[action]).message is Message.MEIMotionMessageNO_AXES_MAPPED
     assert ms.state is S.IDLE
 
 
