@@ -80,7 +80,9 @@ def test_validate_after_create_and_delete(ctl, ms):
 def test_delete_while_moving(ctl, ms, bring):
     # MPI 000, Motion Objects, introduction the supervisor's axis map is not changed while the axes move
     bring(MPIState.MOVING)
-    assert ctl.delete_motion(ms).message is M.MPIMotionMessageMOVING
+    refused = ctl.delete_motion(ms)
+    assert refused.message is M.MPIMotionMessageMOVING
+    assert refused.detail == "state: supervisor 0 is MOVING (IDLE or ERROR only)"  # why, from where decided
     assert ms.validate().ok
 
 

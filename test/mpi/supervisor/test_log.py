@@ -69,7 +69,9 @@ def test_log_print_writes_the_buffer(tmp_path, ctl, ms, params):
 def test_log_print_to_a_bad_path(tmp_path, ms):
     # MPI 000, meiMotionLogPrint, filename "*filename a pointer to a file name string" (a file that cannot be opened)
     ms.log_open(10)
-    assert ms.log_print(str(tmp_path / "no" / "such" / "dir" / "x.csv")).message is Message.MPIMessageFILE_OPEN_ERROR
+    refused = ms.log_print(str(tmp_path / "no" / "such" / "dir" / "x.csv"))
+    assert refused.message is Message.MPIMessageFILE_OPEN_ERROR
+    assert refused.detail.startswith("filename: cannot write ")  # the file, and the system's reason
 
 
 def test_log_close_frees_the_buffer(ctl, ms, params):
