@@ -325,6 +325,9 @@ class MotionSupervisor:
         case nothing is stored either."""
         if not self.valid:
             return HANDLE_INVALID
+        verdict = params.validate()  # stored for any later start: every value must be one it can hold
+        if not verdict.ok:
+            return verdict
         current = self._moves.current
         if self._state.own_state is MPIState.MOVING and current is not None:
             outcome = self._command(current.type, current.attributes & ~_START_ONLY, params, modify=True)

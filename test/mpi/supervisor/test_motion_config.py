@@ -189,6 +189,15 @@ def test_params_get_after_a_start_returns_the_start_s_parameters(ms, params):
     assert ms.params_get()[1].position == [300.0, -100.0]
 
 
+def test_params_set_refuses_a_value_no_start_could_use(ms, params):
+    # MPI 000 mpiMotionParamsSet stores the parameters for a later start (params Null): a value no
+    # controller holds is refused now, with the field that holds it, and nothing is stored
+    assert ms.params_set(params((1.0, 2.0))).ok
+    refused = ms.params_set(params((1e300, 0.0)))
+    assert (refused.message, refused.detail.split(":")[0]) == (M.MPIMessagePARAM_INVALID, "position[0]")
+    assert ms.params_get()[1].position == params((1.0, 2.0)).position
+
+
 def test_params_set_while_moving_changes_the_move_on_the_fly(ctl, ms, params, run_to):
     # MPI 000, mpiMotionParamsSet: while a motion runs the new parameters take effect "on-the-fly"
     # (docs/decisions.md: as a modify of the running move's type)
