@@ -29,7 +29,7 @@ from typing import Any
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import CarriesOutcome, Outcome, Refused
-from mpi_ros.mpi.base.params import check_position, check_settling_reachable, first_refusal, shown
+from mpi_ros.mpi.base.params import shown
 from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
 from mpi_ros.mpi.control import Controller
 
@@ -120,12 +120,6 @@ class Reply(CarriesOutcome):
         return self.message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
 
 
-def _refusal_detail(message: Message, verdict: Outcome) -> str:
-    """The validator's words for a refusal the controller answered (a call that returns a
-    bare Message, like the C API): the same validator, so the same verdict."""
-    return verdict.detail if message is verdict.message else ""
-
-
 def _supervisor(ctl: Controller, command: Command):
     ms = ctl.supervisor(command.supervisor)
     if ms is None:
@@ -150,7 +144,7 @@ def _joint_trajectory(ctl: Controller, command: Command) -> Reply:
     STOP."""
     ms = _supervisor(ctl, command)
     if not command.request.get("time_from_start"):
-        return Reply(ms.action_detail(MPIAction.STOP), state=ms.state)
+        return Reply(ms.action(MPIAction.STOP), state=ms.state)
     chunk = trajectory.Chunk.from_request(command.request)
     axes = [j.axis for j in chunk.joints]
     if axes != list(ms.axis_list):
@@ -181,7 +175,7 @@ def _action(ctl: Controller, command: Command) -> Reply:
                         f"unknown action {shown(name)} (STOP, E_STOP, ABORT, E_STOP_ABORT, RESET, RESUME, MAP)",
                         state=ms.state)
     source = ActionSource.CONTROLLER if command.request.get("source") == "CONTROLLER" else ActionSource.USER
-    return Reply(ms.action_detail(action, source), state=ms.state)
+    return Reply(ms.action(action, source), state=ms.state)
 
 
 def _client_lost(ctl: Controller, command: Command) -> Reply:
@@ -193,26 +187,19 @@ def _client_lost(ctl: Controller, command: Command) -> Reply:
     detail = rq.text(command.request.get("detail", ""), "detail")
     move = ms.current or ms.last_move
     ctl.emit(MPIEventType.CLIENT_LOST, supervisor=ms.number, move_id=move.id if move else 0, detail=detail)
-    return Reply(ms.action_detail(MPIAction.STOP, ActionSource.CONTROLLER), state=ms.state)
+    return Reply(ms.action(MPIAction.STOP, ActionSource.CONTROLLER), state=ms.state)
 
 
 def _config_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
     config = rq.motion_config(command.request.get("config", {}))
-    message = ms.config_set(config)  # validates with MotionConfig.validate
-    if message is Message.MPIMotionMessageAXIS_COUNT:  # MPI 000 MPIMotionMessageAXIS_COUNT
-        return Reply.of(message, "the motion supervisor has no axes", state=ms.state)
-    return Reply.of(message, _refusal_detail(message, config.validate()), state=ms.state)
+    return Reply(ms.config_set(config), state=ms.state)
 
 
 def _params_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
     params = rq.motion_params(command.request.get("params", {}))
-    # mpiMotionParamsSet stores them for any later start: every value must be one it can hold
-    verdict = params.validate()
-    if not verdict.ok:
-        return Reply.of(verdict.message, verdict.detail, state=ms.state)
-    return Reply.of(ms.params_set(params), state=ms.state)
+    return Reply(ms.params_set(params), state=ms.state)
 
 
 def _axis_list_set(ctl: Controller, command: Command) -> Reply:
@@ -225,14 +212,12 @@ def _axis_list_set(ctl: Controller, command: Command) -> Reply:
         return Reply.of(Message.MEIMotionMessageNO_AXES_MAPPED, "map true with an empty axis list: nothing to map "
                         "(map false empties the list)", state=ms.state, value=list(ms.axis_list))
     previous = list(ms.axis_list)
-    message = ms.axis_list_set(numbers)
-    detail = ""
-    if message.ok and mapping:
-        mapped = ms.action_detail(MPIAction.MAP)
-        message, detail = mapped.message, mapped.detail
-        if not message.ok:
+    outcome = ms.axis_list_set(numbers)
+    if outcome.ok and mapping:
+        outcome = ms.action(MPIAction.MAP)
+        if not outcome.ok:
             ms.axis_list_set(previous)  # valid a moment ago, in the same state
-    return Reply.of(message, detail, state=ms.state, value=list(ms.axis_list))
+    return Reply(outcome, state=ms.state, value=list(ms.axis_list))
 
 
 def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
@@ -240,44 +225,40 @@ def _axis_list_edit(ctl: Controller, command: Command) -> Reply:
     operation = rq.text(command.request.get("operation", ""), "operation").upper()
     axis = rq.integer(command.request.get("axis", -1), "axis")
     if operation == "APPEND":
-        message = ms.axis_append(axis)
+        outcome = ms.axis_append(axis)
     elif operation == "INSERT":
-        message = ms.axis_insert(rq.integer(command.request.get("after_axis", -1), "after_axis"), axis)
+        outcome = ms.axis_insert(rq.integer(command.request.get("after_axis", -1), "after_axis"), axis)
     elif operation == "REMOVE":
-        message = ms.axis_remove(axis)
+        outcome = ms.axis_remove(axis)
     else:
         return Reply.of(Message.MPIMessagePARAM_INVALID,
                         f"unknown operation {shown(operation)} (APPEND, INSERT, REMOVE)", value=list(ms.axis_list))
-    return Reply.of(message, state=ms.state, value=list(ms.axis_list))
+    return Reply(outcome, state=ms.state, value=list(ms.axis_list))
 
 
 def _position_set(ctl: Controller, command: Command) -> Reply:
     ms = _supervisor(ctl, command)
     actual = rq.numbers(command.request.get("actual", []), "actual")
     commanded = rq.numbers(command.request.get("command", []), "command")
-    message = ms.position_set(actual, commanded)  # checks each with params.check_position
-    ranges = first_refusal(check_position(f"{name}[{i}]", x)
-                           for name, values in (("actual", actual), ("command", commanded))
-                           for i, x in enumerate(values))
-    return Reply.of(message, _refusal_detail(message, ranges), state=ms.state)
+    return Reply(ms.position_set(actual, commanded), state=ms.state)
 
 
 def _event_notify_set(ctl: Controller, command: Command) -> Reply:
     """mpiMotionEventNotifySet, or mpiAxisEventNotifySet for an axis' command."""
     mask = rq.event_mask(command.request.get("event_types"), "event_types")
     if command.operation == Operation.AXIS_EVENT_NOTIFY_SET:
-        return Reply.of(ctl.axis_event_notify_set(command.axis, mask))
-    return Reply.of(_supervisor(ctl, command).event_notify_set(mask))
+        return Reply(ctl.axis_event_notify_set(command.axis, mask))
+    return Reply(_supervisor(ctl, command).event_notify_set(mask))
 
 
 def _event_reset(ctl: Controller, command: Command) -> Reply:
     """mpiMotionEventReset, or mpiAxisEventReset for an axis' command; the events still latched."""
     mask = rq.event_mask(command.request.get("event_types"), "event_types")
     if command.operation == Operation.AXIS_EVENT_RESET:
-        message = ctl.axis_event_reset(command.axis, mask)
-        return Reply.of(message, value=ctl.axes[command.axis].events.latched.names() if message.ok else [])
+        outcome = ctl.axis_event_reset(command.axis, mask)
+        return Reply(outcome, value=ctl.axes[command.axis].events.latched.names() if outcome.ok else [])
     ms = _supervisor(ctl, command)
-    return Reply.of(ms.event_reset(mask), value=ms.latched.names())
+    return Reply(ms.event_reset(mask), value=ms.latched.names())
 
 
 def _axis_amp_enable_set(ctl: Controller, command: Command) -> Reply:
@@ -288,7 +269,7 @@ def _axis_amp_enable_set(ctl: Controller, command: Command) -> Reply:
 
 def _gate_set(ctl: Controller, command: Command) -> Reply:
     r = command.request
-    return Reply.of(ctl.gate_set(rq.integer(r.get("gate", -1), "gate"), rq.boolean(r.get("closed", False), "closed")))
+    return Reply(ctl.gate_set(rq.integer(r.get("gate", -1), "gate"), rq.boolean(r.get("closed", False), "closed")))
 
 
 def io_space(name) -> IoSpace:
@@ -301,8 +282,8 @@ def io_space(name) -> IoSpace:
 
 def _io_set(ctl: Controller, command: Command) -> Reply:
     r = command.request
-    return Reply.of(ctl.io_set(io_space(r.get("space")), rq.integer(r.get("index", -1), "index"),
-                            rq.integer(r.get("value", 0), "value"), rq.integer(r.get("mask", -1), "mask")))
+    return Reply(ctl.io_set(io_space(r.get("space")), rq.integer(r.get("index", -1), "index"),
+                         rq.integer(r.get("value", 0), "value"), rq.integer(r.get("mask", -1), "mask")))
 
 
 def _axis_config_set(ctl: Controller, command: Command) -> Reply:
@@ -310,25 +291,20 @@ def _axis_config_set(ctl: Controller, command: Command) -> Reply:
     request = command.request
     in_position = rq.in_position(request.get("in_position", {}))
     if not 0 <= command.axis < len(ctl.axes):
-        return Reply.of(ctl.axis_in_position_set(command.axis, in_position), f"no axis {command.axis}")
+        return Reply(ctl.axis_in_position_set(command.axis, in_position))
     master = rq.axis_master(request.get("master"), request.get("master_correction"), ctl.axes[command.axis].master)
-    verdict = ctl.axis_master_check(command.axis, master)  # the one AxisMaster validator
+    verdict = ctl.axis_master_check(command.axis, master)  # checked first: all or nothing
     if not verdict.ok:
-        return Reply.of(verdict.message, verdict.prefixed("master.").detail)
-    message = ctl.axis_in_position_set(command.axis, in_position)  # validates with AxisInPosition.validate
-    # (and against the axis' encoder)
-    checks = [in_position.validate(), check_settling_reachable(in_position, ctl.axes[command.axis].plant.config)]
-    if message.ok:
-        message = ctl.axis_master_set(command.axis, master)
-    return Reply.of(message, _refusal_detail(message, first_refusal(checks)))
+        return Reply(verdict.prefixed("master."))
+    outcome = ctl.axis_in_position_set(command.axis, in_position)
+    if outcome.ok:
+        outcome = ctl.axis_master_set(command.axis, master).prefixed("master.")
+    return Reply(outcome)
 
 
 def _secondary_feedback_set(ctl: Controller, command: Command) -> Reply:
     motor, feedback = rq.secondary_feedback(command.request)
-    message = ctl.secondary_feedback_set(motor, feedback)  # validates with SecondaryFeedback.validate
-    if not 0 <= motor < len(ctl.secondary):
-        return Reply.of(message, f"no motor {motor} ({len(ctl.secondary)} motors)")
-    return Reply.of(message, _refusal_detail(message, feedback.validate()))
+    return Reply(ctl.secondary_feedback_set(motor, feedback))
 
 
 def _axis_position_set(ctl: Controller, command: Command) -> Reply:
@@ -341,8 +317,7 @@ def _axis_position_set(ctl: Controller, command: Command) -> Reply:
     }.get(which)
     if setter is None:
         return Reply.of(Message.MPIMessagePARAM_INVALID, f"unknown position {shown(which)} (COMMAND, ACTUAL, ORIGIN)")
-    message = setter(command.axis, value)  # the axis checks the range with params.check_position
-    return Reply.of(message, _refusal_detail(message, check_position("value", value)))
+    return Reply(setter(command.axis, value))
 
 
 def _axis_fault_config_set(ctl: Controller, command: Command) -> Reply:

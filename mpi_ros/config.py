@@ -26,8 +26,7 @@ from mpi_ros import flash
 from mpi_ros.joints import AxisJoint, Joint, axis_joints
 from mpi_ros.mpi.axes.plant import Plant
 from mpi_ros.mpi.base.events import MPIEventType
-from mpi_ros.mpi.base.messages import Message
-from mpi_ros.mpi.base.outcome import VALID, Outcome
+from mpi_ros.mpi.base.outcome import Outcome
 from mpi_ros.mpi.base.params import (
     MAX_COORD_AXES,
     MAX_OBJECTS,
@@ -41,7 +40,6 @@ from mpi_ros.mpi.base.params import (
     SecondaryFeedback,
     check_frame_buffer_size,
     check_settling_reachable,
-    first_refusal,
 )
 from mpi_ros.mpi.base.types import AxisMasterType, MPIAction
 from mpi_ros.mpi.control import Controller
@@ -137,14 +135,13 @@ class SuiteConfig:
         for n, (in_position, plant) in enumerate(zip(self.in_position, self.plant, strict=True)):
             _require(plant.validate(), f"axes[{n}].plant.")
             ctl.axes[n].plant = Plant(plant)  # before the tolerances: they are checked against its encoder
-            _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position",
-                      first_refusal((in_position.validate(), check_settling_reachable(in_position, plant))))
+            _accepted(ctl.axis_in_position_set(n, in_position), f"axes[{n}].in_position.")
         for n, master in enumerate(self.masters):
-            _accepted(ctl.axis_master_set(n, master), f"axes[{n}].master", ctl.axis_master_check(n, master))
+            _accepted(ctl.axis_master_set(n, master), f"axes[{n}].master.")
         for n, feedback in enumerate(self.secondary):
             if feedback == SecondaryFeedback():  # (motor n may not exist: motor_count < axes)
                 continue
-            _accepted(ctl.secondary_feedback_set(n, feedback), f"axes[{n}].secondary_feedback", feedback.validate())
+            _accepted(ctl.secondary_feedback_set(n, feedback), f"axes[{n}].secondary_feedback.")
         for n, faults in enumerate(self.faults):
             _require(ctl.axis_fault_config_set(n, faults), f"axes[{n}].faults.")
         for i, spec in enumerate(self.supervisors):
@@ -154,13 +151,13 @@ class SuiteConfig:
     @staticmethod
     def _build_supervisor(ctl: Controller, spec: SupervisorSpec, where: str) -> None:
         message, ms = ctl.create_motion(spec.number)
-        _accepted(message, f"{where}.number")
+        _accepted(Outcome(message, f"number: cannot create supervisor {spec.number}"), f"{where}.")
         assert ms is not None  # (created: the message was OK)
         # the axes first: mpiMotionConfigSet answers AXIS_COUNT without them (MPI 000)
-        _accepted(ms.axis_list_set(spec.axes), f"{where}.axes")
-        _accepted(ms.config_set(spec.config), f"{where}.config", spec.config.validate())
-        _accepted(ms.event_notify_set(spec.event_notify), f"{where}.event_notify")
-        _accepted(ms.action(MPIAction.MAP), f"{where}.axes")
+        _accepted(ms.axis_list_set(spec.axes), f"{where}.axes: ")
+        _accepted(ms.config_set(spec.config), f"{where}.config.")
+        _accepted(ms.event_notify_set(spec.event_notify), f"{where}.event_notify: ")
+        _accepted(ms.action(MPIAction.MAP), f"{where}.axes: ")
 
 
 def _require(verdict: Outcome, where: str) -> None:
@@ -169,14 +166,11 @@ def _require(verdict: Outcome, where: str) -> None:
         raise ConfigError(f"{where}{verdict.detail}")
 
 
-def _accepted(message: Message, where: str, verdict: Outcome = VALID) -> None:
-    """Stop unless the controller accepted a call; the validator that refused it (if it was
-    one) names the field."""
-    if message.ok:
-        return
-    if message is verdict.message:
-        raise ConfigError(f"{where}.{verdict.detail} (the controller answered {message.name})")
-    raise ConfigError(f"{where}: the controller answered {message.name}")
+def _accepted(outcome: Outcome, where: str) -> None:
+    """Stop unless the controller accepted a call; ``where`` ends where its detail (which
+    names the field first) is appended."""
+    if not outcome.ok:
+        raise ConfigError(f"{where}{outcome.detail} (the controller answered {outcome.message.name})")
 
 
 def merge(base: dict, override: dict) -> dict:

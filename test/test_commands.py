@@ -147,7 +147,8 @@ def test_axis_position_set_past_what_a_controller_holds_is_refused(ctl, which):
     # MPI 002 mpiAxisActualPositionSet, mpiAxisCommandPositionSet, mpiAxisOriginSet
     reply = apply(ctl, Command("axis_position_set", axis=0, request={"which": which, "value": 1e308}))
     assert reply.message is Message.MPIMessagePARAM_INVALID
-    assert reply.detail.startswith("value:")
+    # the detail names the argument of the MPI call (mpiAxisOriginSet's origin, else position)
+    assert reply.detail.startswith("origin:" if which == "ORIGIN" else "position:")
     assert (ctl.axes[0].cmd_p, ctl.axes[0].act_p, ctl.axes[0].origin) == (0.0, 0.0, 0.0)
 
 
@@ -188,6 +189,63 @@ def test_config_set_with_no_axes_answers_axis_count(ctl):
     assert reply.message is Message.MPIMotionMessageAXIS_COUNT
     assert reply.detail
     assert ctl.supervisor(1).config.decel_time.stop == 0.5
+
+
+# ------------------------------------------------------------------ refusals carry why, from where decided ----
+# The controller's calls answer an Outcome (the reference's message and why); the command layer
+# passes it on, so a reply (and the ROS response or goal result made from it) names the field
+# or object first and says why, without running any validator again.
+@pytest.mark.parametrize(("command", "message", "detail"), [
+    # MPI 000 mpiMotionAxisListSet: an axis that does not exist is an invalid handle
+    (Command("axis_list_set", 0, request={"axis_numbers": [0, 9]}), "MPIMessageHANDLE_INVALID",
+     "axis: no axis 9 (4 axes)"),
+    # MPI 000 mpiMotionAxisAppend, MPIMessageOBJECT_ON_LIST: "axis is already on the list"
+    (Command("axis_list_set", 0, request={"axis_numbers": [1, 1], "map": False}), "MPIMessageOBJECT_ON_LIST",
+     "axis_numbers: axis 1 is on the list twice"),
+    (Command("axis_list_edit", 0, request={"operation": "APPEND", "axis": 1}), "MPIMessageOBJECT_ON_LIST",
+     "axis: axis 1 is already on the list"),
+    # MPI 000 mpiMotionAxisInsert / mpiMotionAxisRemove, MPIMotionMessageAXIS_NOT_FOUND
+    (Command("axis_list_edit", 0, request={"operation": "INSERT", "after_axis": 3, "axis": 2}),
+     "MPIMotionMessageAXIS_NOT_FOUND", "after_axis: axis 3 is not on the list"),
+    (Command("axis_list_edit", 0, request={"operation": "REMOVE", "axis": 2}), "MPIMotionMessageAXIS_NOT_FOUND",
+     "axis: axis 2 is not on the list"),
+    # MPI 000 mpiMotionPositionSet: one value per axis
+    (Command("position_set", 0, request={"actual": [1.0], "command": [1.0, 2.0]}), "MPIMessagePARAM_INVALID",
+     "actual: 1 values for 2 axes"),
+    # meiControlGateSet, and the I/O image's words
+    (Command("gate_set", request={"gate": 32, "closed": True}), "MPIMessagePARAM_INVALID", "gate: no gate 32 (0..31)"),
+    (Command("io_set", request={"space": "IO", "index": 999, "value": 1}), "MPIMessagePARAM_INVALID",
+     "index: no IO word 999"),
+    (Command("secondary_feedback_set", request={"motor": 99}), "MPIMessagePARAM_INVALID", "motor: no motor 99"),
+    # MPI 002 mpiAxisConfigSet / mpiAxisOriginSet on an axis the controller does not have
+    (Command("axis_config_set", axis=9, request={}), "MPIAxisMessageAXIS_INVALID", "axis: no axis 9"),
+    (Command("axis_position_set", axis=9, request={"which": "ORIGIN", "value": 1.0}), "MPIAxisMessageAXIS_INVALID",
+     "axis: no axis 9"),
+])
+def test_a_refusal_reaches_the_reply_with_why(ctl, command, message, detail):
+    before = [list(ms.axis_list) for ms in ctl.supervisors], ctl.io.version
+    reply = apply(ctl, command)
+    assert (reply.message, reply.detail[:len(detail)]) == (Message[message], detail)
+    assert ([list(ms.axis_list) for ms in ctl.supervisors], ctl.io.version) == before
+
+
+def test_a_refused_axis_list_set_names_the_state_that_refuses_it(ctl):
+    # MPI 000 mpiMotionAxisListSet while the motion runs: the message of its state, and why
+    assert apply(ctl, Command("motion_start", 0, request=GOAL)).accepted
+    reply = apply(ctl, Command("axis_list_set", 0, request={"axis_numbers": [0]}))
+    assert (reply.message, reply.detail) == (Message.MPIMotionMessageMOVING, "state: supervisor 0 is MOVING")
+    assert reply.value == [0, 1]
+
+
+def test_a_command_position_refused_while_moving_names_the_axis_and_state(ctl):
+    # MPI 002 mpiAxisCommandPositionSet: MPIAxisMessageCOMMAND_NOT_SET while the axis moves
+    assert apply(ctl, Command("motion_start", 0, request=GOAL)).accepted
+    reply = apply(ctl, Command("axis_position_set", axis=0, request={"which": "COMMAND", "value": 5.0}))
+    assert reply.message is Message.MPIAxisMessageCOMMAND_NOT_SET
+    assert reply.detail == "axis: axis 0 cannot take a command position while MOVING"
+    reply = apply(ctl, Command("position_set", 0, request={"actual": [0.0, 0.0], "command": [0.0, 0.0]}))
+    assert reply.message is Message.MPIAxisMessageCOMMAND_NOT_SET
+    assert reply.detail == "command: axis 0 cannot take a command position while MOVING"
 
 
 # ------------------------------------------------------------------ mpiAxisCommandPositionSet: one rule ----

@@ -43,7 +43,7 @@ from mpi_ros.mpi.base.events import MASK_AXIS, Event, MPIEventType
 from mpi_ros.mpi.base.io import IoImage
 from mpi_ros.mpi.base.masters import SecondaryInputs, Sources
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
-from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
+from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome
 from mpi_ros.mpi.base.params import (
     AxisFaultConfig,
     AxisInPosition,
@@ -60,7 +60,7 @@ from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
 from mpi_ros.mpi.base.wrap import wrap_position, wrap_positions
 from mpi_ros.mpi.faults.monitor import FaultMonitor
 from mpi_ros.mpi.move_log import MoveLog
-from mpi_ros.mpi.supervisor.motion import MotionSupervisor
+from mpi_ros.mpi.supervisor.motion import HANDLE_INVALID, MotionSupervisor
 
 MAX_STRETCH = 4096  # samples computed at once
 EVENTS_KEPT = 10_000  # events Controller.events keeps for a caller that drains them
@@ -136,28 +136,30 @@ class Controller:
             return Message.MPIMotionMessageMOTION_INVALID, None
         ms = MotionSupervisor(self, number, self.motion_defaults)
         if axis is not None:
-            message = ms.axis_append(axis)
-            if not message.ok:
-                return message, None
+            appended = ms.axis_append(axis)
+            if not appended.ok:
+                return appended.message, None
         self._supervisors[number] = ms
         return Message.MPIMessageOK, ms
 
-    def delete_motion(self, ms: MotionSupervisor) -> Message:
+    def delete_motion(self, ms: MotionSupervisor) -> Outcome:
         """mpiMotionDelete (the axes are not deleted)."""
         if not ms.valid or self._supervisors.get(ms.number) is not ms:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
         unmapped = [n for n in ms.axis_list if n not in ms.mapped]
         if unmapped:
-            return Message.MPIAxisMessageNOT_MAPPED_TO_MS
+            return Outcome(Message.MPIAxisMessageNOT_MAPPED_TO_MS,
+                           f"axis_list: axes {unmapped} are listed but not mapped (MAP them or remove them first)")
         if ms.own_state not in (MPIState.IDLE, MPIState.ERROR):
-            return STATE_MESSAGES[ms.own_state.name]
+            return Outcome(STATE_MESSAGES[ms.own_state.name],
+                           f"state: supervisor {ms.number} is {ms.own_state.name} (IDLE or ERROR only)")
         for axis in self.axes:
             if axis.owner == ms.number:
                 axis.unload(self.time, ms.clock)
                 axis.owner = -1
         ms.valid = False
         del self._supervisors[ms.number]
-        return Message.MPIMessageOK
+        return VALID
 
     def supervisor(self, number: int) -> MotionSupervisor | None:
         return self._supervisors.get(number)
@@ -194,9 +196,9 @@ class Controller:
     def axis_validate(self, number: int) -> Outcome:
         """mpiAxisValidate (MPI 002): OK for a valid Axis object, HANDLE_INVALID for a deleted one."""
         if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis {number}: no such axis ({len(self.axes)} axes)")
+            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number} ({len(self.axes)} axes)")
         if not self.axes[number].valid:
-            return Outcome(Message.MPIMessageHANDLE_INVALID, f"axis {number} was deleted (mpiAxisCreate it again)")
+            return Outcome(Message.MPIMessageHANDLE_INVALID, f"axis: axis {number} was deleted (create it again)")
         return Outcome(Message.MPIMessageOK)
 
     def valid_axes(self) -> list[int]:
@@ -236,7 +238,7 @@ class Controller:
         ms = self._supervisors.get(supervisor)
         if ms is None:
             return Outcome(Message.MPIMotionMessageMOTION_INVALID, f"no supervisor {supervisor}")
-        return ms.action_detail(action, source)
+        return ms.action(action, source)
 
     def responsible_for(self, axis: int) -> list[int]:
         """The supervisors that act on a fault of ``axis``: the one commanding it (if the
@@ -301,42 +303,48 @@ class Controller:
         return self.axes[number]
 
     # -- axis calls ---------------------------------------------------------------------
-    def axis_command_position_set(self, number: int, position: float) -> Message:
+    def axis_command_position_set(self, number: int, position: float) -> Outcome:
         """mpiAxisCommandPositionSet under the rule of MPI 002 (Axis.can_set_command, which
         mpiMotionPositionSet applies too): MPIAxisMessageCOMMAND_NOT_SET while it moves."""
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         axis = self.axes[number]
         verdict = check_position("position", position)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         owner = self.supervisor(axis.owner)  # an axis is in its owner's state (IDLE without one)
-        if not axis.can_set_command(owner.own_state if owner is not None else MPIState.IDLE):
-            return Message.MPIAxisMessageCOMMAND_NOT_SET
+        state = owner.own_state if owner is not None else MPIState.IDLE
+        if not axis.can_set_command(state):
+            return Outcome(Message.MPIAxisMessageCOMMAND_NOT_SET,
+                           f"axis: axis {number} cannot take a command position while {state.name}")
         axis.set_command_position(float(position), self.time, owner.clock if owner is not None else None)
-        return Message.MPIMessageOK
+        return VALID
 
-    def axis_actual_position_set(self, number: int, position: float) -> Message:
+    def axis_actual_position_set(self, number: int, position: float) -> Outcome:
         """mpiAxisActualPositionSet (the axis checks the range), at any time: the plant is
         re-anchored along the move the axis follows (its owner's clock)."""
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         axis = self.axes[number]
         owner = self.supervisor(axis.owner)
         return axis.set_actual_position(position, self.time, owner.clock if owner is not None else None)
 
-    def axis_origin_set(self, number: int, origin: float) -> Message:
+    def axis_origin_set(self, number: int, origin: float) -> Outcome:
         """mpiAxisOriginSet (the axis checks the range)."""
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         return self.axes[number].set_origin(origin)
 
     def axis_amp_enable_set(self, number: int, enabled: bool) -> Outcome:
         """The amplifier enable of an axis' motor (MPI 000, MPIMessageOBJECT_NOT_ENABLED).
         Disabling an axis that a motion moves, or keeps STOPPED, ABORTs that motion first
         (docs/decisions.md, "Amplifier enable")."""
-        if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"no axis {number}")
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         axis = self.axes[number]
         state = self.own_state_of(axis.owner) if axis.owner >= 0 else None
         detail = "amplifier enabled" if enabled else "amplifier disabled: the motor coasts"
@@ -352,60 +360,61 @@ class Controller:
 
     def axis_event_notify_get(self, number: int) -> tuple[Message, MPIEventType]:
         """mpiAxisEventNotifyGet (MPI 002)."""
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID, MPIEventType.NONE
-        return Message.MPIMessageOK, self.axes[number].events.mask
+        verdict = self.axis_validate(number)
+        return verdict.message, self.axes[number].events.mask if verdict.ok else MPIEventType.NONE
 
-    def axis_event_notify_set(self, number: int, mask: MPIEventType) -> Message:
+    def axis_event_notify_set(self, number: int, mask: MPIEventType) -> Outcome:
         """mpiAxisEventNotifySet (MPI 002): the events an axis generates (MPIEventMaskAXIS) are
         notified when its mask or a mapped supervisor's asks for them (once, not twice)."""
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
-        self.axes[number].events.notify_set(mask)
-        return Message.MPIMessageOK
+        verdict = self.axis_validate(number)
+        if verdict.ok:
+            self.axes[number].events.notify_set(mask)
+        return verdict
 
-    def axis_event_reset(self, number: int, mask: MPIEventType) -> Message:
+    def axis_event_reset(self, number: int, mask: MPIEventType) -> Outcome:
         """mpiAxisEventReset (MPI 002): clear the axis' latched events in ``mask``."""
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
-        self.axes[number].events.reset(mask)
-        return Message.MPIMessageOK
+        verdict = self.axis_validate(number)
+        if verdict.ok:
+            self.axes[number].events.reset(mask)
+        return verdict
 
-    def axis_in_position_set(self, number: int, in_position: AxisInPosition) -> Message:
+    def axis_in_position_set(self, number: int, in_position: AxisInPosition) -> Outcome:
         """mpiAxisConfigSet (inPosition), checked by the one AxisInPosition validator (the
         YAML loader and the service use it too) and against the axis' encoder."""
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         axis = self.axes[number]
         verdict = in_position.validate()
         if verdict.ok:
             verdict = check_settling_reachable(in_position, axis.plant.config)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         axis.in_position = in_position.copy()
-        return Message.MPIMessageOK
+        return VALID
 
     def axis_master_check(self, number: int, master: AxisMaster) -> Outcome:
         """The one AxisMaster validator, against this controller's axes, motors and I/O words."""
-        if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"no axis {number}")
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         return master.validate(len(self.axes), self.config.motors, self.config.io_words)
 
-    def axis_master_set(self, number: int, master: AxisMaster) -> Message:
+    def axis_master_set(self, number: int, master: AxisMaster) -> Outcome:
         """mpiAxisConfigSet (master, masterCorrection): used by the next cam the axis runs (a
         running cam keeps the master it started with: docs/cams.md)."""
         verdict = self.axis_master_check(number, master)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         motor = master.encoder_fault_motor_number
         if motor is not None:  # its home is the fault configuration (AxisMaster's docstring)
             faults = self.faults.axes[number].config.copy()
             faults.encoder_fault_motor_number = motor
             verdict = self.faults.config_set(number, faults)  # (trips if that encoder faults now)
             if not verdict.ok:
-                return verdict.message
+                return verdict
         self.axes[number].master = dataclasses.replace(master, encoder_fault_motor_number=None)
-        return Message.MPIMessageOK
+        return VALID
 
     def axis_master_get(self, number: int) -> AxisMaster:
         """mpiAxisConfigGet's master (MPIAxisMaster, with masterCorrection), encoderFaultMotorNumber
@@ -413,16 +422,16 @@ class Controller:
         motor = self.faults.axes[number].config.encoder_fault_motor_number
         return dataclasses.replace(self.axes[number].master, encoder_fault_motor_number=motor)
 
-    def secondary_feedback_set(self, motor: int, feedback: SecondaryFeedback) -> Message:
+    def secondary_feedback_set(self, motor: int, feedback: SecondaryFeedback) -> Outcome:
         """Drive a motor's secondary feedback input (MOTOR_FEEDBACK_SECONDARY masters): from the
         next sample it reads ``feedback.position`` and moves at ``feedback.velocity``."""
         if not 0 <= motor < len(self.secondary):
-            return Message.MPIMessagePARAM_INVALID
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"motor: no motor {motor} ({len(self.secondary)} motors)")
         verdict = feedback.validate()  # the one SecondaryFeedback validator (the YAML's too)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         self.secondary.set(motor, feedback, self.sample)
-        return Message.MPIMessageOK
+        return VALID
 
     def master_sources(self, stretch: Stretch | None = None) -> Sources:
         """Where master positions are read: over ``stretch`` (as far as it is traced), or now."""
@@ -445,19 +454,20 @@ class Controller:
     def axis_fault_config_set(self, number: int, config: AxisFaultConfig) -> Outcome:
         """The fault limits and actions of an axis (docs/faults.md), checked by the one
         AxisFaultConfig validator (the YAML loader and the service use it too)."""
-        if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         return self.faults.config_set(number, config)
 
     def axis_fault_config_get(self, number: int) -> tuple[Message, AxisFaultConfig]:
-        if not 0 <= number < len(self.axes):
-            return Message.MPIAxisMessageAXIS_INVALID, AxisFaultConfig()
-        return Message.MPIMessageOK, self.faults.axes[number].config.copy()
+        verdict = self.axis_validate(number)
+        return verdict.message, self.faults.axes[number].config.copy() if verdict.ok else AxisFaultConfig()
 
     def axis_fault_inject(self, number: int, fault: object, active: bool = True) -> Outcome:
         """Inject a fault on an axis (faults.FaultMonitor.inject): it acts at once."""
-        if not 0 <= number < len(self.axes):
-            return Outcome(Message.MPIAxisMessageAXIS_INVALID, f"axis: no axis {number}")
+        verdict = self.axis_validate(number)
+        if not verdict.ok:
+            return verdict
         return self.faults.inject(number, fault, active)
 
     def frame_count(self, number: int) -> int:
@@ -545,21 +555,21 @@ class Controller:
         )
 
     # -- gates and I/O -------------------------------------------------------------------
-    def gate_set(self, gate: int, closed: bool) -> Message:
+    def gate_set(self, gate: int, closed: bool) -> Outcome:
         """meiControlGateSet: opening a gate releases the moves held on it."""
-        message = self.io.gate_set(gate, closed)
-        if message.ok:
+        outcome = self.io.gate_set(gate, closed)
+        if outcome.ok:
             self._io_changed()
-        return message
+        return outcome
 
     def gate_get(self, gate: int) -> tuple[Message, bool]:
         return self.io.gate_get(gate)
 
-    def io_set(self, space: IoSpace, index: int, value: int, mask: int = -1) -> Message:
-        message = self.io.set(space, index, value, mask)
-        if message.ok:
+    def io_set(self, space: IoSpace, index: int, value: int, mask: int = -1) -> Outcome:
+        outcome = self.io.set(space, index, value, mask)
+        if outcome.ok:
             self._io_changed()
-        return message
+        return outcome
 
     def io_get(self, space: IoSpace, index: int) -> tuple[Message, int]:
         return self.io.get(space, index)

@@ -54,8 +54,8 @@ def test_delete_then_create_while_running(ctl: Controller, ms, ms1, params, run_
     assert ctl.axis_delete(3).message is Message.MPIMessageHANDLE_INVALID
     assert ctl.axis_control(3) is None  # mpiAxisControl: MPIHandleVOID "if axis is invalid"
     # MPI 000, mpiMotionAxisAppend: MPIMessageHANDLE_INVALID "Either motion or axis is an invalid handle"
-    assert ms1.axis_append(3) is Message.MPIMessageHANDLE_INVALID
-    assert ms1.axis_list_set([2, 3]) is Message.MPIMessageHANDLE_INVALID
+    assert ms1.axis_append(3).message is Message.MPIMessageHANDLE_INVALID
+    assert ms1.axis_list_set([2, 3]).message is Message.MPIMessageHANDLE_INVALID
     assert ms1.axis_list == [2]
     assert ctl.valid_axes() == [0, 1, 2]
     run_to(ctl, ms, MPIState.IDLE)  # the controller keeps stepping every axis

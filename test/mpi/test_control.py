@@ -68,19 +68,21 @@ def test_validate_after_create_and_delete(ctl, ms):
     # "invalidates its handle"; MPI 000, mpiMotionDelete "does not delete any of the Axis objects"
     assert ms.validate().ok
     assert ctl.delete_motion(ms).ok
-    assert ms.validate() is M.MPIMessageHANDLE_INVALID
+    assert ms.validate().message is M.MPIMessageHANDLE_INVALID
     assert ctl.supervisor(0) is None
     assert len(ctl.axes) == 4
-    assert ctl.delete_motion(ms) is M.MPIMessageHANDLE_INVALID
+    assert ctl.delete_motion(ms).message is M.MPIMessageHANDLE_INVALID
     assert ms.start(T.TRAPEZOIDAL) is M.MPIMessageHANDLE_INVALID
-    assert ms.action(MPIAction.STOP) is M.MPIMessageHANDLE_INVALID
+    assert ms.action(MPIAction.STOP).message is M.MPIMessageHANDLE_INVALID
     assert ctl.create_motion(0)[0].ok  # the number is free again
 
 
 def test_delete_while_moving(ctl, ms, bring):
     # MPI 000, Motion Objects, introduction the supervisor's axis map is not changed while the axes move
     bring(MPIState.MOVING)
-    assert ctl.delete_motion(ms) is M.MPIMotionMessageMOVING
+    refused = ctl.delete_motion(ms)
+    assert refused.message is M.MPIMotionMessageMOVING
+    assert refused.detail == "state: supervisor 0 is MOVING (IDLE or ERROR only)"  # why, from where decided
     assert ms.validate().ok
 
 

@@ -71,7 +71,7 @@ def test_map_of_other_axes_while_stopped_drops_the_pending_profile(ctl, ms):
     assert ms.axis_list_set([2]).ok
     assert ms.action(A.MAP).ok
     assert ms.state is MPIState.IDLE
-    assert ms.action(A.RESUME) is Message.MPIMotionMessageIDLE
+    assert ms.action(A.RESUME).message is Message.MPIMotionMessageIDLE
     ctl.step(2000)
     assert moving_axes(ctl) == []
 
@@ -94,7 +94,7 @@ def test_remap_refused_while_a_leaving_axis_still_creeps(ctl, ms):
     stopped_mid_move(ctl, ms)
     assert ctl.axes[0].cmd_v > 0.0
     assert ms.axis_list_set([2]).ok
-    assert ms.action(A.MAP) is Message.MPIMotionMessageSTOPPED
+    assert ms.action(A.MAP).message is Message.MPIMotionMessageSTOPPED
     assert ms.mapped == [0, 1]
     assert ms.state is MPIState.STOPPED
 
@@ -155,7 +155,7 @@ def test_resume_from_a_second_supervisor_continues_the_shared_motion(ctl):
 
 def test_stop_from_a_second_supervisor_with_nothing_moving_is_refused(ctl):
     a, b = sharing_axis_1(ctl)
-    assert b.action(A.STOP) is Message.MPIMotionMessageIDLE
+    assert b.action(A.STOP).message is Message.MPIMotionMessageIDLE
     assert a.state is MPIState.IDLE
     assert b.state is MPIState.IDLE
 
@@ -250,7 +250,7 @@ def test_a_reset_refused_by_a_fault_on_a_shared_axis_names_the_fault(ctl):
     ctl.step(100)
     assert ctl.axis_fault_inject(1, "AMP_FAULT", True).message.ok
     run_to_state(ctl, b, MPIState.ERROR)
-    outcome = a.action_detail(A.RESET)
+    outcome = a.action(A.RESET)
     assert outcome.message is Message.MPIMotionMessageERROR
     assert "axis 1 AMP_FAULT persists" in outcome.detail
     assert "supervisor 1" in outcome.detail

@@ -262,6 +262,20 @@ def test_trigger_services_answer_the_spec_message(suite, probe, service):
     assert reset.message.startswith("MPIMessageOK")
 
 
+def test_a_refused_axis_list_set_service_carries_the_controllers_words(suite, probe, service, applied):
+    # MPI 000 mpiMotionAxisListSet: an axis that does not exist is an invalid handle. The node passes the
+    # controller's outcome on as it is: the response's message, and the reply (commands topic, recordings,
+    # the Python client) names the axis and why; nothing changes.
+    from mpi_ros.srv import AxisListGet, AxisListSet
+
+    answer = service(probe, AxisListSet, "/mpi/ms0/axis_list_set", AxisListSet.Request(axis_numbers=[0, 9]))
+    assert answer.message == "MPIMessageHANDLE_INVALID"
+    _, command, reply = applied.wait(1)
+    assert (command.operation, reply.message.name, reply.detail) == (
+        "axis_list_set", "MPIMessageHANDLE_INVALID", "axis: no axis 9 (4 axes)")
+    assert list(service(probe, AxisListGet, "/mpi/ms0/axis_list_get", AxisListGet.Request()).axis_numbers) == [0, 1]
+
+
 def test_action_service_rejects_unknown_actions(suite, probe, service):
     from mpi_ros.srv import MotionAction
 

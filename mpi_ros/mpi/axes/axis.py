@@ -32,7 +32,7 @@ from mpi_ros.mpi.axes.status import AxisStatusBits, StatusMode, bits_of, column_
 from mpi_ros.mpi.base import masters
 from mpi_ros.mpi.base.clock import ProfileClock
 from mpi_ros.mpi.base.events import EventNotify
-from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import VALID, Outcome
 from mpi_ros.mpi.base.params import AxisInPosition, AxisMaster, PlantConfig, check_position
 from mpi_ros.mpi.base.types import MPIState
 from mpi_ros.mpi.base.wrap import turn_offset, wrap_position
@@ -236,28 +236,28 @@ class Axis:
         offset = turn_offset(raw - self.origin)
         return self.origin if offset == 0.0 else self.origin + offset
 
-    def set_origin(self, origin: float) -> Message:
+    def set_origin(self, origin: float) -> Outcome:
         """mpiAxisOriginSet: reported positions are raw positions minus the origin."""
         verdict = check_position("origin", origin)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         self.origin = float(origin)
-        return Message.MPIMessageOK
+        return VALID
 
-    def set_actual_position(self, position: float, t: float, clock: ProfileClock | None = None) -> Message:
+    def set_actual_position(self, position: float, t: float, clock: ProfileClock | None = None) -> Outcome:
         """mpiAxisActualPositionSet: the encoder now reads ``position``. The command is
         untouched, so the loop sees the new error and moves to remove it. ``clock`` is the
         owning supervisor's: the plant is re-anchored along the plan the axis follows."""
         verdict = check_position("position", position)
         if not verdict.ok:
-            return verdict.message
+            return verdict
         delta = (float(position) + self.origin) - self.act_p
         if clock is None:  # without the clock only a resting command can be followed
             self._retire_finished_plan(t, None)
         self.rebase(t, clock)
         self.state = PlantState(self.state.t, self.state.y + delta, self.state.dy)
         self.act_p += delta
-        return Message.MPIMessageOK
+        return VALID
 
     def can_set_command(self, state: MPIState) -> bool:
         """The one rule of mpiAxisCommandPositionSet (MPI 002, "mpiAxisCommandPositionSet(...)

@@ -9,6 +9,7 @@ I/O word). Words are 32-bit.
 from __future__ import annotations
 
 from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import VALID, Outcome
 from mpi_ros.mpi.base.params import MAX_GATES
 from mpi_ros.mpi.base.types import IoSpace
 
@@ -33,27 +34,35 @@ class IoImage:
     def _valid(self, space: IoSpace, index: int) -> bool:
         return 0 <= index < len(self.words[space])
 
+    def _check_word(self, space: IoSpace, index: int) -> Outcome:
+        if self._valid(space, index):
+            return VALID
+        return Outcome(Message.MPIMessagePARAM_INVALID,
+                       f"index: no {space.value} word {index} ({len(self.words[space])} words)")
+
     def get(self, space: IoSpace, index: int) -> tuple[Message, int]:
         if not self._valid(space, index):
             return Message.MPIMessagePARAM_INVALID, 0
         return Message.MPIMessageOK, self.words[space][index]
 
-    def set(self, space: IoSpace, index: int, value: int, mask: int = -1) -> Message:
-        if not self._valid(space, index):
-            return Message.MPIMessagePARAM_INVALID
+    def set(self, space: IoSpace, index: int, value: int, mask: int = -1) -> Outcome:
+        verdict = self._check_word(space, index)
+        if not verdict.ok:
+            return verdict
         old = self.words[space][index]
         self.words[space][index] = _to_int32((old & ~mask) | (value & mask))
         self.version += 1
-        return Message.MPIMessageOK
+        return VALID
 
-    def apply_masks(self, space: IoSpace, index: int, on_mask: int, off_mask: int) -> Message:
+    def apply_masks(self, space: IoSpace, index: int, on_mask: int, off_mask: int) -> Outcome:
         """Turn bits on and off (MEIMotionAttrOutput onMask/offMask)."""
-        if not self._valid(space, index):
-            return Message.MPIMessagePARAM_INVALID
+        verdict = self._check_word(space, index)
+        if not verdict.ok:
+            return verdict
         old = self.words[space][index]
         self.words[space][index] = _to_int32((old | on_mask) & ~off_mask)
         self.version += 1
-        return Message.MPIMessageOK
+        return VALID
 
     def matches(self, space: IoSpace, index: int, mask: int, pattern: int) -> bool:
         if not self._valid(space, index):
@@ -61,12 +70,13 @@ class IoImage:
         return (self.words[space][index] & mask & _WORD) == (pattern & _WORD)
 
     # -- gates (meiControlGateSet/Get) -----------------------------------------------
-    def gate_set(self, gate: int, closed: bool) -> Message:
+    def gate_set(self, gate: int, closed: bool) -> Outcome:
+        """meiControlGateSet."""
         if not 0 <= gate < MAX_GATES:
-            return Message.MPIMessagePARAM_INVALID
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"gate: no gate {gate} (0..{MAX_GATES - 1})")
         self.gates_closed[gate] = bool(closed)
         self.version += 1
-        return Message.MPIMessageOK
+        return VALID
 
     def gate_get(self, gate: int) -> tuple[Message, bool]:
         if not 0 <= gate < MAX_GATES:

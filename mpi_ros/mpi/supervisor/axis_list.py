@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import VALID, Outcome
 from mpi_ros.mpi.base.params import MAX_COORD_AXES
 from mpi_ros.mpi.base.types import MPIState
 
@@ -44,68 +45,82 @@ class AxisList:
         list set), so a list never holds two sizes and MAP and the moves need not ask."""
         return len({self._config.frame_buffer_size_of(n) for n in numbers}) > 1
 
-    def _check_axis(self, number: int) -> Message:
+    def _check_axis(self, number: int) -> Outcome:
         # MPI 000, mpiMotionAxisAppend: HANDLE_INVALID for no such axis or a deleted Axis object
-        if not 0 <= number < len(self._axes) or not self._axes[number].valid:
-            return Message.MPIMessageHANDLE_INVALID
+        if not 0 <= number < len(self._axes):
+            return Outcome(Message.MPIMessageHANDLE_INVALID, f"axis: no axis {number} ({len(self._axes)} axes)")
+        if not self._axes[number].valid:
+            return Outcome(Message.MPIMessageHANDLE_INVALID, f"axis: axis {number} was deleted (mpiAxisDelete)")
         if not self._axes[number].enabled:
-            return Message.MPIMessageOBJECT_NOT_ENABLED
-        return OK
+            return Outcome(Message.MPIMessageOBJECT_NOT_ENABLED, f"axis: axis {number} is not enabled")
+        return VALID
 
-    def append(self, number: int) -> Message:
+    def _check_new(self, numbers: list[int], unchecked: list[int]) -> Outcome:
+        """What a new list of ``numbers`` must be (insert, append and list set alike);
+        ``unchecked``: its axes not yet known to exist and be enabled."""
+        if len(numbers) > MAX_COORD_AXES:
+            return Outcome(Message.MPIMessageUNSUPPORTED,
+                           f"axis_numbers: {len(numbers)} axes, a motion coordinates at most {MAX_COORD_AXES}")
+        repeated = sorted({n for n in numbers if numbers.count(n) > 1})
+        if repeated:
+            return Outcome(Message.MPIMessageOBJECT_ON_LIST, f"axis_numbers: axis {repeated[0]} is on the list twice")
+        for number in unchecked:
+            verdict = self._check_axis(number)
+            if not verdict.ok:
+                return verdict
+        if self._frame_sizes_differ(numbers):
+            sizes = {n: self._config.frame_buffer_size_of(n) for n in numbers}
+            return Outcome(Message.MPIMotionMessageAXIS_FRAME_COUNT,
+                           f"axis_numbers: the axes' frame buffer sizes differ ({sizes})")
+        return VALID
+
+    def append(self, number: int) -> Outcome:
         """mpiMotionAxisAppend."""
         return self.insert(self.listed[-1] if self.listed else None, number)
 
-    def insert(self, after: int | None, number: int) -> Message:
+    def insert(self, after: int | None, number: int) -> Outcome:
         """mpiMotionAxisInsert: insert ``number`` just after axis ``after`` (None: first)."""
-        message = self._check_axis(number)
-        if not message.ok:
-            return message
-        if number in self.listed:
-            return Message.MPIMessageOBJECT_ON_LIST
-        if len(self.listed) >= MAX_COORD_AXES:
-            return Message.MPIMessageUNSUPPORTED
-        if self._frame_sizes_differ([*self.listed, number]):
-            return Message.MPIMotionMessageAXIS_FRAME_COUNT
+        verdict = self._check_axis(number)
+        if verdict.ok and number in self.listed:
+            verdict = Outcome(Message.MPIMessageOBJECT_ON_LIST, f"axis: axis {number} is already on the list")
+        if not verdict.ok:
+            return verdict
+        verdict = self._check_new([*self.listed, number], [])
+        if not verdict.ok:
+            return verdict
         if after is None:
             self.listed.insert(0, number)
-            return OK
+            return VALID
         if after not in self.listed:
-            return Message.MPIMotionMessageAXIS_NOT_FOUND
+            return _not_listed("after_axis", after)
         self.listed.insert(self.listed.index(after) + 1, number)
-        return OK
+        return VALID
 
-    def remove(self, number: int, own_state: MPIState, refusal: Message) -> Message:
-        """mpiMotionAxisRemove; ``refusal``: the message of the state the supervisor shows."""
-        message = self._check_axis(number)
-        if not message.ok:
-            return message
+    def remove(self, number: int, own_state: MPIState, refusal: Outcome) -> Outcome:
+        """mpiMotionAxisRemove; ``refusal``: the answer of the state the supervisor shows."""
+        verdict = self._check_axis(number)
+        if not verdict.ok:
+            return verdict
         if number not in self.listed:
-            return Message.MPIMotionMessageAXIS_NOT_FOUND
+            return _not_listed("axis", number)
         if number not in self.mapped:
             # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS: on the list but not mapped.
-            return Message.MPIAxisMessageNOT_MAPPED_TO_MS
+            return Outcome(Message.MPIAxisMessageNOT_MAPPED_TO_MS,
+                           f"axis: axis {number} is listed but not mapped (MAP the list first)")
         if own_state not in (MPIState.IDLE, MPIState.ERROR):
             return refusal
         self.listed.remove(number)
-        return OK
+        return VALID
 
-    def set(self, numbers: list[int], own_state: MPIState, refusal: Message) -> Message:
+    def set(self, numbers: list[int], own_state: MPIState, refusal: Outcome) -> Outcome:
         """mpiMotionAxisListSet: the coordinate system is completely replaced."""
-        if len(numbers) > MAX_COORD_AXES:
-            return Message.MPIMessageUNSUPPORTED
-        if len(set(numbers)) != len(numbers):
-            return Message.MPIMessageOBJECT_ON_LIST
-        for number in numbers:
-            message = self._check_axis(number)
-            if not message.ok:
-                return message
-        if self._frame_sizes_differ(numbers):
-            return Message.MPIMotionMessageAXIS_FRAME_COUNT
+        verdict = self._check_new(numbers, numbers)
+        if not verdict.ok:
+            return verdict
         if own_state not in (MPIState.IDLE, MPIState.ERROR, MPIState.STOPPED):
             return refusal
         self.listed = list(numbers)
-        return OK
+        return VALID
 
     def index(self, number: int) -> int:
         """mpiMotionAxisIndex: -1 if not on the list."""
@@ -132,3 +147,7 @@ class AxisList:
         """Write the list as the mapping (MEIActionMAP); returns it."""
         self.mapped = list(self.listed)
         return self.mapped
+
+
+def _not_listed(field: str, number: int) -> Outcome:
+    return Outcome(Message.MPIMotionMessageAXIS_NOT_FOUND, f"{field}: axis {number} is not on the list")

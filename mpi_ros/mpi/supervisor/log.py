@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mpi_ros.mpi.base.messages import Message
+from mpi_ros.mpi.base.outcome import VALID, Outcome
 
 
 @dataclass(slots=True)
@@ -37,7 +38,7 @@ class MotionLog:
         self.columns.append(np.column_stack(cols) if cols else np.zeros((n, 0)))
         self.count += n
 
-    def write(self, filename: str, axes: list[int]) -> Message:
+    def write(self, filename: str, axes: list[int]) -> Outcome:
         header = ["sample", "state"]
         for a in axes:
             header += [f"axis{a}_command", f"axis{a}_actual", f"axis{a}_velocity"]
@@ -48,6 +49,6 @@ class MotionLog:
                     for i, sample in enumerate(samples):
                         values = ",".join(repr(float(x)) for x in cols[i])
                         out.write(f"{int(sample)},{state}" + (f",{values}" if values else "") + "\n")
-        except OSError:
-            return Message.MPIMessageFILE_OPEN_ERROR
-        return Message.MPIMessageOK
+        except OSError as exc:
+            return Outcome(Message.MPIMessageFILE_OPEN_ERROR, f"filename: cannot write {filename!r}: {exc.strerror}")
+        return VALID

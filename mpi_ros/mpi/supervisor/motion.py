@@ -1,7 +1,8 @@
 """MotionSupervisor: the Motion object of MPI 000 (mpiMotion*).
 
-Every method answers a :class:`Message` (and a value where the C API writes one), or an
-Outcome where the words matter. A refused call changes nothing. State transitions follow
+Every call that can be refused answers an :class:`Outcome` (the reference's message and why,
+decided where it is refused); a getter answers a :class:`Message` and the value the C API
+writes. A refused call changes nothing. State transitions follow
 MPI 000 and docs/state-machine.md; the controller calls :meth:`scan`/:meth:`transition`
 while it steps so motion-driven transitions (DONE, stop complete, hold release) happen at
 the exact sample their condition is met.
@@ -28,7 +29,7 @@ from mpi_ros.mpi.base.clock import ProfileClock
 from mpi_ros.mpi.base.events import EventNotify, MPIEventType
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
 from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome, Refused
-from mpi_ros.mpi.base.params import AxisMaster, MotionConfig, MotionParams, check_position
+from mpi_ros.mpi.base.params import AxisMaster, MotionConfig, MotionParams, check_position, first_refusal
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, FrameBufferStatus, MotionSnapshot
 from mpi_ros.mpi.base.types import (
     HOLD_ATTRS,
@@ -52,6 +53,8 @@ from mpi_ros.mpi.supervisor.state import SupervisorState
 from mpi_ros.mpi.supervisor.stepping import Transitions
 
 OK = Message.MPIMessageOK
+HANDLE_INVALID = Outcome(Message.MPIMessageHANDLE_INVALID, "motion: invalid handle (the supervisor was deleted)")
+NO_AXES = Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes")
 # Attributes that belong to a start, not to the on-the-fly modify of mpiMotionParamsSet.
 # Bits read on every start and modify, as plain ints (an IntFlag's ``in`` is a Python call).
 _APPEND, _AUTO_START, _DELAY = int(MotionAttr.APPEND), int(MotionAttr.AUTO_START), int(MotionAttr.DELAY)
@@ -190,9 +193,9 @@ class MotionSupervisor:
         return self._moves.element_id(self._moves.current or self._moves.last_move)
 
     # ================================================================= handles ====
-    def validate(self) -> Message:
+    def validate(self) -> Outcome:
         """mpiMotionValidate."""
-        return OK if self.valid else Message.MPIMessageHANDLE_INVALID
+        return VALID if self.valid else HANDLE_INVALID
 
     def _axis(self, number: int) -> Axis:
         return self._host.axes[number]
@@ -209,29 +212,31 @@ class MotionSupervisor:
         commanding its axes (MPI 000: status is derived from each axis' status)."""
         return self._moves.shown_state()
 
-    def _state_message(self) -> Message:
-        return STATE_MESSAGES[self.state.name]
+    def _state_refusal(self) -> Outcome:
+        """The answer of a call the state refuses: the message of the state shown."""
+        state = self.state
+        return Outcome(STATE_MESSAGES[state.name], f"state: supervisor {self.number} is {state.name}")
 
     # ================================================================= axis list ====
-    def axis_append(self, number: int) -> Message:
+    def axis_append(self, number: int) -> Outcome:
         """mpiMotionAxisAppend."""
-        return self._axis_list.append(number) if self.valid else Message.MPIMessageHANDLE_INVALID
+        return self._axis_list.append(number) if self.valid else HANDLE_INVALID
 
-    def axis_insert(self, after: int | None, number: int) -> Message:
+    def axis_insert(self, after: int | None, number: int) -> Outcome:
         """mpiMotionAxisInsert: insert ``number`` just after axis ``after`` (None: first)."""
-        return self._axis_list.insert(after, number) if self.valid else Message.MPIMessageHANDLE_INVALID
+        return self._axis_list.insert(after, number) if self.valid else HANDLE_INVALID
 
-    def axis_remove(self, number: int) -> Message:
+    def axis_remove(self, number: int) -> Outcome:
         """mpiMotionAxisRemove."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
-        return self._axis_list.remove(number, self._state.own_state, self._state_message())
+            return HANDLE_INVALID
+        return self._axis_list.remove(number, self._state.own_state, self._state_refusal())
 
-    def axis_list_set(self, numbers: list[int]) -> Message:
+    def axis_list_set(self, numbers: list[int]) -> Outcome:
         """mpiMotionAxisListSet: the coordinate system is completely replaced."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
-        return self._axis_list.set(numbers, self._state.own_state, self._state_message())
+            return HANDLE_INVALID
+        return self._axis_list.set(numbers, self._state.own_state, self._state_refusal())
 
     def axis_list_get(self) -> tuple[Message, list[int]]:
         return (OK, self.axis_list) if self.valid else (Message.MPIMessageHANDLE_INVALID, [])
@@ -262,14 +267,10 @@ class MotionSupervisor:
         return self._axis_list.neighbour(number, -1) if self.valid else (Message.MPIMessageHANDLE_INVALID, None)
 
     # ================================================================= actions ====
-    def action(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Message:
+    def action(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Outcome:
         """mpiMotionAction."""
-        return self.action_detail(action, source).message
-
-    def action_detail(self, action: MPIAction, source: ActionSource = ActionSource.USER) -> Outcome:
-        """mpiMotionAction, with why in words."""
         if not self.valid:
-            return Outcome(Message.MPIMessageHANDLE_INVALID, "invalid motion handle")
+            return HANDLE_INVALID
         if not self._actions.knows(action):
             return Outcome(Message.MPIMessagePARAM_INVALID, f"unknown action {action!r}")
         current = self._moves.current
@@ -299,16 +300,16 @@ class MotionSupervisor:
         config.axis_numbers = list(self._axis_list.mapped)
         return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), config
 
-    def config_set(self, config: MotionConfig) -> Message:
+    def config_set(self, config: MotionConfig) -> Outcome:
         """mpiMotionConfigSet; a new normal feedrate applies on the fly (ramped over the
         stop time while moving)."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
         if not self._axis_list.listed:  # MPI 000 MPIMotionMessageAXIS_COUNT: "from mpiMotionConfigSet ... no axes"
-            return Message.MPIMotionMessageAXIS_COUNT
+            return NO_AXES
         verdict = config.validate()  # the one MotionConfig validator (params.py): YAML and services too
         if not verdict.ok:
-            return verdict.message
+            return verdict
         old_normal = self._state.config.normal_feedrate
         kept_axes = self._state.config.axis_numbers
         self._state.config = config.copy()
@@ -321,27 +322,30 @@ class MotionSupervisor:
             t = self._host.time
             self._moves.rebase(t)
             self._state.clock = self._state.clock.ramp_to(t, config.normal_feedrate, 0.0)
-        return OK
+        return VALID
 
     # ================================================================= params ====
     def params_get(self) -> tuple[Message, MotionParams]:
         """mpiMotionParamsGet: the parameters a start with null params uses."""
         return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.stored_params.copy()
 
-    def params_set(self, params: MotionParams) -> Message:
+    def params_set(self, params: MotionParams) -> Outcome:
         """mpiMotionParamsSet. While a motion runs the parameters apply "on-the-fly" (MPI 000,
         mpiMotionParamsSet): a modify of the running move's type with its attributes (less
         those that only make sense at a start), refused as that modify would be, in which
         case nothing is stored either."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
+        verdict = params.validate()  # stored for any later start: every value must be one it can hold
+        if not verdict.ok:
+            return verdict
         current = self._moves.current
         if self._state.own_state is MPIState.MOVING and current is not None:
             outcome = self._command(current.type, current.attributes & ~_START_ONLY, params, modify=True)
             if not outcome.ok:
-                return outcome.message
+                return outcome
         self.stored_params = params.copy()
-        return OK
+        return VALID
 
     # ================================================================= positions ====
     def position_get(self) -> tuple[Message, list[float], list[float]]:
@@ -351,27 +355,36 @@ class MotionSupervisor:
         axes = self._list_axes()
         return OK, [a.actual_position for a in axes], [a.command_position for a in axes]
 
-    def position_set(self, actual: list[float], command: list[float]) -> Message:
+    def position_set(self, actual: list[float], command: list[float]) -> Outcome:
         """mpiMotionPositionSet: both arrays one value per axis; each command position is set
         under the rule of mpiAxisCommandPositionSet (Axis.can_set_command), all or none."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
         axes = self._list_axes()
         if not axes:
-            return Message.MPIMotionMessageAXIS_COUNT
-        if len(actual) != len(axes) or len(command) != len(axes):
-            return Message.MPIMessagePARAM_INVALID
-        if not all(check_position("position", x).ok for x in list(actual) + list(command)):
-            return Message.MPIMessagePARAM_INVALID
+            return NO_AXES
+        verdict = first_refusal(self._check_positions(name, values, len(axes))
+                                for name, values in (("actual", actual), ("command", command)))
+        if not verdict.ok:
+            return verdict
         # an axis is in the state of the supervisor commanding it (IDLE without one)
         states = [_or_idle(self._host.own_state_of(a.owner)) for a in axes]
-        if not all(a.can_set_command(state) for a, state in zip(axes, states, strict=True)):
-            return Message.MPIAxisMessageCOMMAND_NOT_SET
+        refused = [(a.number, s.name) for a, s in zip(axes, states, strict=True) if not a.can_set_command(s)]
+        if refused:
+            return Outcome(Message.MPIAxisMessageCOMMAND_NOT_SET,
+                           f"command: axis {refused[0][0]} cannot take a command position while {refused[0][1]}")
         t = self._host.time
         for axis, act, cmd in zip(axes, actual, command, strict=True):
             axis.set_actual_position(act, t)
             axis.set_command_position(cmd, t)
-        return OK
+        return VALID
+
+    @staticmethod
+    def _check_positions(name: str, values: list[float], count: int) -> Outcome:
+        """One position per axis, each in range (params.check_position)."""
+        if len(values) != count:
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"{name}: {len(values)} values for {count} axes")
+        return first_refusal(check_position(f"{name}[{i}]", x) for i, x in enumerate(values))
 
     def _list_axes(self) -> list[Axis]:
         return [self._axis(n) for n in self._axis_list.listed]
@@ -387,23 +400,23 @@ class MotionSupervisor:
     def event_notify_get(self) -> tuple[Message, MPIEventType]:
         return (OK if self.valid else Message.MPIMessageHANDLE_INVALID), self.notify_mask
 
-    def event_notify_set(self, mask: MPIEventType) -> Message:
+    def event_notify_set(self, mask: MPIEventType) -> Outcome:
         """mpiMotionEventNotifySet (also maps the axes, MPI 002 NOT_MAPPED_TO_MS)."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
         if self._state.own_state in (MPIState.IDLE, MPIState.STOPPED, MPIState.ERROR):
             remapped = self._moves.remap()
             if not remapped.ok:
-                return remapped.message
+                return remapped
         self.events.notify_set(mask)
-        return OK
+        return VALID
 
-    def event_reset(self, mask: MPIEventType) -> Message:
+    def event_reset(self, mask: MPIEventType) -> Outcome:
         """mpiMotionEventReset: clear latched events."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
         self.events.reset(mask)
-        return OK
+        return VALID
 
     def frame_buffer_status(self) -> tuple[Message, list[FrameBufferStatus]]:
         """meiMotionFrameBufferStatus for each mapped axis."""
@@ -413,25 +426,25 @@ class MotionSupervisor:
         return OK, [FrameBufferStatus(a.number, size(a.number), self._host.frame_count(a.number)) for a in self.axes]
 
     # ================================================================= log ====
-    def log_open(self, max_entries: int) -> Message:
+    def log_open(self, max_entries: int) -> Outcome:
         """meiMotionLogOpen."""
         if not self.valid:
-            return Message.MPIMessageHANDLE_INVALID
+            return HANDLE_INVALID
         if max_entries <= 0:
-            return Message.MPIMessagePARAM_INVALID
+            return Outcome(Message.MPIMessagePARAM_INVALID, f"max_entries: must be > 0, got {max_entries}")
         self.log = MotionLog(max_entries)
-        return OK
+        return VALID
 
-    def log_print(self, filename: str) -> Message:
+    def log_print(self, filename: str) -> Outcome:
         """meiMotionLogPrint."""
         if self.log is None:
-            return Message.MPIMessageHANDLE_INVALID
+            return Outcome(Message.MPIMessageHANDLE_INVALID, "log: no log open (meiMotionLogOpen first)")
         return self.log.write(filename, self._axis_list.mapped)
 
-    def log_close(self) -> Message:
+    def log_close(self) -> Outcome:
         """meiMotionLogClose."""
         self.log = None
-        return OK
+        return VALID
 
     def action_function(self, callback: ActionCallback | None) -> ActionCallback | None:
         """meiMotionActionFunction: returns the previous callback."""
@@ -499,10 +512,10 @@ class MotionSupervisor:
         """May this supervisor take a start or modify of this type now, and how (behind what
         runs, into an open path, as an AUTO_START)?"""
         if not self.valid:
-            return Outcome(Message.MPIMessageHANDLE_INVALID, "invalid motion handle")
+            return HANDLE_INVALID
         self._notify_action(motion_type, "MODIFY" if modify else "START")
         if not self._axis_list.listed:
-            return Outcome(Message.MPIMotionMessageAXIS_COUNT, "the motion supervisor has no axes")
+            return NO_AXES
         disabled = [n for n in self._axis_list.listed if not self._host.axes[n].enabled]
         if disabled:  # MPI 000, MPIMessageOBJECT_NOT_ENABLED: "axis is not an enabled axis"
             return Outcome(Message.MPIMessageOBJECT_NOT_ENABLED,
@@ -586,12 +599,10 @@ class MotionSupervisor:
         the axes need in place?"""
         if queued:
             current = [self._moves.current] if self._moves.current else []
-            message = self._check_frames(list(self._moves.queue) + current + [move])
+            verdict = self._check_frames(list(self._moves.queue) + current + [move])
         else:
-            message = self._check_frames([move])
-        if not message.ok:
-            return Outcome(message, "the move does not fit in the frame buffer")
-        return self._moves.remap()
+            verdict = self._check_frames([move])
+        return verdict if not verdict.ok else self._moves.remap()
 
     def _commit(self, move: Move, notes: PlanNotes, params: MotionParams, modify: bool,
                 admitted: _Admitted) -> Outcome:
@@ -711,15 +722,18 @@ class MotionSupervisor:
         now = self._host.master_sources()
         return [(master, float(now.position(master)[0]), now.frame(master)) for master in masters]
 
-    def _check_frames(self, moves: list[Move]) -> Message:
+    def _check_frames(self, moves: list[Move]) -> Outcome:
         """Do the moves fit the frame buffer? A path's points need not: the library holds
         what does not fit and loads it as the buffer drains (MPI 001, LOW_COUNT)."""
         size = self._host.config.frame_buffer_size_of
         loaded = [move for move in moves if move.stream is None]
         for n in self._axis_list.listed:
-            if frames_needed(loaded, n) > size(n):
-                return Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
-        return OK
+            needed = frames_needed(loaded, n)
+            if needed > size(n):
+                return Outcome(Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL,
+                               f"the move does not fit in the frame buffer: axis {n} needs {needed} frames "
+                               f"of {size(n)}")
+        return VALID
 
     def _low_count(self, attrs: MotionAttr, params: MotionParams) -> int:
         """MPI 001 LOW_COUNT: the given count, else a quarter of the frame buffer (32 of 128)."""

@@ -66,7 +66,7 @@ def test_reset_leaves_a_disabled_axis_off_and_its_starts_refused(ctl, ms, params
     ctl.step(400)
     assert ctl.axis_amp_enable_set(1, False).ok
     run_to(ctl, ms, MPIState.ERROR, 10)
-    assert ms.action_detail(MPIAction.RESET).ok
+    assert ms.action(MPIAction.RESET).ok
     assert ms.state is MPIState.IDLE
     assert ctl.axis_snapshot(0).amp_enabled
     assert not ctl.axis_snapshot(1).amp_enabled
@@ -91,5 +91,5 @@ def test_an_unknown_axis_is_refused(ctl):
 def test_a_disabled_axis_cannot_be_appended(ctl, ms):
     # MPI 000, mpiMotionAxisAppend: MPIMessageOBJECT_NOT_ENABLED "axis is not an enabled axis"
     assert ctl.axis_amp_enable_set(3, False).ok
-    assert ms.axis_append(3) is NOT_ENABLED
+    assert ms.axis_append(3).message is NOT_ENABLED
     assert ms.axis_list == [0, 1]

@@ -61,7 +61,7 @@ def test_origin_offsets_every_reported_position(ctl, ms, params, run_to):
 
 def test_origin_must_be_finite(ctl):
     # MPI 000, MPIMessagePARAM_INVALID / docs/quality.md, "Robust": bad input changes nothing
-    assert ctl.axis_origin_set(0, float("nan")) is M.MPIMessagePARAM_INVALID
+    assert ctl.axis_origin_set(0, float("nan")).message is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].origin == 0.0
 
 
@@ -92,7 +92,7 @@ def test_command_not_set_while_moving_stopping_or_stopped(ctl, ms, bring, state)
     # MPI 002, MPIAxisMessageCOMMAND_NOT_SET COMMAND_NOT_SET when "Axis is in a STOPPING, STOPPED, or MOVING state"
     bring(state)
     before = ctl.axes[0].cmd_p
-    assert ctl.axis_command_position_set(0, 5.0) is M.MPIAxisMessageCOMMAND_NOT_SET
+    assert ctl.axis_command_position_set(0, 5.0).message is M.MPIAxisMessageCOMMAND_NOT_SET
     assert ctl.axes[0].cmd_p == before
 
 
@@ -107,7 +107,7 @@ def test_command_not_set_while_the_command_follows_the_actual(ctl, params):
     ctl.step(500)
     ms.action(MPIAction.E_STOP)
     ctl.step(10)
-    assert ctl.axis_command_position_set(0, 5.0) is M.MPIAxisMessageCOMMAND_NOT_SET
+    assert ctl.axis_command_position_set(0, 5.0).message is M.MPIAxisMessageCOMMAND_NOT_SET
 
 
 def test_command_position_set_after_reset(ctl, ms, bring):
@@ -121,16 +121,16 @@ def test_command_position_set_after_reset(ctl, ms, bring):
 @pytest.mark.parametrize("number", [-1, 4, 99])
 def test_axis_invalid_out_of_range(ctl, number):
     # MPI 002, MPIAxisMessageAXIS_INVALID AXIS_INVALID "The axis number is out of range"
-    assert ctl.axis_command_position_set(number, 0.0) is M.MPIAxisMessageAXIS_INVALID
-    assert ctl.axis_actual_position_set(number, 0.0) is M.MPIAxisMessageAXIS_INVALID
-    assert ctl.axis_origin_set(number, 0.0) is M.MPIAxisMessageAXIS_INVALID
-    assert ctl.axis_in_position_set(number, AxisInPosition()) is M.MPIAxisMessageAXIS_INVALID
+    assert ctl.axis_command_position_set(number, 0.0).message is M.MPIAxisMessageAXIS_INVALID
+    assert ctl.axis_actual_position_set(number, 0.0).message is M.MPIAxisMessageAXIS_INVALID
+    assert ctl.axis_origin_set(number, 0.0).message is M.MPIAxisMessageAXIS_INVALID
+    assert ctl.axis_in_position_set(number, AxisInPosition()).message is M.MPIAxisMessageAXIS_INVALID
 
 
 def test_non_finite_positions_are_refused(ctl):
     # MPI 000, MPIMessagePARAM_INVALID / docs/quality.md, "Robust": bad input changes nothing
-    assert ctl.axis_command_position_set(0, float("inf")) is M.MPIMessagePARAM_INVALID
-    assert ctl.axis_actual_position_set(0, float("nan")) is M.MPIMessagePARAM_INVALID
+    assert ctl.axis_command_position_set(0, float("inf")).message is M.MPIMessagePARAM_INVALID
+    assert ctl.axis_actual_position_set(0, float("nan")).message is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].cmd_p == 0.0
     assert ctl.axes[0].act_p == 0.0
 
@@ -141,7 +141,7 @@ def test_in_position_values_are_checked(ctl, field, value):
     # MPI 002, MPIAxisInPosition, tolerance tolerances and settling time are distances, a velocity and a duration
     tol = AxisInPosition()
     setattr(tol, field, value)
-    assert ctl.axis_in_position_set(0, tol) is M.MPIMessagePARAM_INVALID
+    assert ctl.axis_in_position_set(0, tol).message is M.MPIMessagePARAM_INVALID
     assert ctl.axis_in_position_set(0, AxisInPosition(position_fine=3.0)).ok
     assert ctl.axes[0].in_position.position_fine == 3.0
 
@@ -166,19 +166,19 @@ def test_motion_position_set(ctl, ms):
 
 def test_motion_position_set_checks_its_arrays(ctl, ms):
     # MPI 000, mpiMotionPositionSet arrays "with a size equal to the number of axes"
-    assert ms.position_set([1.0], [1.0, 2.0]) is M.MPIMessagePARAM_INVALID
-    assert ms.position_set([1.0, float("nan")], [1.0, 2.0]) is M.MPIMessagePARAM_INVALID
+    assert ms.position_set([1.0], [1.0, 2.0]).message is M.MPIMessagePARAM_INVALID
+    assert ms.position_set([1.0, float("nan")], [1.0, 2.0]).message is M.MPIMessagePARAM_INVALID
     assert [a.cmd_p for a in ctl.axes[:2]] == [0.0, 0.0]
     assert [a.act_p for a in ctl.axes[:2]] == [0.0, 0.0]
     _, empty = ctl.create_motion(1)
-    assert empty.position_set([], []) is M.MPIMotionMessageAXIS_COUNT
+    assert empty.position_set([], []).message is M.MPIMotionMessageAXIS_COUNT
 
 
 def test_motion_position_set_while_moving_changes_nothing(ctl, ms, bring):
     # MPI 002, MPIAxisMessageCOMMAND_NOT_SET COMMAND_NOT_SET while MOVING
     bring(MPIState.MOVING)
     actual = [a.act_p for a in ctl.axes[:2]]
-    assert ms.position_set([0.0, 0.0], [0.0, 0.0]) is M.MPIAxisMessageCOMMAND_NOT_SET
+    assert ms.position_set([0.0, 0.0], [0.0, 0.0]).message is M.MPIAxisMessageCOMMAND_NOT_SET
     assert [a.act_p for a in ctl.axes[:2]] == actual
 
 

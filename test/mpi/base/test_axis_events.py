@@ -52,6 +52,6 @@ def test_axis_events_latch_on_the_axis_until_reset(ctl, ms, params, run_to):
 
 def test_no_axis_mask_by_default_and_an_unknown_axis_is_refused(ctl):
     assert ctl.axis_event_notify_get(0) == (Message.MPIMessageOK, E.NONE)
-    assert ctl.axis_event_notify_set(7, E.DONE) is Message.MPIAxisMessageAXIS_INVALID
-    assert ctl.axis_event_reset(-1, E.DONE) is Message.MPIAxisMessageAXIS_INVALID
+    assert ctl.axis_event_notify_set(7, E.DONE).message is Message.MPIAxisMessageAXIS_INVALID
+    assert ctl.axis_event_reset(-1, E.DONE).message is Message.MPIAxisMessageAXIS_INVALID
     assert ctl.axis_event_notify_get(7)[0] is Message.MPIAxisMessageAXIS_INVALID

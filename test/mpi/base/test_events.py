@@ -79,7 +79,7 @@ def test_notify_mask_none_disables_notification_but_events_latch(ctl, ms, params
     # MPI 000, mpiMotionEventNotifySet, remarks "disable host notification of all events: set eventmask to
     # MPIEventTypeNONE"; MPI 000, mpiMotionEventReset events are latched until mpiMotionEventReset
     assert ms.event_notify_set(E.NONE).ok
-    assert ms.event_notify_get() == (ms.validate(), E.NONE)
+    assert ms.event_notify_get() == (ms.validate().message, E.NONE)
     ms.start(T.TRAPEZOIDAL, params=params((300.0, 0.0)))
     run_to(ctl, ms, MPIState.IDLE, 20_000, chunk=100)
     assert ctl.drain_events() == []

@@ -321,7 +321,7 @@ def test_config_set_refuses_a_feedrate_it_cannot_run(feedrate):
     ctl = Controller()
     ms = _mapped(ctl)
     before = ms.config.copy()
-    assert ms.config_set(MotionConfig(normal_feedrate=feedrate)) is M.MPIMessagePARAM_INVALID
+    assert ms.config_set(MotionConfig(normal_feedrate=feedrate)).message is M.MPIMessagePARAM_INVALID
     assert ms.config == before
     _move_runs_to_idle(ctl, ms)
 
@@ -332,7 +332,7 @@ def test_axis_config_set_refuses_a_settling_time_past_the_sample_counter():
     ctl = Controller()
     ms = _mapped(ctl)
     before = ctl.axes[0].in_position.copy()
-    assert ctl.axis_in_position_set(0, AxisInPosition(settling_time=1e308)) is M.MPIMessagePARAM_INVALID
+    assert ctl.axis_in_position_set(0, AxisInPosition(settling_time=1e308)).message is M.MPIMessagePARAM_INVALID
     assert ctl.axes[0].in_position == before
     assert ctl.axis_in_position_set(0, AxisInPosition(settling_time=MAX_DURATION)).ok  # the longest it holds
     ctl.step(5000)
@@ -350,8 +350,8 @@ def test_axis_positions_past_what_a_controller_holds_are_refused(setter):
     # PARAM_INVALID and nothing changes.
     ctl = Controller()
     before = [(a.cmd_p, a.act_p, a.origin) for a in ctl.axes]
-    assert getattr(ctl, setter)(0, 1e308) is M.MPIMessagePARAM_INVALID
-    assert getattr(ctl, setter)(0, -MAX_POSITION * 2) is M.MPIMessagePARAM_INVALID
+    assert getattr(ctl, setter)(0, 1e308).message is M.MPIMessagePARAM_INVALID
+    assert getattr(ctl, setter)(0, -MAX_POSITION * 2).message is M.MPIMessagePARAM_INVALID
     ctl.step(10)
     assert [(a.cmd_p, a.act_p, a.origin) for a in ctl.axes] == before
     assert getattr(ctl, setter)(0, MAX_POSITION).ok
@@ -384,7 +384,7 @@ _HIGH = dict(
 def test_the_clock_runs_at_the_ends_of_every_range(ends, trajectory):
     # issue 9: "the clock thread can never die on a value it accepted". Every struct at the ends
     # of its range; moves at the ends of the trajectory ranges; every action. Each command is
-    # answered with a Message (a profile no controller can compute is PROFILE_ERROR, MPI 000),
+    # answered with a Message or an Outcome (a profile no controller can compute is PROFILE_ERROR, MPI 000),
     # and every sample after it is finite.
     ctl = Controller(**ends)
     ms = _mapped(ctl)
@@ -396,7 +396,7 @@ def test_the_clock_runs_at_the_ends_of_every_range(ends, trajectory):
              lambda: ms.modify(MPIMotionType.TRAPEZOIDAL, params=p2p), lambda: ms.action(MPIAction.ABORT),
              lambda: ms.action(MPIAction.RESET)]
     for step in steps:
-        assert isinstance(step(), M)
+        assert isinstance(step(), M | Outcome)
         for samples in (1, 17, 400):
             ctl.step(samples)
             assert all(math.isfinite(x) for a in ctl.axes for x in (a.cmd_p, a.cmd_v, a.cmd_a, a.act_p, a.act_v))

@@ -48,7 +48,7 @@ def _split(outcome: Outcome) -> tuple[Message, str]:
 
 
 def reset(ms) -> Outcome:
-    return ms.action_detail(MPIAction.RESET)
+    return ms.action(MPIAction.RESET)
 
 
 # -- following error ------------------------------------------------------------------------

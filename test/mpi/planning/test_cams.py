@@ -48,7 +48,7 @@ def controller(**config) -> Controller:
 
 def follow(ctl: Controller, master: AxisMaster, axes=(1, 2)) -> None:
     for n in axes:
-        assert ctl.axis_master_set(n, master) is M.MPIMessageOK
+        assert ctl.axis_master_set(n, master).message is M.MPIMessageOK
 
 
 def cam(distances, slaves, ratios=(), **fields) -> MotionParams:
@@ -57,7 +57,7 @@ def cam(distances, slaves, ratios=(), **fields) -> MotionParams:
 
 
 def set_word(ctl: Controller, value: int) -> None:
-    assert ctl.io_set(IoSpace.IO, 3, value) is M.MPIMessageOK
+    assert ctl.io_set(IoSpace.IO, 3, value).message is M.MPIMessageOK
 
 
 def command(ctl: Controller, axis: int) -> float:
@@ -162,7 +162,7 @@ def test_repeat_runs_many_cycles_without_drift():
     # master is a line-shaft encoder at 1000 counts/s (1 count per sample): cycle c ends at master
     # 100 + 150 c, where the slave is exactly at 10 + 30 c.
     ctl = controller()
-    assert ctl.secondary_feedback_set(2, SecondaryFeedback(0.0, 1000.0)) is M.MPIMessageOK
+    assert ctl.secondary_feedback_set(2, SecondaryFeedback(0.0, 1000.0)).message is M.MPIMessageOK
     follow(ctl, AxisMaster(S.MOTOR_FEEDBACK_SECONDARY, 2), axes=(1,))
     ms1 = ctl.supervisor(1)
     ms1.axis_list_set([1])
@@ -174,7 +174,7 @@ def test_repeat_runs_many_cycles_without_drift():
         assert command(ctl, 1) == 10.0 + 30.0 * cycle
     assert ms1.state is MPIState.MOVING
     assert ms1.progress() == 0.0
-    assert ms1.action(MPIAction.STOP) is M.MPIMessageOK
+    assert ms1.action(MPIAction.STOP).message is M.MPIMessageOK
     ctl.step(1000)
     assert ms1.state is MPIState.STOPPED
     assert ctl.axes[1].cmd_v == 0.0
@@ -271,7 +271,7 @@ def test_an_origin_change_does_not_move_a_cam_slave(name, master, moved):
         ctl.step(100)
         slave = [command(ctl, 1)]
         if change:
-            assert ctl.axis_origin_set(moved, -1000.0) is M.MPIMessageOK
+            assert ctl.axis_origin_set(moved, -1000.0).message is M.MPIMessageOK
         for _ in range(300):
             ctl.step(1)
             slave.append(command(ctl, 1))
@@ -365,7 +365,7 @@ def test_a_master_that_does_not_exist_is_refused_and_changes_nothing(master, fie
     verdict = ctl.axis_master_check(1, master)
     assert verdict.message is M.MPIMessagePARAM_INVALID
     assert verdict.detail.startswith(field)
-    assert ctl.axis_master_set(1, master) is M.MPIMessagePARAM_INVALID
+    assert ctl.axis_master_set(1, master).message is M.MPIMessagePARAM_INVALID
     assert ctl.axes[1].master == AxisMaster()
 
 
@@ -379,7 +379,7 @@ def test_stop_and_e_stop_bring_the_slaves_to_rest_while_the_master_goes_on(actio
     ms1 = ctl.supervisor(1)
     assert ms1.start(T.CAM_LINEAR, A.NONE, cam([1e6], [1e6, 5e5])).ok
     ctl.step(500)
-    assert ms1.action(action) is M.MPIMessageOK
+    assert ms1.action(action).message is M.MPIMessageOK
     decel = ms1.config.decel_time.stop if action is MPIAction.STOP else ms1.config.decel_time.e_stop
     before = command(ctl, 1)
     ctl.step(int(decel * RATE) + 50)
@@ -403,7 +403,7 @@ def test_resume_continues_the_cam_from_where_the_slave_stopped():
     ctl.step(300)
     ms1.action(MPIAction.STOP)
     ctl.step(1000)
-    assert ms1.action(MPIAction.RESUME) is M.MPIMessageOK
+    assert ms1.action(MPIAction.RESUME).message is M.MPIMessageOK
     ctl.step(1000)
     # back at the master's speed; the phase lost stays lost (docs/cams.md): half a stop time while
     # stopping (250 counts), the 500 samples at rest, half a stop time while resuming

@@ -49,6 +49,16 @@ def test_an_append_that_overflows_is_refused(ctl, ms, params):
     assert ctl.axes[0].command_position == 1000.0 * count  # every accepted move ran, in order
 
 
+def test_the_refusal_names_the_axis_and_its_frames(ctl, ms, params):
+    # MPI 000, MPIMotionMessageFRAME_BUFFER_TOO_SMALL "increase the number of points in the frame buffer":
+    # the outcome says which axis needs how many of its frames
+    fill(ctl, ms, params)
+    outcome, _ = ms.command(T.TRAPEZOIDAL, A.APPEND, params((-5.0, 0.0)), modify=False)
+    assert outcome.message is Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
+    assert outcome.detail.startswith("the move does not fit in the frame buffer: axis 0 needs ")
+    assert outcome.detail.endswith(" frames of 128")
+
+
 def test_the_refusal_changes_nothing(params):
     # docs/decisions.md, "Motion" (frame buffer overflow) and docs/quality.md, "Robust": the refusal changes nothing
     def run(extra):
@@ -205,11 +215,12 @@ def test_an_axis_of_another_frame_buffer_size_is_refused_and_nothing_changes(edi
     assert ms.action(MPIAction.MAP).ok
     answer = {"append": lambda: ms.axis_append(2), "insert": lambda: ms.axis_insert(None, 3),
               "list_set": lambda: ms.axis_list_set([0, 2])}[edit]()
-    assert answer is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert answer.message is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert answer.detail.startswith("axis_numbers: the axes' frame buffer sizes differ ({0: 256, ")
     assert ms.axis_list_get() == (Message.MPIMessageOK, [0, 1])
     assert ms.mapped == [0, 1]
     assert ms.axis_list_set([2, 3]).ok
-    assert ms.axis_append(1) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_append(1).message is Message.MPIMotionMessageAXIS_FRAME_COUNT
 
 
 def test_an_empty_list_takes_any_size_and_same_sizes_mix():
@@ -218,7 +229,7 @@ def test_an_empty_list_takes_any_size_and_same_sizes_mix():
     assert ms.axis_append(1).ok
     assert ms.axis_append(3).ok
     assert ms.axis_append(2).ok
-    assert ms.axis_append(0) is Message.MPIMotionMessageAXIS_FRAME_COUNT
+    assert ms.axis_append(0).message is Message.MPIMotionMessageAXIS_FRAME_COUNT
     assert ms.axis_list_set([0]).ok
     assert ms.frame_buffer_size == 512
 

@@ -368,7 +368,7 @@ def test_config_set_with_no_axes_answers_axis_count(ctl):
     # or mpiMotionModify(...) if there are no axes associated with the motion object"
     _, ms = ctl.create_motion(0)
     before = ms.config.copy()
-    assert ms.config_set(MotionConfig(normal_feedrate=0.5)) is M.MPIMotionMessageAXIS_COUNT
+    assert ms.config_set(MotionConfig(normal_feedrate=0.5)).message is M.MPIMotionMessageAXIS_COUNT
     assert ms.config == before
     assert ms.axis_list_set([0]).ok
     assert ms.config_set(MotionConfig(normal_feedrate=0.5)).ok

@@ -95,7 +95,7 @@ def test_gate_get(ctl):
     ctl.gate_set(5, True)
     assert ctl.gate_get(5) == (M.MPIMessageOK, True)
     # MPI 000, MEIMotionAttrHoldSource, gate "between 0 and 31"
-    assert ctl.gate_set(32, True) is M.MPIMessagePARAM_INVALID
+    assert ctl.gate_set(32, True).message is M.MPIMessagePARAM_INVALID
 
 
 def test_input_hold_matches_mask_and_pattern(ctl, ms, params):
@@ -316,5 +316,5 @@ def test_io_words_are_32_bit(ctl):
     assert ctl.io_get(IoSpace.IO, 0) == (M.MPIMessageOK, -1)
     assert ctl.io_set(IoSpace.IO, 0, 0x0, mask=0x0000FFFF).ok
     assert ctl.io_get(IoSpace.IO, 0)[1] == -65536
-    assert ctl.io_set(IoSpace.IO, 64, 1) is M.MPIMessagePARAM_INVALID
+    assert ctl.io_set(IoSpace.IO, 64, 1).message is M.MPIMessagePARAM_INVALID
     assert ctl.io_get(IoSpace.MOTOR_GENERAL_IO, 4)[0] is M.MPIMessagePARAM_INVALID

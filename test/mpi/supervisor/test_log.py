@@ -69,7 +69,9 @@ def test_log_print_writes_the_buffer(tmp_path, ctl, ms, params):
 def test_log_print_to_a_bad_path(tmp_path, ms):
     # MPI 000, meiMotionLogPrint, filename "*filename a pointer to a file name string" (a file that cannot be opened)
     ms.log_open(10)
-    assert ms.log_print(str(tmp_path / "no" / "such" / "dir" / "x.csv")) is Message.MPIMessageFILE_OPEN_ERROR
+    refused = ms.log_print(str(tmp_path / "no" / "such" / "dir" / "x.csv"))
+    assert refused.message is Message.MPIMessageFILE_OPEN_ERROR
+    assert refused.detail.startswith("filename: cannot write ")  # the file, and the system's reason
 
 
 def test_log_close_frees_the_buffer(ctl, ms, params):
@@ -77,11 +79,11 @@ def test_log_close_frees_the_buffer(ctl, ms, params):
     ms.log_open(10)
     assert ms.log_close().ok
     assert ms.log is None
-    assert ms.log_print("/tmp/unused.csv") is Message.MPIMessageHANDLE_INVALID  # nothing to print
+    assert ms.log_print("/tmp/unused.csv").message is Message.MPIMessageHANDLE_INVALID  # nothing to print
     ctl.step(10)
 
 
 def test_log_open_needs_entries(ms):
     # MPI 000, meiMotionLogOpen, maxEntries maxEntries "determines the log buffer memory size"
-    assert ms.log_open(0) is Message.MPIMessagePARAM_INVALID
+    assert ms.log_open(0).message is Message.MPIMessagePARAM_INVALID
     assert ms.log is None

@@ -314,11 +314,11 @@ def test_reset_and_remap_follow_one_rule_while_stopped_axes_creep(params):
     # and change nothing; an E_STOP decelerates them (decelTime.eStop), and RESET is then OK
     ctl, ms = _creeping(params)
     twin, twin_ms = _creeping(params)
-    reset = ms.action_detail(MPIAction.RESET)
+    reset = ms.action(MPIAction.RESET)
     assert reset.message is Message.MPIMotionMessageSTOPPED
     assert "pauseFeedrate" in reset.detail
     assert ms.axis_list_set([1]).ok
-    remap = ms.action_detail(MPIAction.MAP)
+    remap = ms.action(MPIAction.MAP)
     assert (remap.message, remap.detail) == (reset.message, reset.detail)
     assert twin_ms.axis_list_set([1]).ok
     for _ in range(20):
@@ -365,7 +365,7 @@ def test_stop_while_holding_then_resume(params):
     ctl.gate_set(0, False)
     ctl.step(500)
     assert ctl.axes[0].cmd_p == 0.0  # released, but stopped
-    assert ms.action(MPIAction.RESUME) is Message.MPIMessageOK
+    assert ms.action(MPIAction.RESUME).message is Message.MPIMessageOK
     assert ctl.run_until(lambda c: ms.state is MPIState.IDLE, 20_000, chunk=10)
     assert ctl.axes[0].command_position == 300.0
 

@@ -34,14 +34,14 @@ def test_append_builds_the_list_in_order(empty):
 def test_append_an_axis_already_on_the_list(empty):
     # MPI 000, mpiMotionAxisAppend, return values MPIMessageOBJECT_ON_LIST "axis is already on the list"
     empty.axis_append(1)
-    assert empty.axis_append(1) is M.MPIMessageOBJECT_ON_LIST
+    assert empty.axis_append(1).message is M.MPIMessageOBJECT_ON_LIST
     assert empty.axis_list_get()[1] == [1]
 
 
 @pytest.mark.parametrize("number", [-1, 10, 1000])
 def test_append_an_invalid_axis(empty, number):
     # MPI 000, mpiMotionAxisAppend, return values MPIMessageHANDLE_INVALID "Either motion or axis is an invalid handle"
-    assert empty.axis_append(number) is M.MPIMessageHANDLE_INVALID
+    assert empty.axis_append(number).message is M.MPIMessageHANDLE_INVALID
     assert empty.axis_count() == 0
 
 
@@ -50,22 +50,22 @@ def test_append_past_max_coord_axes(empty):
     # elements (MEIXmpMAX_COORD_AXES)" = 8
     for n in range(8):
         assert empty.axis_append(n).ok
-    assert empty.axis_append(8) is M.MPIMessageUNSUPPORTED
-    assert empty.axis_insert(None, 9) is M.MPIMessageUNSUPPORTED
+    assert empty.axis_append(8).message is M.MPIMessageUNSUPPORTED
+    assert empty.axis_insert(None, 9).message is M.MPIMessageUNSUPPORTED
     assert empty.axis_count() == 8
 
 
 def test_list_set_past_max_coord_axes(empty):
     # MPI 000, mpiMotionAxisAppend, return values (the same limit for a list set at once)
-    assert empty.axis_list_set(list(range(9))) is M.MPIMessageUNSUPPORTED
+    assert empty.axis_list_set(list(range(9))).message is M.MPIMessageUNSUPPORTED
     assert empty.axis_list_set(list(range(8))).ok
 
 
 def test_append_a_disabled_axis(big, empty):
     # MPI 000, mpiMotionAxisAppend, return values MPIMessageOBJECT_NOT_ENABLED "axis is not an enabled axis"
     big.axes[4].enabled = False
-    assert empty.axis_append(4) is M.MPIMessageOBJECT_NOT_ENABLED
-    assert empty.axis_list_set([4]) is M.MPIMessageOBJECT_NOT_ENABLED
+    assert empty.axis_append(4).message is M.MPIMessageOBJECT_NOT_ENABLED
+    assert empty.axis_list_set([4]).message is M.MPIMessageOBJECT_NOT_ENABLED
 
 
 def test_insert_just_after_an_axis(empty):
@@ -79,8 +79,8 @@ def test_insert_just_after_an_axis(empty):
 def test_insert_after_an_axis_not_on_the_list(empty):
     # MPI 000, MPIMotionMessageAXIS_NOT_FOUND AXIS_NOT_FOUND "The specified axis object is not available"
     empty.axis_list_set([1])
-    assert empty.axis_insert(3, 4) is M.MPIMotionMessageAXIS_NOT_FOUND
-    assert empty.axis_insert(1, 1) is M.MPIMessageOBJECT_ON_LIST
+    assert empty.axis_insert(3, 4).message is M.MPIMotionMessageAXIS_NOT_FOUND
+    assert empty.axis_insert(1, 1).message is M.MPIMessageOBJECT_ON_LIST
     assert empty.axis_list_get()[1] == [1]
 
 
@@ -89,15 +89,15 @@ def test_remove_an_axis_not_on_the_list(big, empty):
     # being removed is not a member of the motion object"
     empty.axis_list_set([1])
     empty.action(MPIAction.MAP)
-    assert empty.axis_remove(2) is M.MPIMotionMessageAXIS_NOT_FOUND
-    assert empty.axis_remove(99) is M.MPIMessageHANDLE_INVALID
+    assert empty.axis_remove(2).message is M.MPIMotionMessageAXIS_NOT_FOUND
+    assert empty.axis_remove(99).message is M.MPIMessageHANDLE_INVALID
 
 
 def test_remove_an_axis_not_mapped(empty):
     # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS NOT_MAPPED_TO_MS "returned by ... mpiMotionAxisRemove when an axis is
     # associated with a motion object, but not mapped to a motion supervisor"
     empty.axis_list_set([1, 2])
-    assert empty.axis_remove(1) is M.MPIAxisMessageNOT_MAPPED_TO_MS
+    assert empty.axis_remove(1).message is M.MPIAxisMessageNOT_MAPPED_TO_MS
     # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS "To correct this problem, map the axes"
     assert empty.action(MPIAction.MAP).ok
     assert empty.axis_remove(1).ok
@@ -125,7 +125,7 @@ def test_what_maps_the_axes(big, empty, mapper):
 def test_delete_with_unmapped_axes(big, empty):
     # MPI 002, MPIAxisMessageNOT_MAPPED_TO_MS NOT_MAPPED_TO_MS "returned by mpiMotionDelete ..."
     empty.axis_list_set([1])
-    assert big.delete_motion(empty) is M.MPIAxisMessageNOT_MAPPED_TO_MS
+    assert big.delete_motion(empty).message is M.MPIAxisMessageNOT_MAPPED_TO_MS
     empty.action(MPIAction.MAP)
     assert big.delete_motion(empty).ok
 
@@ -141,7 +141,7 @@ def test_list_set_replaces_the_coordinate_system(empty):
 
 def test_list_set_with_duplicates(empty):
     # MPI 000, mpiMotionAxisAppend, return values OBJECT_ON_LIST (an axis twice)
-    assert empty.axis_list_set([1, 1]) is M.MPIMessageOBJECT_ON_LIST
+    assert empty.axis_list_set([1, 1]).message is M.MPIMessageOBJECT_ON_LIST
     assert empty.axis_count() == 0
 
 
@@ -149,8 +149,8 @@ def test_list_set_while_moving_is_refused(ctl, ms, bring):
     # MPI 000, Motion Objects, introduction "Motion Supervisor to axis maps should NOT be changed when the axes are
     # moving"
     bring(MPIState.MOVING)
-    assert ms.axis_list_set([0]) is M.MPIMotionMessageMOVING
-    assert ms.axis_remove(1) is M.MPIMotionMessageMOVING
+    assert ms.axis_list_set([0]).message is M.MPIMotionMessageMOVING
+    assert ms.axis_remove(1).message is M.MPIMotionMessageMOVING
     assert ms.axis_list_get()[1] == [0, 1]
 
 
@@ -210,13 +210,13 @@ def test_an_invalid_handle_everywhere(big, empty):
     empty.axis_list_set([4])
     empty.action(MPIAction.MAP)
     assert big.delete_motion(empty).ok
-    assert empty.validate() is M.MPIMessageHANDLE_INVALID
+    assert empty.validate().message is M.MPIMessageHANDLE_INVALID
     assert empty.axis_count() == -1
     assert empty.axis_index(4) == -1
     assert empty.axis_at(0) == (M.MPIMessageHANDLE_INVALID, None)
     assert empty.axis_first() == (M.MPIMessageHANDLE_INVALID, None)
-    assert empty.axis_append(5) is M.MPIMessageHANDLE_INVALID
-    assert empty.axis_list_set([5]) is M.MPIMessageHANDLE_INVALID
+    assert empty.axis_append(5).message is M.MPIMessageHANDLE_INVALID
+    assert empty.axis_list_set([5]).message is M.MPIMessageHANDLE_INVALID
     assert empty.axis_list_get() == (M.MPIMessageHANDLE_INVALID, [])
 
 
@@ -233,11 +233,11 @@ def test_map_writes_the_mapping(empty):
 
 def test_map_with_an_empty_list(big, empty):
     # MPI 000, MEIMotionMessageNO_AXES_MAPPED NO_AXES_MAPPED for an action with no axes
-    assert empty.action(MPIAction.MAP) is M.MEIMotionMessageNO_AXES_MAPPED
+    assert empty.action(MPIAction.MAP).message is M.MEIMotionMessageNO_AXES_MAPPED
     empty.axis_list_set([2])
     empty.action(MPIAction.MAP)
     empty.axis_list_set([])
-    assert empty.action(MPIAction.MAP) is M.MEIMotionMessageNO_AXES_MAPPED
+    assert empty.action(MPIAction.MAP).message is M.MEIMotionMessageNO_AXES_MAPPED
     assert empty.config_get()[1].axis_numbers == [2]  # the mapping stays as it was
 
 

@@ -74,7 +74,7 @@ def test_config_set_refuses_bad_values(ms, change):
     # -1.0 to 1.0; the times are durations and the feedrates fractions (docs/quality.md, "Robust")
     config = ms.config_get()[1]
     change(config)
-    assert ms.config_set(config) is M.MPIMessagePARAM_INVALID
+    assert ms.config_set(config).message is M.MPIMessagePARAM_INVALID
     assert ms.config_get()[1] == MotionConfig(axis_numbers=[0, 1])
 
 
@@ -189,6 +189,15 @@ def test_params_get_after_a_start_returns_the_start_s_parameters(ms, params):
     assert ms.params_get()[1].position == [300.0, -100.0]
 
 
+def test_params_set_refuses_a_value_no_start_could_use(ms, params):
+    # MPI 000 mpiMotionParamsSet stores the parameters for a later start (params Null): a value no
+    # controller holds is refused now, with the field that holds it, and nothing is stored
+    assert ms.params_set(params((1.0, 2.0))).ok
+    refused = ms.params_set(params((1e300, 0.0)))
+    assert (refused.message, refused.detail.split(":")[0]) == (M.MPIMessagePARAM_INVALID, "position[0]")
+    assert ms.params_get()[1].position == params((1.0, 2.0)).position
+
+
 def test_params_set_while_moving_changes_the_move_on_the_fly(ctl, ms, params, run_to):
     # MPI 000, mpiMotionParamsSet: while a motion runs the new parameters take effect "on-the-fly"
     # (docs/decisions.md: as a modify of the running move's type)
@@ -205,7 +214,7 @@ def test_params_set_while_moving_that_the_move_refuses_changes_nothing(ctl, ms, 
     assert ms.start(T.TRAPEZOIDAL, params=params((100_000.0, 0.0))).ok
     ctl.step(300)
     before = ms.params_get()[1]
-    assert ms.params_set(params((1.0,))) is M.MPIMessagePARAM_INVALID  # one position for two axes
+    assert ms.params_set(params((1.0,))).message is M.MPIMessagePARAM_INVALID  # one position for two axes
     assert ms.params_get()[1].position == before.position
     assert ms.current.plans[0].target == 100_000.0
 
@@ -257,5 +266,5 @@ def test_action_callback_runs_on_every_call_even_refused(ms):
     # will be executed"
     calls = []
     ms.action_function(lambda motion, kind, action: calls.append(action))
-    assert ms.action(MPIAction.STOP) is M.MPIMotionMessageIDLE
+    assert ms.action(MPIAction.STOP).message is M.MPIMotionMessageIDLE
     assert calls == ["STOP"]

@@ -41,7 +41,7 @@ def command(ms, name: str) -> Message:
         return ms.start(T.TRAPEZOIDAL, params=p2p(OTHER))
     if name == "modify":
         return ms.modify(T.TRAPEZOIDAL, params=p2p(OTHER))
-    return ms.action(MPIAction[name])
+    return ms.action(MPIAction[name]).message
 
 
 # (state, command, message, state right after the call). One row per cell of docs/state-machine.md.
@@ -202,7 +202,7 @@ def test_start_from_stopped_drops_the_pending_profile(prepared):
     assert [a.command_position for a in ms.axes] == list(OTHER)
     ended = {end.serial: end.message for end in ctl.move_log.recent(ms.number)}
     assert ended[serial] is STOPPED  # the dropped move ended with the state it was dropped in
-    assert ms.action(MPIAction.RESUME) is IDLE  # nothing pending any more
+    assert ms.action(MPIAction.RESUME).message is IDLE  # nothing pending any more
 
 
 def test_reset_from_stopped_drops_the_pending_profile(prepared):
@@ -214,7 +214,7 @@ def test_reset_from_stopped_drops_the_pending_profile(prepared):
     ctl.step(2000)
     assert ms.state is S.IDLE
     assert [a.command_position for a in ms.axes] == where
-    assert ms.action(MPIAction.RESUME) is IDLE  # MPI 000, MPIMotionMessageIDLE "no motion profile pending"
+    assert ms.action(MPIAction.RESUME).message is IDLE  # MPI 000, MPIMotionMessageIDLE "no motion profile pending"
 
 
 def test_resume_from_stopped_finishes_the_move():
@@ -308,7 +308,7 @@ def test_actions_without_axes_answer_no_axes_mapped(action):
     # mpiMotionAction if there are no axes mapped to the motion object"
     ctl = Controller()
     _, ms = ctl.create_motion(0)
-    assert ms.action(MPIAction[action]) is Message.MEIMotionMessageNO_AXES_MAPPED
+    assert ms.action(MPIAction[action]).message is Message.MEIMotionMessageNO_AXES_MAPPED
     assert ms.state is S.IDLE
 
 
