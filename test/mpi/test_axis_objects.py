@@ -98,3 +98,31 @@ def test_create_and_delete_are_commands_a_replay_repeats(ctl: Controller, ms1):
     assert reply.message is Message.MPIAxisMessageAXIS_INVALID
     assert apply(ctl, Command(Operation.AXIS_CREATE, axis=3)).message is Message.MPIMessageOK
     assert ctl.axes[3].valid
+
+
+def test_every_axis_call_on_a_deleted_axis_is_handle_invalid_and_changes_nothing(ctl: Controller, ms1):
+    # MPI 002, mpiAxisValidate: a deleted Axis object is an invalid handle, so each mpiAxis* call
+    # on it answers MPIMessageHANDLE_INVALID (a replayed or direct call as well as one over ROS)
+    assert ms1.axis_remove(3).ok
+    assert ms1.action(MPIAction.MAP).ok
+    assert ctl.axis_delete(3).ok
+    before = ctl.axis_snapshot(3)
+    calls = {
+        "command position": lambda: ctl.axis_command_position_set(3, 50.0),
+        "actual position": lambda: ctl.axis_actual_position_set(3, 50.0),
+        "origin": lambda: ctl.axis_origin_set(3, 50.0),
+        "amplifier": lambda: ctl.axis_amp_enable_set(3, False),
+        "event mask": lambda: ctl.axis_event_notify_set(3, ctl.axis_event_notify_get(0)[1]),
+        "fault inject": lambda: ctl.axis_fault_inject(3, "AMP_FAULT"),
+    }
+    for name, call in calls.items():
+        outcome = call()
+        assert outcome.message is Message.MPIMessageHANDLE_INVALID, name
+        assert "deleted" in outcome.detail, name
+    assert ctl.axis_event_notify_get(3)[0] is Message.MPIMessageHANDLE_INVALID
+    assert ctl.axis_fault_config_get(3)[0] is Message.MPIMessageHANDLE_INVALID
+    after = ctl.axis_snapshot(3)
+    assert (after.command_position, after.actual_position, after.origin, after.amp_enabled) == (
+        before.command_position, before.actual_position, before.origin, before.amp_enabled)
+    assert ctl.axis_create(3)[0].ok
+    assert ctl.axis_origin_set(3, 50.0).ok
