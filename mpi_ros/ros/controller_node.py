@@ -225,7 +225,6 @@ class ControllerNode(Node):
             with self._axes_synced:
                 if not self._axes_synced.wait_for(lambda: (command.axis in self._axis_endpoints) == valid, 5.0):
                     self.get_logger().error(f"axis{command.axis}: its endpoints did not follow {command.operation}")
-        response.detail = reply.detail
         return convert.answer(response, reply)
 
     def _on_axis_validate(self, request, response):
@@ -239,7 +238,6 @@ class ControllerNode(Node):
 
     def _on_amp_enable(self, k: int, request, response):
         reply = self._submit_axis(Operation.AXIS_AMP_ENABLE_SET, k, {"enable": request.enable})
-        response.detail = reply.detail
         response.enabled = bool(reply.value)
         return convert.answer(response, reply)
 
@@ -401,13 +399,11 @@ class ControllerNode(Node):
     def _on_fault_config_set(self, k: int, request, response):
         reply, _ = self.runner.submit(Command(Operation.AXIS_FAULT_CONFIG_SET, axis=k,
                                               request={"config": convert.to_dict(request.config)}))
-        response.detail = reply.detail
         return convert.answer(response, reply)
 
     def _on_fault_inject(self, k: int, request, response):
         reply, _ = self.runner.submit(Command(Operation.AXIS_FAULT_INJECT, axis=k,
                                               request={"fault": request.fault, "active": request.active}))
-        response.detail = reply.detail
         response.faults = list(reply.value or [])
         return convert.answer(response, reply)
 
@@ -452,7 +448,6 @@ class ControllerNode(Node):
         reply, entry = self._flash_entry("supervisors", n)
         if entry is not None:
             convert.fill(response.config, rq.motion_config_to_dict(rq.motion_config(entry)))
-        response.detail = reply.detail
         return convert.answer(response, reply)
 
     def _on_motion_flash_set(self, n: int, request, response):
@@ -465,7 +460,6 @@ class ControllerNode(Node):
             verdict = config.validate()
             reply = (Reply(verdict) if not verdict.ok
                      else self._flash_write("supervisors", n, flash_file.motion_entry(config)))
-        response.detail = reply.detail
         return convert.answer(response, reply)
 
     def _on_axis_flash_get(self, k: int, response):
@@ -477,7 +471,6 @@ class ControllerNode(Node):
             convert.fill(response.in_position, rq.in_position_to_dict(rq.in_position(entry["in_position"])))
             convert.fill(response.master, rq.axis_master_to_dict(rq.axis_master(master, correction, AxisMaster())))
             response.master_correction = correction
-        response.detail = reply.detail
         return convert.answer(response, reply)
 
     def _on_axis_flash_set(self, k: int, request, response):
@@ -492,7 +485,6 @@ class ControllerNode(Node):
                      else self._flash_write("axes", k, flash_file.axis_entry(in_position, master)))
         except Refused as exc:
             reply = Reply.of(exc.message, exc.detail)
-        response.detail = reply.detail
         return convert.answer(response, reply)
 
 

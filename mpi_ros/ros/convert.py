@@ -41,9 +41,11 @@ from . import rcl
 
 
 def answer(response, reply):
-    """Put a controller reply's message (name and code) into a service response."""
+    """Put a controller reply's outcome (the message's name and code, and why in words) into a
+    service response: every response of the suite's services has the three fields."""
     response.message = reply.message.name
     response.code = reply.message.code
+    response.detail = reply.detail
     return response
 
 
@@ -52,6 +54,7 @@ def event_mask_answer(response, message, mask):
     response.event_types = mask.names()
     response.message = message.name
     response.code = message.code
+    response.detail = "" if message.ok else f"no event mask: {message.name}"
     return response
 
 

@@ -264,12 +264,12 @@ def test_trigger_services_answer_the_spec_message(suite, probe, service):
 
 def test_a_refused_axis_list_set_service_carries_the_controllers_words(suite, probe, service, applied):
     # MPI 000 mpiMotionAxisListSet: an axis that does not exist is an invalid handle. The node passes the
-    # controller's outcome on as it is: the response's message, and the reply (commands topic, recordings,
-    # the Python client) names the axis and why; nothing changes.
+    # controller's outcome on as it is: the response's message and detail, and the reply (commands topic,
+    # recordings, the Python client) names the axis and why; nothing changes.
     from mpi_ros.srv import AxisListGet, AxisListSet
 
     answer = service(probe, AxisListSet, "/mpi/ms0/axis_list_set", AxisListSet.Request(axis_numbers=[0, 9]))
-    assert answer.message == "MPIMessageHANDLE_INVALID"
+    assert (answer.message, answer.detail) == ("MPIMessageHANDLE_INVALID", "axis: no axis 9 (4 axes)")
     _, command, reply = applied.wait(1)
     assert (command.operation, reply.message.name, reply.detail) == (
         "axis_list_set", "MPIMessageHANDLE_INVALID", "axis: no axis 9 (4 axes)")
