@@ -177,7 +177,7 @@ class Axis:
         self.element_id = 0
         self._held_feedforward = 0.0  # PTF/PVTF feedforward kept from move to move
         self.state = PlantState(0.0, 0.0, 0.0)
-        self._cache: dict[tuple, _Command] = {}  # (_command_of)
+        self._cache: dict[tuple[float | None, ...], _Command] = {}  # (_command_of)
         self._sampled: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # a cam slave's last trace
         self.status_mode = StatusMode.POINT_TO_POINT
         self.target = 0.0
@@ -404,7 +404,9 @@ class Axis:
         self.holding = False
 
     # -- tracing ---------------------------------------------------------------------
-    def _command_arrays(self, t: np.ndarray, clock: ProfileClock | None):
+    def _command_arrays(
+        self, t: np.ndarray, clock: ProfileClock | None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         n = len(t)
         if self.plan is None or clock is None:
             const = np.full(n, self.rest)
@@ -422,7 +424,7 @@ class Axis:
         they do not depend on). Looked up once per question, not per piece."""
         plan = self.plan
         if plan is None or clock is None:
-            key: tuple = (None, self.rest, self._held_feedforward)
+            key: tuple[float | None, ...] = (None, self.rest, self._held_feedforward)
         else:
             key = (id(plan), self.tau_start, clock.t0, clock.tau0, clock.f0, clock.f1, clock.t_end,
                    self._held_feedforward)
@@ -469,7 +471,9 @@ class Axis:
         command.forced[ts] = forced
         return forced
 
-    def _pieces(self, t_from: float, t_to: float, clock: ProfileClock | None):
+    def _pieces(
+        self, t_from: float, t_to: float, clock: ProfileClock | None,
+    ) -> list[tuple[float, float, Forced | None]]:
         """[(start, end, steady response)] of the command pieces covering [t_from, t_to]."""
         if self.mode is CommandMode.COAST:
             return [(t_from, math.inf, None)]
@@ -514,7 +518,9 @@ class Axis:
             y, dy, anchors = self._trace_plant(samples, t, clock)
         return AxisTrace(samples, t, cmd_p, cmd_v, cmd_a, self.plant.read(y), dy, rel, anchors)
 
-    def _trace_plant(self, samples: np.ndarray, t: np.ndarray, clock: ProfileClock | None):
+    def _trace_plant(
+        self, samples: np.ndarray, t: np.ndarray, clock: ProfileClock | None,
+    ) -> tuple[np.ndarray, np.ndarray, list[PlantState]]:
         y = np.empty_like(t)
         dy = np.empty_like(t)
         state = self.state
@@ -526,6 +532,7 @@ class Axis:
                 if self.mode is CommandMode.COAST:
                     y[lo:hi], dy[lo:hi] = self.plant.coast(state, samples[lo:hi], self.rate)
                 else:
+                    assert forced is not None  # only a coasting axis has no steady response (_pieces)
                     y[lo:hi], dy[lo:hi] = self.plant.response(state, forced, samples[lo:hi], self.rate)
             if end > t[-1] or not math.isfinite(end):
                 break
@@ -565,7 +572,7 @@ class Axis:
             p0 = p1
         return np.array(ys), np.array(dys)
 
-    def _trace_follow(self, t: np.ndarray):
+    def _trace_follow(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[PlantState]]:
         """settleOnEstopCmdEqAct: each sample the command is the previous actual."""
         y = np.empty_like(t)
         dy = np.empty_like(t)
@@ -648,8 +655,9 @@ class Axis:
         advanced from piece to piece as :meth:`_trace_plant` advances them."""
         state = self.state
         pieces = self._pieces(state.t, t_last, clock)
-        following = []
+        following: list[tuple[PlantState, float, float, Forced]] = []
         for (_, end, forced), (start, nxt_end, nxt_forced) in itertools.pairwise(pieces):
+            assert nxt_forced is not None  # (a coasting axis has its one piece: no continuation)
             state = self._advance_piece(state, forced, end)
             following.append((state, start, nxt_end, nxt_forced))
         return following

@@ -17,7 +17,7 @@ import math
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, fields
 from enum import IntEnum
-from typing import TYPE_CHECKING, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -161,10 +161,12 @@ class PlantRows:
 _PIECE_COLUMNS = ("anchor_t", "piece_end", "terms", "k0", "v0", "v1", "m0", "m1", "decayed_after", "vanishing",
                   "table", "resolution")
 _INT_COLUMNS = ("terms", "k0", "table")
+# A piece's row: the steady response's coefficients (y, dy), then _PIECE_COLUMNS' values
+PieceRow = tuple[list[float], list[float], float, float, int, int, float, float, float, float, float, float, int, float]
 
 
 def _piece_row(anchor: PlantState, end: float, forced: Forced, plant: Plant, rate: float,
-               table_index: Callable[[_FreeTable], int]) -> tuple:
+               table_index: Callable[[_FreeTable], int]) -> PieceRow:
     """A piece's row of PlantRows: the steady response's coefficients (zero-padded: rows are
     evaluated in groups of the same length, exactly as plant.poly_eval evaluates one), then
     the values of _PIECE_COLUMNS; without a transient, k0 and the transient's parts 0,
@@ -274,14 +276,15 @@ class AxisBank:
         self.moved = np.zeros(axis_count, dtype=bool)  # its plant anchor moved: rebuild those rows
         self.kind = np.full(axis_count, Kind.SAMPLED, dtype=np.int8)
         self.owner = np.full(axis_count, -1, dtype=np.int64)
-        self.plans: list = [None] * axis_count  # the AxisPlan each row was written for
+        self.plans: list[AxisPlan | None] = [None] * axis_count  # the AxisPlan each row was written for
         self.command = CommandRows.empty(axis_count)
         self.plant = PlantRows.empty(axis_count)
         self.status = StatusRows.empty(axis_count)
         self.clocks = ClockRows.empty(supervisor_count)
         self.tables: list[_FreeTable] = []
-        self._memo: dict = {}
-        self._clock_memo: dict = {}  # derived from the clocks alone: kept while no clock changes
+        # (values of any type, each the type its caller's compute gives: memo, clock_memo)
+        self._memo: dict[Hashable, Any] = {}
+        self._clock_memo: dict[Hashable, Any] = {}  # derived from the clocks alone: kept while no clock changes
 
     def refresh(self, refresh_row: Callable[[int], None], reanchor_row: Callable[[int], None]) -> None:
         """Rebuild the stale rows (``refresh_row(number)`` does an axis), and those of the

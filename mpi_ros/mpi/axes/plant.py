@@ -19,10 +19,12 @@ The encoder reads y in whole counts (``encoder_resolution``).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 from numpy.lib.stride_tricks import sliding_window_view
 
 from mpi_ros.mpi.base.params import PlantConfig
@@ -95,9 +97,10 @@ class Plant:
         self._dac_gains = self._taylor(num=(config.dac_acceleration,), den=(w * w, 2.0 * z * w, 1.0)).tolist()
         self._resolution = config.encoder_resolution
         self._coast = config.coast_time_constant
-        self._steps: dict = {}  # sample_step, per rate
+        self._steps: dict[tuple[str, float], tuple[tuple[float, ...], tuple[float, ...]]] = {}  # sample_step, per rate
         self._tables: dict[float, _FreeTable] = {}  # table, per rate
-        self._transients: dict = {}  # transient: (id(state), id(forced), rate) -> (state, forced, transient)
+        # transient: (id(state), id(forced), rate) -> (state, forced, transient)
+        self._transients: dict[tuple[int, int, float], tuple[PlantState, Forced, Transient | None]] = {}
         # M^2 = kappa I (Cayley-Hamilton: A's eigenvalues are sigma +- i q, sigma +- q, or sigma twice)
         self._kappa = {"under": -self._q * self._q, "over": self._q * self._q}.get(self._kind, 0.0)
 
@@ -110,7 +113,7 @@ class Plant:
         return "over", w * math.sqrt(z * z - 1.0)
 
     @staticmethod
-    def _taylor(num, den) -> np.ndarray:
+    def _taylor(num: Sequence[float], den: Sequence[float]) -> np.ndarray:
         """Coefficients g_0.. of num(s)/den(s) = sum g_m s^m."""
         g = np.zeros(_MAX_DEGREE + 1)
         for m in range(_MAX_DEGREE + 1):
@@ -335,7 +338,9 @@ class _FreeTable:
 
     __slots__ = ("_bp", "_bq", "_p2", "_q2", "_vanishing", "block_k", "block_p", "block_q", "k", "kappa", "p", "q")
 
-    def __init__(self, p, q, k, kappa: float):
+    def __init__(
+        self, p: npt.NDArray[np.float64], q: npt.NDArray[np.float64], k: npt.NDArray[np.float64], kappa: float,
+    ) -> None:
         self.p, self.q, self.k, self.kappa = p, q, k, kappa
         self.block_p: list[float] = [1.0]  # Phi(n _TABLE dt) for n = 0, 1, ... (grown on demand)
         self.block_q: list[float] = [0.0]
@@ -426,7 +431,7 @@ class _FreeTable:
             bq[row, split:] = self._bq[nxt]
         return bp, bq
 
-    def coast_at(self, m: np.ndarray) -> np.ndarray:
+    def coast_at(self, m: npt.NDArray[np.int64]) -> npt.NDArray[np.float64]:
         if len(m) == 0 or m[-1] < _TABLE:
             return self.k[m]
         n, r = np.divmod(m, _TABLE)
@@ -434,7 +439,9 @@ class _FreeTable:
         return np.array(self.block_k)[n] * self.k[r]
 
 
-def _windows(table: np.ndarray, starts: np.ndarray, n: int, out: np.ndarray | None = None) -> np.ndarray:
+def _windows(
+    table: npt.NDArray[np.float64], starts: npt.NDArray[np.int64], n: int, out: npt.NDArray[np.float64] | None = None,
+) -> npt.NDArray[np.float64]:
     """Rows table[s : s + n] for each start s (copies of contiguous runs), into ``out`` if
     given. Short rows are gathered by index (s + 0 .. n-1), which costs less to set up than
     a window view (a stretch of a few samples pays little else); long rows are copied one by

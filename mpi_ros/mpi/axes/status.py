@@ -248,7 +248,8 @@ class _Arrays:
 
     def absolute_difference(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         difference = np.subtract(a, b, out=self.real("difference"))
-        return np.abs(difference, out=difference)
+        absolute: np.ndarray = np.abs(difference, out=difference)  # (numpy's stubs: Any with out=)
+        return absolute
 
 
 def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scratch) -> StretchStatus:

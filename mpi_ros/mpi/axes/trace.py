@@ -24,6 +24,7 @@ import numpy as np
 
 from mpi_ros.mpi.axes.axis import Axis
 from mpi_ros.mpi.axes.bank import VALUES, AxisBank, ClockColumns, CommandRows, Kind, PlantRows
+from mpi_ros.mpi.axes.plant import _FreeTable
 from mpi_ros.mpi.axes.scratch import Scratch
 from mpi_ros.mpi.axes.stretch import Stretch
 from mpi_ros.mpi.base.clock import ProfileClock
@@ -140,7 +141,9 @@ def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
         p[single], dp[single], ddp[single] = _segment(bank.command, rows[single], rel[single], lo[single],
                                                       hi[single], None)
     for i in np.flatnonzero(~single).tolist():
-        p[i], dp[i], ddp[i] = bank.plans[int(rows[i])].evaluate(rel[i])
+        plan = bank.plans[int(rows[i])]
+        assert plan is not None  # (a planned row: written for its plan)
+        p[i], dp[i], ddp[i] = plan.evaluate(rel[i])
     return p, dp, ddp
 
 
@@ -155,10 +158,11 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     one segment of the plan? A row that moved on to another segment gets it here (one axis
     at a time, only when that happens)."""
     cmd = bank.command
-    keep = (lo >= cmd.seg_lo[rows]) & (hi < cmd.seg_hi[rows])
+    keep: np.ndarray = (lo >= cmd.seg_lo[rows]) & (hi < cmd.seg_hi[rows])
     for i in np.flatnonzero(~keep).tolist():
         row = int(rows[i])
         plan = bank.plans[row]
+        assert plan is not None  # (a planned row: written for its plan)
         table = plan.table
         # SegmentTable.index of the two times (bisect_right is its searchsorted on two values,
         # without numpy's cost per call)
@@ -203,7 +207,8 @@ def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
     stretch starts in it (dt >= +0): SegmentTable.evaluate's sums reduce there to p + dt v'
     and v', v' = v + 0.0, to the bit (+0 times a finite dt >= +0 is +0, and x + +0 is x but
     for x = -0.0)."""
-    return cmd.linear[rows] & (lo >= cmd.seg_start[rows])
+    linear: np.ndarray = cmd.linear[rows] & (lo >= cmd.seg_start[rows])
+    return linear
 
 
 def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
@@ -236,7 +241,7 @@ def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
 
 
 # -- the servo ----------------------------------------------------------------------------
-def _servo(plant: PlantRows, tables: list, rows: np.ndarray, out: Stretch, direct: bool,
+def _servo(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, out: Stretch, direct: bool,
            following: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Actual position and velocity (Plant.response, read) of ``rows`` of ``plant``, at
     every sample of the stretch; ``direct``: into the stretch's own arrays where it can;
@@ -298,7 +303,7 @@ def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) ->
     count = coefficients.shape[1]
     if count == 1:
         return coefficients.copy()
-    out = np.multiply(coefficients[:, -1:], s, out=into)
+    out: np.ndarray = np.multiply(coefficients[:, -1:], s, out=into)
     out += coefficients[:, -2, None]
     for k in range(count - 3, -1, -1):
         out *= s
@@ -306,7 +311,7 @@ def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) ->
     return out
 
 
-def _add_transient(plant: PlantRows, tables: list, rows: np.ndarray, s: np.ndarray, y: np.ndarray,
+def _add_transient(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, s: np.ndarray, y: np.ndarray,
                    dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
     """Plant.response's transient added to the rows that have one."""
     if following:
@@ -349,24 +354,28 @@ def _live_transients(plant: PlantRows, rows: np.ndarray, first: int, y: np.ndarr
     has underflowed to exact zeros over the whole stretch (a long-settled loop), since
     adding a zero changes nothing, unless a value is itself a zero (whose sign it might
     flip): there it is added as ever."""
-    live = plant.decayed_after[rows] > -math.inf
+    live: np.ndarray = plant.decayed_after[rows] > -math.inf
     if not live.any():
         return live
-    vanished = live & (first >= plant.vanishing[rows])
+    vanished: np.ndarray = live & (first >= plant.vanishing[rows])
     if vanished.any():
         vanished &= ~(_has_zero(y, vanished, out) | _has_zero(dy, vanished, out))
-    return live & ~vanished
+    added: np.ndarray = live & ~vanished
+    return added
 
 
 def _has_zero(values: np.ndarray, rows: np.ndarray, out: Stretch) -> np.ndarray:
     """Per row (False where ``rows`` is not set): does it hold a zero?"""
+    has: np.ndarray
     if values.shape[1] == 1:
-        return rows & (values[:, 0] == 0.0)
+        has = rows & (values[:, 0] == 0.0)
+        return has
     zero = np.equal(values, 0.0, out=out.scratch.take("zero", values.shape, bool))
-    return rows & zero.any(axis=1)
+    has = rows & zero.any(axis=1)
+    return has
 
 
-def _free(plant: PlantRows, tables: list, rows: np.ndarray, samples: np.ndarray, scratch: Scratch,
+def _free(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, samples: np.ndarray, scratch: Scratch,
           following: bool) -> tuple[np.ndarray, np.ndarray]:
     """(p, q) of the free response at every sample of each row, from its loop's table (for
     ``following`` rows, sample counts before the anchor read as 0)."""
@@ -391,8 +400,9 @@ def _read(resolution: np.ndarray, y: np.ndarray, into: np.ndarray | None) -> np.
         if step <= 0.0:
             return y
         if step == 1.0:
-            out = np.add(y, 0.5, out=into if y.shape[1] > 1 else None)
-            return np.floor(out, out=out)
+            out: np.ndarray = np.add(y, 0.5, out=into if y.shape[1] > 1 else None)
+            floored: np.ndarray = np.floor(out, out=out)  # (numpy's stubs: Any with out=)
+            return floored
         out = np.divide(y, step, out=into if y.shape[1] > 1 else None)
         out += 0.5
         np.floor(out, out=out)

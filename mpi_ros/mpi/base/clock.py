@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,14 +53,14 @@ class ProfileClock:
         return self.tau0 + dt * (self.f0 + 0.5 * self.rate * dt)
 
     # -- vector queries -------------------------------------------------------------
-    def tau(self, t: np.ndarray) -> np.ndarray:
+    def tau(self, t: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         rate = self.rate
         dt = np.minimum(t, self.t_end) - self.t0
         ramp = self.tau0 + dt * (self.f0 + 0.5 * rate * dt)
         after = np.maximum(t - self.t_end, 0.0)
         return ramp + self.f1 * after
 
-    def feedrates(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def feedrates(self, t: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """Feedrate and its time derivative at each time."""
         rate = self.rate
         in_ramp = t < self.t_end

@@ -10,6 +10,7 @@ others follow the status bits of MPI 002 and the documented quirks (docs/decisio
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import IntFlag
 
@@ -56,7 +57,7 @@ class MPIEventType(IntFlag):
     FRAME_UNDERFLOW = 1 << 31  # an open path's frame buffer ran empty while moving
 
     @classmethod
-    def parse(cls, names) -> MPIEventType | None:
+    def parse(cls, names: Iterable[object]) -> MPIEventType | None:
         """Names (without prefix; ALL, NONE, MOTION and AXIS allowed) to a mask."""
         mask = cls.NONE
         for name in names:

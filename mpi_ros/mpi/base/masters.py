@@ -21,6 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from mpi_ros.mpi.base.io import IoImage
 from mpi_ros.mpi.base.params import AxisMaster, SecondaryFeedback
@@ -63,7 +64,7 @@ class SecondaryInputs:
         one = self._inputs[motor]
         return one.sample, one.feedback
 
-    def at(self, motor: int, samples: np.ndarray, rate: float) -> np.ndarray:
+    def at(self, motor: int, samples: npt.NDArray[np.int64], rate: float) -> npt.NDArray[np.float64]:
         one = self._inputs[motor]
         moved = one.feedback.velocity * ((samples - one.sample) / rate)
         return np.floor(one.feedback.position + moved + 0.5)
@@ -75,9 +76,9 @@ class Sources:
     axis, one column per sample), the samples, each axis' origin, the I/O image, the
     secondary inputs and the sample rate."""
 
-    cmd_p: np.ndarray
-    act_p: np.ndarray
-    samples: np.ndarray
+    cmd_p: npt.NDArray[np.float64]
+    act_p: npt.NDArray[np.float64]
+    samples: npt.NDArray[np.int64]
     origin: Callable[[int], float]
     io: IoImage
     secondary: SecondaryInputs
@@ -91,11 +92,12 @@ class Sources:
             frame += self.origin(master.correction)
         return frame
 
-    def position(self, master: AxisMaster, frame: float | None = None) -> np.ndarray:
+    def position(self, master: AxisMaster, frame: float | None = None) -> npt.NDArray[np.float64]:
         """The master position at each sample: the raw reading less ``frame`` (by default the
         origins now, :meth:`frame`). A cam reads its master with the frame of its start, so
         that a later mpiAxisOriginSet, bookkeeping only, moves no slave."""
         n, kind = master.number, master.type
+        value: npt.NDArray[np.float64]
         if kind is M.AXIS_COMMANDED_POSITION:
             value = self.cmd_p[n] + 0.0  # (a copy)
         elif kind in (M.AXIS_ACTUAL_POSITION, M.MOTOR_FEEDBACK_PRIMARY):

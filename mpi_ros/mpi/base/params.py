@@ -17,9 +17,9 @@ import itertools
 import math
 import numbers
 import reprlib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import TypeGuard
+from typing import Protocol, TypeGuard
 
 from mpi_ros.mpi.base.events import MASK_ALL, MPIEventType
 from mpi_ros.mpi.base.messages import Message
@@ -157,11 +157,17 @@ def check_duration(name: str, value: object, positive: bool = False) -> Outcome:
     return check_range(name, value, 0.0, MAX_DURATION, above_low=positive)
 
 
-def _each(name: str, values: Iterable[object], check) -> Iterable[Outcome]:
+def _each(name: str, values: Iterable[object], check: Callable[[str, object], Outcome]) -> Iterable[Outcome]:
     return (check(f"{name}[{i}]", v) for i, v in enumerate(values))
 
 
-def _each_struct(name: str, structs: Iterable) -> Iterable[Outcome]:
+class _Validated(Protocol):
+    """A parameter struct that checks itself (Trajectory, MotionHold, MotionOutput, ...)."""
+
+    def validate(self) -> Outcome: ...
+
+
+def _each_struct(name: str, structs: Iterable[_Validated]) -> Iterable[Outcome]:
     return (s.validate().prefixed(f"{name}[{i}].") for i, s in enumerate(structs))
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from enum import Enum, IntEnum, IntFlag
 
 
@@ -115,7 +116,7 @@ class MotionAttr(IntFlag):
     NO_WAIT = 1 << 31
 
     @classmethod
-    def parse(cls, names) -> MotionAttr | None:
+    def parse(cls, names: Iterable[object]) -> MotionAttr | None:
         """Attribute names (without prefix) to a mask; None if a name is unknown."""
         mask = cls.NONE
         for name in names:

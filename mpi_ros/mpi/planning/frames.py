@@ -13,9 +13,11 @@ import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Self
+from types import MemberDescriptorType
+from typing import TYPE_CHECKING, Self, cast, overload
 
 import numpy as np
+import numpy.typing as npt
 
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.params import Hold, Output, Trajectory
@@ -32,7 +34,11 @@ if TYPE_CHECKING:
 POINT_TIME_TOLERANCE = 1e-9
 
 
-def reached(rel):
+@overload
+def reached(rel: float) -> float: ...
+@overload
+def reached(rel: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def reached(rel: float | npt.NDArray[np.float64]) -> float | npt.NDArray[np.float64]:
     """The profile time up to which points count as reached at profile time ``rel``."""
     return rel + POINT_TIME_TOLERANCE
 
@@ -250,8 +256,10 @@ class AxisPlan:
 
 
 # The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
-_segments_slot = AxisPlan.__dict__["segments"]
-_limits_slot = AxisPlan.__dict__["limits"]  # (and its limits, likewise)
+# (ScaledAxisPlan: None or Segments; RowAxisPlan: Rows or Segments; AxisPlan: Segments; each
+# reader types what it reads)
+_segments_slot: MemberDescriptorType = AxisPlan.__dict__["segments"]
+_limits_slot: MemberDescriptorType = AxisPlan.__dict__["limits"]  # (and its limits, likewise)
 _new_object = object.__new__
 _with_duration = AxisPlan.with_duration.__func__  # type: ignore[attr-defined]  # (ScaledAxisPlan.of's, for its class)
 
@@ -277,8 +285,8 @@ class ScaledAxisPlan(AxisPlan):
         limits left out. ``duration``: ``end_time(scaled.line)``, the same durations added in the
         same order as ``end_time(scaled.segments())`` adds the segments' (the vector's axes share
         it: calculated once)."""
-        plan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold, outputs,
-                              False, None, start_velocity, start_acceleration, composite)
+        plan: ScaledAxisPlan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold,
+                                              outputs, False, None, start_velocity, start_acceleration, composite)
         plan.scaled = scaled
         plan.vector_limits = vector_limits
         return plan
@@ -290,7 +298,7 @@ class ScaledAxisPlan(AxisPlan):
 
     @property
     def segments(self) -> list[Segment]:
-        made = _segments_slot.__get__(self, AxisPlan)
+        made: list[Segment] | None = _segments_slot.__get__(self, AxisPlan)
         if made is None:
             made = self.scaled.segments()
             _segments_slot.__set__(self, made)
@@ -302,7 +310,7 @@ class ScaledAxisPlan(AxisPlan):
 
     @property
     def limits(self) -> Trajectory | None:
-        made = _limits_slot.__get__(self, AxisPlan)
+        made: Trajectory | None = _limits_slot.__get__(self, AxisPlan)
         if made is None:
             made = self.vector_limits.share(abs(self.scaled.factor))
             _limits_slot.__set__(self, made)
@@ -330,15 +338,17 @@ class RowAxisPlan(AxisPlan):
     __slots__ = ()
 
     def _rows(self) -> Sequence[Row]:
-        return _segments_slot.__get__(self, AxisPlan)
+        rows: Sequence[Row] = _segments_slot.__get__(self, AxisPlan)
+        return rows
 
     @property
     def segments(self) -> list[Segment]:
-        made = _segments_slot.__get__(self, AxisPlan)
-        if type(made[0]) is not Segment:  # (never empty: with_duration and __post_init__ see to it)
-            made = list(map(segment_from, made))
-            _segments_slot.__set__(self, made)
-        return made
+        made: list[Segment] | list[Row] = _segments_slot.__get__(self, AxisPlan)
+        if type(made[0]) is Segment:  # (never empty: with_duration and __post_init__ see to it)
+            return cast("list[Segment]", made)  # (the first is a Segment: all are)
+        segments = list(map(segment_from, made))
+        _segments_slot.__set__(self, segments)
+        return segments
 
     @segments.setter
     def segments(self, value: list[Segment]) -> None:

@@ -23,6 +23,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Refused
@@ -203,16 +204,16 @@ def _knots(begin: float, first: float, point_times: np.ndarray, values: np.ndarr
     return np.concatenate([[begin], begin + point_times]), np.concatenate([[first], values])
 
 
-def _points(params: MotionParams, starts: list[PathStart], relative: bool) -> np.ndarray:
+def _points(params: MotionParams, starts: list[PathStart], relative: bool) -> npt.NDArray[np.float64]:
     """(points, axes) raw positions: RELATIVE from the start, else absolute with the
     shortest-path rule applied to the first point."""
     axes = len(starts)
-    given = np.asarray(params.position, dtype=float).reshape(-1, axes)
-    start = np.array([s.position for s in starts])
+    given: npt.NDArray[np.float64] = np.asarray(params.position, dtype=float).reshape(-1, axes)
+    start: npt.NDArray[np.float64] = np.array([s.position for s in starts])
     if relative:
         return given + start
-    absolute = given + np.array([s.origin for s in starts])
-    turns = np.round((absolute[0] - start) / WRAP) if len(absolute) else np.zeros(axes)
+    absolute: npt.NDArray[np.float64] = given + np.array([s.origin for s in starts])
+    turns: npt.NDArray[np.float64] = np.round((absolute[0] - start) / WRAP) if len(absolute) else np.zeros(axes)
     return absolute - turns * WRAP
 
 

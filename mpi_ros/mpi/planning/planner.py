@@ -269,7 +269,9 @@ def _wait(position: float, duration: float) -> list[Segment]:
     return [Segment(duration, position, 0.0, 0.0, 0.0)] if duration > 0.0 else []
 
 
-def _scalar_profile(motion_type: MPIMotionType, start: AxisStart, target: float, v_final: float, traj: Trajectory):
+def _scalar_profile(
+    motion_type: MPIMotionType, start: AxisStart, target: float, v_final: float, traj: Trajectory,
+) -> list[Segment]:
     return _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, v_final, traj)[0]
 
 
@@ -324,7 +326,7 @@ def _segments(profile: Profile) -> list[Segment]:
     return profile.segments() if isinstance(profile, ScaledProfile) else profile
 
 
-def _dot(a, b) -> float:
+def _dot(a: Sequence[float], b: Sequence[float]) -> float:
     """The exactly rounded dot product (math.fsum of the products)."""
     if len(a) == 2:
         # Two products: their sum is already exactly rounded, as fsum's is. fsum answers +0.0 for
@@ -335,7 +337,7 @@ def _dot(a, b) -> float:
     return math.fsum([x * y for x, y in zip(a, b, strict=True)])
 
 
-def _along(vector, unit, scale: float) -> tuple[float, bool]:
+def _along(vector: Sequence[float], unit: Sequence[float], scale: float) -> tuple[float, bool]:
     """The component of ``vector`` along ``unit``, and whether ``vector`` lies on that line."""
     if not any(vector):  # at rest (or no final velocity): what the calculation gives, without it
         return 0.0, True
@@ -355,8 +357,9 @@ def _accel_along(starts: list[AxisStart], unit: list[float]) -> float:
     return _dot(accels, unit) if any(accels) else 0.0  # (a dot product of zeros is +0.0)
 
 
-def _vector_profiles(motion_type, starts, targets, finals,
-                     traj) -> tuple[list[Profile], list[Trajectory] | None, str, RowLine | None]:
+def _vector_profiles(
+    motion_type: MPIMotionType, starts: list[AxisStart], targets: list[float], finals: list[float], traj: Trajectory,
+) -> tuple[list[Profile], list[Trajectory] | None, str, RowLine | None]:
     """One profile along the straight line from the start to the targets, each axis'
     effective limits (the vector's scaled by the axis' share of the line: None when every
     profile is a ScaledProfile, whose factor is that share, the limits then made when asked for,
@@ -406,7 +409,10 @@ def _vector_profiles(motion_type, starts, targets, finals,
 STOP_THEN_LINE = "vector modify off its line: the vector stops along its line, then moves on a new one"
 
 
-def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
+def _stop_then_line(
+    motion_type: MPIMotionType, starts: list[AxisStart], p0: list[float], v0: list[float], speed: float,
+    targets: list[float], finals: list[float], traj: Trajectory,
+) -> tuple[list[Profile], list[Trajectory], str, None]:
     """A vector modify off the current line: the vector first comes to rest along the line it
     is on (decelerating as the trajectory says), then moves on a straight line to the new
     targets. Both parts are single vector profiles, so the vector's limits hold throughout
@@ -417,7 +423,8 @@ def _stop_then_line(motion_type, starts, p0, v0, speed, targets, finals, traj):
     rest = [p + h * stopped_after for p, h in zip(p0, heading, strict=True)]
     go_starts = [AxisStart(s.axis, p, 0.0, s.origin) for s, p in zip(starts, rest, strict=True)]
     go, go_limits, _, _ = _vector_profiles(motion_type, go_starts, targets, finals, traj)
-    profiles = [scaled_profile(stop, h, p) + _segments(tail) for h, p, tail in zip(heading, p0, go, strict=True)]
+    profiles: list[Profile] = [scaled_profile(stop, h, p) + _segments(tail)
+                               for h, p, tail in zip(heading, p0, go, strict=True)]
     limits = [traj.share(max(abs(h), _limits_of(tail, go_limits, i, traj).velocity / traj.velocity))
               for i, (h, tail) in enumerate(zip(heading, go, strict=True))]
     return profiles, limits, STOP_THEN_LINE, None
@@ -433,7 +440,9 @@ def _stop_profile(motion_type: MPIMotionType, speed: float, traj: Trajectory) ->
     return reshape(ramp_rows(speed, 0.0, traj.acceleration, traj.deceleration), 0.0, jerk_percent)
 
 
-def _sync(profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], bits: int):
+def _sync(
+    profiles: list[list[Segment]], starts: list[AxisStart], targets: list[float], bits: int,
+) -> list[list[Segment]]:
     durations = [sum(s.duration for s in prof) for prof in profiles]
     longest = max(durations, default=0.0)
     out = []
@@ -505,7 +514,9 @@ def path_starts(starts: list[AxisStart]) -> list[PathStart]:
     return [PathStart(s.axis, s.position, s.velocity, s.origin) for s in starts]
 
 
-def _path_plans(motion_type, params, attrs, starts) -> tuple[list[AxisPlan], Stream]:
+def _path_plans(
+    motion_type: MPIMotionType, params: MotionParams, attrs: MotionAttr, starts: list[AxisStart],
+) -> tuple[list[AxisPlan], Stream]:
     """A path's plans (paths.py) and its streaming state; the frame buffer's low count is
     the supervisor's to set (it knows the buffer's size)."""
     relative = bool(attrs & (A.RELATIVE | A.RELATIVE_MOVE))
@@ -515,7 +526,7 @@ def _path_plans(motion_type, params, attrs, starts) -> tuple[list[AxisPlan], Str
     return plans, Stream(open=not params.final, empty_count=params.empty_count, low_count=0, peaks=peaks)
 
 
-def _holds_and_outputs(params: MotionParams, bits: int, index: int):
+def _holds_and_outputs(params: MotionParams, bits: int, index: int) -> tuple[Hold | None, list[Output]]:
     hold = params.hold[index] if bits & _HOLDS else None
     outputs = list(params.output) if bits & _OUTPUT and index == 0 else []
     return hold, outputs
@@ -531,12 +542,13 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     line: Line | None = None  # the 1-D profile of one axis
     vector: RowLine | None = None  # or the one of a vector's axes (_vector_profiles)
     limits: list[Trajectory] | None  # (None: a vector's shares, _limits_of)
+    profiles: Sequence[Profile]
     if bits & _SYNC:
-        profiles = [
+        scalar = [
             _scalar_profile(motion_type, start, target, final, traj)
             for start, target, final, traj in zip(starts, targets, finals, params.trajectory, strict=True)
         ]
-        profiles = _sync(profiles, starts, targets, bits)
+        profiles = _sync(scalar, starts, targets, bits)
         limits = list(params.trajectory)
     elif len(starts) == 1:
         one = starts[0]
@@ -629,7 +641,10 @@ def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: A
                               start.acceleration, composite)
 
 
-def _velocity_plans(motion_type, params, attrs, starts, sample_rate, notes) -> list[AxisPlan]:
+def _velocity_plans(
+    motion_type: MPIMotionType, params: MotionParams, attrs: MotionAttr, starts: list[AxisStart],
+    sample_rate: float, notes: PlanNotes,
+) -> list[AxisPlan]:
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     jerk_limited = _LINE[motion_type].jerk_limited
     trajs = params.trajectory if len(params.trajectory) == len(starts) else params.trajectory * len(starts)

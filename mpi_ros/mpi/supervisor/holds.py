@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from mpi_ros.mpi.base.io import IoImage
 from mpi_ros.mpi.base.params import Hold
@@ -68,13 +69,13 @@ class HoldWait:
         index = self.hold.address if space is IoSpace.IO else self.hold.number
         return io.matches(space, index, self.hold.mask, self.hold.pattern)
 
-    def position_trigger(self, positions: np.ndarray) -> np.ndarray:
+    def position_trigger(self, positions: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]:
         """Trigger state per sample given the watched axis' positions (user units)."""
         if self.greater:
             return positions >= self.hold.position
         return positions <= self.hold.position
 
-    def timed_out(self, samples: np.ndarray) -> np.ndarray:
+    def timed_out(self, samples: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
         if self.deadline is None:
             return np.zeros(len(samples), dtype=bool)
         return samples >= self.deadline

@@ -24,7 +24,7 @@ import numpy as np
 
 from mpi_ros.mpi.axes.axis import Axis
 from mpi_ros.mpi.axes.status import StretchStatus
-from mpi_ros.mpi.axes.trace import Stretch
+from mpi_ros.mpi.axes.stretch import Stretch
 from mpi_ros.mpi.base.clock import ProfileClock
 from mpi_ros.mpi.base.events import EventNotify, MPIEventType
 from mpi_ros.mpi.base.messages import STATE_MESSAGES, Message
@@ -485,7 +485,8 @@ class MotionSupervisor:
                 serial = current.stream.chunks[-1][0]  # the points just appended to the open path
         return outcome, serial
 
-    def _command(self, motion_type, attrs, params, modify) -> Outcome:
+    def _command(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
+                 modify: bool) -> Outcome:
         """A start or modify, in five steps, each of which may refuse it (nothing changes then):
         admit (handle, axes, type, state), check (the request against what runs), plan,
         fit (the frame buffer, the mapping), commit."""

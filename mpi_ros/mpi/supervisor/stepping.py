@@ -12,6 +12,7 @@ from enum import IntEnum
 from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from mpi_ros.mpi.axes.axis import Axis, CommandMode
 from mpi_ros.mpi.axes.status import AT_VELOCITY, DONE, StatusMode
@@ -23,7 +24,7 @@ from mpi_ros.mpi.supervisor.holds import HoldWait
 
 if TYPE_CHECKING:
     from mpi_ros.mpi.axes.status import StretchStatus
-    from mpi_ros.mpi.axes.trace import Stretch
+    from mpi_ros.mpi.axes.stretch import Stretch
     from mpi_ros.mpi.host import SupervisorHost
     from mpi_ros.mpi.planning.frames import Move, Stream
     from mpi_ros.mpi.supervisor.actions import Actions
@@ -167,6 +168,7 @@ class Transitions:
         return ready
 
     def _hold_trigger(self, wait: HoldWait, stretch: Stretch) -> np.ndarray:
+        fired: npt.NDArray[np.bool_]
         if wait.watches_position:
             number = wait.hold.number
             raw = stretch.act_p[number] if wait.hold.type is HoldType.AXIS_POSITION_ACTUAL else stretch.cmd_p[number]

@@ -22,6 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 
 @dataclass(frozen=True, slots=True)
@@ -31,9 +32,9 @@ class CamTable:
     (cumulative slavePosition); ``ratios``: CAM_CUBIC's gear ratio dS/du there (G_0 = 0),
     None for CAM_LINEAR; ``repeat_from``: the first repeated segment, None without REPEAT."""
 
-    knots: np.ndarray
-    slave: np.ndarray
-    ratios: np.ndarray | None
+    knots: npt.NDArray[np.float64]
+    slave: npt.NDArray[np.float64]
+    ratios: npt.NDArray[np.float64] | None
     repeat_from: int | None
 
     @classmethod
@@ -62,7 +63,7 @@ class CamTable:
         frame every move loads (frames.AxisPlan.frame_count)."""
         return len(self.knots)
 
-    def wrap(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def wrap(self, u: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """(travel within the table, completed repeat cycles) at travels ``u`` (>= 0)."""
         if self.repeat_from is None:
             return np.minimum(u, self.length), np.zeros_like(u)
@@ -72,11 +73,12 @@ class CamTable:
         # (clipped: rounding of cycles * period must not leave the repeated part)
         return np.where(cycles > 0.0, np.minimum(np.maximum(u - cycles * period, first), end), u), cycles
 
-    def position(self, u: np.ndarray) -> np.ndarray:
+    def position(self, u: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """The slave's offset from its start at travels ``u`` (before the start: 0)."""
         w, cycles = self.wrap(np.maximum(u, 0.0))
         i, tau, h = self._segment(w)
         s0, s1 = self.slave[i], self.slave[i + 1]
+        inside: npt.NDArray[np.float64]
         if self.ratios is None:
             inside = s0 + (s1 - s0) * tau
         else:
@@ -88,9 +90,10 @@ class CamTable:
         inside = np.where(w >= self.knots[i + 1], s1, inside)
         if self.repeat_from is None:
             return inside
-        return inside + cycles * (self.slave[-1] - self.slave[self.repeat_from])
+        rise: float = self.slave[-1] - self.slave[self.repeat_from]  # (the slave's rise per cycle)
+        return inside + cycles * rise
 
-    def ratio(self, u: np.ndarray) -> np.ndarray:
+    def ratio(self, u: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """The gear ratio dS/du at travels ``u`` (before the start and past a non-repeating end: 0)."""
         w, _ = self.wrap(np.maximum(u, 0.0))
         i, tau, h = self._segment(w)
@@ -104,7 +107,9 @@ class CamTable:
         outside = (u < 0.0) | ((u >= self.length) if self.repeat_from is None else False)
         return np.where(outside, 0.0, slope)
 
-    def _segment(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _segment(
+        self, w: npt.NDArray[np.float64],
+    ) -> tuple[npt.NDArray[np.intp], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """(segment index, fraction 0..1 into it, its length) at travels ``w`` within the table."""
         last = len(self.knots) - 2
         i = np.minimum(np.maximum(np.searchsorted(self.knots, w, side="right") - 1, 0), last)

@@ -15,6 +15,7 @@ distance still fits (found by bisection, the distance grows with the peak).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 from mpi_ros.mpi.planning.profiles.ramps import ProfileError
 from mpi_ros.mpi.planning.profiles.segment import Segment, chain, end_state, total_duration
@@ -40,22 +41,30 @@ def velocity_change(v: float, a: float, v1: float, amax: float, jerk: float) -> 
     return [(d, j) for d, j in pieces if d > 0.0]
 
 
-def _integrate(p: float, v: float, a: float, pieces) -> tuple[list[Segment], tuple[float, float, float], float]:
+def _integrate(
+    p: float, v: float, a: float, pieces: Iterable[tuple[float, float]],
+) -> tuple[list[Segment], tuple[float, float, float], float]:
     """Segments of (duration, jerk) pieces from (p, v, a), their end state and duration."""
     segments = chain(p, v, a, pieces)
     return segments, end_state(segments, (p, v, a)), total_duration(segments)
 
 
-def _limits_for(v_from: float, v_to: float, accel, decel):
+# (acceleration, jerk): the limits of a change that raises |v| (accel) or lowers it (decel)
+Limits = tuple[float, float]
+
+
+def _limits_for(v_from: float, v_to: float, accel: Limits, decel: Limits) -> Limits:
     return accel if abs(v_to) >= abs(v_from) else decel
 
 
-def _change(v: float, a: float, v1: float, accel, decel):
+def _change(v: float, a: float, v1: float, accel: Limits, decel: Limits) -> list[tuple[float, float]]:
     amax, jerk = _limits_for(v, v1, accel, decel)
     return velocity_change(v, a, v1, amax, jerk)
 
 
-def _distance(v0, a0, peak, v_final, accel, decel) -> tuple[float, float]:
+def _distance(
+    v0: float, a0: float, peak: float, v_final: float, accel: Limits, decel: Limits,
+) -> tuple[float, float]:
     """(distance, time) of going from (v0, a0) to peak and from peak to v_final."""
     _, (p1, _, _), t1 = _integrate(0.0, v0, a0, _change(v0, a0, peak, accel, decel))
     _, (p2, _, _), t2 = _integrate(0.0, peak, 0.0, _change(peak, 0.0, v_final, accel, decel))
@@ -64,7 +73,7 @@ def _distance(v0, a0, peak, v_final, accel, decel) -> tuple[float, float]:
 
 def point_to_point_jerk(
     p0: float, v0: float, a0: float, target: float, v_final: float,
-    vmax: float, accel: tuple[float, float], decel: tuple[float, float],
+    vmax: float, accel: Limits, decel: Limits,
 ) -> list[Segment]:
     """S_CURVE_JERK from (p0, v0, a0); accel/decel are (acceleration, jerk) pairs."""
     if vmax <= 0.0:
@@ -86,7 +95,10 @@ def point_to_point_jerk(
     return segments + tail
 
 
-def _peak(direction, distance, v0, a0, v_final, vmax, accel, decel):
+def _peak(
+    direction: float, distance: float, v0: float, a0: float, v_final: float, vmax: float,
+    accel: Limits, decel: Limits,
+) -> tuple[float, float, float] | None:
     """(time, peak velocity, cruise) of the fastest profile peaking in ``direction``."""
     x = direction * distance
 

@@ -82,7 +82,9 @@ def _total_time(peak: float, cruise: float, v_start: float, v_final: float, acce
     return _ramp_time(v_start, peak, accel, decel) + cruise + _ramp_time(peak, v_final, accel, decel)
 
 
-def _peak_in_direction(x: float, u0: float, uf: float, vmax: float, accel: float, decel: float):
+def _peak_in_direction(
+    x: float, u0: float, uf: float, vmax: float, accel: float, decel: float,
+) -> tuple[float, float] | None:
     """Fastest peak velocity w in [0, vmax] and cruise time for one travel direction.
 
     Coordinates are along the direction: x is the distance to go, u0/uf the start and
