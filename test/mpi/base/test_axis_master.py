@@ -49,7 +49,8 @@ def test_a_master_without_it_keeps_the_current_motor(ctl):
 
 @pytest.mark.parametrize("motor", [4, -3])
 def test_a_motor_that_does_not_exist_is_refused_and_changes_nothing(ctl, motor):
-    assert ctl.axis_master_set(0, AxisMaster(encoder_fault_motor_number=motor)).message is Message.MPIMessagePARAM_INVALID
+    outcome = ctl.axis_master_set(0, AxisMaster(encoder_fault_motor_number=motor))
+    assert outcome.message is Message.MPIMessagePARAM_INVALID
     assert ctl.axis_master_get(0).encoder_fault_motor_number == 0
 
 
