@@ -18,6 +18,7 @@ differences; otherwise the report names the first divergence: where, which field
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,6 +28,7 @@ from mcap.exceptions import McapError
 from .. import config as suite_config
 from .. import graph_names as gn
 from ..commands import Command, apply
+from ..mpi.control import MAX_STRETCH
 from ..ros import convert, wire
 from . import fields, schema
 from .reader import BagReader
@@ -35,6 +37,9 @@ from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
 _OLDER_STAMP = "header.stamp"  # where a bag recorded before the headers has its bare `stamp` compared
 STATUS_TYPES = gn.STATUS_TYPES
+# Samples a run of statuses spans at most: the controller's longest stretch (no longer one
+# is any cheaper a sample), and the run's snapshots are all held until it is compared.
+RUN = MAX_STRETCH
 
 
 @dataclass(frozen=True, slots=True)
@@ -236,20 +241,22 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     report = ReplayReport(str(path), truncated=reader.truncated)
     timeline, recorded_events, first_recorded = _timeline(reader, recording)
     statuses = _Statuses(ctl, recording, tolerance)
-    for sample, kind, _, topic, item, msg in timeline:
-        _step_to(ctl, sample)
-        if kind == 1:
-            reply = apply(ctl, Command.from_json(msg.operation, msg.supervisor, msg.axis, msg.request))
-            report.commands += 1
-            if reply.message.name != msg.message:
-                report.record(Divergence(msg.sample, topic, f"{msg.operation}.message", msg.message,
-                                         reply.message.name))
+    report.last_sample = ctl.sample
+    for entries in _runs(timeline):
+        if entries[0][1] == 1:
+            _apply(ctl, report, entries[0])
         else:
-            statuses.compare(report, sample, item, msg)
-            report.statuses += 1
+            statuses.take([entry[0] for entry in entries])
+        for sample, kind, _, _, item, msg in entries:
+            # where stepping entry by entry would have left the controller
+            report.last_sample = max(report.last_sample, sample)
+            if kind == 0:
+                statuses.compare(report, sample, item, msg)
+                report.statuses += 1
+            if stop_at_first and report.first is not None:
+                break
         if stop_at_first and report.first is not None:
             break
-    report.last_sample = ctl.sample
     # a recording of the graph holds the events from when it started; mpi-ros record has them all
     since = (first_recorded if first_recorded is not None else report.last_sample + 1) if recording.graph else 0
     _compare_events(report, recorded_events, replayed_events, ctl.rate, tolerance, recording.epoch_ns,
@@ -311,17 +318,25 @@ class _Statuses:
         self.tolerance = tolerance
         self.skipped = _SKIPPED_FIELDS if self.epoch is None else frozenset()
         self.exact_bytes = wire.AVAILABLE and self.epoch is not None
-        self.sample = -1
-        self.snapshots: tuple[dict, list] = ({}, [])
+        # the snapshots of the run being compared, by sample (the types are told apart by the message's)
+        self.taken: dict[int, tuple[dict, list]] = {}
         self.leaves: dict[tuple[str, int], int] = {}  # (type, axes) -> values a status compares
+
+    def take(self, samples: Sequence[int]) -> None:
+        """Step the controller to the last of ``samples`` (in order), keeping the snapshots
+        of each; a sample the controller has passed is compared where it is (as stepping to
+        each status did)."""
+        ctl = self.ctl
+        wanted = [max(sample, ctl.sample) for sample in samples]
+        taken = ctl.step_snapshots(wanted[-1] - ctl.sample, wanted)
+        self.taken = {sample: taken[at] for sample, at in zip(samples, wanted, strict=True)}
 
     def compare(self, report: ReplayReport, sample: int, recorded: tuple, msg) -> None:
         """``recorded``: (the Recorded, its supervisor's or axis' number); ``msg``: the
-        message decoded, or None."""
+        message decoded, or None. The controller's snapshots at ``sample`` are in
+        :meth:`take`'s run."""
         ctl = self.ctl
-        if ctl.sample != self.sample:
-            self.snapshots, self.sample = ctl.motion_snapshots(), ctl.sample
-        motions, axes = self.snapshots
+        motions, axes = self.taken[sample]
         item, number = recorded
         motion = item.type == STATUS_TYPES[0]
         snap = motions.get(number) if motion else (axes[number] if 0 <= number < len(axes) else None)
@@ -351,6 +366,34 @@ class _Statuses:
 def _step_to(ctl, sample: int) -> None:
     if sample > ctl.sample:
         ctl.step(sample - ctl.sample)
+
+
+def _apply(ctl, report: ReplayReport, entry: tuple) -> None:
+    """A recorded command, applied at the sample before the one it took effect at."""
+    sample, _, _, topic, _, msg = entry
+    _step_to(ctl, sample)
+    reply = apply(ctl, Command.from_json(msg.operation, msg.supervisor, msg.axis, msg.request))
+    report.commands += 1
+    if reply.message.name != msg.message:
+        report.record(Divergence(msg.sample, topic, f"{msg.operation}.message", msg.message, reply.message.name))
+
+
+def _runs(timeline: list[tuple]) -> Iterator[list[tuple]]:
+    """The timeline in runs: each command alone, and the statuses between two commands in
+    runs of at most RUN samples. A run of statuses is stepped through at once, its
+    snapshots taken inside the controller's stretches (Controller.step_snapshots): a stretch
+    costs about the same whatever its length, and was cut at every status (issue 35)."""
+    run: list[tuple] = []
+    for entry in timeline:
+        if run and (entry[1] == 1 or entry[0] - run[0][0] > RUN):
+            yield run
+            run = []
+        if entry[1] == 1:
+            yield [entry]
+        else:
+            run.append(entry)
+    if run:
+        yield run
 
 
 def _compare_events(report: ReplayReport, recorded, replayed, rate: float, tolerance: float,

@@ -72,6 +72,8 @@ _STRETCH_ELEMENTS = 32 * MAX_STRETCH
 _EDGE_EVENTS = tuple(MPIEventType[name.upper()] for name in BITS[:EVENT_BITS])
 
 EventListener = Callable[[Event], None]
+Snapshots = tuple[dict[int, MotionSnapshot], list[AxisSnapshot]]  # what motion_snapshots() answers
+_Found = tuple[int, int, int, MPIEventType, str]  # an event found in a stretch: index, axis, rank, type, detail
 
 
 class Controller:
@@ -623,10 +625,39 @@ class Controller:
         """Advance ``samples`` samples."""
         if samples < 0:
             raise ValueError("samples must be >= 0")
+        self._step_to(self.sample + int(samples), {})
+
+    def step_snapshots(self, samples: int, at: Iterable[int]) -> dict[int, Snapshots]:
+        """Advance ``samples`` samples, as :meth:`step`, and answer :meth:`motion_snapshots`
+        at each sample of ``at`` (sample numbers, from the current one to the end), equal to
+        what stepping to each of them and taking motion_snapshots() there gives.
+
+        A stretch costs about the same whatever its length (its numpy calls), so a caller
+        that wants status at many samples (replay, issue 35) steps in long stretches and
+        takes the snapshots of the samples inside them from the stretch's arrays, instead
+        of cutting the stepping at each one."""
+        if samples < 0:
+            raise ValueError("samples must be >= 0")
         end = self.sample + int(samples)
+        wanted = sorted({int(s) for s in at})
+        if wanted and (wanted[0] < self.sample or wanted[-1] > end):
+            raise ValueError(f"snapshots asked at samples {wanted[0]} to {wanted[-1]}, "
+                             f"outside {self.sample} to {end}")
+        taken: dict[int, Snapshots | None] = dict.fromkeys(wanted)
+        if self.sample in taken:
+            taken[self.sample] = self.motion_snapshots()
+        self._step_to(end, taken)
+        return {s: snaps for s, snaps in taken.items() if snaps is not None}
+
+    def _step_to(self, end: int, taken: dict[int, Snapshots | None]) -> None:
+        """Step to sample ``end``, filling ``taken``'s samples (None: still wanted) with
+        their snapshots on the way."""
         longest = max(64, min(MAX_STRETCH, _STRETCH_ELEMENTS // len(self.axes)))
         while self.sample < end:
-            self._advance(min(end, self.sample + longest))
+            self._advance(min(end, self.sample + longest), taken)
+            # where the stretch stopped, after its transitions: as stepping there leaves it
+            if self.sample in taken:
+                taken[self.sample] = self.motion_snapshots()
 
     def run_until(self, condition: Callable[[Controller], bool], max_samples: int, chunk: int = 1) -> bool:
         """Step ``chunk`` samples at a time until ``condition`` holds (True) or
@@ -642,7 +673,7 @@ class Controller:
         owner = self.supervisor(axis.owner)
         return owner.clock if owner is not None else None
 
-    def _advance(self, k1: int) -> None:
+    def _advance(self, k1: int, taken: dict[int, Snapshots | None]) -> None:
         k0 = self.sample
         self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])),
                           lambda row: self.axes[row].reanchor(self._clock(self.axes[row])))
@@ -659,7 +690,7 @@ class Controller:
         fault_at = self.faults.scan(stretch)
         if fault_at is not None and fault_at <= stop:
             stop = event_at = fault_at
-        self._status_events(stop, stretch, status)
+        self._status_events(stop, stretch, status, taken)
         self._log(stop, stretch, supervisors)
         self._commit(stop, stretch, status)
         self.faults.commit(stop)
@@ -692,9 +723,57 @@ class Controller:
         for row in rows[t - plant.anchor_t[rows] >= plant.snap_after[rows]].tolist():
             self.axes[row].snap(t)
 
-    def _status_events(self, stop: int, stretch: Stretch, status: StretchStatus) -> None:
-        """Events for status bits that turn on in samples up to ``stop``, in sample order."""
-        found: list[tuple[int, int, int, MPIEventType, str]] = []  # stretch index, axis, rank, type, detail
+    def _status_events(self, stop: int, stretch: Stretch, status: StretchStatus,
+                       taken: dict[int, Snapshots | None]) -> None:
+        """Events for status bits that turn on in samples up to ``stop``, in sample order;
+        between them, the snapshots ``taken`` wants at samples before ``stop`` (each after
+        the events of its own sample and before those of later ones, as stepping there)."""
+        found = sorted(self._edge_events(stop, stretch, status), key=lambda e: e[:3])
+        emitted = 0
+        for i in self._wanted_before(stop, stretch, taken):
+            while emitted < len(found) and found[emitted][0] <= i:
+                self._emit_found(found[emitted], stretch)
+                emitted += 1
+            taken[int(stretch.samples[i])] = self._snapshots_inside(i, stretch, status)
+        for item in found[emitted:]:
+            self._emit_found(item, stretch)
+
+    @staticmethod
+    def _wanted_before(stop: int, stretch: Stretch, taken: dict[int, Snapshots | None]) -> list[int]:
+        """The stretch indices before ``stop`` whose snapshots ``taken`` still wants, in order."""
+        if not taken:
+            return []
+        first = int(stretch.samples[0])  # the stretch's samples are consecutive
+        return sorted(s - first for s, snaps in taken.items() if snaps is None and 0 <= s - first < stop)
+
+    def _snapshots_inside(self, i: int, stretch: Stretch, status: StretchStatus) -> Snapshots:
+        """:meth:`motion_snapshots` at stretch index ``i``, before the stretch's stop. Nothing
+        discrete happens before the stop (a transition or a fault stops the stretch where it
+        happens), so the supervisors, plans, faults and the events latched so far are those
+        of sample i, and the bank shows the values and status bits of sample i, which is all
+        that stepping there would have changed. The bank keeps them until _commit writes
+        the stop's over them (nothing between reads them)."""
+        self.bank.values[:] = stretch.values[:, :, i]
+        self.bank.bits[:] = status.bits[:, :, i]
+        current, self.sample = self.sample, int(stretch.samples[i])
+        try:
+            return self.motion_snapshots()
+        finally:
+            self.sample = current
+
+    def _emit_found(self, item: _Found, stretch: Stretch) -> None:
+        i, number, _, kind, detail = item
+        axis = self.axes[number]
+        # The element id at the event's own sample (a path's changes along the stretch).
+        self.emit(kind, supervisor=axis.owner, axis=number, move_id=axis.move_id,
+                  element_id=axis.element_id_at(float(stretch.rel[number, i])), detail=detail,
+                  sample=int(stretch.samples[i]))
+
+    def _edge_events(self, stop: int, stretch: Stretch, status: StretchStatus) -> list[_Found]:
+        """The status bits that turn on in samples up to ``stop`` and the frame time limits
+        reached, unsorted: (stretch index, axis, rank, type, detail). Read against the bank
+        as the stretch found it."""
+        found: list[_Found] = []
         bits = status.bits[:EVENT_BITS, :, : stop + 1]
         before = self.bank.bits[:EVENT_BITS]
         # Only a bit that is on somewhere, and not on throughout after being on, can rise.
@@ -702,15 +781,9 @@ class Controller:
         for rank, number in zip(*np.nonzero(rising), strict=True):
             for i in rising_edges(bool(before[rank, number]), bits[rank, number]):
                 found.append((int(i), int(number), int(rank), _EDGE_EVENTS[rank], ""))
-        found += self._frame_time_limits(stop, stretch)
-        for i, number, _, kind, detail in sorted(found, key=lambda e: e[:3]):
-            axis = self.axes[number]
-            # The element id at the event's own sample (a path's changes along the stretch).
-            self.emit(kind, supervisor=axis.owner, axis=number, move_id=axis.move_id,
-                      element_id=axis.element_id_at(float(stretch.rel[number, i])), detail=detail,
-                      sample=int(stretch.samples[i]))
+        return found + self._frame_time_limits(stop, stretch)
 
-    def _frame_time_limits(self, stop: int, stretch: Stretch) -> list[tuple[int, int, int, MPIEventType, str]]:
+    def _frame_time_limits(self, stop: int, stretch: Stretch) -> list[_Found]:
         """MPI 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
         ends abruptly, reported when the axis gets there."""
         command = self.bank.command
