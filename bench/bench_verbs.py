@@ -188,6 +188,9 @@ def main() -> None:
           f"{min(loads):.1f} to {max(loads):.1f} during the runs")
     print()
     print("\n".join(table(results)))
+    for tree, runs in results.items():  # every run, so that a slow one shows as one or as a tail
+        for verb, *_ in CYCLE:
+            print(f"{tree}, {verb}: " + " ".join(f"{run.effect:.2f}" for run in runs if run.verb == verb))
 
 
 if __name__ == "__main__":
