@@ -29,7 +29,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from mpi_ros.mpi.base.types import MPIMotionType
-from mpi_ros.mpi.planning.frames import AxisPlan
+from mpi_ros.mpi.planning.frames import AxisPlan, Listed
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 from .limits import BlendLimits, check_blend, check_profile, strip_waits
@@ -145,7 +145,8 @@ def _check_blended(plan: AxisPlan, kind: MPIMotionType, axis: int) -> CrossCheck
     against the limits the reference gives a blend (limits.check_blend)."""
     parts = plan.blended_from
     assert parts is not None and plan.limits is not None  # (check_plan's caller: a blended plan)
-    own = check_plan(replace(plan, segments=list(parts.own), composite="", blended_from=None), kind, axis)
+    alone = replace(plan, source=Listed(list(parts.own), plan.limits), composite="", blended_from=None)
+    own = check_plan(alone, kind, axis)
     own_f = plan.limits.jerk_percent / 100.0 if kind is not MPIMotionType.TRAPEZOIDAL else 0.0
     before = parts.tail_limits or plan.limits  # (a move before without recorded limits: the same)
     tail_f = before.jerk_percent / 100.0 if any(s.j != 0.0 for s in parts.tail) else 0.0

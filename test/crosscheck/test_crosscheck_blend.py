@@ -12,7 +12,7 @@ import pytest
 
 from mpi_ros.crosscheck import Reason, Verdict, check_plan
 from mpi_ros.mpi import Controller, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState, Trajectory
-from mpi_ros.mpi.planning.frames import AxisPlan, BlendParts
+from mpi_ros.mpi.planning.frames import AxisPlan, BlendParts, Listed
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 A, T = MotionAttr, MPIMotionType
@@ -79,7 +79,7 @@ def test_a_blend_above_twice_the_acceleration_is_caught():
     parts = plan.blended_from
     assert parts is not None
     harsh = tuple(Segment(s.duration / math.sqrt(3.0), s.p, s.v * math.sqrt(3.0), s.a * 3.0, s.j) for s in parts.tail)
-    broken = replace(plan, segments=_sum(parts.own, harsh), blended_from=BlendParts(parts.own, harsh,
+    broken = replace(plan, source=Listed(_sum(parts.own, harsh), plan.limits), blended_from=BlendParts(parts.own, harsh,
                                                                                     parts.tail_limits))
     result = check_plan(broken, T.TRAPEZOIDAL)
     assert result.verdict is Verdict.DISAGREE
@@ -90,7 +90,7 @@ def test_a_blend_above_twice_the_acceleration_is_caught():
 def test_a_blend_that_is_not_the_sum_of_its_profiles_is_caught():
     plan = _about_face_plan()
     shifted = [Segment(s.duration, s.p + 0.5, s.v, s.a, s.j) for s in plan.segments]
-    result = check_plan(replace(plan, segments=shifted), T.TRAPEZOIDAL)
+    result = check_plan(replace(plan, source=Listed(shifted, plan.limits)), T.TRAPEZOIDAL)
     assert result.verdict is Verdict.DISAGREE
     assert any("not the sum" in p for p in result.problems), result.problems
 

@@ -10,6 +10,7 @@ import pytest
 
 from mpi_ros.cli import main
 from mpi_ros.cli.crosscheck import EXAMPLES
+from mpi_ros.mpi.planning.frames import Listed
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -76,7 +77,7 @@ def test_a_disagreement_is_exit_status_1(monkeypatch, capsys):
     def wrong(supervisor, motion_type, attrs, params, starts, rate):
         fast = replace(params, trajectory=[replace(t, velocity=2 * t.velocity) for t in params.trajectory])
         move, notes = real(supervisor, motion_type, attrs, fast, starts, rate)
-        move.plans[0].limits = params.trajectory[0]
+        move.plans[0].source = Listed(move.plans[0].segments, params.trajectory[0])
         return move, notes
 
     monkeypatch.setattr(request_module, "compile_move", wrong)

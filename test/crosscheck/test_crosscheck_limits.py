@@ -12,7 +12,7 @@ import pytest
 from mpi_ros.crosscheck import ProfileRequest, Reason, Verdict, check_plan
 from mpi_ros.mpi.base.params import MotionParams, Trajectory
 from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
-from mpi_ros.mpi.planning.frames import AxisPlan
+from mpi_ros.mpi.planning.frames import AxisPlan, Listed
 from mpi_ros.mpi.planning.planner import compile_move
 from mpi_ros.mpi.planning.profiles.point_to_point import point_to_point
 from mpi_ros.mpi.planning.profiles.segment import Segment
@@ -23,7 +23,7 @@ LIMITS = Trajectory(500.0, 5000.0, 5000.0, 50.0)
 
 
 def _plan(segments, limits=LIMITS, target=1000.0, **kw) -> AxisPlan:
-    return AxisPlan(axis=0, segments=list(segments), start_position=0.0, target=target, limits=limits, **kw)
+    return AxisPlan(axis=0, source=Listed(list(segments), limits), start_position=0.0, target=target, **kw)
 
 
 def _problems(plan, kind=S) -> str:

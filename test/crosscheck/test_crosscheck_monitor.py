@@ -12,6 +12,7 @@ from mpi_ros.crosscheck import Verdict
 from mpi_ros.crosscheck import monitor as monitor_module
 from mpi_ros.crosscheck.monitor import CrosscheckMonitor
 from mpi_ros.mpi.base.events import MPIEventType
+from mpi_ros.mpi.planning.frames import Listed
 from mpi_ros.mpi.supervisor import motion as motion_module
 from mpi_ros.runner import ControllerRunner
 
@@ -76,7 +77,7 @@ def _plan_with_twice_the_acceleration(monkeypatch):
         fast = replace(params, trajectory=[replace(t, acceleration=2 * t.acceleration) for t in asked])
         move, notes = real(supervisor, motion_type, attrs, fast, starts, rate)
         for plan in move.plans:
-            plan.limits = replace(plan.limits, acceleration=plan.limits.acceleration / 2)
+            plan.source = Listed(plan.segments, replace(plan.limits, acceleration=plan.limits.acceleration / 2))
         return move, notes
 
     monkeypatch.setattr(motion_module, "compile_move", wrong)

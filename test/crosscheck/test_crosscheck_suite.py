@@ -66,6 +66,7 @@ def test_a_disagreement_is_an_event_and_a_diagnostic(crosscheck_suite, probe, mo
 
     from mpi_ros.client import EVENTS_QOS
     from mpi_ros.commands import Command
+    from mpi_ros.mpi.planning.frames import Listed
     from mpi_ros.mpi.supervisor import motion as motion_module
     from mpi_ros.msg import MotionEvent
 
@@ -93,7 +94,7 @@ def test_a_disagreement_is_an_event_and_a_diagnostic(crosscheck_suite, probe, mo
         fast = replace(params, trajectory=[replace(t, acceleration=2 * t.acceleration) for t in params.trajectory])
         move, notes = real(supervisor, motion_type, attrs, fast, starts, rate)
         for plan in move.plans:
-            plan.limits = replace(plan.limits, acceleration=plan.limits.acceleration / 2)
+            plan.source = Listed(plan.segments, replace(plan.limits, acceleration=plan.limits.acceleration / 2))
         return move, notes
 
     monkeypatch.setattr(motion_module, "compile_move", wrong)

@@ -21,7 +21,7 @@ import math
 from mpi_ros.mpi.base.params import Trajectory
 from mpi_ros.mpi.base.types import MotionAttr
 from mpi_ros.mpi.planning.families import FAMILIES, Kind
-from mpi_ros.mpi.planning.frames import AxisPlan, BlendParts, Move
+from mpi_ros.mpi.planning.frames import AxisPlan, BlendParts, Listed, Move
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 _WAITS = MotionAttr.DELAY | MotionAttr.HOLD | MotionAttr.HOLD_LESS | MotionAttr.HOLD_GREATER
@@ -84,9 +84,9 @@ def blended(plan: AxisPlan, tail: list[Segment], rest: float, tail_limits: Traje
     overlapping profiles summed. The plan keeps both parts (``blended_from``)."""
     extra = [Segment(s.duration, s.p - rest, s.v, s.a, s.j) for s in tail]
     own = list(plan.segments)
-    return AxisPlan(axis=plan.axis, segments=superpose(own, extra),
+    return AxisPlan(axis=plan.axis, source=Listed(superpose(own, extra), plan.limits),
                     start_position=plan.start_position, target=plan.target, final_velocity=plan.final_velocity,
-                    outputs=plan.outputs, limits=plan.limits, start_velocity=plan.start_velocity,
+                    outputs=plan.outputs, start_velocity=plan.start_velocity,
                     start_acceleration=plan.start_acceleration, composite="blended with the move before",
                     blended_from=BlendParts(tuple(own), tuple(extra), tail_limits))
 

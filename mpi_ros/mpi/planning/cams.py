@@ -32,7 +32,7 @@ from mpi_ros.mpi.base.params import AxisMaster, MotionParams
 from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
 from mpi_ros.mpi.planning.cam_follow import Backtrack, CamFollow, CamState
 from mpi_ros.mpi.planning.families import FAMILIES
-from mpi_ros.mpi.planning.frames import AxisPlan
+from mpi_ros.mpi.planning.frames import AxisPlan, Listed
 from mpi_ros.mpi.planning.profiles.cam import CamTable
 from mpi_ros.mpi.planning.start import AxisStart
 
@@ -56,7 +56,7 @@ def cam_plans(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParam
         origin = float(params.master_start) if MotionAttr.MASTER_START in attrs else now
         follow = CamFollow(table, master.copy(), direction, origin, Backtrack.of(attrs), start.position,
                            CamState.at_start((now - origin) * direction), frame)
-        plans.append(AxisPlan(axis=start.axis, segments=[], start_position=start.position, target=follow.target,
+        plans.append(AxisPlan(axis=start.axis, source=Listed([]), start_position=start.position, target=follow.target,
                               cam=follow))
     return plans
 

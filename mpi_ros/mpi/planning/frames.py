@@ -13,7 +13,6 @@ import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from types import MemberDescriptorType
 from typing import TYPE_CHECKING, Self, cast, overload
 
 import numpy as np
@@ -22,7 +21,14 @@ import numpy.typing as npt
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.params import Hold, Output, Trajectory
 from mpi_ros.mpi.base.types import MotionAttr, MPIMotionType
-from mpi_ros.mpi.planning.profiles.segment import Row, ScaledProfile, Segment, SegmentTable, end_time, segment_from
+from mpi_ros.mpi.planning.profiles.segment import (
+    Row,
+    Segment,
+    SegmentTable,
+    end_time,
+    scaled_profile,
+    segment_from,
+)
 
 if TYPE_CHECKING:
     from mpi_ros.mpi.planning.cam_follow import CamFollow
@@ -54,11 +60,76 @@ class BlendParts:
 
 
 @dataclass(slots=True)
+class Listed:
+    """Segments listed one by one (every plan but a vector axis' share). ``values``: Segments, or
+    Rows (plain tuples, scurve.reshaped(rows=True): an axis' own point-to-point profile) when
+    ``rows``, which the stepping reads as they are and which are made Segments the first time
+    they are asked for (a cross-check, a plot, a copy): a Segment, a tuple subclass, takes three
+    times as long to make as a tuple, and a modify is planned while its command waits."""
+
+    values: Sequence[Row]
+    planned_limits: Trajectory | None = None  # the limits the profile was planned with
+    total: float | None = None  # end_time(values), where the planner calculated it with them
+    rows: bool = False
+    made: list[Segment] | None = field(default=None, repr=False, compare=False)
+
+    def segments(self) -> list[Segment]:
+        if self.made is None:
+            self.made = list(map(segment_from, self.values)) if self.rows else cast("list[Segment]", self.values)
+        return self.made
+
+    def row_values(self) -> Sequence[Row]:
+        return self.values
+
+    def limits(self) -> Trajectory | None:
+        return self.planned_limits
+
+
+@dataclass(slots=True)
+class Scaled:
+    """A vector axis' share of the vector's 1-D profile (``values``, Rows): ``factor`` times it
+    plus ``offset`` (the axis' start, scaled_profile), and of its limits (``vector_limits``). The
+    segments and limits are made the first time they are asked for (by the stepping's table, a
+    cross-check or a plot), not while the command waits for its plan: a further axis of a
+    vector then costs little to plan. ``total``: end_time(values), the segments' durations added
+    in the same order, calculated once for the vector's axes."""
+
+    values: list[Row]
+    factor: float
+    offset: float
+    total: float
+    vector_limits: Trajectory
+    made: list[Segment] | None = field(default=None, repr=False, compare=False)
+    shared: Trajectory | None = field(default=None, repr=False, compare=False)
+
+    def segments(self) -> list[Segment]:
+        if self.made is None:
+            self.made = scaled_profile(self.values, self.factor, self.offset)
+        return self.made
+
+    def row_values(self) -> Sequence[Row]:
+        return self.segments()
+
+    def limits(self) -> Trajectory:
+        if self.shared is None:
+            self.shared = self.vector_limits.share(abs(self.factor))
+        return self.shared
+
+
+# Where a plan's segments (and the limits they were planned with) come from. Both kinds hold
+# ``values`` (as many as the segments, of the same durations) and ``total`` (their end_time, or
+# None where the plan adds them up), which the plan reads as they are: a plan is made for every
+# axis of every start and modify while its command waits.
+SegmentSource = Listed | Scaled
+
+
+@dataclass(slots=True)
 class AxisPlan:
-    """One axis' part of a move; times are profile time from the axis' start."""
+    """One axis' part of a move; times are profile time from the axis' start. Its segments and
+    limits come from ``source`` (:attr:`segments`, :attr:`limits`): every reader sees Segments."""
 
     axis: int
-    segments: list[Segment]
+    source: SegmentSource
     start_position: float
     target: float  # raw (origin-free) position where the plan ends
     final_velocity: float = 0.0
@@ -67,7 +138,6 @@ class AxisPlan:
     velocity_target: float | None = None  # VELOCITY moves: the commanded velocity
     ramp_end: float = 0.0  # VELOCITY moves: profile time at which the ramp is done
     truncated: bool = False  # a frame hit the 16,384,000-sample limit
-    limits: Trajectory | None = None  # the limits this axis' profile was planned with
     start_velocity: float = 0.0  # velocity (profile time) the profile starts from
     start_acceleration: float = 0.0
     composite: str = ""  # why the segments are more than one profile (e.g. stop, then a new line)
@@ -94,64 +164,32 @@ class AxisPlan:
     _table: SegmentTable | None = field(init=False, default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        if not self.segments:
-            self.segments = [Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)]
-        self.duration = end_time(self.segments, self.origin_time) if self.cam is None else self.cam.duration
+        source = self.source
+        if not source.values:  # a plan holds at least its end
+            source = self.source = Listed([Segment(0.0, self.target, self.final_velocity, 0.0, 0.0)], source.limits())
+        if self.cam is not None:
+            self.duration = self.cam.duration
+        elif source.total is None:
+            self.duration = end_time(source.values, self.origin_time)
+        else:
+            self.duration = self.origin_time + source.total
 
-    @classmethod
-    def with_duration(cls, segments: list[Segment] | list[Row] | None, duration: float, axis: int,
-                      start_position: float, target: float, final_velocity: float, hold: Hold | None,
-                      outputs: list[Output], truncated: bool, limits: Trajectory | None, start_velocity: float,
-                      start_acceleration: float, composite: str) -> Self:
-        """A point-to-point plan (not a VELOCITY move, a path or a cam: origin_time 0) whose
-        ``duration``, ``end_time(segments)``, its planner has calculated already (with the
-        segments: scurve.reshaped), as ``cls(...)`` makes it. Its slots are filled here rather than
-        by the dataclass' __init__ and __post_init__, which would add the segments up again, a
-        pass of their own, behind two calls (a modify is planned while its command waits).
-        ``segments`` None: a ScaledAxisPlan's, made when first asked for; Rows: a RowAxisPlan's."""
-        if segments is not None and not segments:  # (as __post_init__: a plan holds at least its end)
-            segments = [Segment(0.0, target, final_velocity, 0.0, 0.0)]
-            duration = end_time(segments)
-        plan = _new_object(cls)
-        _segments_slot.__set__(plan, segments)  # (past ScaledAxisPlan's property)
-        plan.duration = duration
-        plan.axis = axis
-        plan.start_position = start_position
-        plan.target = target
-        plan.final_velocity = final_velocity
-        plan.hold = hold
-        plan.outputs = outputs
-        plan.truncated = truncated
-        _limits_slot.__set__(plan, limits)  # (past ScaledAxisPlan's property)
-        plan.start_velocity = start_velocity
-        plan.start_acceleration = start_acceleration
-        plan.composite = composite
-        # the other fields' defaults (test_planner checks that every field is as cls(...) makes it)
-        plan.velocity_target = None
-        plan.ramp_end = 0.0
-        plan.origin_time = 0.0
-        plan.point_times = None
-        plan.element_ids = ()
-        plan.timed_outputs = []
-        plan.feedforward = None
-        plan.cam = None
-        plan.spline = None
-        plan.blended_from = None
-        plan._table = None
-        return plan
+    @property
+    def segments(self) -> list[Segment]:
+        return self.source.segments()
+
+    @property
+    def limits(self) -> Trajectory | None:
+        """The limits this axis' profile was planned with."""
+        return self.source.limits()
 
     @property
     def table(self) -> SegmentTable:
         """The segments as arrays. Built on first use, not with the plan: numpy on a handful of
         segments costs more than planning them, and a modify is planned while its command waits."""
         if self._table is None:
-            self._table = SegmentTable(self._rows(), self.origin_time)
+            self._table = SegmentTable(self.source.row_values(), self.origin_time)
         return self._table
-
-    def _rows(self) -> Sequence[Row]:
-        """The segments' values, as the stepping reads them (by index): the segments themselves,
-        or a RowAxisPlan's Rows before its Segments are made."""
-        return self.segments
 
     @property
     def is_velocity(self) -> bool:
@@ -166,7 +204,7 @@ class AxisPlan:
 
     @property
     def segment_count(self) -> int:
-        return len(self.segments)
+        return len(self.source.values)  # (a vector's share: without making its segments)
 
     def frames_left(self, rel: float) -> int:
         """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
@@ -234,7 +272,7 @@ class AxisPlan:
         # bisect_right is searchsorted(side="right") (a nan rel too goes past the end); on a
         # handful of ends it costs a fraction of numpy's call, and it runs for every piece.
         i = min(bisect.bisect_right(table.end, rel), table.count - 1)
-        _, p, v, a, j = self._rows()[i]
+        _, p, v, a, j = self.source.row_values()[i]  # (the stepping reads Rows as they are)
         return float(table.start[i]), [p, v, a / 2.0, j / 6.0]
 
     def boundaries(self) -> np.ndarray:
@@ -253,110 +291,6 @@ class AxisPlan:
             return 0.0, [self.feedforward_at(rel, held)]
         slope = (values[i] - values[i - 1]) / (times[i] - times[i - 1])
         return float(times[i - 1]), [float(values[i - 1]), float(slope)]
-
-
-# The slot AxisPlan keeps its segments in (ScaledAxisPlan reads and fills it behind a property)
-# (ScaledAxisPlan: None or Segments; RowAxisPlan: Rows or Segments; AxisPlan: Segments; each
-# reader types what it reads)
-_segments_slot: MemberDescriptorType = AxisPlan.__dict__["segments"]
-_limits_slot: MemberDescriptorType = AxisPlan.__dict__["limits"]  # (and its limits, likewise)
-_new_object = object.__new__
-_with_duration = AxisPlan.with_duration.__func__  # type: ignore[attr-defined]  # (ScaledAxisPlan.of's, for its class)
-
-
-class ScaledAxisPlan(AxisPlan):
-    """An axis of a vector move whose segments are its share of the vector's 1-D profile
-    (``scaled``), and its limits its share of the vector's (``vector_limits``), each made the
-    first time it is asked for: by the stepping's table, a cross-check or a plot, not while the
-    command waits for its plan (a further axis of a vector then costs little to plan). The
-    segments, limits, duration and frame count are those of an AxisPlan made with
-    ``scaled.segments()`` and ``vector_limits.share(abs(scaled.factor))``, and so is every
-    answer: the two are one plan. Made by :meth:`of`."""
-
-    __slots__ = ("scaled", "vector_limits")
-    scaled: ScaledProfile
-    vector_limits: Trajectory
-
-    @classmethod
-    def of(cls, scaled: ScaledProfile, duration: float, axis: int, start_position: float, target: float,
-           final_velocity: float, hold: Hold | None, outputs: list[Output], vector_limits: Trajectory,
-           start_velocity: float, start_acceleration: float, composite: str) -> ScaledAxisPlan:
-        """The plan of a vector's axis: AxisPlan.with_duration's, not truncated, the segments and
-        limits left out. ``duration``: ``end_time(scaled.line)``, the same durations added in the
-        same order as ``end_time(scaled.segments())`` adds the segments' (the vector's axes share
-        it: calculated once)."""
-        plan: ScaledAxisPlan = _with_duration(cls, None, duration, axis, start_position, target, final_velocity, hold,
-                                              outputs, False, None, start_velocity, start_acceleration, composite)
-        plan.scaled = scaled
-        plan.vector_limits = vector_limits
-        return plan
-
-    def __post_init__(self) -> None:
-        if _segments_slot.__get__(self, AxisPlan) is not None:
-            AxisPlan.__post_init__(self)  # made with its segments (dataclasses.replace, a copy): as any AxisPlan
-        # (made by of(): the duration is given)
-
-    @property
-    def segments(self) -> list[Segment]:
-        made: list[Segment] | None = _segments_slot.__get__(self, AxisPlan)
-        if made is None:
-            made = self.scaled.segments()
-            _segments_slot.__set__(self, made)
-        return made
-
-    @segments.setter
-    def segments(self, value: list[Segment] | None) -> None:
-        _segments_slot.__set__(self, value)
-
-    @property
-    def limits(self) -> Trajectory | None:
-        made: Trajectory | None = _limits_slot.__get__(self, AxisPlan)
-        if made is None:
-            made = self.vector_limits.share(abs(self.scaled.factor))
-            _limits_slot.__set__(self, made)
-        return made
-
-    @limits.setter
-    def limits(self, value: Trajectory | None) -> None:
-        _limits_slot.__set__(self, value)
-
-    @property
-    def segment_count(self) -> int:
-        """As many as the 1-D profile's, without making them (the frame buffer counts them)."""
-        made = _segments_slot.__get__(self, AxisPlan)
-        return len(self.scaled.line) if made is None else len(made)
-
-
-class RowAxisPlan(AxisPlan):
-    """A plan whose segments may be kept as Rows (plain tuples: scurve.reshaped(rows=True), an
-    axis' own profile), which the stepping reads as they are (its table, segment_poly); the
-    Segments are made from them the first time they are asked for (a cross-check, a plot, a
-    copy). A Segment, a tuple subclass, takes three times as long to make as a tuple, and a
-    modify is planned while its command waits. Its segments, and every answer, are those of
-    the AxisPlan with the same values: the two are one plan. Made by ``with_duration``."""
-
-    __slots__ = ()
-
-    def _rows(self) -> Sequence[Row]:
-        rows: Sequence[Row] = _segments_slot.__get__(self, AxisPlan)
-        return rows
-
-    @property
-    def segments(self) -> list[Segment]:
-        made: list[Segment] | list[Row] = _segments_slot.__get__(self, AxisPlan)
-        if type(made[0]) is Segment:  # (never empty: with_duration and __post_init__ see to it)
-            return cast("list[Segment]", made)  # (the first is a Segment: all are)
-        segments = list(map(segment_from, made))
-        _segments_slot.__set__(self, segments)
-        return segments
-
-    @segments.setter
-    def segments(self, value: list[Segment]) -> None:
-        _segments_slot.__set__(self, value)
-
-    @property
-    def segment_count(self) -> int:
-        return len(_segments_slot.__get__(self, AxisPlan))
 
 
 @dataclass(slots=True)
@@ -421,7 +355,7 @@ class Move:
         a planned move not yet taken (serial 0), as the dataclass' __init__ makes it: its slots are
         filled here, without that call in between (compile_move makes a Move for every start and
         modify while the command waits; test_frames checks every field)."""
-        move = _new_object(cls)
+        move = object.__new__(cls)
         move.supervisor = supervisor
         move.type = motion_type
         move.attributes = attributes

@@ -31,7 +31,7 @@ from mpi_ros.mpi.base.params import MotionParams, Output
 from mpi_ros.mpi.base.types import HOLD_ATTRS, MotionAttr, MPIMotionType
 from mpi_ros.mpi.base.wrap import WRAP
 from mpi_ros.mpi.planning.families import FAMILIES, Kind
-from mpi_ros.mpi.planning.frames import AxisPlan, reached
+from mpi_ros.mpi.planning.frames import AxisPlan, Listed, reached
 from mpi_ros.mpi.planning.profiles.path import PathKind, SplineHistory, path_segments, peaks
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
@@ -111,7 +111,7 @@ def compile_path(motion_type: MPIMotionType, attrs: MotionAttr, params: MotionPa
         point_times = np.cumsum(np.asarray(times[k], dtype=float))
         timed = timed_outputs(params, attrs, point_times, 0.0) if k == 0 else []
         plans.append(AxisPlan(
-            axis=start.axis, segments=segments, start_position=start.position, target=ends[k],
+            axis=start.axis, source=Listed(segments), start_position=start.position, target=ends[k],
             outputs=[out for when, out in timed if when <= 0.0], start_velocity=start.velocity,
             point_times=point_times, element_ids=element_ids,
             timed_outputs=[(when, out) for when, out in timed if when > 0.0],
@@ -303,7 +303,7 @@ def extend(plan: AxisPlan, now: float, segments: list[Segment], point_times: np.
     shifted = [*kept, *segments]
     ids = _pending_ids(plan, pending, element_ids, len(point_times))
     return AxisPlan(
-        axis=plan.axis, segments=shifted, start_position=plan.start_position, target=target,
+        axis=plan.axis, source=Listed(shifted), start_position=plan.start_position, target=target,
         start_velocity=plan.start_velocity, origin_time=first,
         point_times=np.concatenate([old_times[pending], new_times]),
         element_ids=ids,

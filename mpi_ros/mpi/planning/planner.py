@@ -39,7 +39,7 @@ from mpi_ros.mpi.base.params import (
 from mpi_ros.mpi.base.types import HOLD_ATTRS, MotionAttr, MPIMotionType
 from mpi_ros.mpi.planning import cams
 from mpi_ros.mpi.planning.families import FAMILIES, Kind
-from mpi_ros.mpi.planning.frames import AxisPlan, Move, RowAxisPlan, ScaledAxisPlan, Stream
+from mpi_ros.mpi.planning.frames import AxisPlan, Listed, Move, Scaled, Stream
 from mpi_ros.mpi.planning.paths import PathStart, compile_path
 from mpi_ros.mpi.planning.profiles.jerk import point_to_point_jerk, velocity_change, velocity_jerk
 from mpi_ros.mpi.planning.profiles.point_to_point import reverses, velocity_move
@@ -47,11 +47,9 @@ from mpi_ros.mpi.planning.profiles.ramps import ProfileError, ramp_rows, trapezo
 from mpi_ros.mpi.planning.profiles.scurve import reshape, reshaped
 from mpi_ros.mpi.planning.profiles.segment import (
     Row,
-    ScaledProfile,
     Segment,
     chain,
     end_time,
-    new_tuple,
     scaled_profile,
 )
 from mpi_ros.mpi.planning.start import AxisStart
@@ -237,12 +235,12 @@ def _no_overflow(offset: float, segments: Sequence[Row]) -> bool:
     return math.isfinite(abs(offset) + bound)
 
 
-def _passes_checks(scaled: ScaledProfile, start: AxisStart, target: float) -> bool:
+def _passes_checks(scaled: Scaled, start: AxisStart, target: float) -> bool:
     """True when the vector axis' share ``scaled`` of a 1-D profile that passed its checks
     (_line_passes) passes _checked as it is, without making its segments: finite, no frame
     beyond the limit, and its last segment, scaled as scaled_profile scales it, ends on the
     target (within the rounding of the positions: otherwise _checked decides)."""
-    line, factor, offset = scaled
+    line, factor, offset = scaled.values, scaled.factor, scaled.offset
     # (_no_overflow's first answer, the usual one, without its call)
     if not (abs(factor) <= 1.0 and (abs(offset) < _HALF_ULP_OF_MAX or _no_overflow(offset, line))):
         return False
@@ -311,19 +309,19 @@ def _profile_from(motion_type: MPIMotionType, p0: float, v0: float, a0: float, t
 
 def _limits_of(profile: Profile, limits: list[Trajectory] | None, i: int, traj: Trajectory) -> Trajectory:
     """Axis i's limits: ``limits[i]``, or where a vector's shares are not made (None: every
-    profile a ScaledProfile), its share of the vector's ``traj``, by its factor (_vector_profiles)."""
+    profile Scaled), its share of the vector's limits, by its factor (_vector_profiles)."""
     if limits is not None:
         return limits[i]
-    assert isinstance(profile, ScaledProfile)
-    return traj.share(abs(profile.factor))
+    assert isinstance(profile, Scaled)
+    return profile.limits()
 
 
 # An axis' profile: its segments, or (a vector's axis) its share of the vector's 1-D profile
-Profile = list[Segment] | ScaledProfile
+Profile = list[Segment] | Scaled
 
 
 def _segments(profile: Profile) -> list[Segment]:
-    return profile.segments() if isinstance(profile, ScaledProfile) else profile
+    return profile.segments() if isinstance(profile, Scaled) else profile
 
 
 def _dot(a: Sequence[float], b: Sequence[float]) -> float:
@@ -362,7 +360,7 @@ def _vector_profiles(
 ) -> tuple[list[Profile], list[Trajectory] | None, str, RowLine | None]:
     """One profile along the straight line from the start to the targets, each axis'
     effective limits (the vector's scaled by the axis' share of the line: None when every
-    profile is a ScaledProfile, whose factor is that share, the limits then made when asked for,
+    profile is Scaled, whose factor is that share, the limits then made when asked for,
     _limits_of), why the profiles are not one profile per axis ("" when they are) and the 1-D
     profile every axis has a share of (None when they have not: no move, or not one line).
     Plain floats: a vector has at most MEIXmpMAX_COORD_AXES components, too few for numpy to
@@ -398,11 +396,10 @@ def _vector_profiles(
     # (only a jerk-limited profile plans from the current acceleration; the others from a = 0)
     accel = _accel_along(starts, unit) if _LINE[motion_type].jerk_limited else 0.0
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj, True)
-    segments = line[0]
+    segments, duration = line[0], line[2]
     profiles: list[Profile] = []
     for i, u in enumerate(unit):  # (unit and p0 are made alike above)
-        # (ScaledProfile(segments, u, p0[i]) without the Python-level __new__ of a NamedTuple, as segments are made)
-        profiles.append(new_tuple(ScaledProfile, (segments, u, p0[i])))
+        profiles.append(Scaled(segments, u, p0[i], duration, traj))
     return profiles, None, "", line
 
 
@@ -561,14 +558,14 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
                                                                params.trajectory[0])
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
     # A vector's axes share one 1-D profile, checked once: an axis whose share provably passes
-    # the checks is planned without making its segments (ScaledAxisPlan); any other, or with
+    # the checks is planned without making its segments (a Scaled source); any other, or with
     # DELAY or NO_REVERSAL, has them made and checked here as every other plan is.
     # reshape's profiles (_profile_from: all but a jerk-limited line's), not padded, delayed or composite
     chained = not _LINE[motion_type].jerk_limited and not bits & _PADDED and not composite
-    # ``shared`` only for a vector's shares (every profile a ScaledProfile) whose 1-D profile
-    # passed its checks; every ScaledAxisPlan's duration is then the 1-D profile's.
+    # ``shared`` only for a vector's shares (every profile Scaled) whose 1-D profile passed its
+    # checks; each such plan's duration is then the 1-D profile's.
     first = profiles[0] if profiles else None
-    shared = (vector is not None and isinstance(first, ScaledProfile) and not bits & _AXIS_BY_AXIS
+    shared = (vector is not None and isinstance(first, Scaled) and not bits & _AXIS_BY_AXIS
               and _line_passes(vector, limit, chained))
     plans: list[AxisPlan] = []
     # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
@@ -577,11 +574,10 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     for i, start in enumerate(starts):
         target, final, profile = targets[i], finals[i], profiles[i]
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])
-        if isinstance(profile, ScaledProfile):
+        if isinstance(profile, Scaled):
             if shared and _passes_checks(profile, start, target):
-                plans.append(ScaledAxisPlan.of(profile, vector[2], start.axis, start.position,  # type: ignore[index]
-                                               target, final, hold, outputs, params.trajectory[0], start.velocity,
-                                               start.acceleration, composite))
+                plans.append(AxisPlan(start.axis, profile, start.position, target, final, hold, outputs, None, 0.0,
+                                      False, start.velocity, start.acceleration, composite))
                 continue
             # (an axis' share of a vector's profile is no chain: each of its segments is scaled alone)
             prof, own = profile.segments(), None
@@ -606,7 +602,7 @@ def _lone_axis_plan(motion_type: MPIMotionType, params: MotionParams, start: Axi
     if len(positions) != 1:  # (_targets' guard)
         raise ValueError(f"{len(positions)} positions for 1 axes")
     target = positions[0] + start.origin  # (_targets' target: not RELATIVE)
-    # (its segments as Rows, the Segments made when first asked for: RowAxisPlan)
+    # (its segments as Rows, the Segments made when first asked for: Listed)
     line = _profile_from(motion_type, start.position, start.velocity, start.acceleration, target, 0.0, traj, True)
     segments, end, duration = line
     limit = VELOCITY_FRAME_LIMIT_SAMPLES / sample_rate
@@ -615,18 +611,18 @@ def _lone_axis_plan(motion_type: MPIMotionType, params: MotionParams, start: Axi
     if chained and duration <= limit and _on_target(end, start, target):
         # _checked's first answer, the usual one: on target, and no segment lasts longer than the
         # limit (_within), so finite (_finite_if_it_ends): the plan as _checked_plan makes it
-        return RowAxisPlan.with_duration(segments, duration, start.axis, start.position, target, 0.0, None, [], False,
-                                         traj, start.velocity, start.acceleration, "")
+        return AxisPlan(start.axis, Listed(segments, traj, duration, True), start.position, target, 0.0, None, [],
+                        None, 0.0, False, start.velocity, start.acceleration, "")
     return _checked_plan(segments, line, chained, start, target, 0.0, limit, notes, None, [],  # type: ignore[arg-type]
-                         traj, "", RowAxisPlan)
+                         traj, "", rows=True)
 
 
 def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: AxisStart, target: float,
                   final: float, limit: float, notes: PlanNotes, hold: Hold | None, outputs: list[Output],
-                  limits: Trajectory, composite: str, kind: type[AxisPlan] = AxisPlan) -> AxisPlan:
+                  limits: Trajectory, composite: str, rows: bool = False) -> AxisPlan:
     """An axis' plan of the segments ``prof`` after _checked. ``own``: the Line they are (where
     they end and their duration, calculated with them), or None; ``chained``: they are
-    reshape's (_point_to_point_plans); ``kind``: the plan's class (RowAxisPlan for Rows)."""
+    reshape's (_point_to_point_plans); ``rows``: they are Rows (Listed)."""
     if own is None:
         end, duration = (_end_position(prof[-1]) if prof else start.position), None
     else:
@@ -634,11 +630,10 @@ def _checked_plan(prof: list[Segment], own: Line | None, chained: bool, start: A
     prof, truncated = _checked(prof, start, target, limit, notes, end, duration if chained else None)
     if truncated:
         # where the cut plan ends, at rest
-        return kind.with_duration(prof, end_time(prof), start.axis, start.position, prof[-1].end_state()[0],
-                                  0.0, hold, outputs, True, limits, start.velocity, start.acceleration, composite)
-    return kind.with_duration(prof, end_time(prof) if duration is None else duration, start.axis,
-                              start.position, target, final, hold, outputs, False, limits, start.velocity,
-                              start.acceleration, composite)
+        return AxisPlan(start.axis, Listed(prof, limits, None, rows), start.position, prof[-1].end_state()[0], 0.0,
+                        hold, outputs, None, 0.0, True, start.velocity, start.acceleration, composite)
+    return AxisPlan(start.axis, Listed(prof, limits, duration, rows), start.position, target, final, hold, outputs,
+                    None, 0.0, False, start.velocity, start.acceleration, composite)
 
 
 def _velocity_plans(
@@ -664,9 +659,9 @@ def _velocity_plans(
         end = prof[-1].end_state() if prof else (start.position, 0.0, 0.0)
         hold, outputs = _holds_and_outputs(params, int(attrs), i)
         plans.append(AxisPlan(
-            axis=start.axis, segments=prof, start_position=start.position, target=end[0],
+            axis=start.axis, source=Listed(prof, traj), start_position=start.position, target=end[0],
             final_velocity=0.0, hold=hold, outputs=outputs, truncated=traj.velocity != 0.0,
             velocity_target=traj.velocity, ramp_end=delay + ramp_time,
-            limits=traj, start_velocity=start.velocity, start_acceleration=start.acceleration,
+            start_velocity=start.velocity, start_acceleration=start.acceleration,
         ))
     return plans

@@ -12,7 +12,7 @@ import pytest
 from mpi_ros.mpi import Controller, ControllerConfig, MotionAttr, MotionParams, MPIAction, MPIMotionType, MPIState
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
-from mpi_ros.mpi.planning.frames import AxisPlan, Move, frames_needed
+from mpi_ros.mpi.planning.frames import AxisPlan, Listed, Move, frames_needed
 from mpi_ros.mpi.planning.profiles.segment import Segment
 
 T = MPIMotionType
@@ -112,8 +112,8 @@ def test_frame_count_decreases_as_the_move_runs(ctl, ms, params):
 def test_trapezoid_frames():
     # MPI 000, Diagram of mpiMotionStart "Number of frames/point vary with type of move (1frame/point for trapezoidal,
     # to 8 frames/point for S-curve)": here a trapezoid is accel, cruise, decel + the final frame
-    plan = AxisPlan(0, [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.9, 50.0, 1e3, 0.0, 0.0),
-                        Segment(0.1, 950.0, 1e3, -1e4, 0.0)], 0.0, 1000.0)
+    plan = AxisPlan(0, Listed([Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.9, 50.0, 1e3, 0.0, 0.0),
+                        Segment(0.1, 950.0, 1e3, -1e4, 0.0)]), 0.0, 1000.0)
     assert plan.frame_count == 4
     assert plan.duration == pytest.approx(1.1)
     assert plan.frames_left(0.0) == 4
@@ -125,7 +125,7 @@ def test_plan_evaluation_ends_exactly_on_target():
     # MPI 002, Configuration of IN_POSITION and DONE Events after STOP or E-STOP Events, AT_TARGET AT_TARGET "TRUE when
     # command = target": the command is the target exactly
     seg = [Segment(0.1, 0.0, 0.0, 1e4, 0.0), Segment(0.1, 50.0, 1e3, -1e4, 0.0)]
-    plan = AxisPlan(0, seg, 0.0, 100.0 + 1e-9)  # rounding in the segments is absorbed at the end
+    plan = AxisPlan(0, Listed(seg), 0.0, 100.0 + 1e-9)  # rounding in the segments is absorbed at the end
     p, v, a = plan.evaluate(np.array([0.05, plan.duration, plan.duration + 1.0]))
     assert p[1] == plan.target
     assert p[2] == plan.target
@@ -135,7 +135,7 @@ def test_plan_evaluation_ends_exactly_on_target():
 
 def test_plan_past_its_end_continues_at_the_final_velocity():
     # MPI 000, MEIMotionAttrFINAL_VEL FINAL_VEL: "a non-zero target velocity for point to point motion types"
-    plan = AxisPlan(0, [Segment(1.0, 0.0, 0.0, 100.0, 0.0)], 0.0, 50.0, final_velocity=100.0)
+    plan = AxisPlan(0, Listed([Segment(1.0, 0.0, 0.0, 100.0, 0.0)]), 0.0, 50.0, final_velocity=100.0)
     p, v, a = plan.evaluate(np.array([1.5]))
     assert p[0] == pytest.approx(100.0)
     assert v[0] == 100.0
@@ -144,7 +144,7 @@ def test_plan_past_its_end_continues_at_the_final_velocity():
 
 def test_an_empty_plan_holds_its_target():
     # frames.py: "one final frame that holds the end state" (a move of zero length)
-    plan = AxisPlan(1, [], 5.0, 5.0)
+    plan = AxisPlan(1, Listed([]), 5.0, 5.0)
     p, v, _ = plan.evaluate(np.array([0.0, 1.0]))
     assert plan.duration == 0.0
     assert list(p) == [5.0, 5.0]
@@ -153,8 +153,8 @@ def test_an_empty_plan_holds_its_target():
 
 def test_frames_needed_counts_per_axis():
     # MPI 000, mpiMotionStart the buffer is per axis
-    a = AxisPlan(0, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)], 0.0, 1.0)
-    b = AxisPlan(1, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)] * 3, 0.0, 3.0)
+    a = AxisPlan(0, Listed([Segment(1.0, 0.0, 1.0, 0.0, 0.0)]), 0.0, 1.0)
+    b = AxisPlan(1, Listed([Segment(1.0, 0.0, 1.0, 0.0, 0.0)] * 3), 0.0, 3.0)
     move = Move(0, T.TRAPEZOIDAL, A.NONE, [a, b])
     assert move.frame_counts == {0: 2, 1: 4}
     assert frames_needed([move, move], 1) == 8
@@ -168,8 +168,9 @@ def test_frames_needed_counts_per_axis():
 @pytest.mark.parametrize("velocity_target", [None, 2.0])
 def test_a_planned_move_is_the_dataclass_move(final_velocity, velocity_target):
     # Move.planned fills the slots itself (compile_move's): every field as Move(...) makes it
-    a = AxisPlan(2, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)], 0.0, 1.0, final_velocity, velocity_target=velocity_target)
-    b = AxisPlan(0, [Segment(1.0, 0.0, 1.0, 0.0, 0.0)], 0.0, 1.0)
+    a = AxisPlan(2, Listed([Segment(1.0, 0.0, 1.0, 0.0, 0.0)]), 0.0, 1.0, final_velocity,
+                 velocity_target=velocity_target)
+    b = AxisPlan(0, Listed([Segment(1.0, 0.0, 1.0, 0.0, 0.0)]), 0.0, 1.0)
     for plans in ([a], [a, b], []):
         made = Move(3, T.S_CURVE, A.ID, plans, 7, 9, MPIEventType.MOTION_DONE, 0, None)
         planned = Move.planned(3, T.S_CURVE, A.ID, plans, 7, 9, MPIEventType.MOTION_DONE, None)

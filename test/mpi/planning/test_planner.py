@@ -13,7 +13,7 @@ from mpi_ros.mpi import Hold, HoldType, MotionAttr, MotionParams, MPIMotionType,
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
 from mpi_ros.mpi.base.outcome import Refused
-from mpi_ros.mpi.planning.frames import AxisPlan, RowAxisPlan, ScaledAxisPlan
+from mpi_ros.mpi.planning.frames import AxisPlan, Listed, Scaled
 from mpi_ros.mpi.planning.planner import compile_move
 from mpi_ros.mpi.planning.profiles.segment import Segment
 from mpi_ros.mpi.planning.start import AxisStart
@@ -242,37 +242,42 @@ def test_hold_and_outputs_go_to_the_plans():
 
 
 def _eager(plan: AxisPlan) -> AxisPlan:
-    """The same plan as a plain AxisPlan, its segments made now."""
-    return AxisPlan(**{f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.init})
+    """The same plan with its segments listed as Segments, made now (its duration theirs)."""
+    return dataclasses.replace(plan, source=Listed(list(plan.segments), plan.limits))
 
 
 def _fields(plan: AxisPlan) -> dict:
-    return {f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.compare}
+    """Every field as a reader sees it: the source as the segments and limits it gives."""
+    fields = {f.name: getattr(plan, f.name) for f in dataclasses.fields(AxisPlan) if f.compare and f.name != "source"}
+    return {**fields, "segments": plan.segments, "limits": plan.limits}
 
 
 @pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
 @pytest.mark.parametrize("axes", [1, 2])
 @pytest.mark.parametrize("cut", [False, True])
-def test_a_plan_made_with_its_duration_is_the_dataclass_plan(kind, axes, cut):
-    # AxisPlan.with_duration fills the slots itself: every field as AxisPlan(...) makes it
+def test_a_plan_given_its_duration_is_the_plan_of_its_segments(kind, axes, cut):
+    # the planner gives a source the duration it calculated with the segments: every field as
+    # a plan of the same Segments makes it
     trajectory = (Trajectory(1.0 if cut else 1000.0, 1e4, 1e4 if cut else 5e3, 40.0, 1e6, 2e6),)
     position = (6e5, 8e5)[:axes] if cut else (3000.0, -4000.0)[:axes]
     move, _ = compile_(position=position, kind=kind, trajectory=trajectory, rate=100.0 if cut else RATE)
     for plan in move.plans:
         assert plan.truncated == cut
         assert _fields(plan) == _fields(_eager(plan))
-    empty = AxisPlan.with_duration([], 0.0, 3, 5.0, 5.0, 0.0, None, [], False, None, 0.0, 0.0, "")
-    assert _fields(empty) == _fields(AxisPlan(3, [], 5.0, 5.0))
+    empty = AxisPlan(3, Listed([], None, 0.0, True), 5.0, 5.0)
+    assert _fields(empty) == _fields(AxisPlan(3, Listed([]), 5.0, 5.0))
 
 
 @pytest.mark.parametrize("kind", [T.S_CURVE, T.TRAPEZOIDAL, T.S_CURVE_JERK])
 @pytest.mark.parametrize("moving", [False, True])
 def test_a_lone_axis_is_stepped_from_its_rows_until_asked_for_its_segments(kind, moving):
-    # RowAxisPlan: the stepping reads the plan's Rows; the Segments are made when asked for
+    # the stepping reads the plan's Rows; the Segments are made when asked for
     trajectory = (Trajectory(1000.0, 10_000.0, 5_000.0, 40.0, 1e6, 2e6),)
     move, _ = compile_(position=(3000.0,), kind=kind, trajectory=trajectory, moving=moving)
     (plan,) = move.plans
-    assert isinstance(plan, RowAxisPlan)
+    assert isinstance(plan.source, Listed)
+    assert plan.source.rows
+    assert plan.source.made is None
     eager = _eager(plan)  # (made from the plan's fields: its Segments are made now)
     again = compile_(position=(3000.0,), kind=kind, trajectory=trajectory, moving=moving)[0].plans[0]
     times = np.linspace(-0.1, 8.0, 50)
@@ -295,7 +300,8 @@ def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving)
     move, _ = compile_(position=(3000.0, -4000.0), kind=kind, trajectory=trajectory, starts=starts)
     times = np.linspace(-0.1, 8.0, 50)
     for plan in move.plans:
-        assert isinstance(plan, ScaledAxisPlan)
+        assert isinstance(plan.source, Scaled)
+        assert plan.source.made is None
         frames = plan.frame_count  # counted from the line, before the segments are made
         eager = _eager(plan)
         assert (frames, plan.duration) == (eager.frame_count, eager.duration)
@@ -308,7 +314,7 @@ def test_vector_axes_share_the_line_until_asked_for_their_segments(kind, moving)
         for again in (copy.deepcopy(plan), dataclasses.replace(plan)):
             assert (again.segments, again.duration, again.frame_count) == (plan.segments, plan.duration,
                                                                             plan.frame_count)
-            assert again.limits == plan.limits == trajectory[0].share(abs(plan.scaled.factor))
+            assert again.limits == plan.limits == trajectory[0].share(abs(plan.source.factor))
 
 
 def test_vector_axes_with_a_delay_or_a_cut_frame_are_made_and_checked_each():

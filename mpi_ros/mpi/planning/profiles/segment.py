@@ -62,19 +62,6 @@ def scaled_profile(segments: Iterable[Row], factor: float, offset: float) -> lis
             for d, p, v, a, j in segments]
 
 
-class ScaledProfile(NamedTuple):
-    """An axis of a vector move: ``factor`` times the vector's 1-D profile ``line`` (its
-    segments, as Rows), plus ``offset`` (the axis' start): :func:`scaled_profile` of them, made
-    when asked for."""
-
-    line: list[Row]
-    factor: float
-    offset: float
-
-    def segments(self) -> list[Segment]:
-        return scaled_profile(self.line, self.factor, self.offset)
-
-
 def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]]) -> list[Segment]:
     """Integrate ``(duration, jerk)`` pieces from (p0, v0, a0) into contiguous segments.
 
@@ -96,7 +83,7 @@ def total_duration(segments: Sequence[Segment]) -> float:
     return float(sum(s.duration for s in segments))
 
 
-def end_time(segments: Sequence[Segment], t0: float = 0.0) -> float:
+def end_time(segments: Sequence[Row], t0: float = 0.0) -> float:
     """``SegmentTable(segments, t0).end[-1]`` without the arrays: the same additions in the
     same order as the table's cumulative sum (``segments`` must not be empty)."""
     # A loop: reduce(add, map(attrgetter)) would make two calls per segment (every plan's
