@@ -12,7 +12,7 @@ ms.action(MPIAction.MAP)  # MEIActionMAP
 
 params = MotionParams(trajectory=[Trajectory(velocity=1000.0, acceleration=10000.0, deceleration=10000.0,
                                              jerk_percent=50.0)], position=[2000.0, 500.0])
-print("start:", ms.start(MPIMotionType.S_CURVE, MotionAttr.NONE, params).name)  # mpiMotionStart
+print("start:", ms.start(MPIMotionType.S_CURVE, MotionAttr.NONE, params).message.name)  # mpiMotionStart
 
 controller.run_until(lambda c: ms.state is MPIState.IDLE, max_samples=20_000, chunk=100)
 status = ms.snapshot()  # mpiMotionStatus

@@ -24,5 +24,5 @@ controller.step(500)
 print("E_STOP:", ms.action(MPIAction.E_STOP).message.name, "->", ms.state.name)  # over decelTime.eStop
 controller.run_until(lambda c: ms.state is MPIState.ERROR, 1000)
 print("start in ERROR:", ms.start(MPIMotionType.VELOCITY, MotionAttr.NONE,
-                                  MotionParams(trajectory=[Trajectory(1.0, 1.0)])).name)
+                                  MotionParams(trajectory=[Trajectory(1.0, 1.0)])).message.name)
 print("RESET:", ms.action(MPIAction.RESET).message.name, "->", ms.state.name)

@@ -27,7 +27,7 @@ cam = mpi.MotionParams(master_distance=[200.0, 200.0, 300.0, 300.0],
                    slave_position=[100.0, 200.0, 150.0, -450.0],
                    gear_ratio=[1.0, 1.0, 0.0, 0.0],
                    repeat_from=0)
-print("cam start:", shear.start(mpi.MPIMotionType.CAM_CUBIC, mpi.MotionAttr.REPEAT, cam).name)
+print("cam start:", shear.start(mpi.MPIMotionType.CAM_CUBIC, mpi.MotionAttr.REPEAT, cam).message.name)
 start = controller.sample
 
 worst = 0.0

@@ -72,7 +72,7 @@ def test_validate_after_create_and_delete(ctl, ms):
     assert ctl.supervisor(0) is None
     assert len(ctl.axes) == 4
     assert ctl.delete_motion(ms).message is M.MPIMessageHANDLE_INVALID
-    assert ms.start(T.TRAPEZOIDAL) is M.MPIMessageHANDLE_INVALID
+    assert ms.start(T.TRAPEZOIDAL).message is M.MPIMessageHANDLE_INVALID
     assert ms.action(MPIAction.STOP).message is M.MPIMessageHANDLE_INVALID
     assert ctl.create_motion(0)[0].ok  # the number is free again
 

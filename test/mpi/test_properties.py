@@ -221,7 +221,7 @@ def test_velocity_moves(first, second, acc, dec, jerk, when):
     ctl.step(1 + int(when * RATE))
     # a first velocity of 0 ends at once: the modify then starts anew (MPI 000, MPIMotionMessageAUTO_START AUTO_START)
     again = MotionParams(trajectory=[Trajectory(second, acc, dec, jerk)])
-    message = ms.modify(T.VELOCITY, MotionAttr.AUTO_START, again)
+    message = ms.modify(T.VELOCITY, MotionAttr.AUTO_START, again).message
     assert message in (Message.MPIMessageOK, Message.MPIMotionMessageAUTO_START)
     ctl.step(int((abs(first) + abs(second)) / acc * RATE) + 20)
     log = logged(ms)

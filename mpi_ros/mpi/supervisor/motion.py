@@ -457,14 +457,14 @@ class MotionSupervisor:
 
     # ================================================================= start/modify ====
     def start(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
-              params: MotionParams | None = None) -> Message:
+              params: MotionParams | None = None) -> Outcome:
         """mpiMotionStart (params None: the parameters stored with params_set)."""
-        return self.command(motion_type, attrs, params, modify=False)[0].message
+        return self.command(motion_type, attrs, params, modify=False)[0]
 
     def modify(self, motion_type: MPIMotionType, attrs: MotionAttr = MotionAttr.NONE,
-               params: MotionParams | None = None) -> Message:
+               params: MotionParams | None = None) -> Outcome:
         """mpiMotionModify."""
-        return self.command(motion_type, attrs, params, modify=True)[0].message
+        return self.command(motion_type, attrs, params, modify=True)[0]
 
     def command(self, motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams | None,
                 modify: bool) -> tuple[Outcome, int]:

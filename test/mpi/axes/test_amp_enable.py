@@ -18,7 +18,7 @@ def test_a_start_on_a_disabled_axis_is_refused_and_changes_nothing(ctl, ms, para
     # MPI 000, MPIMessageOBJECT_NOT_ENABLED
     assert ctl.axis_amp_enable_set(1, False).ok
     before = (ms.state, ctl.axis_snapshot(0).command_position, ctl.axis_snapshot(1).command_position)
-    assert ms.start(T.TRAPEZOIDAL, params=params((1000.0, 0.0))) is NOT_ENABLED
+    assert ms.start(T.TRAPEZOIDAL, params=params((1000.0, 0.0))).message is NOT_ENABLED
     ctl.step(100)
     assert (ms.state, ctl.axis_snapshot(0).command_position, ctl.axis_snapshot(1).command_position) == before
     assert ms.current is None
@@ -29,7 +29,7 @@ def test_a_start_on_a_disabled_axis_is_refused_and_changes_nothing(ctl, ms, para
 def test_a_modify_with_auto_start_on_a_disabled_axis_is_refused(ctl, ms, params):
     # MPI 000, mpiMotionModify with MPIMotionAttrMaskAUTO_START starts a motion: the same check
     assert ctl.axis_amp_enable_set(0, False).ok
-    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, params((1000.0, 0.0))) is NOT_ENABLED
+    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, params((1000.0, 0.0))).message is NOT_ENABLED
     assert ms.state is MPIState.IDLE
     assert ms.current is None
 
@@ -70,7 +70,7 @@ def test_reset_leaves_a_disabled_axis_off_and_its_starts_refused(ctl, ms, params
     assert ms.state is MPIState.IDLE
     assert ctl.axis_snapshot(0).amp_enabled
     assert not ctl.axis_snapshot(1).amp_enabled
-    assert ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0))) is NOT_ENABLED
+    assert ms.start(T.TRAPEZOIDAL, params=params((100.0, 0.0))).message is NOT_ENABLED
 
 
 def test_enabling_in_error_waits_for_reset(ctl, ms, params, run_to):

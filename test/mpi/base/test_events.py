@@ -161,7 +161,7 @@ def test_shared_axis_state_and_only_one_commander(ctl, params):
     a, b = sharing_axis_1(ctl)
     assert a.start(T.TRAPEZOIDAL, params=params((3000.0, 3000.0))).ok
     assert b.state is MPIState.MOVING
-    assert b.start(T.TRAPEZOIDAL, params=params((10.0, 10.0))) is Message.MPIMotionMessageMOVING
+    assert b.start(T.TRAPEZOIDAL, params=params((10.0, 10.0))).message is Message.MPIMotionMessageMOVING
     assert ctl.run_until(lambda c: a.state is MPIState.IDLE, 20_000, chunk=100)
     assert b.state is MPIState.IDLE
     assert b.start(T.TRAPEZOIDAL, params=params((10.0, 10.0))).ok

@@ -83,7 +83,7 @@ def test_slave_follows_the_table_at_the_masters_position_every_sample(kind):
     ctl.step(7)
     origin = command(ctl, 0)
     params = cam([300.0, 300.0, 200.0], [100.0, -40.0, 60.0, 50.0, 10.0, -30.0], [0.5, 0.1, 0.2, 0.0, 0.0, 0.0])
-    assert ms1.start(kind, A.NONE, params) is M.MPIMessageOK
+    assert ms1.start(kind, A.NONE, params).message is M.MPIMessageOK
     ratios = None if kind is T.CAM_LINEAR else [0.5, 0.2, 0.0]
     table1 = CamTable.build([300.0, 300.0, 200.0], [100.0, 60.0, 10.0], ratios, None)
     ratios2 = None if kind is T.CAM_LINEAR else [0.1, 0.0, 0.0]
@@ -470,7 +470,7 @@ def test_cams_cannot_be_modified():
     ctl = controller()
     ms1 = ctl.supervisor(1)
     assert ms1.start(T.CAM_LINEAR, A.NONE, p()).ok
-    assert ms1.modify(T.CAM_LINEAR, A.NONE, p()) is M.MPIMessageUNSUPPORTED
+    assert ms1.modify(T.CAM_LINEAR, A.NONE, p()).message is M.MPIMessageUNSUPPORTED
 
 
 @pytest.mark.parametrize(("kind", "params"), [
@@ -506,7 +506,8 @@ def test_a_cam_that_does_not_fit_the_frame_buffer():
     ctl = controller(frame_buffer_size=16)
     ms1 = ctl.supervisor(1)
     ms1.axis_list_set([1])
-    assert ms1.start(T.CAM_LINEAR, A.NONE, cam([10.0] * 16, [1.0] * 16)) is M.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
+    answer = ms1.start(T.CAM_LINEAR, A.NONE, cam([10.0] * 16, [1.0] * 16))
+    assert answer.message is M.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
     assert ms1.start(T.CAM_LINEAR, A.NONE, cam([10.0] * 15, [1.0] * 15)).ok
     assert ctl.frame_count(1) == 16
 

@@ -24,7 +24,7 @@ def fill(ctl, ms, params, jerk_percent=50.0):
     assert ms.start(T.S_CURVE, params=params((1000.0, 0.0), jerk_percent=jerk_percent)).ok
     count = 1
     while True:
-        message = ms.start(T.S_CURVE, A.APPEND, params((1000.0 * (count + 1), 0.0), jerk_percent=jerk_percent))
+        message = ms.start(T.S_CURVE, A.APPEND, params((1000.0 * (count + 1), 0.0), jerk_percent=jerk_percent)).message
         if not message.ok:
             return count, message
         count += 1
@@ -67,7 +67,7 @@ def test_the_refusal_changes_nothing(params):
         ms.axis_list_set([0, 1])
         _count, _ = fill(ctl, ms, params)
         if extra:
-            refused = ms.start(T.TRAPEZOIDAL, A.APPEND, params((-5.0, 0.0)))
+            refused = ms.start(T.TRAPEZOIDAL, A.APPEND, params((-5.0, 0.0))).message
             assert refused is Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL
         trace = []
         for _ in range(60):
@@ -271,7 +271,7 @@ def test_low_count_defaults_to_a_quarter_of_the_axes_buffer_and_is_bounded_by_it
     assert sorted(lows) == [(0, 100 - 63), (1, 100 - 31)]  # fewer than 64 / 32 left
     big = MotionParams(position=[1.0, 1.0], time=[0.01], final=False, low_count=200)
     assert ms.start(T.PT, A.APPEND | A.LOW_COUNT, big).ok
-    assert ms1.start(T.PT, A.APPEND | A.LOW_COUNT, big) is Message.MPIMessagePARAM_INVALID
+    assert ms1.start(T.PT, A.APPEND | A.LOW_COUNT, big).message is Message.MPIMessagePARAM_INVALID
 
 
 @pytest.mark.parametrize(("sizes", "field"), [({0: 8}, "axis_frame_buffer_sizes[0]"),

@@ -60,8 +60,8 @@ def test_no_wait_answers_ok_for_what_the_controller_refuses(ctl, notified):
 def test_no_wait_still_answers_what_the_library_checks(ms):
     # MPI 000, MEIMotionMessageBAD_PATH_DATA: the MPI "will not load the move"
     bad = MotionParams(position=[float("nan"), 0.0], time=[0.1])
-    assert ms.start(T.PT, A.NO_WAIT, bad) is M.MEIMotionMessageBAD_PATH_DATA
-    assert ms.start(T.S_CURVE, A.NO_WAIT, MotionParams(**PATH)) is M.MPIMotionMessageATTRIBUTE_INVALID
+    assert ms.start(T.PT, A.NO_WAIT, bad).message is M.MEIMotionMessageBAD_PATH_DATA
+    assert ms.start(T.S_CURVE, A.NO_WAIT, MotionParams(**PATH)).message is M.MPIMotionMessageATTRIBUTE_INVALID
 
 
 def test_no_wait_that_starts_sends_motion_start(ctl, notified):
@@ -79,20 +79,21 @@ def test_no_wait_that_starts_sends_motion_start(ctl, notified):
 def test_expected_axes_must_match_the_axis_count(ms):
     # MPI 001, EXPECTED_AXES: "checked against the number of currently mapped axes, and if they
     # don't match an error will result"
-    assert ms.start(T.PT, A.EXPECTED_AXES, MotionParams(**PATH, expected_axes=3)) is M.MPIMotionMessageAXIS_COUNT
+    answer = ms.start(T.PT, A.EXPECTED_AXES, MotionParams(**PATH, expected_axes=3))
+    assert answer.message is M.MPIMotionMessageAXIS_COUNT
     assert ms.state is MPIState.IDLE
     assert ms.start(T.PT, A.EXPECTED_AXES, MotionParams(**PATH, expected_axes=2)).ok
 
 
 def test_behavior_other_than_the_default_is_refused(ms):
     # MPI 001, BEHAVIOR "select a non-default behavior": none is documented
-    assert ms.start(T.PT, A.BEHAVIOR, MotionParams(**PATH, behavior=1)) is M.MPIMessagePARAM_INVALID
+    assert ms.start(T.PT, A.BEHAVIOR, MotionParams(**PATH, behavior=1)).message is M.MPIMessagePARAM_INVALID
     assert ms.start(T.PT, A.BEHAVIOR, MotionParams(**PATH, behavior=0)).ok
 
 
 def test_retain_is_refused_both_ways(ms):
-    assert ms.start(T.PT, A.RETAIN, MotionParams(**PATH)) is M.MPIMessageUNSUPPORTED
-    assert ms.start(T.PT, A.NONE, MotionParams(**PATH, retain=True)) is M.MPIMessageUNSUPPORTED
+    assert ms.start(T.PT, A.RETAIN, MotionParams(**PATH)).message is M.MPIMessageUNSUPPORTED
+    assert ms.start(T.PT, A.NONE, MotionParams(**PATH, retain=True)).message is M.MPIMessageUNSUPPORTED
     assert ms.state is MPIState.IDLE
 
 
@@ -125,12 +126,12 @@ def test_low_count_sets_when_frames_low_is_sent(ctl, notified, low_count, expect
 
 
 def test_low_count_beyond_the_buffer_is_refused(ms):
-    assert ms.start(T.PT, A.LOW_COUNT, MotionParams(**PATH, low_count=129)) is M.MPIMessagePARAM_INVALID
+    assert ms.start(T.PT, A.LOW_COUNT, MotionParams(**PATH, low_count=129)).message is M.MPIMessagePARAM_INVALID
 
 
 @pytest.mark.parametrize("kind", [T.S_CURVE, T.VELOCITY, T.FRAME])
 def test_path_attributes_are_refused_on_other_types(ms, params, kind):
-    assert ms.start(kind, A.NO_WAIT, params()) is M.MPIMotionMessageATTRIBUTE_INVALID
+    assert ms.start(kind, A.NO_WAIT, params()).message is M.MPIMotionMessageATTRIBUTE_INVALID
 
 
 def test_ptf_feedforward_is_interpolated_held_and_kept(ctl, ms):
@@ -223,8 +224,8 @@ def test_a_held_path_takes_appended_points_and_runs_them_all_once_released(ctl, 
     assert [a.cmd_p for a in ms.axes] == [0.0, 0.0]
     assert ms.state is MPIState.MOVING
     assert ms.modify(T.PT, A.APPEND, MotionParams(position=[400.0, 0.0], time=[0.1])).ok
-    assert ms.modify(T.PT, A.APPEND | A.HOLD, MotionParams(position=[0.0, 0.0], time=[0.1],
-                                                           hold=[hold, hold])) is M.MPIMotionMessageATTRIBUTE_INVALID
+    answer = ms.modify(T.PT, A.APPEND | A.HOLD, MotionParams(position=[0.0, 0.0], time=[0.1], hold=[hold, hold]))
+    assert answer.message is M.MPIMotionMessageATTRIBUTE_INVALID
     assert ctl.gate_set(3, False).ok
     trace = []
     while ms.state is MPIState.MOVING and len(trace) < 2000:

@@ -358,8 +358,8 @@ def test_start_with_no_axes_answers_axis_count(ctl):
     # MPI 000, MPIMotionMessageAXIS_COUNT MPIMotionMessageAXIS_COUNT "if the motion object has no axes"; MPI 000,
     # MPIMotionMessageAXIS_COUNT; MPI 000, mpiMotionStart "There must be at least one Axis in the coordinate system"
     _, ms = ctl.create_motion(0)
-    assert ms.start(T.TRAPEZOIDAL, params=p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT
-    assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, p2p([1.0])) is M.MPIMotionMessageAXIS_COUNT
+    assert ms.start(T.TRAPEZOIDAL, params=p2p([1.0])).message is M.MPIMotionMessageAXIS_COUNT
+    assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, p2p([1.0])).message is M.MPIMotionMessageAXIS_COUNT
     assert ms.state is MPIState.IDLE
 
 
@@ -378,13 +378,13 @@ def test_start_in_error_answers_error(ms, bring, params):
     # MPI 000, MPIMotionMessageERROR MPIMotionMessageERROR "if MotionStart is called when the Motion Supervisor is
     # in the error state"
     bring(MPIState.ERROR)
-    assert ms.start(T.TRAPEZOIDAL, params=params()) is M.MPIMotionMessageERROR
+    assert ms.start(T.TRAPEZOIDAL, params=params()).message is M.MPIMotionMessageERROR
 
 
 def test_profile_error_when_the_profile_cannot_be_calculated(ms, params):
     # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "if the Motion profile specified by the parameters cannot be
     # calculated correctly": a final velocity above the trajectory velocity
-    message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[2000.0, 0.0]))
+    message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[2000.0, 0.0])).message
     assert message is M.MPIMotionMessagePROFILE_ERROR
     assert ms.state is MPIState.IDLE
 
@@ -446,7 +446,7 @@ def test_a_refused_command_changes_nothing(name, modify, kind, attrs, request_pa
             ctl.config.frame_buffer_size = ctl.frame_count(0)  # the buffer is full now
     (ctl_a, ms_a), (ctl_b, ms_b) = twin(setup)
     command = ms_b.modify if modify else ms_b.start
-    assert command(kind, attrs, request_params) is expected
+    assert command(kind, attrs, request_params).message is expected
     assert observe(ctl_a, ms_a) == observe(ctl_b, ms_b)
 
 
@@ -465,7 +465,7 @@ EXTREME = [
 def test_extreme_valid_values_never_crash(ctl, ms, kind, traj):
     # docs/quality.md, "Robust": no input can crash a node or leave it inconsistent; bad input gets the
     # reference's message and changes nothing. Finite positive limits at the ends of the float range
-    message = ms.start(kind, params=p2p((1e6, -1.0), trajectory=[traj]))
+    message = ms.start(kind, params=p2p((1e6, -1.0), trajectory=[traj])).message
     assert isinstance(message, M)
     for _ in range(5):
         ctl.step(1000)

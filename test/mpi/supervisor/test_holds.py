@@ -27,7 +27,7 @@ M = Message
 
 
 def held_start(ms, params, hold, attrs=A.HOLD, target=(500.0, 0.0)):
-    message = ms.start(T.TRAPEZOIDAL, attrs, params(target, hold=[hold, hold]))
+    message = ms.start(T.TRAPEZOIDAL, attrs, params(target, hold=[hold, hold])).message
     assert message.ok
     return message
 
@@ -257,7 +257,7 @@ def test_hold_is_refused_on_modify(ctl, ms, params, bring):
     # with a mpiMotionModify(...) method"
     bring(MPIState.MOVING)
     hold = Hold(type=HoldType.GATE, gate=1)
-    assert ms.modify(T.TRAPEZOIDAL, A.HOLD, params(hold=[hold, hold])) is M.MPIMotionMessageATTRIBUTE_INVALID
+    assert ms.modify(T.TRAPEZOIDAL, A.HOLD, params(hold=[hold, hold])).message is M.MPIMotionMessageATTRIBUTE_INVALID
 
 
 @pytest.mark.parametrize("attr", [A.HOLD, A.HOLD_LESS, A.HOLD_GREATER])
@@ -265,7 +265,7 @@ def test_hold_is_refused_on_modify_even_with_auto_start(ctl, ms, params, attr):
     # MPI 000, mpiMotionModify "It is impossible to use the HOLD attributes with mpiMotionModify, even when
     # using the AUTO_START attribute"; MPI 000, MPIMotionMessageATTRIBUTE_INVALID
     hold = Hold(type=HoldType.GATE, gate=1)
-    message = ms.modify(T.TRAPEZOIDAL, A.AUTO_START | attr, params(hold=[hold, hold]))
+    message = ms.modify(T.TRAPEZOIDAL, A.AUTO_START | attr, params(hold=[hold, hold])).message
     assert message is M.MPIMotionMessageATTRIBUTE_INVALID
     assert ms.state is MPIState.IDLE
 

@@ -348,7 +348,7 @@ def test_a_final_velocity_move_goes_on_moving_and_a_modify_continues_from_it(par
     assert not (bits.at_target)
     assert not (bits.done)
     assert not (bits.in_fine_position)
-    assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is Message.MPIMotionMessageMOVING
+    assert ms.start(T.TRAPEZOIDAL, params=params((0.0, 0.0))).message is Message.MPIMotionMessageMOVING
     assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))).ok
     run_smoothly_to_idle(ctl, ms)
     assert ctl.axes[0].command_position == 0.0
@@ -379,7 +379,7 @@ def test_append_in_stopped_queues_behind_the_pending_profile(params):
     ctl.step(400)
     ms.action(MPIAction.STOP)
     assert ctl.run_until(lambda c: ms.state is MPIState.STOPPED, 5000)
-    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.APPEND, params((0.0, 0.0))) is Message.MPIMotionMessageSTOPPED
+    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.APPEND, params((0.0, 0.0))).message is Message.MPIMotionMessageSTOPPED
     assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((100.0, 0.0))).ok
     stopped_at = ctl.axes[0].cmd_p
     ctl.step(200)
@@ -423,11 +423,11 @@ def test_a_move_that_starts_in_motion_cannot_wait(params):
     _ctl, ms = two_axes()
     ms.start(T.TRAPEZOIDAL, MotionAttr.FINAL_VEL, params((1000.0, 0.0), final_velocity=[400.0, 0.0]))
     delayed = params((2000.0, 0.0), delay=[0.1, 0.1])
-    message = ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.DELAY, delayed)
+    message = ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.DELAY, delayed).message
     assert message is Message.MPIMotionMessageILLEGAL_DELAY
     hold = Hold(type=HoldType.GATE, gate=1)
     held = params((2000.0, 0.0), hold=[hold, hold])
-    message = ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.HOLD, held)
+    message = ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND | MotionAttr.HOLD, held).message
     assert message is Message.MPIMotionMessageATTRIBUTE_INVALID
     assert not ms.queue  # nothing changed
     assert ms.start(T.TRAPEZOIDAL, MotionAttr.APPEND, params((2000.0, 0.0))).ok

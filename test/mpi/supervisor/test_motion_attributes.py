@@ -133,8 +133,8 @@ def test_auto_start_after_the_move_finished(ctl, ms, params):
     ms.start(T.TRAPEZOIDAL, params=params((200.0, 0.0)))
     run_idle(ctl, ms)
     # MPI 000, MPIMotionAttrAUTO_START
-    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))) is M.MPIMotionMessageIDLE
-    assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, params((0.0, 50.0))) is M.MPIMotionMessageAUTO_START
+    assert ms.modify(T.TRAPEZOIDAL, params=params((0.0, 0.0))).message is M.MPIMotionMessageIDLE
+    assert ms.modify(T.TRAPEZOIDAL, A.AUTO_START, params((0.0, 50.0))).message is M.MPIMotionMessageAUTO_START
     run_idle(ctl, ms)
     assert [a.command_position for a in ms.axes] == [0.0, 50.0]
 
@@ -157,7 +157,7 @@ def test_delay_per_axis_before_the_profile(ctl, ms, params):
 def test_delay_on_auto_start_is_used(ctl, ms, params):
     # MPI 000, MPIMotionMessageILLEGAL_DELAY "If it is currently not in motion and the AUTO_START attribute is set, this
     # message will not be returned and the specified delay will be used at the beginning"
-    message = ms.modify(T.TRAPEZOIDAL, A.AUTO_START | A.DELAY, params((100.0, 0.0), delay=[0.05, 0.05]))
+    message = ms.modify(T.TRAPEZOIDAL, A.AUTO_START | A.DELAY, params((100.0, 0.0), delay=[0.05, 0.05])).message
     assert message is M.MPIMotionMessageAUTO_START
     ctl.step(100)
     assert ctl.axes[0].cmd_p < 1e-9
@@ -169,7 +169,8 @@ def test_illegal_delay_on_modify_in_motion(ctl, ms, params, bring):
     # MPI 000, MPIMotionMessageILLEGAL_DELAY ILLEGAL_DELAY "Returned if a motion modify is called with a non-zero delay
     # value and the MPIMotionAttrDELAY attribute is set while in motion"
     bring(MPIState.MOVING)
-    assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.0, 0.1])) is M.MPIMotionMessageILLEGAL_DELAY
+    answer = ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.0, 0.1]))
+    assert answer.message is M.MPIMotionMessageILLEGAL_DELAY
     assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.0, 0.0])).ok  # zero is legal
 
 
@@ -181,7 +182,8 @@ def test_illegal_delay_while_the_axes_wait_out_a_delay(ctl, ms, params):
     ctl.step(10)
     assert ms.state is MPIState.MOVING
     assert ctl.axes[0].cmd_v == 0.0
-    assert ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.1, 0.1])) is M.MPIMotionMessageILLEGAL_DELAY
+    answer = ms.modify(T.TRAPEZOIDAL, A.DELAY, params((10.0, 0.0), delay=[0.1, 0.1]))
+    assert answer.message is M.MPIMotionMessageILLEGAL_DELAY
     ctl.step(1)
     assert ctl.axes[0].cmd_v == 0.0
     assert ms.current.plans[0].target == 100.0
@@ -336,13 +338,13 @@ def test_final_velocity_then_appended_move_keeps_the_speed(ctl, ms, params):
 def test_final_velocity_above_the_velocity_is_a_profile_error(ms, params):
     # MPI 000, MPIMotionMessagePROFILE_ERROR PROFILE_ERROR "The motion profile is not possible with the specified
     # constraints"
-    message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[1500.0, 0.0]))
+    message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[1500.0, 0.0])).message
     assert message is M.MPIMotionMessagePROFILE_ERROR
 
 
 def test_vector_final_velocity_off_the_line_is_param_invalid(ms, params):
     # planner.py: "final velocities of a vector move must lie along the move"
-    message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[100.0, 100.0]))
+    message = ms.start(T.TRAPEZOIDAL, A.FINAL_VEL, params((1000.0, 0.0), final_velocity=[100.0, 100.0])).message
     assert message is M.MPIMessagePARAM_INVALID
 
 
@@ -353,7 +355,8 @@ def test_no_reversal_refuses_a_modify_behind_the_motion(ctl, ms, params, bring):
     # MEIMotionAttrNO_REVERSAL
     bring(MPIState.MOVING)
     where = ctl.axes[0].command_position
-    assert ms.modify(T.TRAPEZOIDAL, A.NO_REVERSAL, params((where - 100.0, 0.0))) is M.MPIMotionMessagePROFILE_ERROR
+    answer = ms.modify(T.TRAPEZOIDAL, A.NO_REVERSAL, params((where - 100.0, 0.0)))
+    assert answer.message is M.MPIMotionMessagePROFILE_ERROR
     assert ms.modify(T.TRAPEZOIDAL, A.NO_REVERSAL, params((where + 5000.0, 0.0))).ok
     run_idle(ctl, ms)
     assert ctl.axes[0].command_position == where + 5000.0
@@ -364,7 +367,8 @@ def test_no_reversal_refuses_a_target_too_close_to_stop(ctl, ms, params, bring):
     # axis cannot stop before would need a reversal
     bring(MPIState.MOVING)
     where = ctl.axes[0].command_position
-    assert ms.modify(T.TRAPEZOIDAL, A.NO_REVERSAL, params((where + 1.0, 0.0))) is M.MPIMotionMessagePROFILE_ERROR
+    answer = ms.modify(T.TRAPEZOIDAL, A.NO_REVERSAL, params((where + 1.0, 0.0)))
+    assert answer.message is M.MPIMotionMessagePROFILE_ERROR
     assert ms.modify(T.TRAPEZOIDAL, params=params((where + 1.0, 0.0))).ok  # without it: reverses
 
 
@@ -413,7 +417,8 @@ def test_jerk_types_need_firmware_option_21(ctl, ms, params, kind):
     # MPI 000, MPIMotionType "In the standard firmware, the MPIMotionTypeS_CURVE_JERK and
     # MPIMotionTypeVELOCITY_JERK motion types are not supported and if specified, the MPI will return
     # a profile not supported error"; MPI 000, MPIMotionMessagePROFILE_NOT_SUPPORTED
-    assert ms.start(kind, params=params((100.0, 0.0), trajectory=[JERK])) is M.MPIMotionMessagePROFILE_NOT_SUPPORTED
+    answer = ms.start(kind, params=params((100.0, 0.0), trajectory=[JERK]))
+    assert answer.message is M.MPIMotionMessagePROFILE_NOT_SUPPORTED
     assert ms.state is MPIState.IDLE
 
 

@@ -157,7 +157,7 @@ def test_start_with_null_params_uses_the_stored_ones(ctl, ms, params, run_to):
 def test_start_with_null_params_and_nothing_stored(ms):
     # MPI 000, MPIMotionMessageATTRIBUTE_INVALID / MPI 000, MPIMessagePARAM_INVALID: no usable parameters -> refused,
     # nothing moves
-    assert ms.start(T.TRAPEZOIDAL, params=None) is M.MPIMessagePARAM_INVALID
+    assert ms.start(T.TRAPEZOIDAL, params=None).message is M.MPIMessagePARAM_INVALID
     assert ms.state is MPIState.IDLE
 
 

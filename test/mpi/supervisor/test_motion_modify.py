@@ -259,6 +259,6 @@ def test_modify_during_the_resume_ramp(params):
 def test_modify_answers_stay_put_when_refused(params):
     # MPI 000, MPIMotionMessageIDLE modify in IDLE answers IDLE and nothing starts
     ctl, ms = rig()
-    assert ms.modify(T.TRAPEZOIDAL, params=params((100.0,))) is Message.MPIMotionMessageIDLE
+    assert ms.modify(T.TRAPEZOIDAL, params=params((100.0,))).message is Message.MPIMotionMessageIDLE
     ctl.step(1000)
     assert ctl.axes[0].cmd_p == 0.0

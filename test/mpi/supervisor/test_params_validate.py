@@ -30,7 +30,7 @@ def test_it_answers_what_the_start_answers(ms, params):
     for motion_type, attrs, request in cases:
         validated, _ = ms.params_validate(motion_type, attrs, request)
         assert not validated.ok
-        assert ms.start(motion_type, attrs, request) is validated.message, (motion_type, attrs)
+        assert ms.start(motion_type, attrs, request).message is validated.message, (motion_type, attrs)
 
 
 def test_a_path_counts_its_points(ms):
@@ -44,7 +44,7 @@ def test_the_state_is_the_starts_business(ctl, ms, params):
     # meiMotionParamsValidate checks the parameters; the state (MPIMotionMessageMOVING) is mpiMotionStart's
     assert ms.start(T.VELOCITY, params=params(LONG_MOVE)).ok
     assert ms.params_validate(T.TRAPEZOIDAL, MotionAttr.NONE, params((10.0, 0.0)))[0].ok
-    assert ms.start(T.TRAPEZOIDAL, params=params((10.0, 0.0))) is Message.MPIMotionMessageMOVING
+    assert ms.start(T.TRAPEZOIDAL, params=params((10.0, 0.0))).message is Message.MPIMotionMessageMOVING
 
 
 def test_no_axes(ctl, params):

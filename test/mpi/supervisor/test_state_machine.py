@@ -38,9 +38,9 @@ def p2p(position) -> MotionParams:
 
 def command(ms, name: str) -> Message:
     if name == "start":
-        return ms.start(T.TRAPEZOIDAL, params=p2p(OTHER))
+        return ms.start(T.TRAPEZOIDAL, params=p2p(OTHER)).message
     if name == "modify":
-        return ms.modify(T.TRAPEZOIDAL, params=p2p(OTHER))
+        return ms.modify(T.TRAPEZOIDAL, params=p2p(OTHER)).message
     return ms.action(MPIAction[name]).message
 
 
@@ -172,7 +172,7 @@ def test_modify_auto_start_in_idle_starts_and_answers_auto_start(prepared):
     # was specified and the motion was commanded while the motion supervisor is in the IDLE state";
     # MPI 000, MPIMotionAttrAUTO_START "converts a mpiMotionModify(...) call to a mpiMotionStart(...)"
     ctl, ms = prepared(S.IDLE)
-    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is Message.MPIMotionMessageAUTO_START
+    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)).message is Message.MPIMotionMessageAUTO_START
     assert ms.state is S.MOVING
     assert ctl.run_until(lambda c: ms.state is S.IDLE, 20_000, chunk=100)
     assert [a.command_position for a in ms.axes] == list(OTHER)
@@ -183,14 +183,14 @@ def test_modify_auto_start_in_idle_starts_and_answers_auto_start(prepared):
 def test_auto_start_does_not_start_outside_idle(state, message, prepared):
     # MPI 000, MPIMotionMessageAUTO_START AUTO_START converts a modify to a start only in the IDLE state
     _ctl, ms = prepared(state)
-    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is message
+    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)).message is message
 
 
 def test_modify_auto_start_while_moving_is_a_plain_modify(prepared):
     # MPI 000, MPIMotionAttrAUTO_START AUTO_START acts "if the modify occurs after the previous motion profile has
     # completed"; while moving the modify answers OK
     _ctl, ms = prepared(S.MOVING)
-    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)) is OK
+    assert ms.modify(T.TRAPEZOIDAL, MotionAttr.AUTO_START, p2p(OTHER)).message is OK
 
 
 def test_start_from_stopped_drops_the_pending_profile(prepared):
