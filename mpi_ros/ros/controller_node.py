@@ -229,7 +229,6 @@ class ControllerNode(Node):
 
     def _on_axis_validate(self, request, response):
         outcome = self.runner.read(lambda ctl: ctl.axis_validate(request.number))
-        response.detail = outcome.detail
         return convert.answer(response, Reply(outcome))
 
     def _submit_axis(self, operation: str, k: int, request: dict) -> Reply:

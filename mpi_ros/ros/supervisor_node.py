@@ -401,7 +401,6 @@ class SupervisorNode(Node):
         response.state = int(reply.state)
         response.state_name = reply.state.name
         response.sample = sample
-        response.detail = reply.detail
         return response
 
     def _on_trigger(self, action: str, response):
@@ -471,12 +470,10 @@ class SupervisorNode(Node):
             motion = rq.motion_request({"type": request.type, "attributes": list(request.attributes),
                                         **convert.to_dict(request.params)})
         except Refused as exc:
-            response.detail = exc.detail
-            return convert.answer(response, Reply.of(exc.message))
+            return convert.answer(response, Reply(exc.outcome))
         outcome, points = self._read_ms(
             lambda ms: ms.params_validate(motion.type, motion.attributes, motion.params, request.modify))
         response.points = points
-        response.detail = outcome.detail
         return convert.answer(response, Reply(outcome))
 
     def _on_event_reset(self, request, response):
