@@ -23,7 +23,7 @@ process per run, ``--rounds`` runs of this tree and of ``--baseline`` ("none": t
 alternating.
 
     python -P bench/bench_modify.py [--baseline b39be10] [--rounds 3] [--batches 1 2 5 20]
-    python -P bench/bench_modify.py --ruckig 2000 [--baseline none] [--rounds 1]
+    python -P bench/bench_modify.py --ruckig 2000 [--baseline none] [--rounds 3]
 """
 
 from __future__ import annotations
