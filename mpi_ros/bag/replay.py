@@ -242,13 +242,16 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     timeline, recorded_events, first_recorded = _timeline(reader, recording)
     statuses = _Statuses(ctl, recording, tolerance)
     report.last_sample = ctl.sample
-    for entries in _runs(timeline):
+    runs = list(_runs(timeline))
+    for entries, following in zip(runs, [*runs[1:], None], strict=True):
         if entries[0][1] == 1:
             _apply(ctl, report, entries[0])
             # where stepping entry by entry would have left the controller
             report.last_sample = max(report.last_sample, entries[0][0])
         else:
-            statuses.take(list(dict.fromkeys(entry[0] for entry in entries)))
+            # on to where a command follows in the same go: a stretch fewer than stepping there apart
+            until = following[0][0] if following is not None and following[0][1] == 1 else entries[-1][0]
+            statuses.take(list(dict.fromkeys(entry[0] for entry in entries)), until)
             statuses.compare_run(report, entries, stop_at_first)
         if stop_at_first and report.first is not None:
             break
@@ -330,13 +333,13 @@ class _Statuses:
         self.taken: dict[int, tuple[dict, list]] = {}
         self.leaves: dict[tuple[bool, int], int] = {}  # (motion status, axes) -> values a status compares
 
-    def take(self, samples: Sequence[int]) -> None:
-        """Step the controller to the last of ``samples`` (in order), keeping the snapshots
-        of each; a sample the controller has passed is compared where it is (as stepping to
-        each status did)."""
+    def take(self, samples: Sequence[int], until: int = -1) -> None:
+        """Step the controller to the last of ``samples`` (in order) or on to ``until``,
+        keeping the snapshots of each sample; a sample the controller has passed is compared
+        where it is (as stepping to each status did)."""
         ctl = self.ctl
         wanted = [max(sample, ctl.sample) for sample in samples]
-        taken = ctl.step_snapshots(wanted[-1] - ctl.sample, wanted)
+        taken = ctl.step_snapshots(max(wanted[-1], until) - ctl.sample, wanted)
         self.taken = {sample: taken[at] for sample, at in zip(samples, wanted, strict=True)}
 
     def compare_run(self, report: ReplayReport, entries: list[tuple], stop_at_first: bool) -> None:

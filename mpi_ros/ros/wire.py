@@ -93,12 +93,17 @@ class _Layout:
         return struct.Struct(self.fmt)
 
 
-@cache
-def _stamp_frame(start: int, frame_length: int) -> struct.Struct:
-    """A header (stamp, frame_id) from ``start`` (mod 8), padded to the uint64 ``sample`` after
-    it: where the status' body starts, always 8-aligned."""
-    layout = _Layout(start).add("i", 4).add("I", 4).string(frame_length)
-    return layout.add("x", 1, -layout.pos % 8).struct()
+_STAMP = struct.Struct("<iI")  # a header's stamp: sec, nanosec
+
+
+@lru_cache(maxsize=1024)
+def _frame(namespace: str, supervisor: int, axis: int, start: int) -> bytes:
+    """A header's frame_id (convert.frame_id) and the padding after it to the status' body,
+    for a header from ``start`` (mod 8): constant per source, packed once. (The stamp before
+    it is 8 bytes: the frame_id starts at the same place mod 8.)"""
+    frame = convert.frame_id(namespace, supervisor, axis).encode("utf-8")
+    layout = _Layout(start + _STAMP.size).string(len(frame))
+    return layout.add("x", 1, -layout.pos % 8).struct().pack(len(frame) + 1, frame)
 
 
 def _body_head(name_length: int) -> _Layout:
@@ -120,12 +125,6 @@ def _axis_body(name_length: int, faults: tuple[int, ...]) -> struct.Struct:
 def _motion_body(name_length: int, axes: int) -> struct.Struct:
     """A MotionStatus from its sample to the count of its axes (an 8-aligned start)."""
     return _body_head(name_length).add("I", 4).add("i", 4, axes).add("I", 4).struct()
-
-
-@lru_cache(maxsize=1024)
-def _frame(namespace: str, supervisor: int, axis: int) -> bytes:
-    """A header's frame_id, encoded (convert.frame_id): constant per source, encoded once."""
-    return convert.frame_id(namespace, supervisor, axis).encode("utf-8")
 
 
 @cache
@@ -202,6 +201,8 @@ def _axis_body_bytes(snap: AxisSnapshot) -> bytes:
     if not math.isfinite(sum(values[3:6]) + sum(values[7:11]) + values[23]):
         values = tuple(_finite(x) if i in _FINITE else x for i, x in enumerate(values))
     name = _state_name(values[2])
+    if not snap.faults:
+        return _axis_body(len(name), ()).pack(*values[:3], len(name) + 1, name, *values[3:], 0)
     faults = [text.encode("utf-8") for text in snap.faults]
     return _axis_body(len(name), tuple(map(len, faults))).pack(
         *values[:3], len(name) + 1, name, *values[3:], len(faults),
@@ -224,29 +225,22 @@ class Packer:
         self.epoch_ns = epoch_ns
         self.namespace = namespace
         self._sample = -1
-        self._stamp = (0, 0)
-        self._headers: dict[tuple[bytes, int], bytes] = {}
+        self._stamp = b""
         self._bodies: dict[int, tuple[AxisSnapshot, bytes]] = {}
 
-    def _header(self, sample: int, frame: bytes, start: int) -> bytes:
-        """A header at ``sample`` from ``start`` (mod 8), padded to the body after it."""
-        if sample != self._sample:
-            self._sample, self._stamp = sample, _time(sample, self.rate, self.epoch_ns)
-            self._headers.clear()
-            self._bodies.clear()
-        found = self._headers.get((frame, start))
-        if found is None:
-            found = self._headers[frame, start] = _stamp_frame(start, len(frame)).pack(
-                *self._stamp, len(frame) + 1, frame)
-        return found
+    def _at(self, sample: int) -> None:
+        """Start keeping the statuses of ``sample`` (its stamp), forgetting the last one's."""
+        self._sample, self._stamp = sample, _STAMP.pack(*_time(sample, self.rate, self.epoch_ns))
+        self._bodies.clear()
 
     def _axis(self, snap: AxisSnapshot, start: int) -> bytes:
         """An AxisStatus' bytes (no encapsulation header) from ``start`` (mod 8)."""
-        header = self._header(snap.sample, _frame(self.namespace, -1, snap.number), start)
+        if snap.sample != self._sample:  # its own stamp, even inside a MotionStatus of another sample
+            self._at(snap.sample)
         kept = self._bodies.get(id(snap))
         if kept is None or kept[0] is not snap:
             kept = self._bodies[id(snap)] = (snap, _axis_body_bytes(snap))
-        return header + kept[1]
+        return self._stamp + _frame(self.namespace, -1, snap.number, start) + kept[1]
 
     def axis_status(self, snap: AxisSnapshot) -> bytes:
         """The CDR of ``convert.axis_status(snap, rate, epoch_ns, namespace)``."""
@@ -254,17 +248,20 @@ class Packer:
 
     def motion_status(self, snap: MotionSnapshot) -> bytes:
         """The CDR of ``convert.motion_status(snap, rate, epoch_ns, namespace)``."""
+        if snap.sample != self._sample:
+            self._at(snap.sample)
         name = _state_name(snap.state)
-        parts = [HEADER, self._header(snap.sample, _frame(self.namespace, snap.number, -1), 0),
-                 _motion_body(len(name), len(snap.axis_numbers)).pack(
-                     snap.sample, snap.number, int(snap.state), len(name) + 1, name,
-                     len(snap.axis_numbers), *snap.axis_numbers, len(snap.axes))]
-        at = len(parts[1]) + len(parts[2])  # in the data after the encapsulation header
+        body = _motion_body(len(name), len(snap.axis_numbers)).pack(
+            snap.sample, snap.number, snap.state, len(name) + 1, name,
+            len(snap.axis_numbers), *snap.axis_numbers, len(snap.axes))
+        parts = [HEADER, self._stamp, _frame(self.namespace, snap.number, -1, 0), body]
+        at = len(self._stamp) + len(parts[2]) + len(body)  # in the data after the encapsulation header
         for axis in snap.axes:
-            parts.append(self._axis(axis, at % 8))
-            at += len(parts[-1])
-        last_action, action_source, motion_type = (text.encode("utf-8") for text in
-                                                   (snap.last_action, snap.action_source, snap.motion_type))
+            packed = self._axis(axis, at % 8)
+            parts.append(packed)
+            at += len(packed)
+        last_action, action_source = snap.last_action.encode("utf-8"), snap.action_source.encode("utf-8")
+        motion_type = snap.motion_type.encode("utf-8")
         parts.append(_motion_tail(at % 8, len(last_action), len(action_source), len(motion_type)).pack(
             snap.done, snap.at_target, snap.settled, snap.move_id, snap.element_id, float(snap.feedrate),
             len(last_action) + 1, last_action, len(action_source) + 1, action_source, snap.moves_pending,
