@@ -26,6 +26,10 @@ from mcap_ros2._dynamic import generate_dynamic
 from . import schema
 
 
+def _older(type_name: str, schema_text: str) -> bool:
+    return bool(schema_text) and schema_text != schema.ros2msg(type_name)
+
+
 @dataclass(frozen=True, slots=True)
 class Recorded:
     topic: str
@@ -39,7 +43,7 @@ class Recorded:
     def older(self) -> bool:
         """Whether the bag stores a definition of the type other than the installed one (a bag
         recorded before the type changed, docs/recording.md "Older recordings")."""
-        return bool(self.schema_text) and self.schema_text != schema.ros2msg(self.type)
+        return _older(self.type, self.schema_text)
 
     def decode(self):
         """The message: as its generated Python class (the package must be installed) when the
@@ -69,14 +73,11 @@ class Source:
     type: str  # pkg/msg/Type
     schema_text: str = ""  # the ros2msg definition ("": unknown)
 
+    older: bool = False  # Recorded.older, for every message of the channel
+
     @classmethod
     def of(cls, recorded: Recorded) -> Source:
-        return cls(recorded.topic, recorded.type, recorded.schema_text)
-
-    @property
-    def older(self) -> bool:
-        """Recorded.older, for every message of the channel."""
-        return self.recorded(0, b"").older
+        return cls(recorded.topic, recorded.type, recorded.schema_text, recorded.older)
 
     def recorded(self, log_time: int, data: bytes, sequence: int = 0) -> Recorded:
         return Recorded(self.topic, self.type, log_time, data, sequence, self.schema_text)
@@ -118,6 +119,16 @@ def _recorded_decoder(type_name: str, text: str):
     return generate_dynamic(type_name, text)[type_name]
 
 
+# libyaml's parser where PyYAML was built with it: the same documents, several times faster
+# (a bag's metadata.yaml and its configuration are most of opening a short recording)
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def load_yaml(text: str) -> Any:
+    """``yaml.safe_load``, by libyaml when it is there."""
+    return yaml.load(text, Loader=_YAML_LOADER)
+
+
 def mcap_path(path: str | Path) -> Path:
     """The .mcap file of a bag directory (from its metadata.yaml), or ``path`` itself."""
     path = Path(path)
@@ -125,7 +136,7 @@ def mcap_path(path: str | Path) -> Path:
         return path
     metadata = path / "metadata.yaml"
     if metadata.is_file():
-        info = yaml.safe_load(metadata.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+        info = load_yaml(metadata.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
         return path / info["relative_file_paths"][0]
     files = sorted(path.glob("*.mcap"))
     if not files:
@@ -318,7 +329,8 @@ def _chunk_payloads(chunk: Chunk, sources: dict[int, Source]) -> Iterator[tuple[
 
 
 def _source(schema_: Schema, channel: Channel) -> Source:
-    return Source(channel.topic, schema_.name, schema_.data.decode("utf-8", errors="replace"))
+    text = schema_.data.decode("utf-8", errors="replace")
+    return Source(channel.topic, schema_.name, text, _older(schema_.name, text))
 
 
 def _recorded(schema_: Schema, channel: Channel, message: Message) -> Recorded:

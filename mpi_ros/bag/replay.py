@@ -22,7 +22,6 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import yaml
 from mcap.exceptions import McapError
 
 from .. import config as suite_config
@@ -31,7 +30,7 @@ from ..commands import Command, apply
 from ..mpi.control import MAX_STRETCH
 from ..ros import convert, wire
 from . import fields, schema
-from .reader import BagReader
+from .reader import BagReader, load_yaml
 from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED, commands_topic
 
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
@@ -161,7 +160,7 @@ def inspect(reader: BagReader, namespace: str | None = None) -> Recording:
     setup = None
     if stored is not None:
         stored_epoch = stored.get("stamp_epoch_ns")
-        setup = (yaml.safe_load(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
+        setup = (load_yaml(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
                  int(stored_epoch) if stored_epoch is not None else None, stored.get("namespace"))
         if namespace is not None and setup[4] not in (None, namespace):
             raise MissingInput(f"{reader.path}: the bag recorded the suite in {setup[4]}, not {namespace}")
@@ -169,7 +168,7 @@ def inspect(reader: BagReader, namespace: str | None = None) -> Recording:
         config_topics = _chosen(reader, config_topics, namespace)
         found = next((msg for _, msg in reader.decoded(config_topics[:1])), None)
         if found is not None:
-            setup = (yaml.safe_load(found.config) or {}, config_topics[0], int(found.start_sample),
+            setup = (load_yaml(found.config) or {}, config_topics[0], int(found.start_sample),
                      int(found.epoch_ns), found.ros_namespace or None)
     if setup is None:
         where = (f"the topic {config_topics[0]} is there but holds no message" if config_topics else
@@ -285,32 +284,27 @@ def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], lis
     log-time order did."""
     recorded_events = []
     timeline: list[tuple] = []
-    first_recorded = None
     commands = set(recording.commands)
     wanted = [*recording.commands, *recording.statuses] + ([recording.events] if recording.events else [])
-    older: dict[str, bool] = {}  # by topic
     for position, (source, sequence, log_time, data) in enumerate(reader.payloads(wanted)):
         if source.topic in commands:
             msg = source.recorded(log_time, data, sequence).decode()
             # applied while the controller was one sample before the one it took effect at
             timeline.append((msg.sample - 1, 1, sequence, log_time, position, source, data, None, msg))
-            continue
-        if source.topic == recording.events:
+        elif source.topic == recording.events:
+            recorded_events.append(((sequence, log_time, position), source.recorded(log_time, data, sequence).decode()))
+        elif source.older:
             msg = source.recorded(log_time, data, sequence).decode()
-            first_recorded = msg.sample if first_recorded is None else min(first_recorded, msg.sample)
-            if msg.type not in NOT_REPLAYED:
-                recorded_events.append(((sequence, log_time, position), msg))
-            continue
-        if source.topic not in older:
-            older[source.topic] = source.older
-        msg = source.recorded(log_time, data, sequence).decode() if older[source.topic] else None
-        sample, number = (msg.sample, msg.number) if msg is not None else _status_key(source.type, data)
-        first_recorded = sample if first_recorded is None or sample < first_recorded else first_recorded
-        # statuses at a sample were taken before commands given at that sample
-        timeline.append((sample, 0, sequence, log_time, position, source, data, number, msg))
+            timeline.append((msg.sample, 0, sequence, log_time, position, source, data, msg.number, msg))
+        else:
+            sample, number = _status_key(source.type, data)
+            # statuses at a sample were taken before commands given at that sample
+            timeline.append((sample, 0, sequence, log_time, position, source, data, number, None))
     timeline.sort()  # no two entries have the same position: the sort never compares what follows it
+    seen = [entry[0] for entry in timeline if entry[1] == 0] + [msg.sample for _, msg in recorded_events]
     # the order they were written in, which ties in log time may not keep
-    return timeline, [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0])], first_recorded
+    events = [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0]) if msg.type not in NOT_REPLAYED]
+    return timeline, events, min(seen, default=None)
 
 
 class _Statuses:
