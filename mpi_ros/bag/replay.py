@@ -338,25 +338,27 @@ class _Statuses:
 
     def compare_run(self, report: ReplayReport, entries: list[tuple], stop_at_first: bool) -> None:
         """Compare a run's statuses (timeline entries, in order; their snapshots taken by
-        :meth:`take`); with ``stop_at_first``, up to the first difference."""
+        :meth:`take`): their bytes, or their fields where the bytes differ; with
+        ``stop_at_first``, up to the first difference."""
+        packer, motion_type = self.packer, STATUS_TYPES[0]
         for entry in entries:
+            sample, _, _, _, _, source, data, number, msg = entry
             # where stepping entry by entry would have left the controller
-            report.last_sample = max(report.last_sample, entry[0])
-            self.compare(report, entry)
+            report.last_sample = max(report.last_sample, sample)
             report.statuses += 1
+            motion = source.type == motion_type
+            snap = self._snapshot(sample, motion, number)
+            if msg is None and packer is not None and data == (
+                    packer.motion_status(snap) if motion else packer.axis_status(snap)):
+                report.values += self._leaves(motion, snap)
+                continue
+            self._compare_fields(report, entry, motion, snap)
             if stop_at_first and report.first is not None:
                 return
 
-    def compare(self, report: ReplayReport, entry: tuple) -> None:
-        """One status (a timeline entry): its bytes, or its fields where they differ."""
-        sample, _, sequence, log_time, _, source, data, number, msg = entry
-        motion = source.type == STATUS_TYPES[0]
-        snap = self._snapshot(sample, motion, number)
-        if msg is None and self.packer is not None:
-            packed = self.packer.motion_status(snap) if motion else self.packer.axis_status(snap)
-            if packed == data:
-                report.values += self._leaves(motion, snap)
-                return
+    def _compare_fields(self, report: ReplayReport, entry: tuple, motion: bool, snap) -> None:
+        """One status (a timeline entry) and its snapshot, field by field."""
+        sample, _, sequence, log_time, _, source, data, _, msg = entry
         ctl = self.ctl
         replayed = (convert.motion_status if motion else convert.axis_status)(snap, ctl.rate, self.epoch or 0,
                                                                                 self.namespace)
