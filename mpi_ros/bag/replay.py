@@ -18,7 +18,7 @@ differences; otherwise the report names the first divergence: where, which field
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -261,14 +261,12 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     return report
 
 
-_STATUS_KEYS = {name: fields.field_reader(schema.message_class(name), ("sample", "number")) for name in STATUS_TYPES}
-_LAID_OUT = wire.AVAILABLE  # the installed interfaces are laid out as wire.py packs them
-
-
-def _status_key(type_name: str, data: bytes) -> tuple[int, int]:
-    """A status' sample and number, read from its CDR (where wire.py lays them out, else by
-    the installed definition of the type)."""
-    return wire.sample_and_number(data) if _LAID_OUT else _STATUS_KEYS[type_name](data)
+# A status' sample and number, read from its CDR, by type: where wire.py lays them out, or,
+# if the installed interfaces differ from its layouts, by the installed definition.
+_STATUS_KEYS: dict[str, Callable[[bytes], tuple]] = {
+    name: wire.sample_and_number if wire.AVAILABLE else fields.field_reader(schema.message_class(name),
+                                                                             ("sample", "number"))
+    for name in STATUS_TYPES}
 
 
 def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], list, int | None]:
@@ -297,7 +295,7 @@ def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], lis
             msg = source.recorded(log_time, data, sequence).decode()
             timeline.append((msg.sample, 0, sequence, log_time, position, source, data, msg.number, msg))
         else:
-            sample, number = _status_key(source.type, data)
+            sample, number = _STATUS_KEYS[source.type](data)
             # statuses at a sample were taken before commands given at that sample
             timeline.append((sample, 0, sequence, log_time, position, source, data, number, None))
     timeline.sort()  # no two entries have the same position: the sort never compares what follows it
