@@ -15,7 +15,11 @@ The suite of each source tree (this one and ``--baseline``, extracted with git a
 in turn, each with its own verbs; the trees alternate ``--rounds`` times, since the machine
 is shared and its load changes by the minute (the load average is printed with the figures).
 
-    python -P bench/bench_verbs.py [--runs 8] [--rounds 2] [--baseline REV|none]
+With ``--third``, ``mpi-ros events`` of the same tree runs beside each suite: one more DDS
+participant on the graph (this process is one already), as on any real ROS graph; it was
+what brought out the slow runs (docs/reliability.md).
+
+    python -P bench/bench_verbs.py [--runs 8] [--rounds 2] [--baseline REV|none] [--third]
 """
 
 from __future__ import annotations
@@ -141,13 +145,18 @@ def one(tree: Path, commands: Commands, verb: str, argv: list[str], operation: s
     return Run(verb, effect[1] - start, effect[0] - start, exited, status, usage.ru_utime + usage.ru_stime)
 
 
-def measure(tree: Path, runs: int) -> list[Run]:
+def measure(tree: Path, runs: int, third: bool = False) -> list[Run]:
     suite = start_suite(tree)
     commands = Commands()
+    events = subprocess.Popen([sys.executable, "-P", "-m", "mpi_ros.cli", "events"], cwd=tree, env=_env(tree),
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if third else None
     try:
-        one(tree, commands, *CYCLE[2])  # a first RESET: the suite and this process have met
+        one(tree, commands, *CYCLE[2])  # a first RESET: the suite and this process (and events) have met
         return [one(tree, commands, *step) for _ in range(runs) for step in CYCLE]
     finally:
+        if events is not None:
+            events.terminate()
+            events.wait(timeout=10)
         commands.close()
         suite.terminate()
         suite.wait(timeout=30)
@@ -175,6 +184,7 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=8, help="cycles per round and tree (default 8)")
     parser.add_argument("--rounds", type=int, default=2, help="rounds, the trees alternating (default 2)")
     parser.add_argument("--baseline", default=BASELINE, help=f"revision to compare with (default {BASELINE}), or none")
+    parser.add_argument("--third", action="store_true", help="run `mpi-ros events` beside each suite")
     args = parser.parse_args()
     results: dict[str, list[Run]] = {}
     with tempfile.TemporaryDirectory(prefix="bench_verbs_") as scratch:
@@ -182,10 +192,11 @@ def main() -> None:
         loads = [os.getloadavg()[0]]
         for _ in range(args.rounds):
             for tree, name in trees:
-                results.setdefault(name, []).extend(measure(tree, args.runs))
+                results.setdefault(name, []).extend(measure(tree, args.runs, args.third))
                 loads.append(os.getloadavg()[0])
     print(f"ROS_DOMAIN_ID {os.environ['ROS_DOMAIN_ID']}, {os.cpu_count()} cores, 1-minute load average "
-          f"{min(loads):.1f} to {max(loads):.1f} during the runs")
+          f"{min(loads):.1f} to {max(loads):.1f} during the runs, `mpi-ros events` beside the suite: "
+          f"{'yes' if args.third else 'no'}")
     print()
     print("\n".join(table(results)))
     for tree, runs in results.items():  # every run, so that a slow one shows as one or as a tail
