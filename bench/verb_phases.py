@@ -72,18 +72,13 @@ def one(action: str, timeout: float) -> dict[str, float]:
     return marks
 
 
-# A profile file with no participant profile: Fast DDS's defaults (208 KiB receive buffers
-# here), as the verbs ran before config/fastdds_client.xml; a file of one's own wins over it.
-DEFAULTS_PROFILE = ('<?xml version="1.0"?><profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">'
-                    '<participant profile_name="fast_dds_defaults" is_default_profile="true"><rtps/></participant>'
-                    '</profiles>')
 
 
 def measure(action: str, runs: int, timeout: float, third: bool, compare: bool) -> list[dict[str, float]]:
     """``runs`` verbs against a suite of this tree started here (with ``compare``, each run also
     once with Fast DDS's default profile, alternating); milliseconds per phase each."""
     sys.path.insert(0, str(REPO / "bench"))
-    from bench_verbs import Commands, _env, start_suite
+    from bench_verbs import DEFAULTS_PROFILE, Commands, _env, start_suite
 
     suite = start_suite(REPO)
     commands = Commands()
