@@ -29,6 +29,7 @@ at its defaults (the verbs before it), under the same load.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import os
 import random
@@ -38,6 +39,7 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -160,18 +162,16 @@ def one(tree: Path, commands: Commands, verb: str, argv: list[str], operation: s
     return Run(verb, effect[1] - start, effect[0] - start, exited, status, usage.ru_utime + usage.ru_stime)
 
 
-def measure(tree: Path, runs: int, third: bool = False, defaults: str | None = None) -> list[Run]:
-    """``runs`` cycles against a suite of ``tree``; with ``defaults`` (a profile file's path),
-    each cycle again with the verbs under it, their runs named DEFAULTS."""
+@contextlib.contextmanager
+def graph(tree: Path, third: bool) -> Iterator[Commands]:
+    """A suite of ``tree`` and this process' /mpi/commands (with ``third``, `mpi-ros events` of
+    the tree beside them), taken down on leaving."""
     suite = start_suite(tree)
     commands = Commands()
     events = subprocess.Popen([sys.executable, "-P", "-m", "mpi_ros.cli", "events"], cwd=tree, env=_env(tree),
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if third else None
-    profiles = [None] if defaults is None else [None, defaults]
     try:
-        one(tree, commands, *CYCLE[2])  # a first RESET: the suite and this process (and events) have met
-        return [_named(one(tree, commands, *step, profile=profile), profile)
-                for _ in range(runs) for profile in profiles for step in CYCLE]
+        yield commands
     finally:
         if events is not None:
             events.terminate()
@@ -179,6 +179,16 @@ def measure(tree: Path, runs: int, third: bool = False, defaults: str | None = N
         commands.close()
         suite.terminate()
         suite.wait(timeout=30)
+
+
+def measure(tree: Path, runs: int, third: bool = False, defaults: str | None = None) -> list[Run]:
+    """``runs`` cycles against a suite of ``tree``; with ``defaults`` (a profile file's path),
+    each cycle again with the verbs under it, their runs named DEFAULTS."""
+    profiles = [None] if defaults is None else [None, defaults]
+    with graph(tree, third) as commands:
+        one(tree, commands, *CYCLE[2])  # a first RESET: the suite and this process (and events) have met
+        return [_named(one(tree, commands, *step, profile=profile), profile)
+                for _ in range(runs) for profile in profiles for step in CYCLE]
 
 
 def _named(run: Run, profile: str | None) -> Run:

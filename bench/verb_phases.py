@@ -78,28 +78,16 @@ def measure(action: str, runs: int, timeout: float, third: bool, compare: bool) 
     """``runs`` verbs against a suite of this tree started here (with ``compare``, each run also
     once with Fast DDS's default profile, alternating); milliseconds per phase each."""
     sys.path.insert(0, str(REPO / "bench"))
-    from bench_verbs import DEFAULTS_PROFILE, Commands, _env, start_suite
+    from bench_verbs import DEFAULTS_PROFILE, _env, graph
 
-    suite = start_suite(REPO)
-    commands = Commands()
-    events = subprocess.Popen([sys.executable, "-P", "-m", "mpi_ros.cli", "events"], cwd=REPO, env=_env(REPO),
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if third else None
-    try:
-        with tempfile.NamedTemporaryFile("w", suffix=".xml") as defaults:
-            defaults.write(DEFAULTS_PROFILE)
-            defaults.flush()
-            variants = {"shipped": _env(REPO)}
-            if compare:
-                variants["defaults"] = _env(REPO) | {"FASTRTPS_DEFAULT_PROFILES_FILE": defaults.name}
-            return [_run(action, timeout, commands, env) | {"variant": name}
-                    for _ in range(runs) for name, env in variants.items()]
-    finally:
-        if events is not None:
-            events.terminate()
-            events.wait(timeout=10)
-        commands.close()
-        suite.terminate()
-        suite.wait(timeout=30)
+    with graph(REPO, third) as commands, tempfile.NamedTemporaryFile("w", suffix=".xml") as defaults:
+        defaults.write(DEFAULTS_PROFILE)
+        defaults.flush()
+        variants = {"shipped": _env(REPO)}
+        if compare:
+            variants["defaults"] = _env(REPO) | {"FASTRTPS_DEFAULT_PROFILES_FILE": defaults.name}
+        return [_run(action, timeout, commands, env) | {"variant": name}
+                for _ in range(runs) for name, env in variants.items()]
 
 
 def udp_receive_buffer_errors() -> int:
