@@ -22,8 +22,9 @@ FAST_DDS = ("", "rmw_fastrtps_cpp", "rmw_fastrtps_dynamic_cpp")  # RMW_IMPLEMENT
 
 
 def ours(path: str) -> bool:
-    """Whether ``path`` is one of the profiles shipped here (set by a parent process, not chosen)."""
-    return any(str(config_paths.find(name)) == path for name in (SUITE, CLIENT))
+    """Whether ``path`` is one of the profiles shipped here, wherever it was found (set by a
+    parent process, not chosen by the operator)."""
+    return any(str(place) == path for name in (SUITE, CLIENT) for place in config_paths.candidates(name))
 
 
 def use(environ: MutableMapping[str, str], name: str) -> str | None:

@@ -55,6 +55,13 @@ def test_the_client_profile_declares_a_large_udp_receive_buffer_and_keeps_shared
     assert participant.findtext("p:rtps/p:useBuiltinTransports", namespaces=NS) == "false"
 
 
+def test_a_profile_of_ours_from_another_place_it_is_looked_for_counts_as_ours():
+    # e.g. a tool that found the source tree's copy, a suite that finds the installed one
+    for place in config_paths.candidates(dds_profile.CLIENT):
+        environ = {"FASTRTPS_DEFAULT_PROFILES_FILE": str(place)}
+        assert dds_profile.use(environ, dds_profile.SUITE) == str(config_paths.find(dds_profile.SUITE))
+
+
 def test_a_verbs_session_sets_the_client_profile_before_its_participant_exists():
     # In a process of its own: Fast DDS reads the profile once per process, at its first participant
     code = ("import argparse, os\n"
@@ -65,3 +72,32 @@ def test_a_verbs_session_sets_the_client_profile_before_its_participant_exists()
     done = subprocess.run([sys.executable, "-P", "-c", code], cwd=REPO, env=env | {"PYTHONPATH": str(REPO)},
                           capture_output=True, text=True, timeout=60, check=True)
     assert done.stdout.strip() == str(config_paths.find(dds_profile.CLIENT))
+
+
+def test_a_verbs_sockets_get_the_larger_receive_buffer(tmp_path):
+    # What the profile is for, seen from inside a verb's process: its UDP sockets' SO_RCVBUF.
+    # Linux doubles the request after capping it at net.core.rmem_max; a socket left at the
+    # default has net.core.rmem_default.
+    rmem_max = int(Path("/proc/sys/net/core/rmem_max").read_text())
+    code = ("import argparse, os, socket\n"
+            "from rclpy.node import Node\n"
+            "from mpi_ros.cli.console import Session\n"
+            "with Session(argparse.Namespace(ros_args=[])) as session:\n"
+            "    node = Node('buffers', context=session.context)\n"
+            "    sizes = []\n"
+            "    for fd in os.listdir('/proc/self/fd'):\n"
+            "        try:\n"
+            "            if not os.readlink(f'/proc/self/fd/{fd}').startswith('socket:'):\n"
+            "                continue\n"
+            "            sock = socket.socket(fileno=os.dup(int(fd)))\n"
+            "        except OSError:\n"
+            "            continue\n"
+            "        if sock.type == socket.SOCK_DGRAM:\n"
+            "            sizes.append(sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF))\n"
+            "        sock.close()\n"
+            "    node.destroy_node()\n"
+            "    print(max(sizes))\n")
+    env = {k: v for k, v in os.environ.items() if k not in dds_profile.PROFILE_VARIABLES}
+    done = subprocess.run([sys.executable, "-P", "-c", code], cwd=REPO, env=env | {"PYTHONPATH": str(REPO)},
+                          capture_output=True, text=True, timeout=60, check=True)
+    assert int(done.stdout.strip()) == 2 * min(4 * 1024 * 1024, rmem_max)
