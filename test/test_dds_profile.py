@@ -15,6 +15,15 @@ REPO = Path(__file__).resolve().parents[1]
 NS = {"p": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
 
 
+def in_a_process_of_its_own(code: str) -> str:
+    """What ``code`` prints, run by this tree's Python with no profile file chosen (Fast DDS
+    reads the profile once per process, at its first participant)."""
+    env = {k: v for k, v in os.environ.items() if k not in dds_profile.PROFILE_VARIABLES}
+    done = subprocess.run([sys.executable, "-P", "-c", code], cwd=REPO, env=env | {"PYTHONPATH": str(REPO)},
+                          capture_output=True, text=True, timeout=60, check=True)
+    return done.stdout.strip()
+
+
 def test_a_tool_gets_the_client_profile_when_nothing_was_chosen():
     environ: dict[str, str] = {}
     chosen = dds_profile.use(environ, dds_profile.CLIENT)
@@ -63,18 +72,14 @@ def test_a_profile_of_ours_from_another_place_it_is_looked_for_counts_as_ours():
 
 
 def test_a_verbs_session_sets_the_client_profile_before_its_participant_exists():
-    # In a process of its own: Fast DDS reads the profile once per process, at its first participant
     code = ("import argparse, os\n"
             "from mpi_ros.cli.console import Session\n"
             "with Session(argparse.Namespace(ros_args=[])) as session:\n"
             "    print(os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'])\n")
-    env = {k: v for k, v in os.environ.items() if k not in dds_profile.PROFILE_VARIABLES}
-    done = subprocess.run([sys.executable, "-P", "-c", code], cwd=REPO, env=env | {"PYTHONPATH": str(REPO)},
-                          capture_output=True, text=True, timeout=60, check=True)
-    assert done.stdout.strip() == str(config_paths.find(dds_profile.CLIENT))
+    assert in_a_process_of_its_own(code) == str(config_paths.find(dds_profile.CLIENT))
 
 
-def test_a_verbs_sockets_get_the_larger_receive_buffer(tmp_path):
+def test_a_verbs_sockets_get_the_larger_receive_buffer():
     # What the profile is for, seen from inside a verb's process: its UDP sockets' SO_RCVBUF.
     # Linux doubles the request after capping it at net.core.rmem_max; a socket left at the
     # default has net.core.rmem_default.
@@ -97,7 +102,4 @@ def test_a_verbs_sockets_get_the_larger_receive_buffer(tmp_path):
             "        sock.close()\n"
             "    node.destroy_node()\n"
             "    print(max(sizes))\n")
-    env = {k: v for k, v in os.environ.items() if k not in dds_profile.PROFILE_VARIABLES}
-    done = subprocess.run([sys.executable, "-P", "-c", code], cwd=REPO, env=env | {"PYTHONPATH": str(REPO)},
-                          capture_output=True, text=True, timeout=60, check=True)
-    assert int(done.stdout.strip()) == 2 * min(4 * 1024 * 1024, rmem_max)
+    assert int(in_a_process_of_its_own(code)) == 2 * min(4 * 1024 * 1024, rmem_max)
