@@ -15,14 +15,13 @@ from __future__ import annotations
 
 import copy
 import math
-import sys
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from mpi_ros import flash
+from mpi_ros import config_paths, flash
 from mpi_ros.joints import AxisJoint, Joint, axis_joints
 from mpi_ros.mpi.axes.plant import Plant
 from mpi_ros.mpi.base.events import MPIEventType
@@ -66,18 +65,10 @@ def default_config_path() -> Path:
 
 def config_file(name: str) -> Path:
     """config/<name>: installed under share/mpi_ros/config, or in the source tree."""
-    candidates = [Path(sys.prefix) / "share" / "mpi_ros" / "config" / name]
-    try:
-        from ament_index_python.packages import get_package_share_directory
-
-        candidates.insert(0, Path(get_package_share_directory("mpi_ros")) / "config" / name)
-    except Exception:  # noqa: BLE001 - no ament index (plain venv): fall back below
-        pass
-    candidates.append(Path(__file__).resolve().parent.parent / "config" / name)
-    for candidate in candidates:
-        if candidate.is_file():
-            return candidate
-    raise ConfigError(f"config/{name} not found (looked in " + ", ".join(map(str, candidates)) + ")")
+    found = config_paths.find(name)
+    if found is not None:
+        return found
+    raise ConfigError(f"config/{name} not found (looked in " + ", ".join(map(str, config_paths.candidates(name))) + ")")
 
 
 class ConfigError(ValueError):

@@ -65,6 +65,11 @@ class Session:
     """
 
     def __init__(self, args: argparse.Namespace):
+        from mpi_ros import dds_profile
+
+        # Before rclpy creates the participant: receive buffers that hold the burst of the
+        # graph's endpoint announcements, which a default buffer dropped (dds_profile)
+        dds_profile.use(os.environ, dds_profile.CLIENT)
         import rclpy
 
         self.args = args

@@ -51,21 +51,13 @@ DISCOVERY_RANGES = ("localhost", "subnet", "system_default", "off")  # mpi_ros.s
 RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
 
 
-PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")
-FAST_DDS = ("", "rmw_fastrtps_cpp", "rmw_fastrtps_dynamic_cpp")  # RMW_IMPLEMENTATION values ("" = the default)
-
-
 def announce_often(environ) -> str | None:
     """Point Fast DDS at config/fastdds_discovery.xml (the suite announces itself every 0.1 s,
     so a one-shot verb finds it at once) unless a profile file or another middleware was chosen.
     Returns the file set, or None. Before rclpy.init; the goal front's process inherits it."""
-    from mpi_ros import config as suite_config
+    from mpi_ros import dds_profile
 
-    if environ.get("RMW_IMPLEMENTATION", "") not in FAST_DDS or any(environ.get(v) for v in PROFILE_VARIABLES):
-        return None
-    path = str(suite_config.config_file("fastdds_discovery.xml"))
-    environ[PROFILE_VARIABLES[0]] = path
-    return path
+    return dds_profile.use(environ, dds_profile.SUITE)
 
 
 def discovery_range(flag: str | None, config_path: str | None, environ) -> tuple[str, str]:

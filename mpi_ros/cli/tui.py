@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import os
 import shlex
 import threading
 import time
@@ -70,6 +71,9 @@ class Link:
         self.own_context = context is None
         self.context = context or rclpy.Context()
         if self.own_context:
+            from mpi_ros import dds_profile
+
+            dds_profile.use(os.environ, dds_profile.CLIENT)  # as a one-shot verb's Session does
             rclpy.init(args=["mpi-ros", *getattr(args, "ros_args", [])], context=self.context)
         self.watcher = Watcher(args.namespace, context=self.context, timeout=args.timeout,
                                node_name="mpi_ros_console_watch")
