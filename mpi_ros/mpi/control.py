@@ -498,7 +498,11 @@ class Controller:
     def motion_snapshots(self) -> Snapshots:
         """Every supervisor's mpiMotionStatus, by number, and every axis' mpiAxisStatus, all
         from one read of the axes (the supervisors' snapshots hold the same axis snapshots)."""
-        return self.status_template().at(self.sample, self.bank.values.T.tolist(), self.bank.bits.T.tolist())
+        return self._snapshots_now(self.status_template())
+
+    def _snapshots_now(self, template: StatusTemplate) -> Snapshots:
+        """The snapshots of ``template`` at the current sample, from the bank's values and bits."""
+        return template.at(self.sample, self.bank.values.T.tolist(), self.bank.bits.T.tolist())
 
     def status_template(self) -> StatusTemplate:
         """What the status of every axis and supervisor holds until the next discrete change
@@ -609,10 +613,10 @@ class Controller:
         their snapshots on the way."""
         longest = max(64, min(MAX_STRETCH, _STRETCH_ELEMENTS // len(self.axes)))
         while self.sample < end:
-            self._advance(min(end, self.sample + longest), taken)
+            template = self._advance(min(end, self.sample + longest), taken)
             # where the stretch stopped, after its transitions: as stepping there leaves it
             if self.sample in taken:
-                taken[self.sample] = self.motion_snapshots()
+                taken[self.sample] = self._snapshots_now(template if template is not None else self.status_template())
 
     def run_until(self, condition: Callable[[Controller], bool], max_samples: int, chunk: int = 1) -> bool:
         """Step ``chunk`` samples at a time until ``condition`` holds (True) or
@@ -628,7 +632,10 @@ class Controller:
         owner = self.supervisor(axis.owner)
         return owner.clock if owner is not None else None
 
-    def _advance(self, k1: int, taken: dict[int, Snapshots | None]) -> None:
+    def _advance(self, k1: int, taken: dict[int, Snapshots | None]) -> StatusTemplate | None:
+        """Step one stretch, to sample ``k1`` at most: up to its first transition or fault.
+        Answers the status template the snapshots inside it were taken from, if they were
+        and it still holds (the stretch stopped without a discrete change)."""
         k0 = self.sample
         self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])),
                           lambda row: self.axes[row].reanchor(self._clock(self.axes[row])))
@@ -645,7 +652,7 @@ class Controller:
         fault_at = self.faults.scan(stretch)
         if fault_at is not None and fault_at <= stop:
             stop = event_at = fault_at
-        self._status_events(stop, stretch, status, taken)
+        template = self._status_events(stop, stretch, status, taken)
         self._log(stop, stretch, supervisors)
         self._commit(stop, stretch, status)
         self.faults.commit(stop)
@@ -655,6 +662,8 @@ class Controller:
                 ms.transition(stop, stretch.samples)
             # after the supervisors' transitions of the same sample (a move done there is done)
             self.faults.transition(stop)
+            return None
+        return template
 
     def _log(self, stop: int, stretch: Stretch, supervisors: list[MotionSupervisor]) -> None:
         for ms in supervisors:
@@ -679,7 +688,7 @@ class Controller:
             self.axes[row].snap(t)
 
     def _status_events(self, stop: int, stretch: Stretch, status: StretchStatus,
-                       taken: dict[int, Snapshots | None]) -> None:
+                       taken: dict[int, Snapshots | None]) -> StatusTemplate | None:
         """Events for status bits that turn on in samples up to ``stop``, in sample order;
         between them, the snapshots ``taken`` wants at samples before ``stop`` (each after
         the events of its own sample and before those of later ones, as stepping there).
@@ -689,10 +698,11 @@ class Controller:
         happens), so the supervisors, plans, faults and queues of every sample before it are
         those of its first. The values, status bits and profile times come from the
         stretch's arrays, and the events latched by each sample are read as its snapshot is
-        taken."""
+        taken. Answers that template (None: no snapshot was wanted)."""
         found = sorted(self._edge_events(stop, stretch, status), key=lambda e: e[:3])
         emitted = 0
         inside = self._wanted_before(stop, stretch, taken)
+        template = None
         if inside:
             template = self.status_template()
             values = stretch.values[:, :, inside].transpose(2, 1, 0).tolist()
@@ -705,6 +715,7 @@ class Controller:
                 taken[sample] = template.at(sample, v, b)
         for item in found[emitted:]:
             self._emit_found(item, stretch)
+        return template
 
     @staticmethod
     def _wanted_before(stop: int, stretch: Stretch, taken: dict[int, Snapshots | None]) -> list[int]:
