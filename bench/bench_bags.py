@@ -8,6 +8,9 @@
   rate) over the replay's thread CPU time (and wall time), as a multiple of real time,
   best of ``--rounds``; every replay must be exact (zero differences). Also the whole
   ``mpi-ros replay BAG`` command on the long recording once, interpreter start included.
+- parts (``--only parts``, not run otherwise): where this tree's replay of the long recording
+  spends its thread CPU time: reading the bag, stepping with the snapshots (and the snapshots
+  alone), packing and comparing the statuses, the commands.
 - write: what a recording holds, MotionStatus, AxisStatus and JointState of a moving
   controller (2 supervisors of 2 axes, the default configuration), through
   mpi_ros.bag.writer.BagWriter: ``write`` (message -> canonical CDR -> MCAP) and
@@ -19,7 +22,7 @@
 Load figures of the machine are printed with each table (the machine is shared).
 
     python -P bench/bench_bags.py [--rounds 3] [--messages 60000] [--seconds 180] [--baseline REV]
-                                  [--only replay|write]
+                                  [--only replay|write|parts]
 """
 
 from __future__ import annotations
@@ -69,6 +72,54 @@ wall, cpu = time.perf_counter() - wall, time.thread_time() - cpu
 print(json.dumps({"wall": wall, "cpu": cpu, "identical": report.identical, "summary": report.summary(),
                   "last_sample": report.last_sample, "statuses": report.statuses, "values": report.values}))
 """
+
+
+# Where a replay's thread CPU time goes: each phase's functions wrapped with a timer (the
+# snapshots are inside the stepping's figure; "the rest" is what no phase covers).
+_PARTS = """
+import json, sys, time
+sys.path.insert(0, sys.argv[1])
+from mpi_ros.bag import replay as R
+from mpi_ros.mpi.control import Controller
+spent = {}
+def timed(name, run):
+    def wrapper(*args, **kwargs):
+        start = time.thread_time()
+        try:
+            return run(*args, **kwargs)
+        finally:
+            spent[name] = spent.get(name, 0.0) + time.thread_time() - start
+    return wrapper
+R._timeline = timed("reading the bag (timeline)", R._timeline)
+R._Statuses.take = timed("stepping with snapshots", R._Statuses.take)
+Controller.motion_snapshots = timed("of which the snapshots", Controller.motion_snapshots)
+R._Statuses.compare_run = timed("packing and comparing the statuses", R._Statuses.compare_run)
+R._apply = timed("the commands (stepping to them, applying)", R._apply)
+start = time.thread_time()
+report = R.replay(sys.argv[2])
+print(json.dumps({"total": time.thread_time() - start, "identical": report.identical, **spent}))
+"""
+
+
+def parts_rows(bag: Path, rounds: int) -> list[str]:
+    """The phases of this tree's replay of ``bag`` (fresh processes, the run of least total
+    CPU of ``rounds``): thread CPU time and share of the total."""
+    best: dict = {}
+    for _ in range(rounds):
+        done = subprocess.run([sys.executable, "-P", "-c", _PARTS, str(REPO), str(bag)], check=True,
+                              capture_output=True, text=True, env=_env())
+        run = json.loads(done.stdout.splitlines()[-1])
+        assert run.pop("identical")
+        if not best or run["total"] < best["total"]:
+            best = run
+    total = best.pop("total")
+    rows = [f"| phase ({bag.name}, this tree, best of {rounds}) | CPU | share |", "| --- | --- | --- |"]
+    order = ["reading the bag (timeline)", "stepping with snapshots", "of which the snapshots",
+             "packing and comparing the statuses", "the commands (stepping to them, applying)"]
+    rows += [f"| {name} | {best[name] * 1e3:,.0f} ms | {best[name] / total:.0%} |" for name in order if name in best]
+    covered = total - sum(v for k, v in best.items() if k != "of which the snapshots")
+    rows += [f"| the rest | {covered * 1e3:,.0f} ms | {covered / total:.0%} |", f"| total | {total * 1e3:,.0f} ms | |"]
+    return rows
 
 
 def replay_in(tree: Path, bag: Path) -> dict:
@@ -239,11 +290,16 @@ def main() -> None:
     parser.add_argument("--messages", type=int, default=60_000)
     parser.add_argument("--seconds", type=float, default=180.0, help="the long recording's controller time")
     parser.add_argument("--baseline", default="none", help="a revision to replay with side by side (git archive)")
-    parser.add_argument("--only", choices=("replay", "write"), help="one part only")
+    parser.add_argument("--only", choices=("replay", "write", "parts"),
+                        help="one part only (parts: where the long recording's replay spends its time)")
     args = parser.parse_args()
     print(f"Load before: {load_average()}")
     with tempfile.TemporaryDirectory(prefix="bench_bags_") as tmp:
-        if args.only != "write":
+        if args.only == "parts":
+            long = three_minutes(Path(tmp) / f"recording_{args.seconds:.0f}s", args.seconds)
+            print()
+            print("\n".join(parts_rows(long, args.rounds)))
+        elif args.only != "write":
             trees = compared_trees(args.baseline, Path(tmp))
             long = three_minutes(Path(tmp) / f"recording_{args.seconds:.0f}s", args.seconds)
             fixtures = sorted(p for p in FIXTURES.iterdir() if p.is_dir())
@@ -251,7 +307,7 @@ def main() -> None:
             print("\n".join(replay_rows([*fixtures, long], trees, args.rounds)))
             print()
             print(command_row(long))
-        if args.only != "replay":
+        if args.only not in ("replay", "parts"):
             print()
             print("\n".join(write_read_rows(args.messages, args.rounds)))
     print()

@@ -97,11 +97,11 @@ def measure(axes: int, supervisors: int, motion: str, batch: int, samples: int,
     return {"wall": axes * samples / wall, "cpu": axes * samples / cpu, "real_time": samples / ctl.rate / wall}
 
 
-def measure_in(source: Path, case: tuple | list, bench: str = "bench_controller") -> dict:
-    """``<bench>.measure(*case)`` in a fresh process running the package in ``source``."""
+def measure_in(source: Path, case: tuple | list, bench: str = "bench_controller", function: str = "measure") -> dict:
+    """``<bench>.<function>(*case)`` in a fresh process running the package in ``source``."""
     code = ("import sys, json; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[1]); "
             f"sys.path.insert(0, sys.argv[2]); import {bench} as b; "
-            "print(json.dumps(b.measure(*json.loads(sys.argv[3]))))")
+            f"print(json.dumps(b.{function}(*json.loads(sys.argv[3]))))")
     done = subprocess.run([sys.executable, "-P", "-c", code, str(source), str(REPO / "bench"), json.dumps(case)],
                           check=True, capture_output=True, text=True)
     return json.loads(done.stdout)

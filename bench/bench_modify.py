@@ -18,10 +18,12 @@ timed calls) and the table says whether the digests agree.
 ``--ruckig N`` (issue 35) times instead N modifies of a moving one-axis S-curve through the
 controller's public API (MotionSupervisor.modify: validation, planning, loading), each beside
 ruckig's calculate() for the same problem (the cross-check's mapping of the plan the modify
-loaded, bench_planning.ruckig_input), in one process, the two calls alternating.
+loaded, bench_planning.ruckig_input), in one process, the two calls alternating; a fresh
+process per run, ``--rounds`` runs of this tree and of ``--baseline`` ("none": this tree only)
+alternating.
 
     python -P bench/bench_modify.py [--baseline b39be10] [--rounds 3] [--batches 1 2 5 20]
-    python -P bench/bench_modify.py --ruckig 2000
+    python -P bench/bench_modify.py --ruckig 2000 [--baseline none] [--rounds 3]
 """
 
 from __future__ import annotations
@@ -89,11 +91,14 @@ def measure(batch: int, every: int, samples: int, modify: bool) -> dict:
 
 
 # -- beside ruckig ---------------------------------------------------------------------------------
-def beside_ruckig(count: int) -> list[str]:
+def measure_ruckig(count: int) -> dict:
     """Median and p90 of ``count`` modifies (MotionSupervisor.modify) and of ruckig's
-    calculate() on each one's problem, microseconds, and the ratio of the medians."""
+    calculate() on each one's problem, microseconds."""
+    import importlib
     import statistics
 
+    # the package measured first: importing bench_planning puts this tree's source ahead of it
+    importlib.import_module("mpi_ros")
     from bench_planning import ruckig_input, ruckig_limits
     from ruckig import Result, Ruckig
     from ruckig import Trajectory as RuckigTrajectory
@@ -122,15 +127,30 @@ def beside_ruckig(count: int) -> list[str]:
         theirs.append(clock() - t0)
         assert result in (Result.Working, Result.Finished), result
 
-    def figures(times: list[float]) -> tuple[float, float]:
-        return statistics.median(times) * 1e6, statistics.quantiles(times, n=10)[-1] * 1e6
+    def figures(times: list[float]) -> list[float]:
+        return [statistics.median(times) * 1e6, statistics.quantiles(times, n=10)[-1] * 1e6]
 
-    (ours_median, ours_p90), (ruckig_median, ruckig_p90) = figures(ours), figures(theirs)
-    return ["| modifies | modify median us | modify p90 us | ruckig median us | ruckig p90 us | "
+    return {"modify": figures(ours), "ruckig": figures(theirs)}
+
+
+def beside_ruckig(count: int, baseline: str | None, rounds: int) -> list[str]:
+    """The table of :func:`measure_ruckig`, a fresh process per run, ``rounds`` runs of this tree
+    and (``baseline``) of the package at that commit, alternating."""
+    rows = ["| tree | modifies | modify median us | modify p90 us | ruckig median us | ruckig p90 us | "
             "modify / ruckig (medians) |",
-            "| --- | --- | --- | --- | --- | --- |",
-            f"| {count} | {ours_median:.1f} | {ours_p90:.1f} | {ruckig_median:.2f} | {ruckig_p90:.2f} | "
-            f"{ours_median / ruckig_median:.1f}x |"]
+            "| --- | --- | --- | --- | --- | --- | --- |"]
+    with tempfile.TemporaryDirectory() as scratch:
+        trees = [(REPO, "this tree")]
+        old = baseline_tree(baseline, Path(scratch)) if baseline else None
+        if old is not None:
+            trees.append((old, baseline))
+        for _ in range(rounds):  # alternating, so that both see the same load
+            for tree, name in trees:
+                run = measure_in(tree, [count], "bench_modify", "measure_ruckig")
+                (ours, ours_p90), (ruckig, ruckig_p90) = run["modify"], run["ruckig"]
+                rows.append(f"| {name} | {count} | {ours:.1f} | {ours_p90:.1f} | {ruckig:.2f} | {ruckig_p90:.2f} | "
+                            f"{ours / ruckig:.1f}x |")
+    return rows
 
 
 # -- the table ------------------------------------------------------------------------------
@@ -185,7 +205,7 @@ def _least(runs: list[dict]) -> dict:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--baseline", default="b39be10", help="commit to measure side by side")
+    parser.add_argument("--baseline", help="commit to measure side by side (b39be10; with --ruckig: none)")
     parser.add_argument("--rounds", type=int, default=3, help="runs of each case on each tree (least kept)")
     parser.add_argument("--batches", type=int, nargs="+", default=[1, 2, 5, 20], help="samples stepped at a time")
     parser.add_argument("--every", type=int, default=20, help="samples between modifies of each supervisor")
@@ -193,6 +213,8 @@ if __name__ == "__main__":
     parser.add_argument("--ruckig", type=int, metavar="N", help="time N modifies beside ruckig instead")
     options = parser.parse_args()
     if options.ruckig:
-        print("\n".join(beside_ruckig(options.ruckig)))
+        baseline = None if options.baseline in (None, "none") else options.baseline
+        print("\n".join(beside_ruckig(options.ruckig, baseline, options.rounds)))
         sys.exit()
-    print("\n".join(main(options.baseline, options.rounds, options.batches, options.every, options.seconds)))
+    rows = main(options.baseline or "b39be10", options.rounds, options.batches, options.every, options.seconds)
+    print("\n".join(rows))

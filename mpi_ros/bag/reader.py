@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from mcap.data_stream import ReadDataStream
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
 from mcap.reader import make_reader
@@ -23,6 +24,10 @@ from mcap.stream_reader import StreamReader, get_chunk_data_stream
 from mcap_ros2._dynamic import generate_dynamic
 
 from . import schema
+
+
+def _older(type_name: str, schema_text: str) -> bool:
+    return bool(schema_text) and schema_text != schema.ros2msg(type_name)
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,7 +43,7 @@ class Recorded:
     def older(self) -> bool:
         """Whether the bag stores a definition of the type other than the installed one (a bag
         recorded before the type changed, docs/recording.md "Older recordings")."""
-        return bool(self.schema_text) and self.schema_text != schema.ros2msg(self.type)
+        return _older(self.type, self.schema_text)
 
     def decode(self):
         """The message: as its generated Python class (the package must be installed) when the
@@ -58,6 +63,24 @@ class Recorded:
         from rclpy.serialization import serialize_message
 
         return serialize_message(upgrade(self.decode(), schema.message_class(self.type)))
+
+
+@dataclass(frozen=True, slots=True)
+class Source:
+    """A channel of the bag: its topic, its type and the definition the bag stores for it."""
+
+    topic: str
+    type: str  # pkg/msg/Type
+    schema_text: str = ""  # the ros2msg definition ("": unknown)
+
+    older: bool = False  # Recorded.older, for every message of the channel
+
+    @classmethod
+    def of(cls, recorded: Recorded) -> Source:
+        return cls(recorded.topic, recorded.type, recorded.schema_text, recorded.older)
+
+    def recorded(self, log_time: int, data: bytes, sequence: int = 0) -> Recorded:
+        return Recorded(self.topic, self.type, log_time, data, sequence, self.schema_text)
 
 
 def upgrade(old: Any, cls: Any) -> Any:
@@ -96,6 +119,16 @@ def _recorded_decoder(type_name: str, text: str):
     return generate_dynamic(type_name, text)[type_name]
 
 
+# libyaml's parser where PyYAML was built with it: the same documents, several times faster
+# (a bag's metadata.yaml and its configuration are most of opening a short recording)
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def load_yaml(text: str) -> Any:
+    """``yaml.safe_load``, by libyaml when it is there."""
+    return yaml.load(text, Loader=_YAML_LOADER)
+
+
 def mcap_path(path: str | Path) -> Path:
     """The .mcap file of a bag directory (from its metadata.yaml), or ``path`` itself."""
     path = Path(path)
@@ -103,7 +136,7 @@ def mcap_path(path: str | Path) -> Path:
         return path
     metadata = path / "metadata.yaml"
     if metadata.is_file():
-        info = yaml.safe_load(metadata.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+        info = load_yaml(metadata.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
         return path / info["relative_file_paths"][0]
     files = sorted(path.glob("*.mcap"))
     if not files:
@@ -222,26 +255,41 @@ class BagReader:
 
     def stored(self, topics: Iterable[str]) -> Iterator[Recorded]:
         """The messages of ``topics`` in the order they are stored (each topic's in log-time
-        order as written), without building mcap's record objects for the others: a chunk's
-        records are stepped over by their headers (opcode, length; MCAP's "Records"), its
-        messages read at their fixed offsets. Several times faster than :meth:`messages` on a
-        recording whose status topics are most of it; a bag without a summary (not finished)
-        is read by :meth:`messages` instead."""
+        order as written): :meth:`payloads`, each as a Recorded."""
+        for source, sequence, log_time, data in self.payloads(topics):
+            yield source.recorded(log_time, data, sequence)
+
+    def payloads(self, topics: Iterable[str]) -> Iterator[tuple[Source, int, int, bytes]]:
+        """(source, sequence, log time, CDR) of the messages of ``topics`` in the order they
+        are stored, without building mcap's record objects for them: the chunks that hold
+        them are read where the summary's chunk indexes say, and a chunk's records are
+        stepped over by their headers (opcode, length; MCAP's "Records"), its messages read
+        at their fixed offsets. Several times faster than :meth:`messages` on a recording
+        whose status topics are most of it; a bag without a summary (not finished) is read by
+        :meth:`messages` instead."""
         wanted = set(topics)
         if self._scan is not None:
-            yield from self._scanned(list(wanted))
+            for recorded in self._scanned(list(wanted)):
+                yield Source.of(recorded), recorded.sequence, recorded.log_time, recorded.data
             return
         with open(self.path, "rb") as stream:
             summary = self._reader(stream).get_summary()
             assert summary is not None  # _finished() said so
-            channels = {cid: (channel, summary.schemas[channel.schema_id]) for cid, channel in summary.channels.items()
-                        if channel.topic in wanted and channel.schema_id in summary.schemas}
+            sources = {cid: _source(summary.schemas[channel.schema_id], channel)
+                       for cid, channel in summary.channels.items()
+                       if channel.topic in wanted and channel.schema_id in summary.schemas}
+            if summary.chunk_indexes:
+                # the chunks where the summary says they are, as mcap's own indexed reading
+                # finds them (the message indexes between them not parsed)
+                for index in sorted(summary.chunk_indexes, key=lambda index: index.chunk_start_offset):
+                    if sources.keys() & index.message_index_offsets.keys():
+                        stream.seek(index.chunk_start_offset + _RECORD.size)
+                        yield from _chunk_payloads(Chunk.read(ReadDataStream(stream)), sources)
+                return
             stream.seek(0)
-            for record in StreamReader(stream, emit_chunks=True).records:
-                if isinstance(record, Chunk):
-                    yield from _chunk_messages(record, channels)
-                elif isinstance(record, Message) and record.channel_id in channels:
-                    yield _recorded(*channels[record.channel_id][::-1], record)
+            for record in StreamReader(stream).records:
+                if isinstance(record, Message) and record.channel_id in sources:
+                    yield sources[record.channel_id], record.sequence, record.log_time, record.data
 
     def decoded(self, topics: Iterable[str] | None = None) -> Iterator[tuple[Recorded, Any]]:
         for recorded in self.messages(topics):
@@ -264,22 +312,25 @@ _RECORD = struct.Struct("<BQ")  # a record's opcode and content length
 _MESSAGE = struct.Struct("<HIQQ")  # a Message record's channel id, sequence, log time, publish time
 
 
-def _chunk_messages(chunk: Chunk, channels: dict[int, tuple[Channel, Schema]]) -> Iterator[Recorded]:
-    """The messages of ``channels`` in a chunk (decompressed by mcap), others stepped over."""
+def _chunk_payloads(chunk: Chunk, sources: dict[int, Source]) -> Iterator[tuple[Source, int, int, bytes]]:
+    """The messages of ``sources``' channels in a chunk (decompressed by mcap), others stepped over."""
     records, end = get_chunk_data_stream(chunk)
     data = records.read(end)
-    texts = {cid: schema_.data.decode("utf-8", errors="replace") for cid, (_, schema_) in channels.items()}
     pos = 0
     while pos < end:
         opcode, length = _RECORD.unpack_from(data, pos)
         pos += _RECORD.size
         if opcode == Opcode.MESSAGE:
             channel_id, sequence, log_time, _ = _MESSAGE.unpack_from(data, pos)
-            if channel_id in channels:
-                channel, schema_ = channels[channel_id]
-                yield Recorded(channel.topic, schema_.name, log_time, data[pos + _MESSAGE.size:pos + length], sequence,
-                               texts[channel_id])
+            source = sources.get(channel_id)
+            if source is not None:
+                yield source, sequence, log_time, data[pos + _MESSAGE.size:pos + length]
         pos += length
+
+
+def _source(schema_: Schema, channel: Channel) -> Source:
+    text = schema_.data.decode("utf-8", errors="replace")
+    return Source(channel.topic, schema_.name, text, _older(schema_.name, text))
 
 
 def _recorded(schema_: Schema, channel: Channel, message: Message) -> Recorded:

@@ -18,11 +18,10 @@ differences; otherwise the report names the first divergence: where, which field
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import yaml
 from mcap.exceptions import McapError
 
 from .. import config as suite_config
@@ -31,7 +30,7 @@ from ..commands import Command, apply
 from ..mpi.control import MAX_STRETCH
 from ..ros import convert, wire
 from . import fields, schema
-from .reader import BagReader
+from .reader import BagReader, load_yaml
 from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED, commands_topic
 
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
@@ -161,7 +160,7 @@ def inspect(reader: BagReader, namespace: str | None = None) -> Recording:
     setup = None
     if stored is not None:
         stored_epoch = stored.get("stamp_epoch_ns")
-        setup = (yaml.safe_load(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
+        setup = (load_yaml(stored["config"]) or {}, "metadata", int(stored.get("start_sample", "0")),
                  int(stored_epoch) if stored_epoch is not None else None, stored.get("namespace"))
         if namespace is not None and setup[4] not in (None, namespace):
             raise MissingInput(f"{reader.path}: the bag recorded the suite in {setup[4]}, not {namespace}")
@@ -169,7 +168,7 @@ def inspect(reader: BagReader, namespace: str | None = None) -> Recording:
         config_topics = _chosen(reader, config_topics, namespace)
         found = next((msg for _, msg in reader.decoded(config_topics[:1])), None)
         if found is not None:
-            setup = (yaml.safe_load(found.config) or {}, config_topics[0], int(found.start_sample),
+            setup = (load_yaml(found.config) or {}, config_topics[0], int(found.start_sample),
                      int(found.epoch_ns), found.ros_namespace or None)
     if setup is None:
         where = (f"the topic {config_topics[0]} is there but holds no message" if config_topics else
@@ -242,19 +241,17 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     timeline, recorded_events, first_recorded = _timeline(reader, recording)
     statuses = _Statuses(ctl, recording, tolerance)
     report.last_sample = ctl.sample
-    for entries in _runs(timeline):
+    runs = list(_runs(timeline))
+    for entries, following in zip(runs, [*runs[1:], None], strict=True):
         if entries[0][1] == 1:
             _apply(ctl, report, entries[0])
-        else:
-            statuses.take([entry[0] for entry in entries])
-        for sample, kind, _, _, item, msg in entries:
             # where stepping entry by entry would have left the controller
-            report.last_sample = max(report.last_sample, sample)
-            if kind == 0:
-                statuses.compare(report, sample, item, msg)
-                report.statuses += 1
-            if stop_at_first and report.first is not None:
-                break
+            report.last_sample = max(report.last_sample, entries[0][0])
+        else:
+            # on to where a command follows in the same go: a stretch fewer than stepping there apart
+            until = following[0][0] if following is not None and following[0][1] == 1 else entries[-1][0]
+            statuses.take(list(dict.fromkeys(entry[0] for entry in entries)), until)
+            statuses.compare_run(report, entries, stop_at_first)
         if stop_at_first and report.first is not None:
             break
     # a recording of the graph holds the events from when it started; mpi-ros record has them all
@@ -264,44 +261,48 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     return report
 
 
-_STATUS_KEYS = {name: fields.field_reader(schema.message_class(name), ("sample", "number")) for name in STATUS_TYPES}
+# A status' sample and number, read from its CDR, by type: where wire.py lays them out, or,
+# if the installed interfaces differ from its layouts, by the installed definition.
+_STATUS_KEYS: dict[str, Callable[[bytes], tuple]] = {
+    name: wire.sample_and_number if wire.AVAILABLE else fields.field_reader(schema.message_class(name),
+                                                                             ("sample", "number"))
+    for name in STATUS_TYPES}
 
 
 def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], list, int | None]:
-    """What replay does in order: (controller sample, 0 status / 1 command, order, topic,
-    recorded (for a status with its number), message) sorted; the recorded events in the
-    order they were written; the first sample the recording saw (a graph recording may
-    start late).
+    """What replay does in order, sorted: (controller sample, 0 status / 1 command, then what
+    orders them: sequence, log time, position; the Source, the CDR, the status' supervisor or
+    axis number (None for a command), the message decoded); the recorded events in the order
+    they were written; the first sample the recording saw (a graph recording may start late).
 
     Statuses are most of a recording: their sample and number are read from the CDR and the
     message is decoded only if the replayed bytes differ (None until then). The messages
     are read in the order they are stored (the order they were written in), several times
-    faster than in log-time order; ``order`` sorts them as log-time order did."""
+    faster than in log-time order; the sequence, log time and position sort them as
+    log-time order did."""
     recorded_events = []
     timeline: list[tuple] = []
-    first_recorded = None
+    commands = set(recording.commands)
     wanted = [*recording.commands, *recording.statuses] + ([recording.events] if recording.events else [])
-    for position, item in enumerate(reader.stored(wanted)):
-        key = (item.sequence, item.log_time, position)
-        if item.topic in recording.commands:
-            msg = item.decode()
+    for position, (source, sequence, log_time, data) in enumerate(reader.payloads(wanted)):
+        if source.topic in commands:
+            msg = source.recorded(log_time, data, sequence).decode()
             # applied while the controller was one sample before the one it took effect at
-            timeline.append((msg.sample - 1, 1, key, item.topic, item, msg))
-            continue
-        if item.topic == recording.events:
-            msg = item.decode()
-            first_recorded = msg.sample if first_recorded is None else min(first_recorded, msg.sample)
-            if msg.type not in NOT_REPLAYED:
-                recorded_events.append((key, msg))
-            continue
-        msg = item.decode() if item.older else None
-        sample, number = (msg.sample, msg.number) if msg is not None else _STATUS_KEYS[item.type](item.data)
-        first_recorded = sample if first_recorded is None else min(first_recorded, sample)
-        # statuses at a sample were taken before commands given at that sample
-        timeline.append((sample, 0, key, item.topic, (item, number), msg))
-    timeline.sort(key=lambda entry: entry[:3])
+            timeline.append((msg.sample - 1, 1, sequence, log_time, position, source, data, None, msg))
+        elif source.topic == recording.events:
+            recorded_events.append(((sequence, log_time, position), source.recorded(log_time, data, sequence).decode()))
+        elif source.older:
+            msg = source.recorded(log_time, data, sequence).decode()
+            timeline.append((msg.sample, 0, sequence, log_time, position, source, data, msg.number, msg))
+        else:
+            sample, number = _STATUS_KEYS[source.type](data)
+            # statuses at a sample were taken before commands given at that sample
+            timeline.append((sample, 0, sequence, log_time, position, source, data, number, None))
+    timeline.sort()  # no two entries have the same position: the sort never compares what follows it
+    seen = [entry[0] for entry in timeline if entry[1] == 0] + [msg.sample for _, msg in recorded_events]
     # the order they were written in, which ties in log time may not keep
-    return timeline, [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0])], first_recorded
+    events = [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0]) if msg.type not in NOT_REPLAYED]
+    return timeline, events, min(seen, default=None)
 
 
 class _Statuses:
@@ -309,7 +310,8 @@ class _Statuses:
     their canonical CDR first (mpi_ros.ros.wire, the bytes the suite publishes and the
     recorder stores), field by field only where the bytes differ (or where they cannot be
     the same: a bag recorded before a type changed or without the stamps' epoch). Every
-    axis is read once a sample, for all the topics (Controller.motion_snapshots)."""
+    axis is read once a sample, for all the topics (Controller.motion_snapshots), and packed
+    once for its own status and the supervisor's that holds it (wire.Packer)."""
 
     def __init__(self, ctl, recording: Recording, tolerance: float):
         self.ctl = ctl
@@ -318,49 +320,67 @@ class _Statuses:
         self.tolerance = tolerance
         self.skipped = _SKIPPED_FIELDS if self.epoch is None else frozenset()
         self.exact_bytes = wire.AVAILABLE and self.epoch is not None
+        self.packer = wire.Packer(ctl.rate, self.epoch, self.namespace) if self.exact_bytes else None
         # the snapshots of the run being compared, by sample (the types are told apart by the message's)
         self.taken: dict[int, tuple[dict, list]] = {}
-        self.leaves: dict[tuple[str, int], int] = {}  # (type, axes) -> values a status compares
+        self.leaves: dict[tuple[bool, int], int] = {}  # (motion status, axes) -> values a status compares
 
-    def take(self, samples: Sequence[int]) -> None:
-        """Step the controller to the last of ``samples`` (in order), keeping the snapshots
-        of each; a sample the controller has passed is compared where it is (as stepping to
-        each status did)."""
+    def take(self, samples: Sequence[int], until: int = -1) -> None:
+        """Step the controller to the last of ``samples`` (in order) or on to ``until``,
+        keeping the snapshots of each sample; a sample the controller has passed is compared
+        where it is (as stepping to each status did)."""
         ctl = self.ctl
         wanted = [max(sample, ctl.sample) for sample in samples]
-        taken = ctl.step_snapshots(wanted[-1] - ctl.sample, wanted)
+        taken = ctl.step_snapshots(max(wanted[-1], until) - ctl.sample, wanted)
         self.taken = {sample: taken[at] for sample, at in zip(samples, wanted, strict=True)}
 
-    def compare(self, report: ReplayReport, sample: int, recorded: tuple, msg) -> None:
-        """``recorded``: (the Recorded, its supervisor's or axis' number); ``msg``: the
-        message decoded, or None. The controller's snapshots at ``sample`` are in
-        :meth:`take`'s run."""
+    def compare_run(self, report: ReplayReport, entries: list[tuple], stop_at_first: bool) -> None:
+        """Compare a run's statuses (timeline entries, in order; their snapshots taken by
+        :meth:`take`): their bytes, or their fields where the bytes differ; with
+        ``stop_at_first``, up to the first difference."""
+        packer, motion_type = self.packer, STATUS_TYPES[0]
+        for entry in entries:
+            sample, _, _, _, _, source, data, number, msg = entry
+            # where stepping entry by entry would have left the controller
+            report.last_sample = max(report.last_sample, sample)
+            report.statuses += 1
+            motion = source.type == motion_type
+            snap = self._snapshot(sample, motion, number)
+            if msg is None and packer is not None and data == (
+                    packer.motion_status(snap) if motion else packer.axis_status(snap)):
+                report.values += self._leaves(motion, snap)
+                continue
+            self._compare_fields(report, entry, motion, snap)
+            if stop_at_first and report.first is not None:
+                return
+
+    def _compare_fields(self, report: ReplayReport, entry: tuple, motion: bool, snap) -> None:
+        """One status (a timeline entry) and its snapshot, field by field."""
+        sample, _, sequence, log_time, _, source, data, _, msg = entry
         ctl = self.ctl
+        replayed = (convert.motion_status if motion else convert.axis_status)(snap, ctl.rate, self.epoch or 0,
+                                                                                self.namespace)
+        recorded = msg if msg is not None else source.recorded(log_time, data, sequence).decode()
+        _compare(report, sample, source.topic, recorded, replayed, self.tolerance, self.skipped)
+
+    def _snapshot(self, sample: int, motion: bool, number: int):
+        """The replayed snapshot of supervisor or axis ``number`` at ``sample``."""
         motions, axes = self.taken[sample]
-        item, number = recorded
-        motion = item.type == STATUS_TYPES[0]
         snap = motions.get(number) if motion else (axes[number] if 0 <= number < len(axes) else None)
         if snap is None:  # what the controller answers for a supervisor or axis it does not have
-            snap = ctl.supervisor(number).snapshot() if motion else ctl.axis_snapshot(number)
-        if msg is None and self.exact_bytes:
-            encode = wire.motion_status if motion else wire.axis_status
-            if encode(snap, ctl.rate, self.epoch, self.namespace) == item.data:
-                report.values += self._leaves(item.type, snap)
-                return
-        convert_ = convert.motion_status if motion else convert.axis_status
-        replayed = convert_(snap, ctl.rate, self.epoch or 0, self.namespace)
-        _compare(report, sample, item.topic, msg if msg is not None else item.decode(), replayed, self.tolerance,
-                 self.skipped)
+            snap = self.ctl.supervisor(number).snapshot() if motion else self.ctl.axis_snapshot(number)
+        return snap
 
-    def _leaves(self, msg_type: str, snap) -> int:
+    def _leaves(self, motion: bool, snap) -> int:
         """The values a field-by-field comparison of this status counts (fixed by its type
         and its number of axes)."""
-        key = (msg_type, len(getattr(snap, "axes", ())))
-        if key not in self.leaves:
-            convert_ = convert.motion_status if msg_type == STATUS_TYPES[0] else convert.axis_status
+        key = (motion, len(snap.axes) if motion else 0)
+        found = self.leaves.get(key)
+        if found is None:
+            convert_ = convert.motion_status if motion else convert.axis_status
             built = convert_(snap, self.ctl.rate, self.epoch or 0, self.namespace)
-            self.leaves[key] = sum(1 for _ in _flatten(convert.to_dict(built), skipped=self.skipped))
-        return self.leaves[key]
+            found = self.leaves[key] = sum(1 for _ in _flatten(convert.to_dict(built), skipped=self.skipped))
+        return found
 
 
 def _step_to(ctl, sample: int) -> None:
@@ -370,7 +390,8 @@ def _step_to(ctl, sample: int) -> None:
 
 def _apply(ctl, report: ReplayReport, entry: tuple) -> None:
     """A recorded command, applied at the sample before the one it took effect at."""
-    sample, _, _, topic, _, msg = entry
+    sample, _, _, _, _, source, _, _, msg = entry
+    topic = source.topic
     _step_to(ctl, sample)
     reply = apply(ctl, Command.from_json(msg.operation, msg.supervisor, msg.axis, msg.request))
     report.commands += 1

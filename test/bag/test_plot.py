@@ -169,3 +169,32 @@ def test_reading_in_stored_order_gives_what_mcap_gives(name):
     fast = list(reader.stored(topics))
     assert fast == list(reader.messages(topics, in_order=False))
     assert len(fast) > 100
+
+
+def test_reading_a_bag_without_chunks_in_stored_order_gives_what_mcap_gives(tmp_path: Path):
+    """Where the summary has no chunk indexes (an MCAP written without chunks), the records
+    are read one by one from the start."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    source = BagReader(BAGS / "two_supervisors")
+    path = tmp_path / "flat.mcap"
+    with open(path, "wb") as stream:
+        writer = Writer(stream, use_chunking=False)
+        writer.start(profile="ros2", library="test")
+        channels: dict[str, int] = {}
+        for recorded in source.messages():
+            if recorded.topic not in channels:
+                schema_id = writer.register_schema(recorded.type, "ros2msg", recorded.schema_text.encode())
+                channels[recorded.topic] = writer.register_channel(recorded.topic, "cdr", schema_id)
+            writer.add_message(channels[recorded.topic], recorded.log_time, recorded.data, recorded.log_time,
+                               recorded.sequence)
+        writer.finish()
+    with open(path, "rb") as stream:
+        assert not make_reader(stream).get_summary().chunk_indexes
+    reader = BagReader(path)
+    assert not reader.truncated
+    topics = [topic for topic in reader.topics() if topic != "/mpi/configuration"]
+    flat = list(reader.stored(topics))
+    # written in log-time order: stored in it
+    assert flat == list(reader.messages(topics, in_order=False)) == list(source.messages(topics))

@@ -33,8 +33,8 @@ def _snapshots_seen(monkeypatch: pytest.MonkeyPatch, bag: Path) -> dict[int, str
     seen: dict[int, str] = {}
     take = replay_module._Statuses.take
 
-    def recording_take(self, samples):
-        take(self, samples)
+    def recording_take(self, samples, until=-1):
+        take(self, samples, until)
         seen.update({sample: repr(snapshots) for sample, snapshots in self.taken.items()})
 
     monkeypatch.setattr(replay_module._Statuses, "take", recording_take)

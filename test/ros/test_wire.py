@@ -15,6 +15,7 @@ from mpi_ros import config
 from mpi_ros.bag import cdr
 from mpi_ros.mpi import MotionAttr, MotionParams, MPIAction, MPIMotionType, Trajectory
 from mpi_ros.mpi.base.types import MPIState
+from mpi_ros.msg import AxisStatus, MotionStatus
 from mpi_ros.ros import convert, wire
 
 EPOCH = 1_795_000_000_123_456_789
@@ -140,3 +141,48 @@ def test_snapshots_are_read_once_a_sample_and_read_again_after_a_command():
     assert snapshots.axis(ctl, 3).state is MPIState.STOPPING_ERROR
     runner.step(1)
     assert snapshots.axis(ctl, 0).sample == ctl.sample == first[0].sample + 1
+
+
+@pytest.mark.parametrize("namespace", ["/mpi", "/plant/cell_a", "/c"])
+def test_a_packer_packs_each_sample_as_the_functions_do(namespace):
+    """wire.Packer keeps a sample's stamp, each source's frame_id and each axis snapshot's
+    body: whatever order the statuses are packed in, and when a sample is seen again with
+    other snapshots (a command given at it), its bytes are the canonical CDR of each."""
+    from mpi_ros.commands import Command, apply
+
+    ctl = _controller()
+    packer = wire.Packer(ctl.rate, EPOCH, namespace)
+    for step, moving in enumerate(_moving_states(ctl)):
+        rounds = [moving.motion_snapshots()]
+        if step == 20:  # the same sample, other snapshots (the state changes, the sample does not)
+            assert apply(moving, Command("action", 0, -1, {"action": "E_STOP"})).outcome.ok
+            rounds.append(moving.motion_snapshots())
+            assert rounds[1][0][0].state != rounds[0][0][0].state
+        for motions, axes in rounds:
+            order = [*motions.values(), *axes] if step % 2 else [*axes, *motions.values()]
+            for snap in order:
+                if snap in axes:
+                    expected = cdr.serialize(convert.axis_status(snap, ctl.rate, EPOCH, namespace))
+                    assert packer.axis_status(snap) == expected
+                else:
+                    expected = cdr.serialize(convert.motion_status(snap, ctl.rate, EPOCH, namespace))
+                    assert packer.motion_status(snap) == expected
+
+
+@pytest.mark.parametrize("namespace", ["/mpi", "/plant/cell_a", "/c", "/cell_b7"])
+def test_a_status_sample_and_number_are_read_where_the_fields_reader_finds_them(namespace):
+    """Every length of the frame_id mod 8 (the namespaces) moves where the sample lies."""
+    from mpi_ros.bag import fields
+
+    readers = {kind: fields.field_reader(kind, ("sample", "number")) for kind in (AxisStatus, MotionStatus)}
+    ctl = _controller()
+    ctl.step(2**20 + 3)
+    motions, axes = ctl.motion_snapshots()
+    for snap in axes:
+        data = wire.axis_status(snap, ctl.rate, EPOCH, namespace)
+        assert wire.sample_and_number(data) == readers[AxisStatus](data) == (ctl.sample, snap.number)
+    for snap in motions.values():
+        data = wire.motion_status(snap, ctl.rate, EPOCH, namespace)
+        assert wire.sample_and_number(data) == readers[MotionStatus](data) == (ctl.sample, snap.number)
+    with pytest.raises(ValueError, match="little-endian"):
+        wire.sample_and_number(b"\x00\x00" + data[2:])

@@ -13,7 +13,6 @@ way it comes in, and a value the controller accepted can never break its clock.
 from __future__ import annotations
 
 import copy
-import itertools
 import math
 import numbers
 import reprlib
@@ -72,6 +71,10 @@ IO_WORDS_MAX = 65_536
 # (at most FRAME_BUFFER_MAX frames per axis) is fed anyway.
 MAX_REQUEST_VALUES = 1 << 16
 MAX_REQUEST_TEXT = 1 << 14
+# The attributes whose arrays MotionParams.validate reads, as ints (an IntFlag's & makes a member)
+_DELAY, _FINAL_VEL, _HOLDS, _OUTPUT = (int(MotionAttr.DELAY), int(MotionAttr.FINAL_VEL), int(HOLD_ATTRS),
+                                       int(MotionAttr.OUTPUT))
+_EVERY_ATTRIBUTE = -1  # every bit set: validate(None) reads every attribute's array
 
 
 
@@ -96,7 +99,10 @@ def refuse(detail: str, message: Message = Message.MPIMessagePARAM_INVALID) -> O
 
 def first_refusal(verdicts: Iterable[Outcome]) -> Outcome:
     """The first verdict that refuses, else VALID."""
-    return next((v for v in verdicts if not v.ok), VALID)
+    for verdict in verdicts:
+        if not verdict.ok:
+            return verdict
+    return VALID
 
 
 def _finite_number(value: object) -> TypeGuard[float]:
@@ -157,8 +163,14 @@ def check_duration(name: str, value: object, positive: bool = False) -> Outcome:
     return check_range(name, value, 0.0, MAX_DURATION, above_low=positive)
 
 
-def _each(name: str, values: Iterable[object], check: Callable[[str, object], Outcome]) -> Iterable[Outcome]:
-    return (check(f"{name}[{i}]", v) for i, v in enumerate(values))
+def _each(name: str, values: Iterable[object], check: Callable[[str, object], Outcome]) -> Outcome:
+    """The first of ``values`` that ``check`` refuses, named by its index ("position[3]: ..."),
+    else VALID. The indexed name is made for a refusal only: every value of every start and
+    modify passes through here."""
+    for i, value in enumerate(values):
+        if not check(name, value).ok:
+            return check(f"{name}[{i}]", value)
+    return VALID
 
 
 class _Validated(Protocol):
@@ -167,8 +179,21 @@ class _Validated(Protocol):
     def validate(self) -> Outcome: ...
 
 
-def _each_struct(name: str, structs: Iterable[_Validated]) -> Iterable[Outcome]:
-    return (s.validate().prefixed(f"{name}[{i}].") for i, s in enumerate(structs))
+def _each_struct(name: str, structs: Iterable[_Validated]) -> Outcome:
+    """The first refusal of ``structs``' validators, prefixed by the struct's index, else VALID."""
+    for i, struct in enumerate(structs):
+        verdict = struct.validate()
+        if not verdict.ok:
+            return verdict.prefixed(f"{name}[{i}].")
+    return VALID
+
+
+def _check_velocity(name: str, value: object) -> Outcome:
+    return check_magnitude(name, value, MAX_VELOCITY)
+
+
+def _check_ratio(name: str, value: object) -> Outcome:
+    return check_magnitude(name, value, MAX_RATIO)
 
 
 @dataclass(slots=True)
@@ -313,49 +338,38 @@ class MotionParams:
         VELOCITY "will ignore these values"), an attribute's array only with the attribute.
         Lengths are checked with the move."""
 
-        bits = None if attributes is None else attributes.value  # (int masks: a Flag's & costs a new member)
-
-        def uses(attr: MotionAttr) -> bool:
-            return bits is None or bool(bits & attr.value)
-
-        checks: list[Iterable[Outcome]] = [
-            _each("position", self.position if position else (), check_position),
+        bits = _EVERY_ATTRIBUTE if attributes is None else int(attributes)
+        return first_refusal((
+            _each("position", self.position, check_position) if position else VALID,
             _each_struct("trajectory", self.trajectory),
-            (check_bool("final", self.final),
-             check_bool("retain", self.retain),
-             check_long("empty_count", self.empty_count),  # any value: <= 0 disables (empty_count_disabled)
-             check_long("id", self.id),
-             check_long("master_start", self.master_start),
-             check_long("repeat_from", self.repeat_from),
-             check_long("behavior", self.behavior),
-             check_long("low_count", self.low_count),
-             check_long("expected_axes", self.expected_axes)),
+            check_bool("final", self.final),
+            check_bool("retain", self.retain),
+            check_long("empty_count", self.empty_count),  # any value: <= 0 disables (empty_count_disabled)
+            check_long("id", self.id),
+            check_long("master_start", self.master_start),
+            check_long("repeat_from", self.repeat_from),
+            check_long("behavior", self.behavior),
+            check_long("low_count", self.low_count),
+            check_long("expected_axes", self.expected_axes),
             _each("element_id", self.element_id, check_long),
-        ]
-        if uses(MotionAttr.DELAY):
-            checks.append(_each("delay", self.delay, check_duration))
-        if uses(MotionAttr.FINAL_VEL):
-            checks.append(_each("final_velocity", self.final_velocity,
-                                lambda n, v: check_magnitude(n, v, MAX_VELOCITY)))
-        if uses(HOLD_ATTRS):
-            checks.append(_each_struct("hold", self.hold))
-        if uses(MotionAttr.OUTPUT):
-            checks.append(_each_struct("output", self.output))
-        if path_data:
-            checks += self._path_checks()
-        return first_refusal(itertools.chain.from_iterable(checks))
+            _each("delay", self.delay, check_duration) if bits & _DELAY else VALID,
+            _each("final_velocity", self.final_velocity, _check_velocity) if bits & _FINAL_VEL else VALID,
+            _each_struct("hold", self.hold) if bits & _HOLDS else VALID,
+            _each_struct("output", self.output) if bits & _OUTPUT else VALID,
+            self._path_data() if path_data else VALID,
+        ))
 
-    def _path_checks(self) -> list[Iterable[Outcome]]:
+    def _path_data(self) -> Outcome:
         """Path, cam and frame data (read only by those types)."""
-        return [
-            _each("point_velocity", self.point_velocity, lambda n, v: check_magnitude(n, v, MAX_VELOCITY)),
+        return first_refusal((
+            _each("point_velocity", self.point_velocity, _check_velocity),
             _each("time", self.time, check_duration),
-            _each("feedforward", self.feedforward, lambda n, v: check_magnitude(n, v, MAX_VELOCITY)),
+            _each("feedforward", self.feedforward, _check_velocity),
             _each("master_distance", self.master_distance, check_position),
             _each("slave_position", self.slave_position, check_position),
-            _each("gear_ratio", self.gear_ratio, lambda n, v: check_magnitude(n, v, MAX_RATIO)),
+            _each("gear_ratio", self.gear_ratio, _check_ratio),
             _each_struct("frames", self.frames),
-        ]
+        ))
 
 
 @dataclass(slots=True)

@@ -527,8 +527,8 @@ class MotionSupervisor:
         verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21, append=append)
         if not verdict.ok:
             return verdict
-        state = self._moves.state_for(self._axis_list.listed)
         held = self._moves.held_by_others(self._axis_list.listed)
+        state = self._moves.state_with(held)
         if held:
             # A start or modify would take the axis out of the other supervisor's vector (its
             # motion, running or stopped, keeps it until it ends or is RESET): answered with the

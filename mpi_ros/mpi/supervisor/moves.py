@@ -133,8 +133,15 @@ class Moves:
     def state_for(self, numbers: list[int]) -> MPIState:
         """The state as a command on axes ``numbers`` sees it: the own state, and the states
         of the other supervisors whose motion holds one of them."""
-        states = [self._state.own_state] + [state for _, _, state in self.held_by_others(numbers)]
-        return max(states, key=STATE_SEVERITY.__getitem__)
+        return self.state_with(self.held_by_others(numbers))
+
+    def state_with(self, held: list[tuple[int, int, MPIState]]) -> MPIState:
+        """The own state, or the most severe of it and the states ``held`` gives
+        (:meth:`held_by_others`' answer, for a caller that needs both)."""
+        own = self._state.own_state
+        if not held:
+            return own
+        return max([own, *(state for _, _, state in held)], key=STATE_SEVERITY.__getitem__)
 
     def held_by_others(self, numbers: list[int]) -> list[tuple[int, int, MPIState]]:
         """(axis, supervisor, its own state) for each axis of ``numbers`` in the motion of

@@ -247,6 +247,20 @@ def test_params_check_only_what_the_move_reads():
     assert refused(params.validate(), "position[0]")
 
 
+def test_params_answer_the_first_refusal_in_field_order_with_its_index():
+    # Every value passes one check a start or modify needs: the first refused field wins (the
+    # array before the attribute arrays after it), and within it the first refused value, named
+    # by its index; a refused value after it changes nothing of the answer.
+    params = MotionParams(trajectory=[Trajectory(1e3, 1e4, 1e4)], position=[1.0, 2.0, math.inf, math.nan],
+                          final_velocity=[1e300])
+    assert refused(params.validate(MotionAttr.FINAL_VEL), "position[2]")
+    params.position = [1.0, 2.0]
+    assert refused(params.validate(MotionAttr.FINAL_VEL), "final_velocity[0]")
+    assert params.validate(MotionAttr.NONE).ok
+    params.trajectory.append(Trajectory(1e3, 1e4, -math.inf))
+    assert refused(params.validate(MotionAttr.FINAL_VEL), "trajectory[1].deceleration")
+
+
 @pytest.mark.parametrize(("struct", "field"), [
     (Hold(type=HoldType.GATE, mask=2**32), "mask"),
     (Hold(type=HoldType.INPUT, pattern=-(2**31) - 1), "pattern"),
