@@ -53,9 +53,13 @@ layers, each importing only the ones above it in this list (test/mpi/test_archit
 | its state machine as the controller steps (DONE, stop     | supervisor/stepping.py |
 |   complete, ERROR, hold release at the exact sample)      |   |
 | motion log (meiMotionLogOpen/Print/Close)                 | supervisor/log.py |
+| its mpiMotionStatus from a template (what holds until the | supervisor/status.py |
+|   next change) and a sample's axis snapshots              |   |
 | **the controller**                                        |   |
 | Controller: sample clock, step/run_until, objects, events | control.py |
 | how moves ended, when a goal is over                      | move_log.py |
+| status snapshots of every axis and supervisor, from       | snapshots.py |
+|   templates (the live status and inside stretches)        |   |
 
 Start with ``Controller``: create it, ``create_motion``, ``axis_list_set``, ``start``,
 then ``step(n)`` or ``run_until(...)``. Every call answers a ``Message``.

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import math
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 
@@ -23,15 +22,8 @@ from mpi_ros.mpi.axes.axis import Axis
 from mpi_ros.mpi.axes.bank import AxisBank
 from mpi_ros.mpi.axes.scratch import Scratch
 from mpi_ros.mpi.axes.status import (
-    AT_TARGET,
-    AT_VELOCITY,
     BITS,
-    DONE,
     EVENT_BITS,
-    IN_COARSE,
-    IN_FINE,
-    SETTLED,
-    TC,
     StretchStatus,
     compute,
     rising_edges,
@@ -55,11 +47,12 @@ from mpi_ros.mpi.base.params import (
     check_position,
     check_settling_reachable,
 )
-from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionFeedback, MotionSnapshot
+from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionFeedback
 from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
-from mpi_ros.mpi.base.wrap import wrap_position, wrap_positions
+from mpi_ros.mpi.base.wrap import wrap_positions
 from mpi_ros.mpi.faults.monitor import FaultMonitor
 from mpi_ros.mpi.move_log import MoveLog
+from mpi_ros.mpi.snapshots import AxisTemplate, Snapshots, StatusTemplate
 from mpi_ros.mpi.supervisor.motion import HANDLE_INVALID, MotionSupervisor
 
 MAX_STRETCH = 4096  # samples computed at once
@@ -72,7 +65,6 @@ _STRETCH_ELEMENTS = 32 * MAX_STRETCH
 _EDGE_EVENTS = tuple(MPIEventType[name.upper()] for name in BITS[:EVENT_BITS])
 
 EventListener = Callable[[Event], None]
-Snapshots = tuple[dict[int, MotionSnapshot], list[AxisSnapshot]]  # what motion_snapshots() answers
 _Found = tuple[int, int, int, MPIEventType, str]  # an event found in a stretch: index, axis, rank, type, detail
 
 
@@ -473,19 +465,9 @@ class Controller:
         return self.faults.inject(number, fault, active)
 
     def frame_count(self, number: int) -> int:
-        """Frames in an axis' buffer: the rest of the move it runs and the ones queued. A
-        path's points beyond the buffer wait in the library (MPI 001, LOW_COUNT): the buffer
-        never shows more than it holds."""
+        """Frames in an axis' buffer (AxisTemplate.frame_count)."""
         axis = self.axes[number]
-        return self._frame_count(axis, axis.rel, self.supervisor(axis.owner))
-
-    def _frame_count(self, axis: Axis, rel: float, owner: MotionSupervisor | None) -> int:
-        count = 0
-        if axis.plan is not None:
-            count += axis.plan.frames_left(rel if math.isfinite(rel) else 0.0)
-        if owner is not None:
-            count += owner.frames_queued(axis.number)
-        return min(count, self.config.frame_buffer_size_of(axis.number))
+        return self._axis_template(axis, axis.owner).frame_count(axis.rel)
 
     def joint_values(self) -> tuple[list[float], list[float], list[float]]:
         """Every axis' actual position (user units), actual velocity and servo effort
@@ -500,61 +482,38 @@ class Controller:
     def axis_snapshots(self, numbers: Sequence[int] | None = None) -> list[AxisSnapshot]:
         """mpiAxisStatus of several axes (every axis by default). Their values are read from
         the bank's arrays in one go: reading them axis by axis, value by value, cost more than
-        the rest of a snapshot (17 numpy reads an axis, about half of its time)."""
+        the rest of a snapshot."""
         bank = self.bank
         if numbers is None:
             numbers = range(len(self.axes))
             values, bits, owners = bank.values.T.tolist(), bank.bits.T.tolist(), bank.owner.tolist()
         else:
             index = list(numbers)
-            values = bank.values[:, index].T.tolist()
-            bits, owners = bank.bits[:, index].T.tolist(), bank.owner[index].tolist()
+            values, bits = bank.values[:, index].T.tolist(), bank.bits[:, index].T.tolist()
+            owners = bank.owner[index].tolist()
         axes = self.axes
-        return [self._axis_snapshot(axes[n], v, b, o) for n, v, b, o in zip(numbers, values, bits, owners, strict=True)]
+        return [self._axis_template(axes[n], o).at(self.sample, v, b)
+                for n, v, b, o in zip(numbers, values, bits, owners, strict=True)]
 
-    def motion_snapshots(self) -> tuple[dict[int, MotionSnapshot], list[AxisSnapshot]]:
+    def motion_snapshots(self) -> Snapshots:
         """Every supervisor's mpiMotionStatus, by number, and every axis' mpiAxisStatus, all
         from one read of the axes (the supervisors' snapshots hold the same axis snapshots)."""
-        axes = self.axis_snapshots()
-        return {ms.number: ms.snapshot(axes) for ms in self.supervisors}, axes
+        return self._snapshots_now(self.status_template())
 
-    def _axis_snapshot(self, axis: Axis, values: list[float], bits: list[bool], owner_number: int) -> AxisSnapshot:
-        """One axis' snapshot from its values (bank.VALUES order), status bits (status.BITS
-        order) and owner at the current sample."""
-        cmd_p, cmd_v, cmd_a, act_p, act_v, rel = values
-        owner = self._supervisors.get(owner_number)
-        plan, origin = axis.plan, axis.origin
-        feedforward = axis.feedforward_at(rel)
-        amp_enabled = axis.amp_enabled
-        return AxisSnapshot(
-            sample=self.sample,
-            number=axis.number,
-            state=owner.own_state if owner is not None else MPIState.IDLE,
-            command_position=wrap_position(cmd_p - origin),
-            actual_position=wrap_position(act_p - origin),
-            position_error=cmd_p - act_p,
-            # A velocity move has no target: NaN, rather than the end of its long frame.
-            target_position=math.nan if plan is not None and plan.is_velocity else axis.target_position,
-            origin=origin,
-            command_velocity=cmd_v,
-            actual_velocity=act_v,
-            command_acceleration=cmd_a,
-            done=bits[DONE],
-            at_target=bits[AT_TARGET],
-            in_fine_position=bits[IN_FINE],
-            in_coarse_position=bits[IN_COARSE],
-            settled=bits[SETTLED],
-            at_velocity=bits[AT_VELOCITY],
-            trajectory_complete=bits[TC],
-            amp_enabled=amp_enabled,
-            move_id=axis.move_id,
-            element_id=axis.element_id_at(rel),
-            frame_count=self._frame_count(axis, rel, owner),
-            supervisor=owner_number,
-            feedforward=feedforward,
-            faults=self.faults.names(axis.number),
-            servo_effort=axis.effort_of(cmd_p - act_p, cmd_v, act_v, cmd_a, feedforward) if amp_enabled else 0.0,
-        )
+    def _snapshots_now(self, template: StatusTemplate) -> Snapshots:
+        """The snapshots of ``template`` at the current sample, from the bank's values and bits."""
+        return template.at(self.sample, self.bank.values.T.tolist(), self.bank.bits.T.tolist())
+
+    def status_template(self) -> StatusTemplate:
+        """What the status of every axis and supervisor holds until the next discrete change
+        (snapshots.py)."""
+        return StatusTemplate(tuple(map(self._axis_template, self.axes, self.bank.owner.tolist())),
+                              tuple((ms, ms.status_template()) for ms in self.supervisors))
+
+    def _axis_template(self, axis: Axis, owner: int) -> AxisTemplate:
+        """Axis ``axis``' status template; ``owner``: the supervisor commanding it (-1: none)."""
+        return AxisTemplate.of(axis, owner, self._supervisors.get(owner),
+                               self.config.frame_buffer_size_of(axis.number), self.faults.names(axis.number))
 
     # -- gates and I/O -------------------------------------------------------------------
     def gate_set(self, gate: int, closed: bool) -> Outcome:
@@ -654,10 +613,10 @@ class Controller:
         their snapshots on the way."""
         longest = max(64, min(MAX_STRETCH, _STRETCH_ELEMENTS // len(self.axes)))
         while self.sample < end:
-            self._advance(min(end, self.sample + longest), taken)
+            template = self._advance(min(end, self.sample + longest), taken)
             # where the stretch stopped, after its transitions: as stepping there leaves it
             if self.sample in taken:
-                taken[self.sample] = self.motion_snapshots()
+                taken[self.sample] = self._snapshots_now(template if template is not None else self.status_template())
 
     def run_until(self, condition: Callable[[Controller], bool], max_samples: int, chunk: int = 1) -> bool:
         """Step ``chunk`` samples at a time until ``condition`` holds (True) or
@@ -673,7 +632,10 @@ class Controller:
         owner = self.supervisor(axis.owner)
         return owner.clock if owner is not None else None
 
-    def _advance(self, k1: int, taken: dict[int, Snapshots | None]) -> None:
+    def _advance(self, k1: int, taken: dict[int, Snapshots | None]) -> StatusTemplate | None:
+        """Step one stretch, to sample ``k1`` at most: up to its first transition or fault.
+        Answers the status template the snapshots inside it were taken from, if they were
+        and it still holds (the stretch stopped without a discrete change)."""
         k0 = self.sample
         self.bank.refresh(lambda row: self.axes[row].refresh(self._clock(self.axes[row])),
                           lambda row: self.axes[row].reanchor(self._clock(self.axes[row])))
@@ -690,7 +652,7 @@ class Controller:
         fault_at = self.faults.scan(stretch)
         if fault_at is not None and fault_at <= stop:
             stop = event_at = fault_at
-        self._status_events(stop, stretch, status, taken)
+        template = self._status_events(stop, stretch, status, taken)
         self._log(stop, stretch, supervisors)
         self._commit(stop, stretch, status)
         self.faults.commit(stop)
@@ -700,6 +662,8 @@ class Controller:
                 ms.transition(stop, stretch.samples)
             # after the supervisors' transitions of the same sample (a move done there is done)
             self.faults.transition(stop)
+            return None
+        return template
 
     def _log(self, stop: int, stretch: Stretch, supervisors: list[MotionSupervisor]) -> None:
         for ms in supervisors:
@@ -724,19 +688,34 @@ class Controller:
             self.axes[row].snap(t)
 
     def _status_events(self, stop: int, stretch: Stretch, status: StretchStatus,
-                       taken: dict[int, Snapshots | None]) -> None:
+                       taken: dict[int, Snapshots | None]) -> StatusTemplate | None:
         """Events for status bits that turn on in samples up to ``stop``, in sample order;
         between them, the snapshots ``taken`` wants at samples before ``stop`` (each after
-        the events of its own sample and before those of later ones, as stepping there)."""
+        the events of its own sample and before those of later ones, as stepping there).
+
+        One status template serves every snapshot of the stretch: nothing discrete happens
+        before the stretch's stop (a transition or a fault stops the stretch where it
+        happens), so the supervisors, plans, faults and queues of every sample before it are
+        those of its first. The values, status bits and profile times come from the
+        stretch's arrays, and the events latched by each sample are read as its snapshot is
+        taken. Answers that template (None: no snapshot was wanted)."""
         found = sorted(self._edge_events(stop, stretch, status), key=lambda e: e[:3])
         emitted = 0
-        for i in self._wanted_before(stop, stretch, taken):
-            while emitted < len(found) and found[emitted][0] <= i:
-                self._emit_found(found[emitted], stretch)
-                emitted += 1
-            taken[int(stretch.samples[i])] = self._snapshots_inside(i, stretch, status)
+        inside = self._wanted_before(stop, stretch, taken)
+        template = None
+        if inside:
+            template = self.status_template()
+            values = stretch.values[:, :, inside].transpose(2, 1, 0).tolist()
+            bits = status.bits[:, :, inside].transpose(2, 1, 0).tolist()
+            for i, v, b in zip(inside, values, bits, strict=True):
+                while emitted < len(found) and found[emitted][0] <= i:
+                    self._emit_found(found[emitted], stretch)
+                    emitted += 1
+                sample = int(stretch.samples[i])
+                taken[sample] = template.at(sample, v, b)
         for item in found[emitted:]:
             self._emit_found(item, stretch)
+        return template
 
     @staticmethod
     def _wanted_before(stop: int, stretch: Stretch, taken: dict[int, Snapshots | None]) -> list[int]:
@@ -745,21 +724,6 @@ class Controller:
             return []
         first = int(stretch.samples[0])  # the stretch's samples are consecutive
         return sorted(s - first for s, snaps in taken.items() if snaps is None and 0 <= s - first < stop)
-
-    def _snapshots_inside(self, i: int, stretch: Stretch, status: StretchStatus) -> Snapshots:
-        """:meth:`motion_snapshots` at stretch index ``i``, before the stretch's stop. Nothing
-        discrete happens before the stop (a transition or a fault stops the stretch where it
-        happens), so the supervisors, plans, faults and the events latched so far are those
-        of sample i, and the bank shows the values and status bits of sample i, which is all
-        that stepping there would have changed. The bank keeps them until _commit writes
-        the stop's over them (nothing between reads them)."""
-        self.bank.values[:] = stretch.values[:, :, i]
-        self.bank.bits[:] = status.bits[:, :, i]
-        current, self.sample = self.sample, int(stretch.samples[i])
-        try:
-            return self.motion_snapshots()
-        finally:
-            self.sample = current
 
     def _emit_found(self, item: _Found, stretch: Stretch) -> None:
         i, number, _, kind, detail = item

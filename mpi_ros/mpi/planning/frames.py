@@ -210,7 +210,7 @@ class AxisPlan:
         """Frames still in the buffer ``rel`` seconds of profile time into the plan."""
         if self.cam is not None:
             return self.frame_count
-        done = int(self.table.end.searchsorted(rel, side="right"))
+        done = bisect.bisect_right(self.table.ends, rel)
         return max(1, self.frame_count - done - (1 if self.hold is not None else 0))
 
     def points_left(self, rel: float | np.ndarray) -> int | np.ndarray:

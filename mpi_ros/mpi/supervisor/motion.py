@@ -50,6 +50,7 @@ from mpi_ros.mpi.supervisor.axis_list import AxisList
 from mpi_ros.mpi.supervisor.log import MotionLog
 from mpi_ros.mpi.supervisor.moves import Moves
 from mpi_ros.mpi.supervisor.state import SupervisorState
+from mpi_ros.mpi.supervisor.status import AxisSnapshots, MotionTemplate
 from mpi_ros.mpi.supervisor.stepping import Transitions
 
 OK = Message.MPIMessageOK
@@ -827,40 +828,37 @@ class MotionSupervisor:
         """mpiMotionStatus; ``axis_snapshots``: every axis' at this sample, when already taken
         (Controller.motion_snapshots), else its axes' are taken here."""
         mapped = self._axis_list.mapped
-        if axis_snapshots is None:
-            axes = tuple(self._host.axis_snapshots(mapped))
-        else:
-            axes = tuple(axis_snapshots[n] for n in mapped)
-        move = self._moves.current or self._moves.last_move
-        done = all(a.done for a in axes) if axes else True
-        return MotionSnapshot(
-            sample=self._host.sample,
-            number=self.number,
-            state=self._reported_state(),
-            axis_numbers=tuple(self._axis_list.mapped),
-            axes=axes,
-            done=done and self._state.own_state is not MPIState.MOVING,
-            at_target=all(a.at_target for a in axes) if axes else True,
-            settled=all(a.settled for a in axes) if axes else True,
-            move_id=move.id if move else 0,
-            element_id=self._moves.element_id(move),
-            feedrate=self._state.clock.feedrate(self._host.time),
-            last_action=self._state.last_action,
-            action_source=self._state.action_source.value,
-            moves_pending=len(self._moves.queue),
-            motion_type=move.type.name if move else "",
-            progress=self.progress(),
-            latched_events=tuple(self.latched.names()),
-        )
+        axes: AxisSnapshots = (dict(zip(mapped, self._host.axis_snapshots(mapped), strict=True))
+                               if axis_snapshots is None else axis_snapshots)
+        return self.status_template().at(self._host.sample, axes, lambda n: self._axis(n).rel, self.latched_events())
 
-    def _reported_state(self) -> MPIState:
-        """The state status reports: IDLE at the sample of a start given NO_HANDSHAKE or
-        NO_WAIT (MPI 001 remarks: "the state is reported as MPIStateIDLE until the controller
-        begins the profile execution"), the state otherwise."""
-        state = self.state
-        if self._state.unacknowledged == self._host.sample and state is MPIState.MOVING:
-            return MPIState.IDLE
-        return state
+    def latched_events(self) -> tuple[str, ...]:
+        """The names of the events latched now (what status shows)."""
+        return tuple(self.latched.names())
+
+    def status_template(self) -> MotionTemplate:
+        """What this supervisor's mpiMotionStatus holds until its next discrete change
+        (status.py): the snapshot of any sample up to then is built from it."""
+        moves, state = self._moves, self._state
+        move = moves.current or moves.last_move
+        element_axis, element_id = moves.element_of(move)
+        return MotionTemplate(
+            number=self.number,
+            state=self.state,
+            own_moving=state.own_state is MPIState.MOVING,
+            unacknowledged=state.unacknowledged,
+            axis_numbers=tuple(self._axis_list.mapped),
+            move_id=move.id if move else 0,
+            element_axis=element_axis,
+            element_id=element_id,
+            motion_type=move.type.name if move else "",
+            moves_pending=len(moves.queue),
+            last_action=state.last_action,
+            action_source=state.action_source.value,
+            progress=moves.progress_of(),
+            clock=state.clock,
+            rate=self._host.rate,
+        )
 
 
 

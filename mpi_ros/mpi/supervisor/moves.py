@@ -28,6 +28,7 @@ from mpi_ros.mpi.planning.frames import AxisPlan, Move
 from mpi_ros.mpi.supervisor.axis_list import AxisList
 from mpi_ros.mpi.supervisor.holds import HoldWait
 from mpi_ros.mpi.supervisor.state import SupervisorState
+from mpi_ros.mpi.supervisor.status import Progress
 
 OK = Message.MPIMessageOK
 
@@ -91,29 +92,38 @@ class Moves:
 
     def progress(self) -> float:
         """0..1 along the current move (profile time over its duration)."""
+        return self.progress_of().at(lambda n: self.axis(n).rel)
+
+    def progress_of(self) -> Progress:
+        """How :meth:`progress` follows the axes' profile times until the next change of
+        move or plan."""
         move = self.current
         if move is None:
-            return 1.0 if self.last_move is not None else 0.0
-        fractions = []
+            return Progress((1.0,) if self.last_move is not None else (), ())
+        fixed: list[float] = []
+        spans: list[tuple[int, float]] = []
         for plan in move.plans:
-            axis = self.axis(plan.axis)
-            if axis.plan is not plan:
-                fractions.append(0.0)
-            elif plan.is_velocity:
-                fractions.append(1.0 if plan.ramp_end <= 0.0 else min(1.0, max(0.0, axis.rel / plan.ramp_end)))
+            if self.axis(plan.axis).plan is not plan:
+                fixed.append(0.0)
             else:
-                fractions.append(1.0 if plan.duration <= 0.0 else min(1.0, max(0.0, axis.rel / plan.duration)))
-        return min(fractions) if fractions else 0.0
+                spans.append((plan.axis, plan.ramp_end if plan.is_velocity else plan.duration))
+        return Progress(tuple(fixed), tuple(spans))
 
     def element_id(self, move: Move | None) -> int:
         """The move's element id; a path's, of the point its first axis runs toward."""
+        axis, fixed = self.element_of(move)
+        return fixed if axis is None else axis.current_element_id
+
+    def element_of(self, move: Move | None) -> tuple[Axis | None, int]:
+        """Where :meth:`element_id` comes from until the next change of move or plan: the
+        axis whose path point gives it (None: none does) and the id otherwise."""
         if move is None:
-            return 0
+            return None, 0
         if move.stream is not None and move.plans:
             axis = self.axis(move.plans[0].axis)
             if axis.plan is move.plans[0]:
-                return axis.current_element_id
-        return move.element_id
+                return axis, 0
+        return None, move.element_id
 
     def shown_state(self) -> MPIState:
         """The most severe of the supervisor's own state and the states of the supervisors

@@ -102,7 +102,7 @@ def end_state(segments: Sequence[Segment], start: tuple[float, float, float]) ->
 class SegmentTable:
     """A profile as arrays, for evaluating many sample times at once."""
 
-    __slots__ = ("a", "count", "end", "j", "p", "start", "v")
+    __slots__ = ("a", "count", "end", "ends", "j", "p", "start", "v")
 
     def __init__(self, segments: Sequence[Row], t0: float = 0.0):
         # One array of every segment's fields in a row (np.fromiter: five np.array calls on
@@ -110,6 +110,7 @@ class SegmentTable:
         values = np.fromiter(_chain_iterables.from_iterable(segments), float, 5 * len(segments))
         d, self.p, self.v, self.a, self.j = values.reshape(-1, 5).T
         self.end = t0 + np.cumsum(d)
+        self.ends = self.end.tolist()  # for one time at a time (bisect: no numpy call for a scalar)
         self.start = self.end - d
         self.count = len(segments)
 

@@ -1,0 +1,86 @@
+"""Status snapshots: what the controller's status costs, at one sample and inside a stretch.
+
+Every axis runs a VELOCITY move (bench_controller's _controller and _velocity), in two-axis
+supervisors: 8 axes in 4 and 32 axes in 16. Per case, in microseconds a call:
+``step(20)`` (the stepping alone), ``motion_snapshots()`` (the live status of every
+supervisor and axis) and ``step_snapshots(20, 10 stops)`` (the same 20 samples, with the
+status of every second one: what publishing at 1 kHz from a 2 kHz controller in 10 ms
+batches asks).
+
+The machines are shared and noisy: each tree (this one and ``--baseline``, extracted with git
+archive) runs every case in a fresh process, the trees alternating ``--rounds`` times; a
+figure is the best CPU time (process_time) of its process, and the ratio compares the two
+trees' figures of one case.
+
+    python -P bench/bench_snapshots.py [--baseline main] [--rounds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run with -P: the sibling bench_controller
+from bench_controller import compared_trees, measure_in
+
+CASES = [(8, 4), (32, 16)]
+CALLS = ("step(20)", "motion_snapshots()", "step_snapshots(20, 10 stops)")
+BATCH, EVERY = 20, 2  # samples a call steps; a status every EVERY samples
+
+
+def _best(call: Callable[[], object], number: int, repeat: int = 7) -> float:
+    """The best CPU time of one call, in microseconds, over ``repeat`` runs of ``number``."""
+    best = float("inf")
+    for _ in range(repeat):
+        start = time.process_time()
+        for _ in range(number):
+            call()
+        best = min(best, (time.process_time() - start) / number)
+    return best * 1e6
+
+
+def measure(axes: int, supervisors: int) -> dict[str, float]:
+    """Each of CALLS' best CPU time, in a controller with ``axes`` axes in ``supervisors``
+    supervisors, every axis in a VELOCITY move."""
+    from bench_controller import _controller, _velocity
+
+    ctl = _controller(axes, supervisors)
+    _velocity(ctl)
+    number = max(20, 800 // axes)
+
+    def stops() -> range:
+        return range(ctl.sample + EVERY, ctl.sample + BATCH + 1, EVERY)
+
+    return {"step(20)": _best(lambda: ctl.step(BATCH), number),
+            "motion_snapshots()": _best(ctl.motion_snapshots, number),
+            "step_snapshots(20, 10 stops)": _best(lambda: ctl.step_snapshots(BATCH, stops()), number)}
+
+
+def main(baseline: str, rounds: int) -> list[str]:
+    rows = ["| axes / supervisors | call | this tree (us) | " + baseline + " (us) | this tree / " + baseline + " |",
+            "| --- | --- | --- | --- | --- |"]
+    with tempfile.TemporaryDirectory() as scratch:
+        trees = compared_trees(baseline, Path(scratch))
+        for case in CASES:
+            runs: dict[str, list[dict[str, float]]] = {name: [] for _, name in trees}
+            for _ in range(rounds):  # alternate, so both trees see the same load
+                for tree, name in trees:
+                    runs[name].append(measure_in(tree, case, "bench_snapshots"))
+            best = {name: {call: min(run[call] for run in found) for call in CALLS} for name, found in runs.items()}
+            for call in CALLS:
+                new = best["this tree"][call]
+                old = best[baseline][call] if baseline in best else float("nan")
+                rows.append(f"| {case[0]} / {case[1]} | {call} | {new:,.0f} | {old:,.0f} | {new / old:.2f} |")
+    return rows
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--baseline", default="main", help="commit to measure side by side ('none': only this tree)")
+    parser.add_argument("--rounds", type=int, default=3, help="processes of each case on each tree (best kept)")
+    options = parser.parse_args()
+    print("\n".join(main(options.baseline, options.rounds)))
