@@ -187,7 +187,7 @@ def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
                  ) -> tuple[list[float], list[float], list[float]]:
     """Every axis' (actual position, actual velocity, servo effort): what /joint_states
     carries (the effort: the simulated servo's, plant.servo_effort). ``snapshots``: every
-    axis' AxisSnapshot at the controller's sample, if they were taken (see snapshots.py)."""
+    axis' AxisSnapshot at the sample published, if they were taken (runner.AtSample)."""
     if snapshots is None:
         position, velocity, effort = ctl.joint_values()
     else:
