@@ -104,9 +104,10 @@ CASES = {case.name: case for case in (Case("32x100", 32, 100.0), Case("8x1000", 
 SUBSCRIBER_PROCESSES = 3  # --subscribers rclpy: the status topics are shared out among these
 
 
-def suite_yaml(case: Case, directory: Path) -> Path:
-    """config/default.yaml with ``case.axes`` axes in two-axis supervisors and its rates."""
-    raw = yaml.safe_load((REPO / "config" / "default.yaml").read_text(encoding="utf-8"))
+def suite_yaml(case: Case, directory: Path, tree: Path = REPO) -> Path:
+    """``tree``'s config/default.yaml (the settings that tree knows) with ``case.axes`` axes in
+    two-axis supervisors and its rates."""
+    raw = yaml.safe_load((tree / "config" / "default.yaml").read_text(encoding="utf-8"))
     raw["axes"]["count"] = case.axes
     raw["supervisors"] = [{"number": n, "axes": [2 * n, 2 * n + 1]} for n in range(case.supervisors)]
     raw["ros"].update(status_rate=case.status_rate, joint_states_rate=case.status_rate)
@@ -410,6 +411,13 @@ class Result:
     def worst(self) -> TopicFigures:
         return max(self.topics, key=lambda t: abs(t.error))
 
+    @property
+    def cpu_per_controller_second(self) -> float:
+        """The suite's CPU per second of controller time: what it takes of a core to do a
+        second's work, whether or not it kept real time (a suite starved by other load does
+        less work in the window, and its CPU share alone would flatter it)."""
+        return self.suite_cpu / self.real_time if self.real_time > 0 else math.nan
+
 
 def _mark(marks: str | None, what: str) -> None:
     if marks is None:
@@ -476,7 +484,7 @@ def run_case(case: Case, seconds: float, command: list[str] | None = None, marks
     import rclpy
 
     with tempfile.TemporaryDirectory(prefix="bench_suite_") as tmp:
-        config = suite_yaml(case, Path(tmp))
+        config = suite_yaml(case, Path(tmp), tree)
         argv = command or [sys.executable, "-P", "-m", "mpi_ros.cli", "run", "--time-scale", "1"]
         with open(Path(tmp) / "suite.log", "w") as log:
             suite = subprocess.Popen([*argv, "--config", str(config)], cwd=tmp, stdout=subprocess.DEVNULL,
@@ -706,7 +714,8 @@ def report(results: list[Result]) -> list[str]:
 def summary(results: list[Result]) -> list[str]:
     """Per case and tree: the median of the runs (the machine is shared: compare side by side)."""
     lines = ["| case | suite | runs | real time, median | worst topic, median | topics within 2 % in every run "
-             "| suite CPU, median (range) |", "| --- | --- | --- | --- | --- | --- | --- |"]
+             "| suite CPU, median (range) | suite CPU per controller second, median |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for case in dict.fromkeys(r.case for r in results):
         for tree in dict.fromkeys(r.tree for r in results):
             runs = [r for r in results if r.case == case and r.tree == tree]
@@ -718,7 +727,8 @@ def summary(results: list[Result]) -> list[str]:
                          f"{(statistics.median(r.real_time for r in runs) - 1) * 100:+.3f} % | "
                          f"{statistics.median(r.worst.error for r in runs) * 100:+.2f} % | "
                          f"{'yes' if within else 'no'} | "
-                         f"{statistics.median(cpu):.1f} % ({cpu[0]:.1f}-{cpu[-1]:.1f}) |")
+                         f"{statistics.median(cpu):.1f} % ({cpu[0]:.1f}-{cpu[-1]:.1f}) | "
+                         f"{statistics.median(r.cpu_per_controller_second for r in runs) * 100:.1f} % |")
     return lines
 
 

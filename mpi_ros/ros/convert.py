@@ -210,16 +210,18 @@ def default_joints(ctl, prefix: str = "") -> JointStates:
                                                                            strict=True)])
 
 
-def joint_state(ctl, epoch_ns: int | None = None, joints: JointStates | None = None) -> JointState:
+def joint_state(ctl, epoch_ns: int | None = None, joints: JointStates | None = None, sample: int | None = None,
+                snapshots: Mapping[int, AxisSnapshot] | None = None) -> JointState:
     """Every axis as a joint (``joints``: SuiteConfig.axis_joints() as JointStates; default:
     ``axis<k>`` in counts): actual position (m or rad; counts without a joint), actual velocity
     (per s) and the servo's control effort (per s^2: the acceleration the servo demands, see
-    plant.servo_effort)."""
+    plant.servo_effort). At the controller's sample, or at ``sample`` from every axis'
+    ``snapshots`` there (a status stepped past: runner.AtSample)."""
     joints = default_joints(ctl) if joints is None else joints
     msg = JointState()
-    msg.header.stamp = stamp(ctl.sample, ctl.rate, epoch_ns)
+    msg.header.stamp = stamp(ctl.sample if sample is None else sample, ctl.rate, epoch_ns)
     msg.name = list(joints.names)
-    msg.position, msg.velocity, msg.effort = joints.convert(*joint_values(ctl))
+    msg.position, msg.velocity, msg.effort = joints.convert(*joint_values(ctl, snapshots))
     return msg
 
 
