@@ -206,8 +206,13 @@ class ControllerRunner:
 
     def _loop(self) -> None:
         hold = self._hold()
-        fastest = min((max(p.every, hold if p.status else 0) for p in self._periodic), default=10**9) / self.ctl.rate
-        period = min(self.wake_period, fastest / max(self.time_scale or 1.0, 1e-9))
+        scale = max(self.time_scale or 1.0, 1e-9)
+        # it waits for the first stop due (a status: its sample + hold), but catches up in pieces
+        # of the fastest periodic's period: a piece of CATCH_UP waits would publish CATCH_UP x
+        # (hold / period) statuses a topic at once, more than a slow reliable reader's queue holds
+        fastest = min((p.every for p in self._periodic), default=10**9) / self.ctl.rate
+        period = min(self.wake_period, max(fastest, hold / self.ctl.rate) / scale)
+        piece = min(self.wake_period, fastest / scale)
         while self._running.is_set():
             try:
                 # Commands step the controller to their sample too (submit catches up), so
@@ -220,7 +225,7 @@ class ControllerRunner:
                         if self.running:
                             served = self._take_mailbox()
                             self._apply(served)
-                            self._advance_to(self._clock_target(self.due_sample(), period))
+                            self._advance_to(self._clock_target(self.due_sample(), piece))
                     finally:
                         self.lock.release()
                         for batch in served:
