@@ -109,9 +109,10 @@ def measure_in(source: Path, case: tuple | list, bench: str = "bench_controller"
 
 # -- the table ------------------------------------------------------------------------------
 def baseline_tree(revision: str, into: Path) -> Path | None:
-    """The package at ``revision`` (git archive), or None where there is no git history."""
+    """The package at ``revision`` and its config/ (git archive), or None where there is no
+    git history."""
     try:
-        archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros"],
+        archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros", "config"],
                                  check=True, capture_output=True).stdout
     except (OSError, subprocess.CalledProcessError):
         return None

@@ -1,8 +1,8 @@
 """Status reads: what the status topics take of the controller at each status sample.
 
 At every status sample the suite reads every supervisor's mpiMotionStatus and every axis'
-mpiAxisStatus (ros/snapshots.py), under the runner's lock, on the thread that steps the
-controller: at 100 Hz and 8 axes moving this was the largest piece of the suite's work
+mpiAxisStatus (once a sample, for every node: runner.add_status), under the runner's lock,
+on the thread that steps the controller: at 100 Hz and 8 axes moving this was the largest piece of the suite's work
 besides stepping (bench/RESULTS.md, "Status reads"). Timed here on the controller alone,
 every axis in a VELOCITY move (or back-to-back S-curves), reads alternating with 20-sample
 steps, side by side with the controller of a baseline commit (``--baseline``, extracted with

@@ -1,12 +1,16 @@
 """The whole suite under load, as a user sees it (issue 10).
 
-Two processes, so that every figure is the suite's and not the GIL of a shared probe:
+Separate processes, so that every figure is the suite's and not the GIL of a shared probe:
 - the suite: ``mpi-ros run --time-scale 1 --config <generated YAML>`` (this source tree);
-- this process, the probe: it starts a VELOCITY move on every supervisor through its
-  MotionStart action (mpi_ros.client.MotionClient, the public client), waits until every
-  axis is at its velocity, then counts the messages of every status topic, /joint_states
-  and /clock against the wall clock over a window (raw subscriptions: the probe reads the
-  stamp from the CDR bytes, it deserializes nothing).
+- this process: it starts a VELOCITY move on every supervisor through its MotionStart
+  action (mpi_ros.client.MotionClient, the public client) and waits until every axis is at
+  its velocity;
+- the subscribers, which count the messages of every status topic, /joint_states and
+  /clock against the wall clock over a window. By default (``--subscribers rclpy``, issue
+  35: "as a user sees it") three plain rclpy subscriber processes, each with a share of the
+  topics, the generated message types and rclpy's executor: every message deserialized,
+  its stamp read from its header. ``--subscribers raw``: the probe of earlier figures, in
+  this process, which takes the CDR bytes and deserializes nothing.
 
 Figures per case:
 - real time: controller time (the stamps of /mpi/ms0/status, ``epoch + sample / rate``)
@@ -20,10 +24,12 @@ Figures per case:
 - the suite's CPU: utime + stime of its process (/proc/<pid>/stat, every thread) over the
   window, as a share of one core (target for 32 axes: < 40 %), split into the Python
   threads and the DDS threads (by thread name in /proc/<pid>/task);
-- the probe's own CPU, to judge what it takes from the suite on a 2-core machine.
+- the subscribers' (or probe's) own CPU, to judge what they take from the suite on a
+  2-core machine.
 
 Cases: 32 axes in 16 two-axis supervisors with status and joint states at 100 Hz; 8 axes
-in 4 two-axis supervisors with status and joint states at 1 kHz.
+in 4 two-axis supervisors with status and joint states at 1 kHz, at the default sample
+rate (2 kHz) and at 4 kHz (``8x1000@4k``).
 
 The machines are shared and noisy, so each case also runs the suite of a baseline revision
 (``--baseline``, extracted with git archive), alternating with this tree, ``--rounds`` times;
@@ -34,6 +40,7 @@ by phase (its own CPU clock around every step, periodic callback and the publish
 leaves); ``--profile CASE`` runs it under cProfile (slower: ``--profile-time-scale``).
 
     python -P bench/bench_suite.py [--seconds 20] [--rounds 2] [--case 32x100] [--baseline REV|none]
+                                   [--subscribers rclpy|raw]
     python -P bench/bench_suite.py --phases 8x1000 [--seconds 20]
     python -P bench/bench_suite.py --profile 32x100 [--profile-time-scale 0.25]
 """
@@ -42,6 +49,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import math
 import os
 import random
@@ -84,21 +92,26 @@ class Case:
     name: str
     axes: int
     status_rate: float  # Hz: MotionStatus, AxisStatus and JointState
+    sample_rate: float = 2000.0  # Hz: the controller's
 
     @property
     def supervisors(self) -> int:
         return self.axes // 2
 
 
-CASES = {case.name: case for case in (Case("32x100", 32, 100.0), Case("8x1000", 8, 1000.0))}
+CASES = {case.name: case for case in (Case("32x100", 32, 100.0), Case("8x1000", 8, 1000.0),
+                                      Case("8x1000@4k", 8, 1000.0, 4000.0))}
+SUBSCRIBER_PROCESSES = 3  # --subscribers rclpy: the status topics are shared out among these
 
 
-def suite_yaml(case: Case, directory: Path) -> Path:
-    """config/default.yaml with ``case.axes`` axes in two-axis supervisors and its rates."""
-    raw = yaml.safe_load((REPO / "config" / "default.yaml").read_text(encoding="utf-8"))
+def suite_yaml(case: Case, directory: Path, tree: Path = REPO) -> Path:
+    """``tree``'s config/default.yaml (the settings that tree knows) with ``case.axes`` axes in
+    two-axis supervisors and its rates."""
+    raw = yaml.safe_load((tree / "config" / "default.yaml").read_text(encoding="utf-8"))
     raw["axes"]["count"] = case.axes
     raw["supervisors"] = [{"number": n, "axes": [2 * n, 2 * n + 1]} for n in range(case.supervisors)]
     raw["ros"].update(status_rate=case.status_rate, joint_states_rate=case.status_rate)
+    raw["controller"]["sample_rate"] = case.sample_rate
     path = directory / f"suite_{case.name}.yaml"
     path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
     return path
@@ -255,6 +268,85 @@ class Probe:
         self.node.destroy_node()
 
 
+class Subscribers:
+    """Plain rclpy subscriber processes, what a user's node is: each subscribes to its share
+    of the topics with the generated message types, and rclpy's executor deserializes every
+    message and calls back with it and its message info (the middleware's source and
+    reception timestamps); the stamp is read from the message. Each writes what it counted
+    to a file when told to stop (serve_subscribers)."""
+
+    def __init__(self, names: list[str], processes: int, directory: Path):
+        self.directory = directory
+        self.shares = [names[i::processes] for i in range(processes)]
+        self.procs = [subprocess.Popen([sys.executable, "-P", str(Path(__file__).resolve()), "--serve-subscribers",
+                                        str(directory / f"subscriber{i}"), "--", *share])
+                      for i, share in enumerate(self.shares)]
+
+    @property
+    def pids(self) -> list[int]:
+        return [proc.pid for proc in self.procs]
+
+    def wait_ready(self) -> None:
+        deadline = time.monotonic() + WAIT
+        while not all((self.directory / f"subscriber{i}.ready").exists() for i in range(len(self.procs))):
+            if time.monotonic() > deadline or any(proc.poll() is not None for proc in self.procs):
+                raise RuntimeError("the rclpy subscriber processes did not come up")
+            threading.Event().wait(0.05)
+
+    def close(self, topics: dict[str, Topic]) -> None:
+        """Stop them and put what each counted into ``topics``."""
+        for i in range(len(self.procs)):
+            (self.directory / f"subscriber{i}.stop").touch()
+        for i, proc in enumerate(self.procs):
+            try:
+                proc.wait(timeout=WAIT)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+                raise RuntimeError(f"subscriber process {i} did not stop") from None
+            counted = json.loads((self.directory / f"subscriber{i}.json").read_text(encoding="utf-8"))
+            for name, messages in counted.items():
+                topics[name].messages = [tuple(m) for m in messages]
+
+
+def serve_subscribers(out: str, names: list[str]) -> int:
+    """One subscriber process (Subscribers): an rclpy node spun by rclpy's executor, a
+    subscription per topic; <out>.ready once subscribed, counts until <out>.stop exists,
+    then writes {topic: [[sent, received, stamp], ...]} to <out>.json."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    rclpy.init()
+    node = Node(f"bench_suite_subscriber_{os.getpid()}")
+    counted: dict[str, list[tuple[int, int, int]]] = {name: [] for name in names}
+
+    def counter(name: str):
+        stamp_of = (lambda msg: msg.clock) if name == "/clock" else (lambda msg: msg.header.stamp)
+        messages = counted[name]
+
+        def on_message(msg, info) -> None:
+            stamp = stamp_of(msg)
+            messages.append((info["source_timestamp"], info["received_timestamp"],
+                             stamp.sec * 1_000_000_000 + stamp.nanosec))
+        return on_message
+
+    for name in names:  # deep queues, as the raw probe's (/clock is offered best effort)
+        reliability = ReliabilityPolicy.BEST_EFFORT if name == "/clock" else ReliabilityPolicy.RELIABLE
+        node.create_subscription(topic_type(name), name, counter(name), QoSProfile(depth=1000, reliability=reliability))
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    Path(f"{out}.ready").touch()
+    stop = Path(f"{out}.stop")
+    while not stop.exists():
+        executor.spin_once(timeout_sec=0.1)
+    Path(f"{out}.json").write_text(json.dumps(counted), encoding="utf-8")
+    node.destroy_node()
+    rclpy.shutdown()
+    return 0
+
+
 def case_topics(case: Case) -> dict[str, Topic]:
     """The topics a case counts: every status topic, /joint_states and /clock."""
     rates = ([(f"/mpi/ms{n}/status", case.status_rate) for n in range(case.supervisors)]
@@ -319,6 +411,13 @@ class Result:
     def worst(self) -> TopicFigures:
         return max(self.topics, key=lambda t: abs(t.error))
 
+    @property
+    def cpu_per_controller_second(self) -> float:
+        """The suite's CPU per second of controller time: what it takes of a core to do a
+        second's work, whether or not it kept real time (a suite starved by other load does
+        less work in the window, and its CPU share alone would flatter it)."""
+        return self.suite_cpu / self.real_time if self.real_time > 0 else math.nan
+
 
 def _mark(marks: str | None, what: str) -> None:
     if marks is None:
@@ -357,44 +456,58 @@ class _Window:
     load_after: str
 
 
-def _window(pid: int, seconds: float, marks: str | None) -> _Window:
+def _window(pid: int, seconds: float, marks: str | None, subscribers: list[int]) -> _Window:
+    """``subscribers``: the pids of the subscriber processes, whose CPU counts as the probe's."""
     load_before = load_average()
-    cpu0, threads0, probe0 = cpu_seconds(pid), thread_cpu(pid), time.process_time()
+
+    def probe_cpu() -> float:
+        return time.process_time() + sum(cpu_seconds(p) for p in subscribers)
+
+    cpu0, threads0, probe0 = cpu_seconds(pid), thread_cpu(pid), probe_cpu()
     _mark(marks, "start")
     start = time.time_ns()  # the middleware's timestamps are wall-clock (system) time
     threading.Event().wait(seconds)
     end = time.time_ns()
     _mark(marks, "end")
-    cpu1, threads1, probe1 = cpu_seconds(pid), thread_cpu(pid), time.process_time()
+    cpu1, threads1, probe1 = cpu_seconds(pid), thread_cpu(pid), probe_cpu()
     threads = Counter({name: threads1[name] - threads0.get(name, 0.0) for name in threads1})
     return _Window(start, end, cpu1 - cpu0, threads, probe1 - probe0, load_before, load_average())
 
 
 def run_case(case: Case, seconds: float, command: list[str] | None = None, marks: str | None = None,
-             tree: Path = REPO, label: str = "working tree") -> Result:
+             tree: Path = REPO, label: str = "working tree", subscribers: str = "rclpy") -> Result:
     """One run of ``case``; ``command`` starts the suite (default: mpi-ros run at time scale 1)
     from the source ``tree`` (the installed package supplies the generated interfaces);
-    ``marks``: create <marks>.start and <marks>.end when the window begins and ends (serve_phases)."""
+    ``marks``: create <marks>.start and <marks>.end when the window begins and ends (serve_phases);
+    ``subscribers``: who counts the topics, rclpy subscriber processes (Subscribers) or the
+    raw probe in this process (Probe)."""
     import rclpy
 
     with tempfile.TemporaryDirectory(prefix="bench_suite_") as tmp:
-        config = suite_yaml(case, Path(tmp))
+        config = suite_yaml(case, Path(tmp), tree)
         argv = command or [sys.executable, "-P", "-m", "mpi_ros.cli", "run", "--time-scale", "1"]
         with open(Path(tmp) / "suite.log", "w") as log:
             suite = subprocess.Popen([*argv, "--config", str(config)], cwd=tmp, stdout=subprocess.DEVNULL,
                                      stderr=log, env={**os.environ, "PYTHONPATH": str(tree)})
         context = rclpy.Context()
         rclpy.init(context=context)
-        probe = None
+        probe: Probe | None = None
+        readers: Subscribers | None = None
         topics = case_topics(case)
         try:
-            probe = Probe(context, [(topic_type(name), name, topic) for name, topic in topics.items()])
+            if subscribers == "rclpy":
+                readers = Subscribers(list(topics), SUBSCRIBER_PROCESSES, Path(tmp))
+                readers.wait_ready()
+            else:
+                probe = Probe(context, [(topic_type(name), name, topic) for name, topic in topics.items()])
             at_velocity = start_moves(context, case)
             threading.Event().wait(SETTLE)
-            window = _window(suite.pid, seconds, marks)
+            window = _window(suite.pid, seconds, marks, readers.pids if readers is not None else [])
         finally:
             if probe is not None:
                 probe.close()
+            if readers is not None:
+                readers.close(topics)
             context.try_shutdown()
             stopped = _stop(suite)
         if stopped is None and suite.returncode != 0:
@@ -462,8 +575,8 @@ class _Phases:
         """A periodic callback or change hook: itself, then the output it returns, each timed."""
         timed = self.timed(name, callback)
 
-        def wrapper(ctl):
-            output = timed(ctl)
+        def wrapper(*args):  # (controller) or, a status, (controller, at)
+            output = timed(*args)
             return None if output is None else self.timed(f"{name} (output)", output)
         return wrapper
 
@@ -499,6 +612,11 @@ def serve_phases(out: str, argv: list[str]) -> int:
         self, rate, phases.producer(f"periodic {named(callback)}", callback))
     ControllerRunner.on_change = lambda self, hook: on_change(self, phases.producer(f"change hook {named(hook)}", hook))
     Controller.step = phases.timed("Controller.step (the core)", Controller.step)
+    if hasattr(ControllerRunner, "add_status"):  # statuses stepped in stretches (issue 35)
+        add_status = ControllerRunner.add_status
+        ControllerRunner.add_status = lambda self, rate, callback, snapshots=True: add_status(
+            self, rate, phases.producer(f"status {named(callback)}", callback), snapshots)
+        Controller.step_snapshots = phases.timed("Controller.step_snapshots (the core)", Controller.step_snapshots)
 
     def clock_loop(self) -> None:
         clock_thread.append(time.pthread_getcpuclockid(threading.get_ident()))
@@ -524,7 +642,8 @@ def _window_watch(phases: _Phases, clock_thread: list[int], out: str) -> None:
     Path(f"{out}.phases.md").write_text("\n".join(table) + "\n", encoding="utf-8")
 
 
-def profile(case: Case, seconds: float, out: Path, time_scale: float, top: int = 25) -> None:
+def profile(case: Case, seconds: float, out: Path, time_scale: float, top: int = 25,
+            subscribers: str = "rclpy") -> None:
     """The case with the suite under cProfile (serve_profiled); prints each thread's top
     functions by own time and by cumulative time. ``time_scale`` < 1 gives the profiled
     suite the time the profiler takes (every status round does the same work, fewer of them
@@ -534,7 +653,7 @@ def profile(case: Case, seconds: float, out: Path, time_scale: float, top: int =
 
     command = [sys.executable, "-P", str(Path(__file__).resolve()), "--serve-profiled", str(out), "--",
                "--time-scale", f"{time_scale:g}"]
-    result = run_case(case, seconds, command)
+    result = run_case(case, seconds, command, subscribers=subscribers)
     print(f"Under cProfile, time scale {time_scale:g} (rates scale with it):")
     print("\n".join(report([result])))
     for name in ("clock", "executor"):
@@ -544,13 +663,13 @@ def profile(case: Case, seconds: float, out: Path, time_scale: float, top: int =
         stats.sort_stats("cumulative").print_stats(top)
 
 
-def phases(case: Case, seconds: float, out: Path) -> None:
+def phases(case: Case, seconds: float, out: Path, subscribers: str = "rclpy") -> None:
     """The case with the suite's clock thread timed by phase (serve_phases), in real time."""
     for stale in (".start", ".end", ".phases.md"):
         Path(f"{out}{stale}").unlink(missing_ok=True)
     command = [sys.executable, "-P", str(Path(__file__).resolve()), "--serve-phases", str(out), "--",
                "--time-scale", "1"]
-    result = run_case(case, seconds, command, marks=str(out))
+    result = run_case(case, seconds, command, marks=str(out), subscribers=subscribers)
     print("\n".join(report([result])))
     print()
     print(Path(f"{out}.phases.md").read_text(encoding="utf-8"))
@@ -569,7 +688,7 @@ def rows(result: Result) -> list[str]:
     case = result.case
     worst = result.worst
     lost = sum(t.lost for t in result.topics)
-    status = f"status and joint states at {case.status_rate:g} Hz"
+    status = f"status and joint states at {case.status_rate:g} Hz, sample rate {case.sample_rate / 1000:g} kHz"
     return [
         f"| {case.axes} axes, {case.supervisors} supervisors, {status}, every axis moving "
         f"({len(result.topics)} topics, {result.seconds:.1f} s; load {result.load_before} -> {result.load_after}) "
@@ -595,7 +714,8 @@ def report(results: list[Result]) -> list[str]:
 def summary(results: list[Result]) -> list[str]:
     """Per case and tree: the median of the runs (the machine is shared: compare side by side)."""
     lines = ["| case | suite | runs | real time, median | worst topic, median | topics within 2 % in every run "
-             "| suite CPU, median (range) |", "| --- | --- | --- | --- | --- | --- | --- |"]
+             "| suite CPU, median (range) | suite CPU per controller second, median |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for case in dict.fromkeys(r.case for r in results):
         for tree in dict.fromkeys(r.tree for r in results):
             runs = [r for r in results if r.case == case and r.tree == tree]
@@ -607,7 +727,8 @@ def summary(results: list[Result]) -> list[str]:
                          f"{(statistics.median(r.real_time for r in runs) - 1) * 100:+.3f} % | "
                          f"{statistics.median(r.worst.error for r in runs) * 100:+.2f} % | "
                          f"{'yes' if within else 'no'} | "
-                         f"{statistics.median(cpu):.1f} % ({cpu[0]:.1f}-{cpu[-1]:.1f}) |")
+                         f"{statistics.median(cpu):.1f} % ({cpu[0]:.1f}-{cpu[-1]:.1f}) | "
+                         f"{statistics.median(r.cpu_per_controller_second for r in runs) * 100:.1f} % |")
     return lines
 
 
@@ -616,6 +737,9 @@ def main() -> None:
     parser.add_argument("--case", action="append", choices=sorted(CASES), help="default: every case")
     parser.add_argument("--seconds", type=float, default=20.0, help="the measuring window (default 20)")
     parser.add_argument("--rounds", type=int, default=2, help="runs of each case and tree (default 2)")
+    parser.add_argument("--subscribers", choices=("rclpy", "raw"), default="rclpy",
+                        help=f"who counts the topics: {SUBSCRIBER_PROCESSES} plain rclpy subscriber processes "
+                             "(default: what a user's nodes are) or a raw probe in this process")
     parser.add_argument("--baseline", default=BASELINE,
                         help=f"also run the suite of this revision, alternating (default {BASELINE}; 'none': not)")
     parser.add_argument("--profile", choices=sorted(CASES), help="run this case with the suite under cProfile")
@@ -627,23 +751,29 @@ def main() -> None:
                         help="where the profiles go (<this>.<thread>.prof)")
     parser.add_argument("--serve-profiled", metavar="OUT", help=argparse.SUPPRESS)  # the profiled suite's process
     parser.add_argument("--serve-phases", metavar="OUT", help=argparse.SUPPRESS)  # the timed suite's process
+    parser.add_argument("--serve-subscribers", metavar="OUT", help=argparse.SUPPRESS)  # a subscriber process
     parser.add_argument("run_args", nargs="*", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.serve_profiled:
         sys.exit(serve_profiled(args.serve_profiled, args.run_args))
+    if args.serve_subscribers:
+        sys.exit(serve_subscribers(args.serve_subscribers, args.run_args))
     if args.serve_phases:
         sys.exit(serve_phases(args.serve_phases, args.run_args))
     if args.phases:
-        phases(CASES[args.phases], args.seconds, Path(args.profile_out))
+        phases(CASES[args.phases], args.seconds, Path(args.profile_out), args.subscribers)
         return
     if args.profile:
-        profile(CASES[args.profile], args.seconds, Path(args.profile_out), args.profile_time_scale)
+        profile(CASES[args.profile], args.seconds, Path(args.profile_out), args.profile_time_scale,
+                subscribers=args.subscribers)
         return
     with tempfile.TemporaryDirectory(prefix="bench_suite_baseline_") as tmp:
         trees = compared_trees(args.baseline, Path(tmp), "working tree")
-        results = [run_case(CASES[name], args.seconds, tree=tree, label=label)
+        results = [run_case(CASES[name], args.seconds, tree=tree, label=label, subscribers=args.subscribers)
                    for _ in range(args.rounds) for name in args.case or CASES for tree, label in trees]
-    print(f"`python -P bench/bench_suite.py --seconds {args.seconds:g} --rounds {args.rounds}` on "
+    cases = "".join(f" --case {name}" for name in args.case or ())
+    print(f"`python -P bench/bench_suite.py --seconds {args.seconds:g} --rounds {args.rounds}{cases} "
+          f"--subscribers {args.subscribers} --baseline {args.baseline}` on "
           f"{time.strftime('%Y-%m-%d')}, {os.cpu_count()} cores; the runs alternate between the trees.")
     print()
     print("\n".join(summary(results)))

@@ -11,6 +11,14 @@ caller. Change hooks (``on_change``) run under the lock after every step batch a
 command, so whoever follows the controller (the goals of the nodes) is told without
 a thread of its own waiting on it.
 
+Status publications (``add_status``) read only the controller's snapshots at their own
+sample, so they need not stop the stepping: the runner steps through several of their
+samples in one stretch (Controller.step_snapshots, which answers the snapshots of each, equal
+to stepping there) and calls each callback with its sample's snapshots, in sample order. How
+long a status may wait for the stretch that carries it is ``publish_period`` (the setting
+ros.publish_period; 0: each ends a stretch as it falls due). Periodic work that reads the live
+controller (``add_periodic``: feedback, diagnostics) still ends a stretch at its stop.
+
 Modes: ``time_scale`` 1 = real time, >1 faster, 0 = as fast as possible, None = manual
 (nothing runs by itself; ``step`` advances, as tests and replay do).
 """
@@ -27,7 +35,7 @@ from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 
 from mpi_ros.mpi.base.events import Event
-from mpi_ros.mpi.control import Controller
+from mpi_ros.mpi.control import Controller, Snapshots
 
 from .commands import Command, Reply, apply
 
@@ -56,11 +64,32 @@ class _Batch:
         return self.answers
 
 
+@dataclass(frozen=True, slots=True)
+class AtSample:
+    """What a status callback reads: its sample and, if it asked for them, every
+    supervisor's and axis' snapshot there (Controller.motion_snapshots at that sample)."""
+
+    sample: int
+    snapshots: Snapshots | None
+
+    def taken(self) -> Snapshots:
+        """The snapshots (for a callback added with ``snapshots``: always there)."""
+        if self.snapshots is None:
+            raise ValueError(f"the status at sample {self.sample} was collected without its snapshots")
+        return self.snapshots
+
+
+LiveCallback = Callable[[Controller], Output | None]
+StatusCallback = Callable[[Controller, AtSample], Output | None]
+
+
 @dataclass(slots=True)
 class _Periodic:
     every: int
-    callback: Callable[[Controller], Output | None]
     next_sample: int
+    live: LiveCallback | None = None  # reads the controller now: its stop ends a stretch
+    status: StatusCallback | None = None  # reads its sample's snapshots: may wait in a stretch
+    snapshots: bool = False  # the status callback reads the snapshots (not only the sample)
 
 
 @dataclass(order=True, slots=True)
@@ -75,10 +104,14 @@ class _Scheduled:
 
 
 class ControllerRunner:
-    def __init__(self, controller: Controller, time_scale: float | None = 1.0, wake_period: float = 0.01):
+    def __init__(self, controller: Controller, time_scale: float | None = 1.0, wake_period: float = 0.01,
+                 publish_period: float = 0.0):
         if time_scale is not None and time_scale < 0:
             raise ValueError("time_scale must be >= 0 (0: as fast as possible) or None (manual)")
+        if not publish_period >= 0:
+            raise ValueError(f"publish_period must be >= 0 s, got {publish_period!r}")
         self.ctl = controller
+        self.publish_period = publish_period
         self.time_scale = time_scale
         self.wake_period = wake_period
         self.lock = threading.RLock()
@@ -100,13 +133,38 @@ class ControllerRunner:
         controller.listeners.append(self._on_event)
 
     # -- configuration ---------------------------------------------------------------
-    def add_periodic(self, rate_hz: float, callback: Callable[[Controller], Output | None]) -> None:
+    def add_periodic(self, rate_hz: float, callback: LiveCallback) -> None:
         """Call ``callback(controller)`` (under the lock) every 1/rate_hz of controller time,
         at exact samples; what it returns is run after the lock is released."""
-        every = max(1, round(self.ctl.rate / rate_hz))
+        self._add(rate_hz, _Periodic(0, 0, live=callback))
+
+    def add_status(self, rate_hz: float, callback: StatusCallback, snapshots: bool = True) -> None:
+        """Call ``callback(controller, at)`` (under the lock) every 1/rate_hz of controller
+        time, for exact samples: ``at`` holds the sample and (``snapshots``) the snapshots
+        there. The controller may be past that sample by then (at most ``publish_period``):
+        the callback reads ``at``, and of the controller only what no step changes (its
+        rate, its axes' list). What it returns is run after the lock is released."""
+        self._add(rate_hz, _Periodic(0, 0, status=callback, snapshots=snapshots))
+
+    def _add(self, rate_hz: float, periodic: _Periodic) -> None:
+        periodic.every = max(1, round(self.ctl.rate / rate_hz))
         with self.lock:
-            start = (self.ctl.sample // every + 1) * every
-            self._periodic.append(_Periodic(every, callback, start))
+            periodic.next_sample = (self.ctl.sample // periodic.every + 1) * periodic.every
+            self._periodic.append(periodic)
+
+    def _hold(self) -> int:
+        """Samples a status may wait past its sample: publish_period, rounded down to a
+        whole number of the fastest status' periods (a wait that gathers no further status
+        would only delay it)."""
+        everies = [p.every for p in self._periodic if p.status is not None]
+        if not everies:
+            return 0
+        fastest = min(everies)
+        return int(self.publish_period * self.ctl.rate + 1e-9) // fastest * fastest
+
+    def _deadline(self, periodic: _Periodic, hold: int) -> int:
+        """The sample by which ``periodic``'s next stop must have been stepped to."""
+        return periodic.next_sample + (hold if periodic.status is not None else 0)
 
     def on_command(self, listener: Callable[[int, Command, Reply], None]) -> None:
         """``listener(sample, command, reply)`` for every command applied (under the lock)."""
@@ -147,8 +205,14 @@ class ControllerRunner:
         return self._thread is not None and self._running.is_set()
 
     def _loop(self) -> None:
+        hold = self._hold()
+        scale = max(self.time_scale or 1.0, 1e-9)
+        # it waits for the first stop due (a status: its sample + hold), but catches up in pieces
+        # of the fastest periodic's period: a piece of CATCH_UP waits would publish CATCH_UP x
+        # (hold / period) statuses a topic at once, more than a slow reliable reader's queue holds
         fastest = min((p.every for p in self._periodic), default=10**9) / self.ctl.rate
-        period = min(self.wake_period, fastest / max(self.time_scale or 1.0, 1e-9))
+        period = min(self.wake_period, max(fastest, hold / self.ctl.rate) / scale)
+        piece = min(self.wake_period, fastest / scale)
         while self._running.is_set():
             try:
                 # Commands step the controller to their sample too (submit catches up), so
@@ -161,7 +225,7 @@ class ControllerRunner:
                         if self.running:
                             served = self._take_mailbox()
                             self._apply(served)
-                            self._advance_to(self._clock_target(self.due_sample(), period))
+                            self._advance_to(self._clock_target(self.due_sample(), piece))
                     finally:
                         self.lock.release()
                         for batch in served:
@@ -199,7 +263,8 @@ class ControllerRunner:
         scale = self.time_scale
         if not self._periodic or self._anchor_wall is None or not scale:  # manual or as fast as possible
             return period
-        ahead = min(p.next_sample for p in self._periodic) - self._anchor_sample
+        hold = self._hold()
+        ahead = min(self._deadline(p, hold) for p in self._periodic) - self._anchor_sample
         due_at = self._anchor_wall + ahead / (scale * self.ctl.rate)
         # a little late rather than early: early, the sample due would still be the one before
         return min(period, max(0.0, due_at - time.monotonic() + _WAKE_MARGIN))
@@ -232,21 +297,54 @@ class ControllerRunner:
         ctl = self.ctl
         if ctl.sample >= target:
             return
+        hold = self._hold()
         while ctl.sample < target:
             self._apply_scheduled()
-            stop = min([target] + [p.next_sample for p in self._periodic]
-                       + [entry.sample for entry in self._scheduled[:1]])
-            if stop > ctl.sample:
-                ctl.step(stop - ctl.sample)
-            for periodic in self._periodic:
-                if periodic.next_sample <= ctl.sample:
-                    behind = (ctl.sample - periodic.next_sample) // periodic.every + 1
-                    periodic.next_sample += periodic.every * max(1, behind)
-                    output = periodic.callback(ctl)
-                    if output is not None:
-                        self._outputs.append(output)
+            self._skip_passed()
+            end = min([target] + [self._deadline(p, hold) for p in self._periodic]
+                      + [entry.sample for entry in self._scheduled[:1]])
+            stops = self._stops(end)
+            wanted = [sample for sample, due in stops.items() if any(p.snapshots for p in due)]
+            taken = ctl.step_snapshots(end - ctl.sample, wanted) if end > ctl.sample else {}
+            for sample, due in stops.items():
+                self._call(due, sample, taken.get(sample))
         self._apply_scheduled()
         self._changed()
+
+    def _stops(self, end: int) -> dict[int, list[_Periodic]]:
+        """The periodic stops up to ``end``, in sample order, each with its due callbacks in
+        the order they were added; every one's next stop moved past ``end``."""
+        stops: dict[int, list[_Periodic]] = {}
+        for periodic in self._periodic:
+            while periodic.next_sample <= end:
+                stops.setdefault(periodic.next_sample, []).append(periodic)
+                periodic.next_sample += periodic.every
+        order = {id(p): i for i, p in enumerate(self._periodic)}
+        return {sample: sorted(stops[sample], key=lambda p: order[id(p)]) for sample in sorted(stops)}
+
+    def _skip_passed(self) -> None:
+        """Periodic stops the controller has passed without the runner (stepped directly):
+        each such callback runs once, now, and its next stop is the first one ahead."""
+        ctl = self.ctl
+        passed = [p for p in self._periodic if p.next_sample <= ctl.sample]
+        if not passed:
+            return
+        for periodic in passed:
+            periodic.next_sample += periodic.every * ((ctl.sample - periodic.next_sample) // periodic.every + 1)
+        wanted = any(p.snapshots for p in passed)
+        self._call(passed, ctl.sample, ctl.motion_snapshots() if wanted else None)
+
+    def _call(self, due: list[_Periodic], sample: int, snapshots: Snapshots | None) -> None:
+        """Lock held: the callbacks due at ``sample``; their outputs queued."""
+        at = AtSample(sample, snapshots)
+        for periodic in due:
+            if periodic.status is not None:
+                output = periodic.status(self.ctl, at)
+            else:
+                assert periodic.live is not None and sample == self.ctl.sample  # live stops end stretches
+                output = periodic.live(self.ctl)
+            if output is not None:
+                self._outputs.append(output)
 
     # -- commands at a given sample ----------------------------------------------------------
     def schedule(self, sample: int, command: Command, tag: Hashable = None,

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import re
 import threading
+
+import pytest
 
 from mpi_ros import config
 from mpi_ros.commands import Command
@@ -177,3 +180,79 @@ def test_the_clock_thread_steps_to_the_last_periodic_stop_due_and_catches_up_in_
     fast = ControllerRunner(config.load().build_controller(), time_scale=0.0)
     fast.add_periodic(100.0, lambda ctl: None)
     assert fast._clock_target(2047, period) == 2047
+
+
+# -- statuses stepped in stretches (runner.add_status, ros.publish_period; issue 35) ------------------
+def _status_run(publish_period: float, script: list[tuple[str, int]]):
+    """Steps a manual runner through ``script`` (("step", n) or ("e_stop", supervisor)) with
+    a 1 kHz status (every 2 samples at 2 kHz) and a 100 Hz live periodic; what each saw."""
+    runner = ControllerRunner(config.load().build_controller(), time_scale=None, publish_period=publish_period)
+    statuses, live, stretches = [], [], []
+    step_snapshots = runner.ctl.step_snapshots
+    runner.ctl.step_snapshots = lambda samples, at: stretches.append(samples) or step_snapshots(samples, at)
+
+    def status(ctl, at):
+        motions, axes = at.taken()
+        statuses.append((at.sample, ctl.sample, motions, axes))
+
+    runner.add_status(1000.0, status)
+    runner.add_periodic(100.0, lambda ctl: live.append(ctl.sample))
+    runner.submit(Command("motion_start", 0, request=GOAL))
+    answers = []
+    for what, value in script:
+        if what == "step":
+            runner.step(value)
+        else:
+            answers.append(runner.submit(Command("action", value, request={"action": "E_STOP"})))
+    return statuses, live, stretches, answers
+
+
+SCRIPT = [("step", 37), ("step", 3), ("e_stop", 0), ("step", 1), ("step", 150), ("e_stop", 1), ("step", 61)]
+
+
+def test_statuses_in_stretches_equal_the_statuses_stepped_one_by_one():
+    batched, live, stretches, answers = _status_run(0.005, SCRIPT)
+    single, single_live, single_stretches, single_answers = _status_run(0.0, SCRIPT)
+    # every status at its own sample, with what stepping there gives (Controller.step_snapshots)
+    assert [s[0] for s in batched] == list(range(2, 253, 2))
+    assert [(s[0], s[2], s[3]) for s in batched] == [(s[0], s[2], s[3]) for s in single]
+    # the commands took effect at the same samples (the sample after the controller's)
+    assert [sample for _, sample in answers] == [sample for _, sample in single_answers] == [41, 192]
+    # live periodic work still stops the stepping at its sample
+    assert live == single_live == list(range(20, 253, 20))
+    # and fewer stretches were stepped (each costs about the same whatever its length)
+    assert len(stretches) < len(single_stretches) / 3
+
+
+def test_a_status_waits_at_most_the_publish_period_in_manual_stepping():
+    batched, _, _, _ = _status_run(0.005, SCRIPT)  # 10 samples at 2 kHz
+    waits = [controller - sample for sample, controller, _, _ in batched]
+    assert max(waits) == 10
+    assert min(waits) == 0
+    one_by_one, _, _, _ = _status_run(0.0, SCRIPT)
+    assert {controller - sample for sample, controller, _, _ in one_by_one} == {0}
+
+
+def test_an_e_stop_between_two_status_stops_shows_from_its_sample_on():
+    # E_STOP at sample 41 (after step 40, between the statuses of 40 and 42): MPI 000,
+    # mpiMotionAction, "E_STOP" decelerates the motion to the ERROR state
+    batched, _, _, answers = _status_run(0.005, SCRIPT)
+    states = {sample: motions[0].state.name for sample, _, motions, _ in batched}
+    assert answers[0][1] == 41
+    assert states[40] == "MOVING"
+    assert states[42] in ("STOPPING_ERROR", "ERROR")
+
+
+def test_a_status_period_shorter_than_its_rate_waits_for_nothing():
+    # 100 Hz status (20 samples) with a 5 ms period (10 samples): no second status would join
+    # the first's stretch, so it is not held back at all
+    runner = ControllerRunner(config.load().build_controller(), time_scale=None, publish_period=0.005)
+    seen = []
+    runner.add_status(100.0, lambda ctl, at: seen.append((at.sample, ctl.sample)))
+    runner.step(100)
+    assert seen == [(s, s) for s in range(20, 101, 20)]
+
+
+def test_a_negative_publish_period_is_refused():
+    with pytest.raises(ValueError, match=re.escape("publish_period must be >= 0 s, got -0.001")):
+        ControllerRunner(config.load().build_controller(), time_scale=None, publish_period=-0.001)

@@ -32,7 +32,7 @@ from ..commands import Reply
 from ..config import SuiteConfig
 from ..joints import JointStates
 from ..ros import convert
-from ..runner import ControllerRunner, Output
+from ..runner import AtSample, ControllerRunner, Output
 from .writer import BagWriter, TopicQos
 
 COMMANDS_TOPIC = gn.COMMANDS.name()  # with the default namespace; in general commands_topic(namespace)
@@ -92,8 +92,9 @@ class Recorder:
         })
         self.writer.write(configuration_topic(ns), convert.configuration(config, self.rate, ctl.sample, self.epoch),
                           self.log_time(ctl.sample))
-        runner.add_periodic(config.ros.status_rate, self._collect_status)
-        runner.add_periodic(config.ros.joint_states_rate, self._collect_joints)
+        # statuses: from the snapshots of their sample, which the runner may step past (runner.add_status)
+        runner.add_status(config.ros.status_rate, self._collect_status)
+        runner.add_status(config.ros.joint_states_rate, self._collect_joints)
         runner.on_event(self._on_event)
         runner.on_command(self._on_command)
 
@@ -104,9 +105,9 @@ class Recorder:
         return convert.stamp_ns(sample, self.rate, self.epoch)
 
     # -- hooks (periodic collection under the runner lock, writing after it) --------------------------
-    def _collect_status(self, ctl: Controller) -> Output:
-        t = self.log_time(ctl.sample)
-        motions, axes = ctl.motion_snapshots()  # every axis read once for both kinds of topic
+    def _collect_status(self, ctl: Controller, at: AtSample) -> Output:
+        t = self.log_time(at.sample)
+        motions, axes = at.taken()  # every axis read once for both kinds of topic
         messages: list[tuple[str, object]] = [
             (gn.MOTION_STATUS.name(self.ns, number), convert.motion_status(snap, ctl.rate, self.epoch, self.namespace))
             for number, snap in motions.items()
@@ -122,9 +123,9 @@ class Recorder:
 
         return write
 
-    def _collect_joints(self, ctl):
-        msg = convert.joint_state(ctl, self.epoch, self.joints)
-        t = self.log_time(ctl.sample)
+    def _collect_joints(self, ctl: Controller, at: AtSample) -> Output:
+        msg = convert.joint_state(ctl, self.epoch, self.joints, at.sample, {s.number: s for s in at.taken()[1]})
+        t = self.log_time(at.sample)
         return lambda: self.writer.write(self.joint_states_topic, msg, t)
 
     def _on_event(self, event) -> None:

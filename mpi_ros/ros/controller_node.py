@@ -76,8 +76,8 @@ from ..commands import Command, Operation, Reply, io_space
 from ..config import RosSettings
 from ..joints import AxisJoint, JointStates
 from ..qos import profile
-from ..runner import ControllerRunner
-from . import convert, snapshots, wire
+from ..runner import AtSample, ControllerRunner
+from . import convert, wire
 
 _LEVELS = {
     MPIState.ERROR: DiagnosticStatus.ERROR,
@@ -101,7 +101,6 @@ class ControllerNode(Node):
         super().__init__("controller", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.settings = settings
-        self._snapshots = snapshots.shared(runner)
         # every axis' joint; /joint_states names those of the valid Axis objects (_joints_of)
         self._axis_joints = list(joints) if joints is not None else [
             AxisJoint(a.number, name, None) for a, name in zip(
@@ -157,13 +156,13 @@ class ControllerNode(Node):
         runner.on_command(self._on_command)
         runner.on_change(self._collect_commands)
         runner.on_change(self._collect_axes)
-        runner.add_periodic(settings.status_rate, self._collect_axis_status)
-        runner.add_periodic(settings.joint_states_rate, self._collect_joints)
+        runner.add_status(settings.status_rate, self._collect_axis_status)
+        runner.add_status(settings.joint_states_rate, self._collect_joints)
         self.diagnostic_providers: list = []  # add_diagnostic(): more statuses for /diagnostics
         runner.add_periodic(settings.diagnostics_rate, self._collect_diagnostics)
         if settings.clock:
             self._pub_clock = self._publisher(Clock, gn.CLOCK, gn.CLOCK.name())
-            runner.add_periodic(settings.clock_rate, self._collect_clock)
+            runner.add_status(settings.clock_rate, self._collect_clock, snapshots=False)
         runner.on_event(lambda event: convert.publish(
             self, self._pub_events, convert.motion_event(event, runner.ctl.rate, self.epoch_ns, settings.namespace)))
 
@@ -273,28 +272,29 @@ class ControllerNode(Node):
         return publish
 
     # -- periodic topics ------------------------------------------------------------------
-    def _collect_axis_status(self, ctl):
+    # Status topics: the runner calls these with the snapshots of their sample (runner.add_status),
+    # taken once for every node, so the axis topics and the supervisors' statuses show the same
+    # reading of an axis; the controller may be past that sample: they read ``at``.
+    def _collect_axis_status(self, ctl, at: AtSample):
         # packed straight into CDR and published raw where the interfaces allow (wire.py: the
-        # same bytes, a third of the work); the snapshots are the supervisors' (snapshots.py)
+        # same bytes, a third of the work)
         encode = wire.axis_status if wire.AVAILABLE else convert.axis_status
         publishers = self._pub_axis_status
-        sends = [(publishers[a.number], encode(self._snapshots.axis(ctl, a.number), ctl.rate, self.epoch_ns,
-                                               self.settings.namespace))
-                 for a in ctl.axes if a.valid and a.number in publishers]
+        sends = [(publishers[snap.number], encode(snap, ctl.rate, self.epoch_ns, self.settings.namespace))
+                 for snap in at.taken()[1] if ctl.axes[snap.number].valid and snap.number in publishers]
         return lambda: convert.publish_all(self, sends)
 
-    def _collect_joints(self, ctl):
-        joints, rows = self._joints_of(ctl)
-        # from the axis topics' snapshots when they were taken now
-        values = convert.joint_values(ctl, self._snapshots.taken_axes(ctl) if wire.AVAILABLE else None)
+    def _collect_joints(self, ctl, at: AtSample):
+        joints, rows = self._joints_of(ctl)  # the valid axes change by commands only, never within a stretch
+        values = convert.joint_values(ctl, {snap.number: snap for snap in at.taken()[1]})
         if len(rows) < len(self._axis_joints):
             values = ([values[0][r] for r in rows], [values[1][r] for r in rows], [values[2][r] for r in rows])
         position, velocity, effort = joints.convert(*values)
         if wire.AVAILABLE:  # packed straight into CDR
-            msg = wire.joint_state(ctl.sample, ctl.rate, self.epoch_ns, joints.names, position, velocity, effort)
+            msg = wire.joint_state(at.sample, ctl.rate, self.epoch_ns, joints.names, position, velocity, effort)
         else:
             msg = JointState(name=list(joints.names), position=position, velocity=velocity, effort=effort)
-            msg.header.stamp = convert.stamp(ctl.sample, ctl.rate, self.epoch_ns)
+            msg.header.stamp = convert.stamp(at.sample, ctl.rate, self.epoch_ns)
         return lambda: convert.publish(self, self._pub_joints, msg)
 
     def _joints_of(self, ctl) -> tuple[JointStates, tuple[int, ...]]:
@@ -306,8 +306,8 @@ class ControllerNode(Node):
             self._joint_rows = rows
         return self.joints, rows
 
-    def _collect_clock(self, ctl):
-        msg = Clock(clock=convert.stamp(ctl.sample, ctl.rate, self.epoch_ns))
+    def _collect_clock(self, ctl, at: AtSample):
+        msg = Clock(clock=convert.stamp(at.sample, ctl.rate, self.epoch_ns))
         return lambda: convert.publish(self, self._pub_clock, msg)
 
     def _collect_diagnostics(self, ctl):

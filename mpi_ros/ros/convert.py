@@ -187,7 +187,7 @@ def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
                  ) -> tuple[list[float], list[float], list[float]]:
     """Every axis' (actual position, actual velocity, servo effort): what /joint_states
     carries (the effort: the simulated servo's, plant.servo_effort). ``snapshots``: every
-    axis' AxisSnapshot at the controller's sample, if they were taken (see snapshots.py)."""
+    axis' AxisSnapshot at the sample published, if they were taken (runner.AtSample)."""
     if snapshots is None:
         position, velocity, effort = ctl.joint_values()
     else:
@@ -210,16 +210,18 @@ def default_joints(ctl, prefix: str = "") -> JointStates:
                                                                            strict=True)])
 
 
-def joint_state(ctl, epoch_ns: int | None = None, joints: JointStates | None = None) -> JointState:
+def joint_state(ctl, epoch_ns: int | None = None, joints: JointStates | None = None, sample: int | None = None,
+                snapshots: Mapping[int, AxisSnapshot] | None = None) -> JointState:
     """Every axis as a joint (``joints``: SuiteConfig.axis_joints() as JointStates; default:
     ``axis<k>`` in counts): actual position (m or rad; counts without a joint), actual velocity
     (per s) and the servo's control effort (per s^2: the acceleration the servo demands, see
-    plant.servo_effort)."""
+    plant.servo_effort). At the controller's sample, or at ``sample`` from every axis'
+    ``snapshots`` there (a status stepped past: runner.AtSample)."""
     joints = default_joints(ctl) if joints is None else joints
     msg = JointState()
-    msg.header.stamp = stamp(ctl.sample, ctl.rate, epoch_ns)
+    msg.header.stamp = stamp(ctl.sample if sample is None else sample, ctl.rate, epoch_ns)
     msg.name = list(joints.names)
-    msg.position, msg.velocity, msg.effort = joints.convert(*joint_values(ctl))
+    msg.position, msg.velocity, msg.effort = joints.convert(*joint_values(ctl, snapshots))
     return msg
 
 

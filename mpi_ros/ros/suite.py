@@ -54,7 +54,7 @@ class Suite:
                                   else robot_description)
         self.controller = config.build_controller()
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)
-        self.runner = ControllerRunner(self.controller, time_scale)
+        self.runner = ControllerRunner(self.controller, time_scale, publish_period=config.ros.publish_period)
         self.controller_node = ControllerNode(self.runner, config.ros, config.axis_joints(), self.robot_description,
                                               flash=config.flash, context=context)
         self.goal_loop: GoalLoop | GoalRelay = (

@@ -63,9 +63,9 @@ from ..commands import Command, Operation, Reply
 from ..config import RosSettings
 from ..joints import AxisJoint
 from ..qos import profile
-from ..runner import ControllerRunner, Output
+from ..runner import AtSample, ControllerRunner, Output
 from ..trajectory_feed import TrajectoryFeed
-from . import convert, snapshots, wire
+from . import convert, wire
 from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
 from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
@@ -96,7 +96,6 @@ class SupervisorNode(Node):
         self._shutting_down = False
         self._service_group = ReentrantCallbackGroup()
         self._book = GoalBook(number)
-        self._snapshots = snapshots.shared(runner)
         self._closing = threading.Condition()
         self._goal_loop = goal_loop
         self._unfinished = 0  # goals ended whose result has not been handed to their server yet
@@ -133,7 +132,7 @@ class SupervisorNode(Node):
         self._service(MotionParamsValidate, gn.PARAMS_VALIDATE, self._on_params_validate)
         self._pub_status = self.create_publisher(MotionStatus, gn.MOTION_STATUS.name(ns, number),
                                                  profile(gn.MOTION_STATUS.qos))
-        runner.add_periodic(settings.status_rate, self._collect_status)
+        runner.add_status(settings.status_rate, self._collect_status)
         runner.add_periodic(settings.feedback_rate, self._collect_feedback)
         runner.on_change(self._review)
         # JointTrajectory commands in SI units (trajectory_feed.py, docs/trajectories.md)
@@ -185,8 +184,10 @@ class SupervisorNode(Node):
         return super().destroy_node()
 
     # -- status -----------------------------------------------------------------------
-    def _collect_status(self, ctl):
-        snap = self._snapshots.motion(ctl, self.number)  # read once a sample for every node (snapshots.py)
+    def _collect_status(self, ctl, at: AtSample):
+        """The runner calls it with the snapshots of its sample (runner.add_status), the same
+        ones the axis topics publish; the controller may be past that sample."""
+        snap = at.taken()[0].get(self.number)
         if snap is None:
             return None
         # packed straight into CDR and published raw where the interfaces allow (wire.py)

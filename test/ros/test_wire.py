@@ -116,33 +116,6 @@ def test_joint_state_bytes_equal_the_canonical_cdr_of_convert_from_the_axes_or_t
     assert any(effort != 0.0 for effort in direct[2])
 
 
-def test_snapshots_are_read_once_a_sample_and_read_again_after_a_command():
-    from mpi_ros.commands import Command
-    from mpi_ros.ros.snapshots import shared
-    from mpi_ros.runner import ControllerRunner
-
-    ctl = _controller(axes=8)  # axes 6 and 7: no supervisor maps them
-    runner = ControllerRunner(ctl, time_scale=None)
-    snapshots = shared(runner)
-    assert shared(runner) is snapshots
-    next(_moving_states(ctl))
-    reads = []
-    taken = ctl.axis_snapshots
-    ctl.axis_snapshots = lambda numbers=None: reads.append(numbers) or taken(numbers)  # counts the reads
-    first = {a.number: snapshots.axis(ctl, a.number) for a in ctl.axes}
-    assert snapshots.motion(ctl, 1).axes == (first[1], first[2])
-    assert reads == [None]
-    assert snapshots.taken_axes(ctl) == first
-    assert first == {a.number: snap for a, snap in zip(ctl.axes, taken(), strict=True)}
-
-    runner.submit(Command("action", 2, request={"action": "E_STOP"}))  # at the same sample
-    assert snapshots.taken_axes(ctl) is None
-    assert snapshots.motion(ctl, 2).state is MPIState.STOPPING_ERROR
-    assert snapshots.axis(ctl, 3).state is MPIState.STOPPING_ERROR
-    runner.step(1)
-    assert snapshots.axis(ctl, 0).sample == ctl.sample == first[0].sample + 1
-
-
 @pytest.mark.parametrize("namespace", ["/mpi", "/plant/cell_a", "/c"])
 def test_a_packer_packs_each_sample_as_the_functions_do(namespace):
     """wire.Packer keeps a sample's stamp, each source's frame_id and each axis snapshot's
