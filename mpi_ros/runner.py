@@ -35,7 +35,8 @@ from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 
 from mpi_ros.mpi.base.events import Event
-from mpi_ros.mpi.control import Controller, Snapshots
+from mpi_ros.mpi.control import Controller
+from mpi_ros.mpi.snapshots import Snapshots
 
 from .commands import Command, Reply, apply
 
