@@ -244,7 +244,10 @@ class Packer:
         kept = self._bodies.get(id(snap))
         if kept is None or kept[0] is not snap:
             kept = self._bodies[id(snap)] = (snap, _axis_body_bytes(snap))
-        return self._stamp + _frame(self.namespace, -1, snap.number, start) + kept[1]
+        # the stamp's int32 is 4-aligned: after an AxisStatus whose faults' last string ends
+        # anywhere, the next one inside a MotionStatus starts with padding
+        pad = -start % 4
+        return b"\x00" * pad + self._stamp + _frame(self.namespace, -1, snap.number, start + pad) + kept[1]
 
     def axis_status(self, snap: AxisSnapshot) -> bytes:
         """The CDR of ``convert.axis_status(snap, rate, epoch_ns, namespace)``."""
