@@ -33,16 +33,20 @@ logged() {  # logged NAME FILTER COMMAND...: run COMMAND, its output to build/se
         exit 1
     fi
 }
+# Debian's awk (mawk) reads a pipe in blocks, so progress came in bursts minutes apart (the
+# issue's "9 of them silent"): -W interactive makes it read line by line.
+if awk -W version 2>/dev/null | grep -q mawk; then lines_awk() { awk -W interactive "$@"; }
+else lines_awk() { awk "$@"; }; fi
 uv_progress() {  # uv's summary lines, and a line every 25 wheels downloaded (from its -v log)
-    awk '/^(Resolved|Prepared|Installed|Uninstalled) [0-9]+ package/ { printf "[setup]   %s\n", $0; fflush(); next }
+    lines_awk '/^(Resolved|Prepared|Installed|Uninstalled) [0-9]+ package/ { printf "[setup]   %s\n", $0; fflush(); next }
          /Sending fresh GET request for: .*\.whl$/ { n++; if (n % 25 == 0) { printf "[setup]   %d wheels downloaded\n", n; fflush() } }'
 }
 pip_progress() {  # pip's lines, condensed: a line every 25 packages resolved, then the install
-    awk '/^Collecting / { n++; if (n % 25 == 1) { printf "[setup]   %d packages resolved\n", n; fflush() } next }
+    lines_awk '/^Collecting / { n++; if (n % 25 == 1) { printf "[setup]   %d packages resolved\n", n; fflush() } next }
          /^Installing collected packages/ { printf "[setup]   installing %d packages\n", n; fflush() }'
 }
 build_progress() {  # setup.py's own lines and the build's progress every 10 % (pip indents them)
-    awk '{ sub(/^ +/, "") }
+    lines_awk '{ sub(/^ +/, "") }
          /^\[mpi_ros setup.py\]/ { sub(/^\[mpi_ros setup.py\] /, ""); if (length($0) > 96) $0 = substr($0, 1, 93) "..."
                                   printf "[setup]   %s\n", $0; fflush(); next }
          /^\[ *[0-9]+%\]/ { show(substr($0, 2, index($0, "%") - 2) + 0); next }   # make: [ 42%]
