@@ -49,6 +49,8 @@ build_progress() {  # setup.py's own lines and the build's progress every 10 % (
     lines_awk '{ sub(/^ +/, "") }
          /^\[mpi_ros setup.py\]/ { sub(/^\[mpi_ros setup.py\] /, ""); if (length($0) > 96) $0 = substr($0, 1, 93) "..."
                                   printf "[setup]   %s\n", $0; fflush(); next }
+         / Generating .* for ROS interfaces| Generating .* type support / {   # the rosidl generators,
+             sub(/^[^]]*\] /, ""); printf "[setup]   %s\n", $0; fflush() }       # a long step each
          /^\[ *[0-9]+%\]/ { show(substr($0, 2, index($0, "%") - 2) + 0); next }   # make: [ 42%]
          /^\[[0-9]+\/[0-9]+\]/ { split(substr($0, 2, index($0, "]") - 2), f, "/")   # ninja: [12/93]
                                 show(int(100 * f[1] / f[2])) }
