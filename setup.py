@@ -3,8 +3,9 @@
 It drives the same CMakeLists.txt as colcon (rosidl_generate_interfaces + the hand-written
 Python package), so both routes install the same files:
 
-1. configure (once) and build in ``build/cmake`` (Python users' generators only:
-   MPI_ROS_PYTHON_ONLY in CMakeLists.txt) (persistent, so a re-install after a
+1. configure (once) and build in ``build/cmake`` with Ninja when installed (requirements/
+   runtime.txt pins it) at -O2 (Python users' generators only: MPI_ROS_PYTHON_ONLY in
+   CMakeLists.txt; docs/setup.md has the costs) (persistent, so a re-install after a
    Python-only change rebuilds nothing; wiped when the venv, the source directory or the set
    of interface files changes),
    with CMAKE_INSTALL_PREFIX = the venv (sys.prefix), Python3_EXECUTABLE = the venv's python;
