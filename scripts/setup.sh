@@ -37,9 +37,9 @@ logged() {  # logged NAME FILTER COMMAND...: run COMMAND, its output to build/se
 # issue's "9 of them silent"): -W interactive makes it read line by line.
 if awk -W version 2>/dev/null | grep -q mawk; then lines_awk() { awk -W interactive "$@"; }
 else lines_awk() { awk "$@"; }; fi
-uv_progress() {  # uv's summary lines, and a line every 25 wheels downloaded (from its -v log)
+uv_progress() {  # uv's summary lines, and a line every 25 wheel downloads started (its -v log)
     lines_awk '/^(Resolved|Prepared|Installed|Uninstalled) [0-9]+ package/ { printf "[setup]   %s\n", $0; fflush(); next }
-         /Sending fresh GET request for: .*\.whl$/ { n++; if (n % 25 == 0) { printf "[setup]   %d wheels downloaded\n", n; fflush() } }'
+         /Sending fresh GET request for: .*\.whl$/ { n++; if (n % 25 == 0) { printf "[setup]   %d wheel downloads started\n", n; fflush() } }'
 }
 pip_progress() {  # pip's lines, condensed: a line every 25 packages resolved, then the install
     lines_awk '/^Collecting / { n++; if (n % 25 == 1) { printf "[setup]   %d packages resolved\n", n; fflush() } next }
@@ -125,6 +125,7 @@ deps_stamp="$venv/.mpi_ros-deps.stamp"
 install_uv() {  # uv of requirements/setup.txt into the venv; fails when pip cannot get it
     local want; want="$(sed -n 's/^uv==//p' "$req/setup.txt")"
     [[ "$("$venv/bin/uv" --version 2>/dev/null)" == "uv $want"* ]] && return 0
+    say "  installing uv $want (requirements/setup.txt) with pip"
     "$vpy" -m pip install --progress-bar off -r "$req/setup.txt" > "$repo/build/setup-uv.log" 2>&1
 }
 if [[ "$(cat "$deps_stamp" 2>/dev/null || true)" != "$deps_hash" ]]; then
@@ -132,7 +133,7 @@ if [[ "$(cat "$deps_stamp" 2>/dev/null || true)" != "$deps_hash" ]]; then
     rm -f "$deps_stamp" "$venv/.mpi_ros-package.stamp"
     start=$SECONDS
     if install_uv; then
-        # No .pyc compilation here (pip compiles all 160 packages): the first import of a module
+        # No .pyc compilation here (pip compiles all 5,500 modules): the first import of a module
         # writes its .pyc, and the tests import a fraction of these files (docs/setup.md).
         logged requirements uv_progress \
             "$venv/bin/uv" pip install -v --python "$vpy" -r "$req/runtime.txt" -r "$req/test.txt"
