@@ -3,8 +3,9 @@
 It drives the same CMakeLists.txt as colcon (rosidl_generate_interfaces + the hand-written
 Python package), so both routes install the same files:
 
-1. configure (once) and build in ``build/cmake`` (Python users' generators only:
-   MPI_ROS_PYTHON_ONLY in CMakeLists.txt) (persistent, so a re-install after a
+1. configure (once) and build in ``build/cmake`` with Ninja when installed (requirements/
+   runtime.txt pins it) at -O2 (Python users' generators only: MPI_ROS_PYTHON_ONLY in
+   CMakeLists.txt; docs/setup.md has the costs) (persistent, so a re-install after a
    Python-only change rebuilds nothing; wiped when the venv, the source directory or the set
    of interface files changes),
    with CMAKE_INSTALL_PREFIX = the venv (sys.prefix), Python3_EXECUTABLE = the venv's python;
@@ -42,6 +43,9 @@ BUILD_DIR = os.path.join(ROOT, "build", "cmake")
 STAGE_DIR = os.path.join(ROOT, "build", "stage")
 FINGERPRINT = os.path.join(ROOT, "build", "cmake-fingerprint.json")
 PACKAGE = "mpi_ros"
+# -O2, as the ROS packages of a distribution are built (RelWithDebInfo without -g): CMake's Release
+# -O3 costs 10 % more compile time for generated code that mostly copies fields (docs/setup.md).
+OPT_FLAGS = "-O2 -DNDEBUG"
 
 
 def _version() -> str:
@@ -77,6 +81,17 @@ def _run(cmd: list[str], env: dict[str, str]) -> None:
     subprocess.run(cmd, check=True, env=env)
 
 
+def _ninja() -> str | None:
+    """Ninja (requirements/runtime.txt installs it into the venv), else None: make it is.
+
+    Ninja starts the next compile as soon as a core is free and checks what is up to date
+    faster than make's recursive Makefiles (docs/setup.md).
+    """
+    found = shutil.which("ninja", path=os.pathsep.join(
+        [os.path.join(sys.prefix, "bin"), os.environ.get("PATH", "")]))
+    return os.path.realpath(found) if found else None
+
+
 def _python_install_dir() -> str:
     """site-packages relative to the prefix, as ament_cmake_python computes it."""
     purelib = sysconfig.get_path("purelib", vars={"base": sys.prefix, "platbase": sys.prefix})
@@ -109,9 +124,12 @@ def cmake_build_and_stage() -> str:
         for sub, suffix in (("msg", ".msg"), ("srv", ".srv"), ("action", ".action"))
         if os.path.isdir(os.path.join(ROOT, sub))
         for name in os.listdir(os.path.join(ROOT, sub)) if name.endswith(suffix))
+    ninja = _ninja()
     fingerprint = {
         "interfaces": interfaces,
         "python_only": True,  # -DMPI_ROS_PYTHON_ONLY=ON below (CMakeLists.txt)
+        "generator": ninja or "Unix Makefiles",
+        "flags": OPT_FLAGS,
         "source": ROOT,
         "prefix": prefix,
         "python": os.path.realpath(sys.executable),
@@ -129,12 +147,15 @@ def cmake_build_and_stage() -> str:
         shutil.rmtree(BUILD_DIR)
     if not os.path.isfile(os.path.join(BUILD_DIR, "CMakeCache.txt")):
         os.makedirs(BUILD_DIR, exist_ok=True)
-        _run([cmake, "-S", ROOT, "-B", BUILD_DIR,
+        generator = ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"] if ninja else []
+        _run([cmake, "-S", ROOT, "-B", BUILD_DIR, *generator,
               f"-DCMAKE_INSTALL_PREFIX={prefix}",
               f"-DCMAKE_PREFIX_PATH={prefix}",
               f"-DPython3_EXECUTABLE={sys.executable}",
               "-DPython3_FIND_VIRTUALENV=ONLY",
               "-DCMAKE_BUILD_TYPE=Release",
+              f"-DCMAKE_C_FLAGS_RELEASE={OPT_FLAGS}",
+              f"-DCMAKE_CXX_FLAGS_RELEASE={OPT_FLAGS}",
               "-DBUILD_TESTING=OFF",
               "-DMPI_ROS_PYTHON_ONLY=ON"], env)
         with open(FINGERPRINT, "w", encoding="utf-8") as f:

@@ -2,10 +2,12 @@
 # One command for all set-up, on a fresh machine or an old one:
 #   1. find a CPython 3.11 (the ROS 2 Jazzy wheels on PyPI are cp311 only);
 #   2. create the virtual environment .venv in the repo;
-#   3. install the pinned requirements (requirements/runtime.txt + test.txt) and point the ROS
-#      wheels' CMake files at this venv's Python (scripts/fix-ros-wheel-paths.py);
-#   4. build the interfaces and install the package: pip install . (setup.py drives CMake,
-#      build dir build/cmake is kept, so a Python-only change rebuilds nothing).
+#   3. install the pinned requirements (requirements/runtime.txt + test.txt) with uv (pinned in
+#      requirements/setup.txt; pip only when uv cannot be installed) and point the ROS wheels'
+#      CMake files at this venv's Python (scripts/fix-ros-wheel-paths.py);
+#   4. build the interfaces and install the package: pip install . (setup.py drives CMake with
+#      Ninja, build dir build/cmake is kept, so a Python-only change rebuilds nothing).
+# docs/setup.md has what each step costs and why it is done this way.
 # Each step is skipped when its inputs did not change (hash stamps in .venv/), so a re-run with
 # nothing changed takes well under a second. Safe to run concurrently (a lock serialises runs).
 #
@@ -31,16 +33,28 @@ logged() {  # logged NAME FILTER COMMAND...: run COMMAND, its output to build/se
         exit 1
     fi
 }
+# Debian's awk (mawk) reads a pipe in blocks, so progress came in bursts minutes apart (the
+# issue's "9 of them silent"): -W interactive makes it read line by line.
+if awk -W version 2>/dev/null | grep -q mawk; then lines_awk() { awk -W interactive "$@"; }
+else lines_awk() { awk "$@"; }; fi
+uv_progress() {  # uv's summary lines, and a line every 25 wheel downloads started (its -v log)
+    lines_awk '/^(Resolved|Prepared|Installed|Uninstalled) [0-9]+ package/ { printf "[setup]   %s\n", $0; fflush(); next }
+         /Sending fresh GET request for: .*\.whl$/ { n++; if (n % 25 == 0) { printf "[setup]   %d wheel downloads started\n", n; fflush() } }'
+}
 pip_progress() {  # pip's lines, condensed: a line every 25 packages resolved, then the install
-    awk '/^Collecting / { n++; if (n % 25 == 1) { printf "[setup]   %d packages resolved\n", n; fflush() } next }
+    lines_awk '/^Collecting / { n++; if (n % 25 == 1) { printf "[setup]   %d packages resolved\n", n; fflush() } next }
          /^Installing collected packages/ { printf "[setup]   installing %d packages\n", n; fflush() }'
 }
-build_progress() {  # setup.py's own lines and CMake's percentage, every 10 % (pip indents them)
-    awk '{ sub(/^ +/, "") }
+build_progress() {  # setup.py's own lines and the build's progress every 10 % (pip indents them)
+    lines_awk '{ sub(/^ +/, "") }
          /^\[mpi_ros setup.py\]/ { sub(/^\[mpi_ros setup.py\] /, ""); if (length($0) > 96) $0 = substr($0, 1, 93) "..."
                                   printf "[setup]   %s\n", $0; fflush(); next }
-         /^\[ *[0-9]+%\]/ { p = substr($0, 2, index($0, "%") - 2) + 0
-                             if (p >= last + 10) { printf "[setup]   building the interfaces: %d%%\n", p; fflush(); last = p } }'
+         / Generating .* for ROS interfaces| Generating .* type support / {   # the rosidl generators,
+             sub(/^[^]]*\] /, ""); printf "[setup]   %s\n", $0; fflush() }       # a long step each
+         /^\[ *[0-9]+%\]/ { show(substr($0, 2, index($0, "%") - 2) + 0); next }   # make: [ 42%]
+         /^\[[0-9]+\/[0-9]+\]/ { split(substr($0, 2, index($0, "]") - 2), f, "/")   # ninja: [12/93]
+                                show(int(100 * f[1] / f[2])) }
+         function show(p) { if (p >= last + 10) { printf "[setup]   building the interfaces: %d%%\n", p; fflush(); last = p } }'
 }
 
 mkdir -p "$repo/build"
@@ -103,17 +117,31 @@ hash_files() {  # hash of the names and contents of the given files (sorted, NUL
 }
 interp_id="$("$vpy" -c 'import sys, os; print(sys.version, os.path.realpath(sys.executable))')"
 
-deps_hash="$( { printf '%s\0' "$req/runtime.txt" "$req/test.txt"; } | hash_files)"
+deps_hash="$( { printf '%s\0' "$req/setup.txt" "$req/runtime.txt" "$req/test.txt"; } | hash_files)"
 deps_hash="$(printf '%s %s' "$deps_hash" "$interp_id" | sha256sum | cut -d' ' -f1)"
 deps_stamp="$venv/.mpi_ros-deps.stamp"
 
 # --- 2. pinned requirements ----------------------------------------------------------------
+install_uv() {  # uv of requirements/setup.txt into the venv; fails when pip cannot get it
+    local want; want="$(sed -n 's/^uv==//p' "$req/setup.txt")"
+    [[ "$("$venv/bin/uv" --version 2>/dev/null)" == "uv $want"* ]] && return 0
+    say "  installing uv $want (requirements/setup.txt) with pip"
+    "$vpy" -m pip install --progress-bar off -r "$req/setup.txt" > "$repo/build/setup-uv.log" 2>&1
+}
 if [[ "$(cat "$deps_stamp" 2>/dev/null || true)" != "$deps_hash" ]]; then
     say "installing pinned requirements (requirements/runtime.txt, requirements/test.txt)"
     rm -f "$deps_stamp" "$venv/.mpi_ros-package.stamp"
     start=$SECONDS
-    logged requirements pip_progress \
-        "$vpy" -m pip install --progress-bar off -r "$req/runtime.txt" -r "$req/test.txt"
+    if install_uv; then
+        # No .pyc compilation here (pip compiles all 5,500 modules): the first import of a module
+        # writes its .pyc, and the tests import a fraction of these files (docs/setup.md).
+        logged requirements uv_progress \
+            "$venv/bin/uv" pip install -v --python "$vpy" -r "$req/runtime.txt" -r "$req/test.txt"
+    else
+        say "uv could not be installed (build/setup-uv.log): installing with pip, which is slower"
+        logged requirements pip_progress \
+            "$vpy" -m pip install --progress-bar off -r "$req/runtime.txt" -r "$req/test.txt"
+    fi
     "$vpy" "$repo/scripts/fix-ros-wheel-paths.py" --prefix "$venv"
     printf '%s' "$deps_hash" > "$deps_stamp"
     say "requirements installed in $((SECONDS - start)) s"
