@@ -358,11 +358,3 @@ class _PickedRuns:
 
     def at(self, index: int) -> np.ndarray:
         return np.where(self.rows, self.chosen.at(index), self.other.at(index))
-
-
-def rising_edges(previous: bool, bits: np.ndarray) -> np.ndarray:
-    """Indices at which a bit turns on."""
-    if not bits.any() or (previous and bits.all()):
-        return _NONE
-    before = np.concatenate(([previous], bits[:-1]))
-    return np.flatnonzero(bits & ~before)
