@@ -19,6 +19,7 @@ from __future__ import annotations
 import bisect
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -47,7 +48,8 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     rows = bank.of_kind(Kind.PIECE)
     if len(rows):
         _command(bank, rows, out)
-        act_p, act_v = _servo(bank.plant, bank.tables, rows, out, direct=True)
+        transients = bank.memo("transients", lambda: _Transients.of(bank.plant, rows))
+        act_p, act_v = _servo(bank.plant, bank.tables, rows, transients, out, direct=True)
         out.place("act_p", rows, act_p)
         out.place("act_v", rows, act_v)
         ending = t[-1] >= bank.plant.piece_end[rows]
@@ -241,15 +243,15 @@ def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
 
 
 # -- the servo ----------------------------------------------------------------------------
-def _servo(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, out: Stretch, direct: bool,
-           following: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Actual position and velocity (Plant.response, read) of ``rows`` of ``plant``, at
-    every sample of the stretch; ``direct``: into the stretch's own arrays where it can;
-    ``following``: pieces that start inside the stretch (the samples before a row's anchor
-    come out meaningless, to be left out)."""
+def _servo(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, transients: _Transients, out: Stretch,
+           direct: bool, following: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Actual position and velocity (Plant.response, read) of ``rows`` of ``plant`` (whose
+    transients are ``transients``), at every sample of the stretch; ``direct``: into the
+    stretch's own arrays where it can; ``following``: pieces that start inside the stretch
+    (the samples before a row's anchor come out meaningless, to be left out)."""
     s = np.subtract(out.t, plant.anchor_t[rows, None], out=out.temporary("s", rows))
     y, dy = _steady_response(plant, rows, s, out)
-    y, dy = _add_transient(plant, tables, rows, s, y, dy, out, following)
+    y, dy = _add_transient(tables, transients, s, y, dy, out, following)
     return _read(plant.resolution[rows], y, out.into("act_p", rows) if direct else None), dy
 
 
@@ -269,7 +271,9 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
             pieces.append((row, start, end))
             out.anchors[row].append(anchor)
     rows_of = PlantRows.of_pieces(followers, bank.table_index)
-    act_p, act_v = _servo(rows_of, bank.tables, np.arange(len(pieces)), out, direct=False, following=True)
+    every = np.arange(len(pieces))
+    act_p, act_v = _servo(rows_of, bank.tables, every, _Transients.of(rows_of, every), out, direct=False,
+                          following=True)
     shape = (len(pieces), len(t))
     act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
     spans = np.searchsorted(t, [(start, end) for _, start, end in pieces], side="left").tolist()
@@ -311,29 +315,69 @@ def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) ->
     return out
 
 
-def _add_transient(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, s: np.ndarray, y: np.ndarray,
-                   dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Plant.response's transient added to the rows that have one."""
-    if following:
+@dataclass(frozen=True, slots=True)
+class _Transients:
+    """The rows with a transient among some rows of PlantRows, and what adding it reads of
+    them (gathered once per bank refresh for the bank's pieces: bank.memo)."""
+
+    where: slice | np.ndarray  # those rows among the rows: all of them (a slice), or their indices
+    rows: np.ndarray  # their rows of PlantRows
+    v0: np.ndarray  # (rows, 1) columns of the Transient's parts
+    m0: np.ndarray
+    v1: np.ndarray
+    m1: np.ndarray
+    decayed: np.ndarray  # (rows, 1): PlantRows.decayed_after
+    vanishing: np.ndarray  # PlantRows.vanishing
+    k0: np.ndarray
+    table: np.ndarray
+    dropped: bool  # may one be dropped once decayed (a finite decayed_after)?
+    first_vanishing: float  # the first sample from which one of them is exact zeros
+    one_table: int  # the free-response table every one reads (-1: not one for all)
+
+    @classmethod
+    def of(cls, plant: PlantRows, rows: np.ndarray) -> _Transients:
         live = plant.decayed_after[rows] > -math.inf
-    else:
-        live = _live_transients(plant, rows, int(out.samples[0]), y, dy, out)
-    if not live.any():
+        where = slice(None) if live.all() else np.flatnonzero(live)
+        picked = rows[where]
+        return cls.gathered(where, picked, plant.v0[picked, None], plant.m0[picked, None], plant.v1[picked, None],
+                            plant.m1[picked, None], plant.decayed_after[picked, None], plant.vanishing[picked],
+                            plant.k0[picked], plant.table[picked])
+
+    @classmethod
+    def gathered(cls, where: slice | np.ndarray, rows: np.ndarray, v0: np.ndarray, m0: np.ndarray, v1: np.ndarray,
+                 m1: np.ndarray, decayed: np.ndarray, vanishing: np.ndarray, k0: np.ndarray,
+                 table: np.ndarray) -> _Transients:
+        one = len(table) > 0 and bool((table == table[0]).all())
+        return cls(where, rows, v0, m0, v1, m1, decayed, vanishing, k0, table, not bool(np.isposinf(decayed).all()),
+                   float(vanishing.min(initial=math.inf)), int(table[0]) if one else -1)
+
+    def kept(self, keep: np.ndarray) -> _Transients:
+        """Those at indices ``keep`` among them."""
+        where = keep if isinstance(self.where, slice) else self.where[keep]
+        return self.gathered(where, self.rows[keep], self.v0[keep], self.m0[keep], self.v1[keep], self.m1[keep],
+                             self.decayed[keep], self.vanishing[keep], self.k0[keep], self.table[keep])
+
+
+def _add_transient(tables: list[_FreeTable], transients: _Transients, s: np.ndarray, y: np.ndarray,
+                   dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Plant.response's transient added to the rows that have one (``transients``)."""
+    added = transients if following else _not_vanished(transients, int(out.samples[0]), y, dy)
+    if added is None or not len(added.rows):
         return y, dy
+    transients = added
     y, dy = _full(y, s.shape, out, "y"), _full(dy, s.shape, out, "dy")
-    sub = slice(None) if live.all() else np.flatnonzero(live)
-    rows, decayed = rows[sub], plant.decayed_after[rows[sub]]
-    p, q = _free(plant, tables, rows, out.samples, out.scratch, following)
-    h0 = np.multiply(p, plant.v0[rows, None], out=out.temporary("h0", rows))
-    h0 += np.multiply(q, plant.m0[rows, None], out=out.temporary("product", rows))
-    h1 = np.multiply(p, plant.v1[rows, None], out=out.temporary("h1", rows))
-    h1 += np.multiply(q, plant.m1[rows, None], out=out.temporary("product", rows))
-    if np.isposinf(decayed).all():
+    sub, rows = transients.where, transients.rows
+    p, q = _free(tables, transients, out.samples, out.scratch, following)
+    h0 = np.multiply(p, transients.v0, out=out.temporary("h0", rows))
+    h0 += np.multiply(q, transients.m0, out=out.temporary("product", rows))
+    h1 = np.multiply(p, transients.v1, out=out.temporary("h1", rows))
+    h1 += np.multiply(q, transients.m1, out=out.temporary("product", rows))
+    if not transients.dropped:
         y[sub] += h0
         dy[sub] += h1
         return y, dy
     # At rest on a constant command the transient is dropped once it has decayed.
-    settled = s[sub] >= decayed[:, None]
+    settled = s[sub] >= transients.decayed
     y[sub] = np.where(settled, y[sub], y[sub] + h0)
     dy[sub] = np.where(settled, dy[sub], dy[sub] + h1)
     return y, dy
@@ -348,48 +392,42 @@ def _full(values: np.ndarray, shape: tuple[int, int], out: Stretch, name: str) -
     return full
 
 
-def _live_transients(plant: PlantRows, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray,
-                     out: Stretch) -> np.ndarray:
-    """Per row: must its transient be added? Not without one; nor where the free response
-    has underflowed to exact zeros over the whole stretch (a long-settled loop), since
-    adding a zero changes nothing, unless a value is itself a zero (whose sign it might
-    flip): there it is added as ever."""
-    live: np.ndarray = plant.decayed_after[rows] > -math.inf
-    if not live.any():
-        return live
-    vanished: np.ndarray = live & (first >= plant.vanishing[rows])
-    if vanished.any():
-        vanished &= ~(_has_zero(y, vanished, out) | _has_zero(dy, vanished, out))
-    added: np.ndarray = live & ~vanished
-    return added
+def _not_vanished(transients: _Transients, first: int, y: np.ndarray, dy: np.ndarray) -> _Transients | None:
+    """The transients that must be added from sample ``first`` on (None: none): not those
+    whose free response has underflowed to exact zeros over the whole stretch (a
+    long-settled loop), since adding a zero changes nothing, unless a value is itself a
+    zero (whose sign it might flip): there it is added as ever."""
+    if first < transients.first_vanishing:  # (none has vanished yet)
+        return transients
+    sub = transients.where
+    vanished: np.ndarray = first >= transients.vanishing
+    vanished &= ~(_has_zero(y[sub]) | _has_zero(dy[sub]))
+    if not vanished.any():
+        return transients
+    return None if vanished.all() else transients.kept(np.flatnonzero(~vanished))
 
 
-def _has_zero(values: np.ndarray, rows: np.ndarray, out: Stretch) -> np.ndarray:
-    """Per row (False where ``rows`` is not set): does it hold a zero?"""
-    has: np.ndarray
-    if values.shape[1] == 1:
-        has = rows & (values[:, 0] == 0.0)
-        return has
-    zero = np.equal(values, 0.0, out=out.scratch.take("zero", values.shape, bool))
-    has = rows & zero.any(axis=1)
+def _has_zero(values: np.ndarray) -> np.ndarray:
+    """Per row: does it hold a zero?"""
+    has: np.ndarray = (values == 0.0).any(axis=1)
     return has
 
 
-def _free(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, samples: np.ndarray, scratch: Scratch,
+def _free(tables: list[_FreeTable], transients: _Transients, samples: np.ndarray, scratch: Scratch,
           following: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(p, q) of the free response at every sample of each row, from its loop's table (for
-    ``following`` rows, sample counts before the anchor read as 0)."""
-    which = plant.table[rows]
-    first, n = int(samples[0]), len(samples)
-    if not following and (which == which[0]).all():
-        return tables[int(which[0])].window(first - plant.k0[rows], n, scratch)
-    p, q = np.empty((len(rows), n)), np.empty((len(rows), n))
+    """(p, q) of the free response at every sample of each of ``transients``' rows, from its
+    loop's table (for ``following`` rows, sample counts before the anchor read as 0)."""
+    first, n, k0 = int(samples[0]), len(samples), transients.k0
+    if not following and transients.one_table >= 0:
+        return tables[transients.one_table].window(first - k0, n, scratch)
+    which = transients.table
+    p, q = np.empty((len(k0), n)), np.empty((len(k0), n))
     for index in np.unique(which).tolist():
         group = np.flatnonzero(which == index)
         if following:
-            p[group], q[group] = tables[index].at(np.maximum(samples - plant.k0[rows[group], None], 0))
+            p[group], q[group] = tables[index].at(np.maximum(samples - k0[group, None], 0))
         else:
-            p[group], q[group] = tables[index].window(first - plant.k0[rows[group]], n)
+            p[group], q[group] = tables[index].window(first - k0[group], n)
     return p, q
 
 
