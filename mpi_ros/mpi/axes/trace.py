@@ -96,26 +96,44 @@ def _steady(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
 # -- the command ------------------------------------------------------------------------
 def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
     """Command of ``rows``: a plan read through the supervisor's clock, or the rest."""
-    planned = bank.command.planned[rows]
-    resting = rows[~planned]
+    plans = bank.memo("plans", lambda: _Plans.of(bank.command, rows))
+    resting = plans.resting
     if len(resting):
         out.cmd_p[resting] = bank.command.rest[resting, None]
         out.cmd_v[resting] = out.cmd_a[resting] = 0.0
         out.rel[resting] = math.nan
-    if planned.any():
-        _planned(bank, rows[planned], out)
+    if len(plans.rows):
+        _planned(bank, plans, out)
 
 
-def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
+@dataclass(frozen=True, slots=True)
+class _Plans:
+    """The pieces' rows that rest and those that run a plan, with what reading the plans
+    takes of the command rows besides their segments (once per bank refresh)."""
+
+    resting: np.ndarray
+    rows: np.ndarray  # planned
+    clocks: bytes  # the clocks the planned rows run on (the key, as a modify keeps them)
+    tau_start: np.ndarray  # (rows, 1)
+    duration: np.ndarray
+
+    @classmethod
+    def of(cls, command: CommandRows, rows: np.ndarray) -> _Plans:
+        planned = command.planned[rows]
+        chosen = rows[planned]
+        return cls(rows[~planned], chosen, command.clock[chosen].tobytes(), command.tau_start[chosen, None],
+                   command.duration[chosen])
+
+
+def _planned(bank: AxisBank, plans: _Plans, out: Stretch) -> None:
     """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate)."""
-    cmd = bank.command
-    numbers = cmd.clock[rows]  # (the clocks the rows run on: the key, as a modify keeps them)
-    which, clocks = bank.clock_memo(numbers.tobytes(), lambda: _clocks_of(bank, numbers))
+    cmd, rows = bank.command, plans.rows
+    which, clocks = bank.clock_memo(plans.clocks, lambda: _clocks_of(bank, cmd.clock[rows]))
     tau, f, df = clocks.evaluate(out.t, out.scratch)
     rel = np.take(tau, which, axis=0, out=out.target("rel", rows))
-    rel -= cmd.tau_start[rows, None]
+    rel -= plans.tau_start
     lo, hi = rel.min(axis=1), rel.max(axis=1)
-    duration = cmd.duration[rows]
+    duration = plans.duration
     # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
     single = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
     if single.all():
