@@ -311,6 +311,10 @@ class AxisBank:
         """A value derived from the rows, kept until one changes (``compute()`` makes it)."""
         return _memoised(self._memo, key, compute)
 
+    def forget(self, key: Hashable) -> None:
+        """Drop what :meth:`memo` keeps for ``key`` (a row it derives from changed)."""
+        self._memo.pop(key, None)
+
     def command_memo(self, key: Hashable, compute: Callable[[], T]) -> T:
         """:meth:`memo` for a value derived from the command rows alone: kept while only
         plant anchors move, until an axis' rows are rebuilt."""

@@ -137,7 +137,9 @@ def _planned(bank: AxisBank, plans: _Plans, out: Stretch) -> None:
     # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
     single = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
     if single.all():
-        p, dp, ddp = _segment(cmd, rows, rel, lo, hi, out)
+        # (after the segments _in_one_segment chose)
+        segments = bank.memo("segments", lambda: _Segments.of(cmd, rows))
+        p, dp, ddp = _segment(cmd, rows, segments, rel, lo, hi, out)
     else:
         p, dp, ddp = _segments(bank, rows, rel, lo, hi, single, out)
     f, df = f[which], df[which]
@@ -158,8 +160,9 @@ def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
     shape = rel.shape
     p, dp, ddp = np.empty(shape), np.empty(shape), np.empty(shape)
     if single.any():
-        p[single], dp[single], ddp[single] = _segment(bank.command, rows[single], rel[single], lo[single],
-                                                      hi[single], None)
+        chosen = rows[single]
+        p[single], dp[single], ddp[single] = _segment(bank.command, chosen, _Segments.of(bank.command, chosen),
+                                                      rel[single], lo[single], hi[single], None)
     for i in np.flatnonzero(~single).tolist():
         plan = bank.plans[int(rows[i])]
         assert plan is not None  # (a planned row: written for its plan)
@@ -178,7 +181,11 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     one segment of the plan? A row that moved on to another segment gets it here (one axis
     at a time, only when that happens)."""
     cmd = bank.command
-    keep: np.ndarray = (lo >= cmd.seg_lo[rows]) & (hi < cmd.seg_hi[rows])
+    segments = bank.memo("segments", lambda: _Segments.of(cmd, rows))
+    keep: np.ndarray = (lo >= segments.lo) & (hi < segments.hi)
+    if keep.all():
+        return keep
+    bank.forget("segments")  # (a row may move on to its next segment)
     for i in np.flatnonzero(~keep).tolist():
         row = int(rows[i])
         plan = bank.plans[row]
@@ -193,24 +200,50 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     return keep
 
 
-def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-             out: Stretch | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+@dataclass(frozen=True, slots=True)
+class _Segments:
+    """The segment each of some rows is evaluated in (CommandRows.set_segment), gathered:
+    ``lo``, ``hi``, ``linear`` and ``duration`` per row, the rest as (rows, 1) columns."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+    linear: np.ndarray
+    duration: np.ndarray
+    start: np.ndarray
+    p: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    j: np.ndarray
+
+    @classmethod
+    def of(cls, cmd: CommandRows, rows: np.ndarray) -> _Segments:
+        return cls(cmd.seg_lo[rows], cmd.seg_hi[rows], cmd.linear[rows], cmd.duration[rows],
+                   *(x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
+
+    def of_group(self, group: np.ndarray) -> _Segments:
+        """Those of the rows ``group`` (a mask) picks."""
+        return _Segments(self.lo[group], self.hi[group], self.linear[group], self.duration[group], self.start[group],
+                         self.p[group], self.v[group], self.a[group], self.j[group])
+
+
+def _segment(cmd: CommandRows, rows: np.ndarray, segments: _Segments, rel: np.ndarray, lo: np.ndarray,
+             hi: np.ndarray, out: Stretch | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, d/dtau, d2/dtau2 of each row's plan at profile times ``rel`` (whose extremes
-    are ``lo``, ``hi``): its segment (SegmentTable.evaluate) until the plan's end, the end
-    state from there on (AxisPlan.evaluate). Velocity and acceleration may come back as
-    (rows, 1) columns, constant over the stretch."""
-    duration = cmd.duration[rows]
+    are ``lo``, ``hi``): its segment (SegmentTable.evaluate, ``segments``) until the plan's
+    end, the end state from there on (AxisPlan.evaluate). Velocity and acceleration may come
+    back as (rows, 1) columns, constant over the stretch."""
+    duration = segments.duration
     inside = rel if (hi < duration).all() else np.minimum(rel, duration[:, None])
-    linear = _linear(cmd, rows, np.minimum(lo, duration))
+    linear = _linear(segments, np.minimum(lo, duration))
     position = out.into("cmd_p", rows) if out is not None else None
     if linear.all():
-        pos, vel, acc = _linear_segment(cmd, rows, inside, position)
+        pos, vel, acc = _linear_segment(segments, inside, position)
     elif not linear.any():
-        pos, vel, acc = _cubic_segment(cmd, rows, inside, position)
+        pos, vel, acc = _cubic_segment(segments, inside, position)
     else:
         pos, vel, acc = np.empty_like(rel), np.empty_like(rel), np.empty_like(rel)
         for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
-            pos[group], vel[group], acc[group] = evaluate(cmd, rows[group], inside[group], None)
+            pos[group], vel[group], acc[group] = evaluate(segments.of_group(group), inside[group], None)
     if (hi >= duration).any():
         duration = duration[:, None]
         complete = rel >= duration
@@ -222,28 +255,28 @@ def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray
     return pos, vel, acc
 
 
-def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
+def _linear(segments: _Segments, lo: np.ndarray) -> np.ndarray:
     """Rows whose segment has acceleration and jerk +0.0 (CommandRows.linear) and whose
     stretch starts in it (dt >= +0): SegmentTable.evaluate's sums reduce there to p + dt v'
     and v', v' = v + 0.0, to the bit (+0 times a finite dt >= +0 is +0, and x + +0 is x but
     for x = -0.0)."""
-    linear: np.ndarray = cmd.linear[rows] & (lo >= cmd.seg_start[rows])
+    linear: np.ndarray = segments.linear & (lo >= segments.start[:, 0])
     return linear
 
 
-def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+def _linear_segment(segments: _Segments, inside: np.ndarray,
                     into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    velocity = cmd.v[rows, None] + 0.0
-    pos = np.subtract(inside, cmd.seg_start[rows, None], out=into)
+    velocity = segments.v + 0.0
+    pos = np.subtract(inside, segments.start, out=into)
     pos *= velocity
-    pos += cmd.p[rows, None]
+    pos += segments.p
     return pos, velocity, np.zeros_like(velocity)
 
 
-def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+def _cubic_segment(segments: _Segments, inside: np.ndarray,
                    into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """SegmentTable.evaluate's sums, operation for operation (x + y and x y commute)."""
-    start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
+    start, p, v, a, j = segments.start, segments.p, segments.v, segments.a, segments.j
     dt = inside - start
     jerk = dt * j
     pos = np.divide(jerk, 6.0, out=into)
