@@ -48,11 +48,11 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     rows = bank.of_kind(Kind.PIECE)
     if len(rows):
         _command(bank, rows, out)
-        transients = bank.memo("transients", lambda: _Transients.of(bank.plant, rows))
-        act_p, act_v = _servo(bank.plant, bank.tables, rows, transients, out, direct=True)
+        servos = bank.memo("servos", lambda: _Servos.of(bank.plant, rows))
+        act_p, act_v = _servo(bank.tables, rows, servos, out, direct=True)
         out.place("act_p", rows, act_p)
         out.place("act_v", rows, act_v)
-        ending = t[-1] >= bank.plant.piece_end[rows]
+        ending = t[-1] >= servos.piece_end
         out.pieces = rows[~ending]
         if ending.any():
             _following_pieces(bank, axes, clock_of, rows[ending], out)
@@ -294,16 +294,40 @@ def _cubic_segment(segments: _Segments, inside: np.ndarray,
 
 
 # -- the servo ----------------------------------------------------------------------------
-def _servo(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, transients: _Transients, out: Stretch,
-           direct: bool, following: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Actual position and velocity (Plant.response, read) of ``rows`` of ``plant`` (whose
-    transients are ``transients``), at every sample of the stretch; ``direct``: into the
-    stretch's own arrays where it can; ``following``: pieces that start inside the stretch
-    (the samples before a row's anchor come out meaningless, to be left out)."""
-    s = np.subtract(out.t, plant.anchor_t[rows, None], out=out.temporary("s", rows))
-    y, dy = _steady_response(plant, rows, s, out)
-    y, dy = _add_transient(tables, transients, s, y, dy, out, following)
-    return _read(plant.resolution[rows], y, out.into("act_p", rows) if direct else None), dy
+@dataclass(frozen=True, slots=True)
+class _Servos:
+    """What the servo of some rows of PlantRows reads of them, gathered (once per bank
+    refresh for the bank's pieces: bank.memo)."""
+
+    anchor_t: np.ndarray  # (rows, 1)
+    piece_end: np.ndarray
+    terms: np.ndarray
+    one_terms: int  # the coefficients every row uses (-1: not the same for all)
+    steady_y: np.ndarray  # (rows, _MAX_TERMS)
+    steady_dy: np.ndarray
+    resolution: np.ndarray
+    one_resolution: bool  # is the encoder resolution of every row the same?
+    transients: _Transients
+
+    @classmethod
+    def of(cls, plant: PlantRows, rows: np.ndarray) -> _Servos:
+        terms, resolution = plant.terms[rows], plant.resolution[rows]
+        one_terms = int(terms[0]) if len(terms) and (terms == terms[0]).all() else -1
+        return cls(plant.anchor_t[rows, None], plant.piece_end[rows], terms, one_terms, plant.steady_y[rows],
+                   plant.steady_dy[rows], resolution, len(rows) > 0 and bool((resolution == resolution[0]).all()),
+                   _Transients.of(plant, rows))
+
+
+def _servo(tables: list[_FreeTable], rows: np.ndarray, servos: _Servos, out: Stretch, direct: bool,
+           following: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Actual position and velocity (Plant.response, read) of ``rows`` (whose servos are
+    ``servos``), at every sample of the stretch; ``direct``: into the stretch's own arrays
+    where it can; ``following``: pieces that start inside the stretch (the samples before a
+    row's anchor come out meaningless, to be left out)."""
+    s = np.subtract(out.t, servos.anchor_t, out=out.temporary("s", rows))
+    y, dy = _steady_response(servos, rows, s, out)
+    y, dy = _add_transient(tables, servos.transients, s, y, dy, out, following)
+    return _read(servos, y, out.into("act_p", rows) if direct else None), dy
 
 
 def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileClock | None],
@@ -323,8 +347,7 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
             out.anchors[row].append(anchor)
     rows_of = PlantRows.of_pieces(followers, bank.table_index)
     every = np.arange(len(pieces))
-    act_p, act_v = _servo(rows_of, bank.tables, every, _Transients.of(rows_of, every), out, direct=False,
-                          following=True)
+    act_p, act_v = _servo(bank.tables, every, _Servos.of(rows_of, every), out, direct=False, following=True)
     shape = (len(pieces), len(t))
     act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
     spans = np.searchsorted(t, [(start, end) for _, start, end in pieces], side="left").tolist()
@@ -333,23 +356,22 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
         out.act_v[row, first:last] = act_v[i, first:last]
 
 
-def _steady_response(plant: PlantRows, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
+def _steady_response(servos: _Servos, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
     """The steady response's polynomials, rows of the same length at once (a constant one
     as a column)."""
-    terms = plant.terms[rows]
-    if (terms == terms[0]).all():
-        return _steady_group(plant, rows, s, int(terms[0]), out.temporary("y", rows))
+    if servos.one_terms >= 0:
+        return _steady_group(servos.steady_y, servos.steady_dy, s, servos.one_terms, out.temporary("y", rows))
+    terms = servos.terms
     y, dy = np.empty_like(s), np.empty_like(s)
     for count in np.unique(terms).tolist():
         group = np.flatnonzero(terms == count)
-        y[group], dy[group] = _steady_group(plant, rows[group], s[group], count, None)
+        y[group], dy[group] = _steady_group(servos.steady_y[group], servos.steady_dy[group], s[group], count, None)
     return y, dy
 
 
-def _steady_group(plant: PlantRows, rows: np.ndarray, s: np.ndarray, terms: int,
+def _steady_group(steady_y: np.ndarray, steady_dy: np.ndarray, s: np.ndarray, terms: int,
                   into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    return (_horner(plant.steady_y[rows, :terms], s, into),
-            _horner(plant.steady_dy[rows, :max(1, terms - 1)], s, None))
+    return _horner(steady_y[:, :terms], s, into), _horner(steady_dy[:, :max(1, terms - 1)], s, None)
 
 
 def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) -> np.ndarray:
@@ -482,9 +504,10 @@ def _free(tables: list[_FreeTable], transients: _Transients, samples: np.ndarray
     return p, q
 
 
-def _read(resolution: np.ndarray, y: np.ndarray, into: np.ndarray | None) -> np.ndarray:
+def _read(servos: _Servos, y: np.ndarray, into: np.ndarray | None) -> np.ndarray:
     """Plant.read, one encoder per row (y/1.0 and x*1.0 are x to the bit: skipped)."""
-    if (resolution == resolution[0]).all():
+    resolution = servos.resolution
+    if servos.one_resolution:
         step = float(resolution[0])
         if step <= 0.0:
             return y
