@@ -60,7 +60,7 @@ class Stretch:
 
     def into_if_full(self, name: str, rows: np.ndarray, *operands: np.ndarray) -> np.ndarray | None:
         """:meth:`into`, when ``operands`` broadcast to (rows, samples) (not to columns)."""
-        # (every operand is 2-D: a column broadcasts; np.broadcast_shapes costs tens of us a call)
+        # (every operand is 2-D, so the shapes say it; np.broadcast_shapes makes arrays to find out)
         if all(x.shape[1] == 1 for x in operands):
             return None
         return self.into(name, rows)
