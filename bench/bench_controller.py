@@ -17,7 +17,7 @@ moves less with the load of other processes).
 Every case can run at several sample rates (``--rates 2000 4000``): the same moves at 4 kHz
 cost twice the samples for the same controller time, so "x real time" is the figure to compare.
 
-    python -P bench/bench_controller.py [--baseline dd12ae1] [--rounds 3] [--rates 2000 4000]
+    python -P bench/bench_controller.py [--baseline dd12ae1] [--rounds 3] [--rates 2000 4000] [--stretch]
 """
 
 from __future__ import annotations
@@ -43,6 +43,13 @@ CASES = [
     (8, 8, "velocity", 4096, 400_000), (8, 8, "velocity", 10, 20_000),
     (32, 16, "velocity", 4096, 400_000), (32, 16, "velocity", 20, 20_000),
     (32, 16, "s-curves", 4096, 40_000), (32, 16, "s-curves", 20, 20_000),
+]
+# --stretch (issue 35): a stretch's fixed cost, in the batches the live suite steps (2 and 20
+# samples) at 8 axes in two-axis supervisors and at 32
+STRETCH_CASES = [
+    (8, 4, "velocity", 2, 20_000), (8, 4, "velocity", 20, 40_000),
+    (32, 16, "velocity", 2, 20_000), (32, 16, "velocity", 20, 40_000),
+    (32, 16, "s-curves", 2, 20_000), (32, 16, "s-curves", 20, 40_000),
 ]
 
 
@@ -140,13 +147,14 @@ def _best(source: Path, case: tuple, rounds: int) -> dict[str, float]:
     return {key: max(run[key] for run in runs) for key in runs[0]}
 
 
-def main(baseline: str = "dd12ae1", rounds: int = 3, rates: tuple[float, ...] = (2000.0,)) -> list[str]:
+def main(baseline: str = "dd12ae1", rounds: int = 3, rates: tuple[float, ...] = (2000.0,),
+         cases: list[tuple[int, int, str, int, int]] | None = None) -> list[str]:
     rows = [f"| rate | axes | supervisors | motion | batch | axis-samples/s | per CPU second | x real time | "
-            f"{baseline}: axis-samples/s | {baseline}: per CPU second | speed-up (CPU) |",
-            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+            f"{baseline}: axis-samples/s | {baseline}: per CPU second | speed-up (CPU) | CPU per step, us |",
+            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     with tempfile.TemporaryDirectory() as scratch:
         old = baseline_tree(baseline, Path(scratch))
-        for case in [(*case, rate) for rate in rates for case in CASES]:
+        for case in [(*case, rate) for rate in rates for case in cases or CASES]:
             new_runs, old_runs = [], []
             for _ in range(rounds):  # alternate, so both see the same load
                 new_runs.append(measure_in(REPO, case))
@@ -156,11 +164,14 @@ def main(baseline: str = "dd12ae1", rounds: int = 3, rates: tuple[float, ...] = 
             axes, supervisors, motion, batch, _, rate = case
             row = (f"| {rate / 1000:g} kHz | {axes} | {supervisors} | {motion} | {batch} | {new['wall']:,.0f} | "
                    f"{new['cpu']:,.0f} | {new['real_time']:,.0f} |")
+            step = f"{axes * batch / new['cpu'] * 1e6:.0f}"  # a step(batch)'s CPU time
             if old_runs:
                 before = {key: max(run[key] for run in old_runs) for key in old_runs[0]}
-                row += f" {before['wall']:,.0f} | {before['cpu']:,.0f} | {new['cpu'] / before['cpu']:.1f}x |"
+                row += f" {before['wall']:,.0f} | {before['cpu']:,.0f} | {new['cpu'] / before['cpu']:.2f}x |"
+                step += f" ({axes * batch / before['cpu'] * 1e6:.0f})"
             else:
                 row += " - | - | - |"
+            row += f" {step} |"
             rows.append(row)
     return rows
 
@@ -171,5 +182,8 @@ if __name__ == "__main__":
     parser.add_argument("--rounds", type=int, default=3, help="runs of each case on each tree (best kept)")
     parser.add_argument("--rates", type=float, nargs="+", default=[2000.0],
                         help="sample rates (Hz) to step every case at (the default 2 kHz; issue 35 asks 4 kHz too)")
+    parser.add_argument("--stretch", action="store_true",
+                        help="the small batches of issue 35 (a stretch's fixed cost) instead of the default cases")
     options = parser.parse_args()
-    print("\n".join(main(options.baseline, options.rounds, tuple(options.rates))))
+    print("\n".join(main(options.baseline, options.rounds, tuple(options.rates),
+                         STRETCH_CASES if options.stretch else None)))

@@ -19,14 +19,13 @@ from collections.abc import Callable, Iterable, Sequence
 import numpy as np
 
 from mpi_ros.mpi.axes.axis import Axis
-from mpi_ros.mpi.axes.bank import AxisBank
+from mpi_ros.mpi.axes.bank import AxisBank, CommandRows, Kind
 from mpi_ros.mpi.axes.scratch import Scratch
 from mpi_ros.mpi.axes.status import (
     BITS,
     EVENT_BITS,
     StretchStatus,
     compute,
-    rising_edges,
 )
 from mpi_ros.mpi.axes.stretch import Stretch
 from mpi_ros.mpi.axes.trace import trace
@@ -682,10 +681,12 @@ class Controller:
         t = float(stretch.t[stop])
         for row, anchors in stretch.anchors.items():
             self.axes[row].keep_anchor(anchors, t)
-        rows = stretch.pieces
         plant = bank.plant
-        for row in rows[t - plant.anchor_t[rows] >= plant.snap_after[rows]].tolist():
-            self.axes[row].snap(t)
+        # only an axis at rest snaps (a finite snap_after): with none, nothing to test
+        if bank.memo("snapping", lambda: bool(np.isfinite(plant.snap_after[bank.of_kind(Kind.PIECE)]).any())):
+            rows = stretch.pieces
+            for row in rows[t - plant.anchor_t[rows] >= plant.snap_after[rows]].tolist():
+                self.axes[row].snap(t)
 
     def _status_events(self, stop: int, stretch: Stretch, status: StretchStatus,
                        taken: dict[int, Snapshots | None]) -> StatusTemplate | None:
@@ -737,25 +738,33 @@ class Controller:
         """The status bits that turn on in samples up to ``stop`` and the frame time limits
         reached, unsorted: (stretch index, axis, rank, type, detail). Read against the bank
         as the stretch found it."""
-        found: list[_Found] = []
         bits = status.bits[:EVENT_BITS, :, : stop + 1]
-        before = self.bank.bits[:EVENT_BITS]
-        # Only a bit that is on somewhere, and not on throughout after being on, can rise.
-        rising = bits.any(axis=2) & ~(bits.all(axis=2) & before)
-        for rank, number in zip(*np.nonzero(rising), strict=True):
-            for i in rising_edges(bool(before[rank, number]), bits[rank, number]):
-                found.append((int(i), int(number), int(rank), _EDGE_EVENTS[rank], ""))
+        # Each sample's bits beside the sample's before (the first: the bank's): one pass
+        # finds every rising edge of every bit and axis.
+        before = self._scratch.take("edges.before", bits.shape, bool)
+        before[:, :, 0] = self.bank.bits[:EVENT_BITS]
+        before[:, :, 1:] = bits[:, :, :-1]
+        rising = np.greater(bits, before, out=before)
+        found: list[_Found] = [(i, number, rank, _EDGE_EVENTS[rank], "")
+                               for rank, number, i in zip(*(x.tolist() for x in np.nonzero(rising)), strict=True)]
         return found + self._frame_time_limits(stop, stretch)
 
     def _frame_time_limits(self, stop: int, stretch: Stretch) -> list[_Found]:
         """MPI 000 mpiMotionStart: a frame lasts at most 16,384,000 samples; a plan cut there
         ends abruptly, reported when the axis gets there."""
-        command = self.bank.command
-        rows = self.bank.memo("truncated", lambda: np.flatnonzero(command.truncated))
-        rows = rows[self.bank.rel[rows] < command.duration[rows]]  # not there yet (nan: no plan running)
-        reached = stretch.rel[rows, : stop + 1] >= command.duration[rows, None]
+        rows, duration = self.bank.command_memo("truncated", lambda: _truncated(self.bank.command))
+        reached = stretch.rel[rows, : stop + 1] >= duration  # (nan: no plan running)
+        if not reached.any():  # (nearly always: one test of them all)
+            return []
+        waiting = self.bank.rel[rows] < duration[:, 0]  # not there yet
         found = []
-        for i in np.flatnonzero(reached.any(axis=1)).tolist():
+        for i in np.flatnonzero(waiting & reached.any(axis=1)).tolist():
             found.append((int(np.argmax(reached[i])), int(rows[i]), -1, MPIEventType.FRAME_TIME_LIMIT,
                           "a frame reached 16,384,000 samples: the axis stopped abruptly"))
         return found
+
+
+def _truncated(command: CommandRows) -> tuple[np.ndarray, np.ndarray]:
+    """The rows whose plan a frame's limit cut, and the (rows, 1) durations of those plans."""
+    rows = np.flatnonzero(command.truncated)
+    return rows, command.duration[rows, None]

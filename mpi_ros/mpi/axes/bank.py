@@ -282,8 +282,9 @@ class AxisBank:
         self.status = StatusRows.empty(axis_count)
         self.clocks = ClockRows.empty(supervisor_count)
         self.tables: list[_FreeTable] = []
-        # (values of any type, each the type its caller's compute gives: memo, clock_memo)
+        # (values of any type, each the type its caller's compute gives: memo, command_memo, clock_memo)
         self._memo: dict[Hashable, Any] = {}
+        self._command_memo: dict[Hashable, Any] = {}  # derived from the command rows: kept while an anchor moves
         self._clock_memo: dict[Hashable, Any] = {}  # derived from the clocks alone: kept while no clock changes
 
     def refresh(self, refresh_row: Callable[[int], None], reanchor_row: Callable[[int], None]) -> None:
@@ -291,14 +292,12 @@ class AxisBank:
         axes whose anchor moved (``reanchor_row(number)``)."""
         stale, moved = np.flatnonzero(self.stale), np.flatnonzero(self.moved & ~self.stale)
         if len(stale):
-            self._memo.clear()
-        elif len(moved):
-            # A moved anchor changes only the axes' kinds and plant rows: what derives from
-            # the command rows (their clocks, the truncated plans) stands, and is not redone
-            # at every piece an axis starts (each sample, stepped a sample at a time).
-            for kind in Kind:
-                self._memo.pop(kind, None)
+            self._command_memo.clear()
         if len(stale) or len(moved):
+            # A moved anchor changes only the axes' kinds and plant rows: what derives from
+            # the command rows alone (command_memo: the truncated plans) stands, and is not
+            # redone at every piece an axis starts (each sample, stepped a sample at a time).
+            self._memo.clear()
             for row in stale.tolist():
                 refresh_row(row)
             for row in moved.tolist():
@@ -310,20 +309,23 @@ class AxisBank:
 
     def memo(self, key: Hashable, compute: Callable[[], T]) -> T:
         """A value derived from the rows, kept until one changes (``compute()`` makes it)."""
-        value = self._memo.get(key)
-        if value is None:
-            value = self._memo[key] = compute()
-        return value
+        return _memoised(self._memo, key, compute)
+
+    def forget(self, key: Hashable) -> None:
+        """Drop what :meth:`memo` keeps for ``key`` (a row it derives from changed)."""
+        self._memo.pop(key, None)
+
+    def command_memo(self, key: Hashable, compute: Callable[[], T]) -> T:
+        """:meth:`memo` for a value derived from the command rows alone: kept while only
+        plant anchors move, until an axis' rows are rebuilt."""
+        return _memoised(self._command_memo, key, compute)
 
     def clock_memo(self, key: Hashable, compute: Callable[[], T]) -> T:
         """:meth:`memo` for a value derived from the clocks (ClockRows) and ``key`` alone:
         kept across changes of the rows (a modify's new plan), until a clock changes."""
-        value = self._clock_memo.get(key)
-        if value is None:
-            if len(self._clock_memo) >= 64:  # (keys of rows no longer planned)
-                self._clock_memo.clear()
-            value = self._clock_memo[key] = compute()
-        return value
+        if len(self._clock_memo) >= 64 and key not in self._clock_memo:  # (keys of rows no longer planned)
+            self._clock_memo.clear()
+        return _memoised(self._clock_memo, key, compute)
 
     def table_index(self, table: _FreeTable) -> int:
         """A small number for a free-response table (axes with identical loops share one)."""
@@ -338,7 +340,16 @@ class AxisBank:
         self.clocks.set(number, clock)
         self.stale |= self.owner == number
         self._memo.clear()
+        self._command_memo.clear()
         self._clock_memo.clear()
 
     def reset_counters(self, row: int) -> None:
         self.runs[:, row] = 0
+
+
+def _memoised(store: dict[Hashable, Any], key: Hashable, compute: Callable[[], T]) -> T:
+    """``store[key]``, made by ``compute()`` the first time it is asked."""
+    value: T | None = store.get(key)
+    if value is None:
+        value = store[key] = compute()
+    return value

@@ -336,7 +336,7 @@ class _FreeTable:
     from the C library's scalar functions (the same on every CPU); beyond, products
     Phi((a + b) dt) = Phi(a dt) Phi(b dt), using M^2 = kappa I."""
 
-    __slots__ = ("_bp", "_bq", "_p2", "_q2", "_vanishing", "block_k", "block_p", "block_q", "k", "kappa", "p", "q")
+    __slots__ = ("_bp", "_bq", "_pq", "_pq2", "_vanishing", "block_k", "block_p", "block_q", "k", "kappa", "p", "q")
 
     def __init__(
         self, p: npt.NDArray[np.float64], q: npt.NDArray[np.float64], k: npt.NDArray[np.float64], kappa: float,
@@ -345,10 +345,11 @@ class _FreeTable:
         self.block_p: list[float] = [1.0]  # Phi(n _TABLE dt) for n = 0, 1, ... (grown on demand)
         self.block_q: list[float] = [0.0]
         self.block_k: list[float] = [1.0]
-        # The table twice over: the remainders of a run of samples that crosses a block
-        # boundary are then one contiguous window.
-        self._p2 = np.concatenate((p[:_TABLE], p[:_TABLE]))
-        self._q2 = np.concatenate((q[:_TABLE], q[:_TABLE]))
+        # p and q as the two rows of one array, so a window reads both at once; and twice
+        # over: the remainders of a run of samples that crosses a block boundary are then
+        # one contiguous window.
+        self._pq = np.stack((p, q))
+        self._pq2 = np.concatenate((self._pq[:, :_TABLE], self._pq[:, :_TABLE]), axis=1)
         self._bp = np.array(self.block_p)
         self._bq = np.array(self.block_q)
         self._vanishing: float | None = None
@@ -389,14 +390,15 @@ class _FreeTable:
         every count stays below _TABLE, else as blocks x remainders; the two agree where
         both apply (block 0 is exactly Phi(0) = I), so any mix of rows is exact. The
         arrays come from ``scratch`` (stretch.Scratch) if given."""
-        def take(name: str) -> np.ndarray | None:
-            return None if scratch is None else scratch.take("free." + name, (len(m0), n))
+        def take(name: str, *shape: int) -> np.ndarray | None:
+            return None if scratch is None else scratch.take("free." + name, (*shape, len(m0), n))
         if int(m0.max()) + n <= _TABLE:
-            return _windows(self.p, m0, n, take("p")), _windows(self.q, m0, n, take("q"))
+            p, q = _windows(self._pq, m0, n, take("pq", 2))
+            return p, q
         blocks, r0 = np.divmod(m0, _TABLE)
         self._blocks(int(blocks.max()) + 1)
         bp, bq = self._block_rows(blocks, r0, n)
-        pr, qr = _windows(self._p2, r0, n, take("pr")), _windows(self._q2, r0, n, take("qr"))
+        pr, qr = _windows(self._pq2, r0, n, take("pqr", 2))
         # bp pr + kappa bq qr and bp qr + bq pr, as `at` sums them
         p = np.multiply(bp, pr, out=take("p"))
         p += np.multiply(self.kappa * bq, qr, out=take("product"))
@@ -440,18 +442,19 @@ class _FreeTable:
 
 
 def _windows(
-    table: npt.NDArray[np.float64], starts: npt.NDArray[np.int64], n: int, out: npt.NDArray[np.float64] | None = None,
+    tables: npt.NDArray[np.float64], starts: npt.NDArray[np.int64], n: int, out: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]:
-    """Rows table[s : s + n] for each start s (copies of contiguous runs), into ``out`` if
-    given. Short rows are gathered by index (s + 0 .. n-1), which costs less to set up than
-    a window view (a stretch of a few samples pays little else); long rows are copied one by
-    one (np.take on a window view would first copy the whole virtual view)."""
+    """(tables, starts, n): rows tables[:, s : s + n] for each start s (copies of contiguous
+    runs), into ``out`` if given. Short rows are gathered by index (s + 0 .. n-1), which
+    costs less to set up than a window view (a stretch of a few samples pays little else);
+    long rows are copied one by one (np.take on a window view would first copy the whole
+    virtual view)."""
     if n < 256:
-        return np.take(table, starts[:, None] + np.arange(n), out=out)
+        return np.take(tables, starts[:, None] + np.arange(n), axis=1, out=out)
     if out is None:
-        return sliding_window_view(table, n)[starts]
+        return sliding_window_view(tables, n, axis=1)[:, starts]
     for row, start in enumerate(starts.tolist()):
-        out[row] = table[start:start + n]
+        out[:, row] = tables[:, start:start + n]
     return out
 
 

@@ -25,6 +25,7 @@ velocity| < velocity tolerance for the settling time.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, fields
 from enum import Enum
@@ -112,14 +113,22 @@ class Runs:
 
     @classmethod
     def never(cls, count: int) -> Runs:
-        return cls(np.zeros(count, dtype=np.int64), np.zeros(count, dtype=bool), _NONE, _NONE)
+        return _never(count)
 
-    def at(self, index: int) -> np.ndarray:
-        """Every row's run length at stretch sample ``index``."""
-        out = np.where(self.every, self.carry + (index + 1), 0)
+    def at(self, index: int, out: np.ndarray) -> None:
+        """``out`` = every row's run length at stretch sample ``index``."""
+        np.multiply(self.every, self.carry + (index + 1), out=out)
         if len(self.mixed):
             out[self.mixed] = self.mixed_runs[:, index]
-        return out
+
+
+@functools.cache
+def _never(count: int) -> Runs:
+    """The runs of a criterion that never holds, one for each number of axes (read only:
+    a Runs is never changed once made)."""
+    carry, every = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=bool)
+    carry.flags.writeable = every.flags.writeable = False
+    return Runs(carry, every, _NONE, _NONE)
 
 
 def settle(criterion: np.ndarray | None, carry: np.ndarray, need: np.ndarray, out: np.ndarray) -> Runs:
@@ -231,7 +240,7 @@ class StretchStatus:
     def counters_at(self, index: int, out: np.ndarray) -> None:
         """``out`` = the (3, axes) settling counters at stretch sample ``index``."""
         for row, runs in zip(out, self.runs, strict=True):
-            row[:] = runs.at(index)
+            runs.at(index, row)
 
 
 class _Arrays:
@@ -356,13 +365,8 @@ class _PickedRuns:
     chosen: Runs
     other: Runs
 
-    def at(self, index: int) -> np.ndarray:
-        return np.where(self.rows, self.chosen.at(index), self.other.at(index))
-
-
-def rising_edges(previous: bool, bits: np.ndarray) -> np.ndarray:
-    """Indices at which a bit turns on."""
-    if not bits.any() or (previous and bits.all()):
-        return _NONE
-    before = np.concatenate(([previous], bits[:-1]))
-    return np.flatnonzero(bits & ~before)
+    def at(self, index: int, out: np.ndarray) -> None:
+        chosen = np.empty_like(out)
+        self.chosen.at(index, chosen)
+        self.other.at(index, out)
+        np.copyto(out, chosen, where=self.rows)

@@ -60,6 +60,7 @@ class Stretch:
 
     def into_if_full(self, name: str, rows: np.ndarray, *operands: np.ndarray) -> np.ndarray | None:
         """:meth:`into`, when ``operands`` broadcast to (rows, samples) (not to columns)."""
-        if np.broadcast_shapes(*(x.shape for x in operands))[1] == 1:
+        # (every operand is 2-D, so the shapes say it; np.broadcast_shapes makes arrays to find out)
+        if all(x.shape[1] == 1 for x in operands):
             return None
         return self.into(name, rows)

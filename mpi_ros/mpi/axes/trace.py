@@ -19,6 +19,7 @@ from __future__ import annotations
 import bisect
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -47,10 +48,11 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
     rows = bank.of_kind(Kind.PIECE)
     if len(rows):
         _command(bank, rows, out)
-        act_p, act_v = _servo(bank.plant, bank.tables, rows, out, direct=True)
+        servos = bank.memo("servos", lambda: _Servos.of(bank.plant, rows))
+        act_p, act_v = _servo(bank.tables, rows, servos, out, direct=True)
         out.place("act_p", rows, act_p)
         out.place("act_v", rows, act_v)
-        ending = t[-1] >= bank.plant.piece_end[rows]
+        ending = t[-1] >= servos.piece_end
         out.pieces = rows[~ending]
         if ending.any():
             _following_pieces(bank, axes, clock_of, rows[ending], out)
@@ -94,30 +96,50 @@ def _steady(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
 # -- the command ------------------------------------------------------------------------
 def _command(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
     """Command of ``rows``: a plan read through the supervisor's clock, or the rest."""
-    planned = bank.command.planned[rows]
-    resting = rows[~planned]
+    plans = bank.memo("plans", lambda: _Plans.of(bank.command, rows))
+    resting = plans.resting
     if len(resting):
         out.cmd_p[resting] = bank.command.rest[resting, None]
         out.cmd_v[resting] = out.cmd_a[resting] = 0.0
         out.rel[resting] = math.nan
-    if planned.any():
-        _planned(bank, rows[planned], out)
+    if len(plans.rows):
+        _planned(bank, plans, out)
 
 
-def _planned(bank: AxisBank, rows: np.ndarray, out: Stretch) -> None:
+@dataclass(frozen=True, slots=True)
+class _Plans:
+    """The pieces' rows that rest and those that run a plan, with what reading the plans
+    takes of the command rows besides their segments (once per bank refresh)."""
+
+    resting: np.ndarray
+    rows: np.ndarray  # planned
+    clocks: bytes  # the clocks the planned rows run on (the key, as a modify keeps them)
+    tau_start: np.ndarray  # (rows, 1)
+    duration: np.ndarray
+
+    @classmethod
+    def of(cls, command: CommandRows, rows: np.ndarray) -> _Plans:
+        planned = command.planned[rows]
+        chosen = rows[planned]
+        return cls(rows[~planned], chosen, command.clock[chosen].tobytes(), command.tau_start[chosen, None],
+                   command.duration[chosen])
+
+
+def _planned(bank: AxisBank, plans: _Plans, out: Stretch) -> None:
     """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate)."""
-    cmd = bank.command
-    numbers = cmd.clock[rows]  # (the clocks the rows run on: the key, as a modify keeps them)
-    which, clocks = bank.clock_memo(numbers.tobytes(), lambda: _clocks_of(bank, numbers))
+    cmd, rows = bank.command, plans.rows
+    which, clocks = bank.clock_memo(plans.clocks, lambda: _clocks_of(bank, cmd.clock[rows]))
     tau, f, df = clocks.evaluate(out.t, out.scratch)
     rel = np.take(tau, which, axis=0, out=out.target("rel", rows))
-    rel -= cmd.tau_start[rows, None]
+    rel -= plans.tau_start
     lo, hi = rel.min(axis=1), rel.max(axis=1)
-    duration = cmd.duration[rows]
+    duration = plans.duration
     # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
     single = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
     if single.all():
-        p, dp, ddp = _segment(cmd, rows, rel, lo, hi, out)
+        # (after the segments _in_one_segment chose)
+        segments = bank.memo("segments", lambda: _Segments.of(cmd, rows))
+        p, dp, ddp = _segment(cmd, rows, segments, rel, lo, hi, out)
     else:
         p, dp, ddp = _segments(bank, rows, rel, lo, hi, single, out)
     f, df = f[which], df[which]
@@ -138,8 +160,9 @@ def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
     shape = rel.shape
     p, dp, ddp = np.empty(shape), np.empty(shape), np.empty(shape)
     if single.any():
-        p[single], dp[single], ddp[single] = _segment(bank.command, rows[single], rel[single], lo[single],
-                                                      hi[single], None)
+        chosen = rows[single]
+        p[single], dp[single], ddp[single] = _segment(bank.command, chosen, _Segments.of(bank.command, chosen),
+                                                      rel[single], lo[single], hi[single], None)
     for i in np.flatnonzero(~single).tolist():
         plan = bank.plans[int(rows[i])]
         assert plan is not None  # (a planned row: written for its plan)
@@ -158,7 +181,11 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     one segment of the plan? A row that moved on to another segment gets it here (one axis
     at a time, only when that happens)."""
     cmd = bank.command
-    keep: np.ndarray = (lo >= cmd.seg_lo[rows]) & (hi < cmd.seg_hi[rows])
+    segments = bank.memo("segments", lambda: _Segments.of(cmd, rows))
+    keep: np.ndarray = (lo >= segments.lo) & (hi < segments.hi)
+    if keep.all():
+        return keep
+    bank.forget("segments")  # (a row may move on to its next segment)
     for i in np.flatnonzero(~keep).tolist():
         row = int(rows[i])
         plan = bank.plans[row]
@@ -173,24 +200,50 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     return keep
 
 
-def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-             out: Stretch | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+@dataclass(frozen=True, slots=True)
+class _Segments:
+    """The segment each of some rows is evaluated in (CommandRows.set_segment), gathered:
+    ``lo``, ``hi``, ``linear`` and ``duration`` per row, the rest as (rows, 1) columns."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+    linear: np.ndarray
+    duration: np.ndarray
+    start: np.ndarray
+    p: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    j: np.ndarray
+
+    @classmethod
+    def of(cls, cmd: CommandRows, rows: np.ndarray) -> _Segments:
+        return cls(cmd.seg_lo[rows], cmd.seg_hi[rows], cmd.linear[rows], cmd.duration[rows],
+                   *(x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
+
+    def of_group(self, group: np.ndarray) -> _Segments:
+        """Those of the rows ``group`` (a mask) picks."""
+        return _Segments(self.lo[group], self.hi[group], self.linear[group], self.duration[group], self.start[group],
+                         self.p[group], self.v[group], self.a[group], self.j[group])
+
+
+def _segment(cmd: CommandRows, rows: np.ndarray, segments: _Segments, rel: np.ndarray, lo: np.ndarray,
+             hi: np.ndarray, out: Stretch | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, d/dtau, d2/dtau2 of each row's plan at profile times ``rel`` (whose extremes
-    are ``lo``, ``hi``): its segment (SegmentTable.evaluate) until the plan's end, the end
-    state from there on (AxisPlan.evaluate). Velocity and acceleration may come back as
-    (rows, 1) columns, constant over the stretch."""
-    duration = cmd.duration[rows]
+    are ``lo``, ``hi``): its segment (SegmentTable.evaluate, ``segments``) until the plan's
+    end, the end state from there on (AxisPlan.evaluate). Velocity and acceleration may come
+    back as (rows, 1) columns, constant over the stretch."""
+    duration = segments.duration
     inside = rel if (hi < duration).all() else np.minimum(rel, duration[:, None])
-    linear = _linear(cmd, rows, np.minimum(lo, duration))
+    linear = _linear(segments, np.minimum(lo, duration))
     position = out.into("cmd_p", rows) if out is not None else None
     if linear.all():
-        pos, vel, acc = _linear_segment(cmd, rows, inside, position)
+        pos, vel, acc = _linear_segment(segments, inside, position)
     elif not linear.any():
-        pos, vel, acc = _cubic_segment(cmd, rows, inside, position)
+        pos, vel, acc = _cubic_segment(segments, inside, position)
     else:
         pos, vel, acc = np.empty_like(rel), np.empty_like(rel), np.empty_like(rel)
         for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
-            pos[group], vel[group], acc[group] = evaluate(cmd, rows[group], inside[group], None)
+            pos[group], vel[group], acc[group] = evaluate(segments.of_group(group), inside[group], None)
     if (hi >= duration).any():
         duration = duration[:, None]
         complete = rel >= duration
@@ -202,28 +255,28 @@ def _segment(cmd: CommandRows, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray
     return pos, vel, acc
 
 
-def _linear(cmd: CommandRows, rows: np.ndarray, lo: np.ndarray) -> np.ndarray:
+def _linear(segments: _Segments, lo: np.ndarray) -> np.ndarray:
     """Rows whose segment has acceleration and jerk +0.0 (CommandRows.linear) and whose
     stretch starts in it (dt >= +0): SegmentTable.evaluate's sums reduce there to p + dt v'
     and v', v' = v + 0.0, to the bit (+0 times a finite dt >= +0 is +0, and x + +0 is x but
     for x = -0.0)."""
-    linear: np.ndarray = cmd.linear[rows] & (lo >= cmd.seg_start[rows])
+    linear: np.ndarray = segments.linear & (lo >= segments.start[:, 0])
     return linear
 
 
-def _linear_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+def _linear_segment(segments: _Segments, inside: np.ndarray,
                     into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    velocity = cmd.v[rows, None] + 0.0
-    pos = np.subtract(inside, cmd.seg_start[rows, None], out=into)
+    velocity = segments.v + 0.0
+    pos = np.subtract(inside, segments.start, out=into)
     pos *= velocity
-    pos += cmd.p[rows, None]
+    pos += segments.p
     return pos, velocity, np.zeros_like(velocity)
 
 
-def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
+def _cubic_segment(segments: _Segments, inside: np.ndarray,
                    into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """SegmentTable.evaluate's sums, operation for operation (x + y and x y commute)."""
-    start, p, v, a, j = (x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j))
+    start, p, v, a, j = segments.start, segments.p, segments.v, segments.a, segments.j
     dt = inside - start
     jerk = dt * j
     pos = np.divide(jerk, 6.0, out=into)
@@ -241,16 +294,40 @@ def _cubic_segment(cmd: CommandRows, rows: np.ndarray, inside: np.ndarray,
 
 
 # -- the servo ----------------------------------------------------------------------------
-def _servo(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, out: Stretch, direct: bool,
+@dataclass(frozen=True, slots=True)
+class _Servos:
+    """What the servo of some rows of PlantRows reads of them, gathered (once per bank
+    refresh for the bank's pieces: bank.memo)."""
+
+    anchor_t: np.ndarray  # (rows, 1)
+    piece_end: np.ndarray
+    terms: np.ndarray
+    one_terms: int  # the coefficients every row uses (-1: not the same for all)
+    steady_y: np.ndarray  # (rows, _MAX_TERMS)
+    steady_dy: np.ndarray
+    resolution: np.ndarray
+    one_resolution: bool  # is the encoder resolution of every row the same?
+    transients: _Transients
+
+    @classmethod
+    def of(cls, plant: PlantRows, rows: np.ndarray) -> _Servos:
+        terms, resolution = plant.terms[rows], plant.resolution[rows]
+        one_terms = int(terms[0]) if len(terms) and (terms == terms[0]).all() else -1
+        return cls(plant.anchor_t[rows, None], plant.piece_end[rows], terms, one_terms, plant.steady_y[rows],
+                   plant.steady_dy[rows], resolution, len(rows) > 0 and bool((resolution == resolution[0]).all()),
+                   _Transients.of(plant, rows))
+
+
+def _servo(tables: list[_FreeTable], rows: np.ndarray, servos: _Servos, out: Stretch, direct: bool,
            following: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Actual position and velocity (Plant.response, read) of ``rows`` of ``plant``, at
-    every sample of the stretch; ``direct``: into the stretch's own arrays where it can;
-    ``following``: pieces that start inside the stretch (the samples before a row's anchor
-    come out meaningless, to be left out)."""
-    s = np.subtract(out.t, plant.anchor_t[rows, None], out=out.temporary("s", rows))
-    y, dy = _steady_response(plant, rows, s, out)
-    y, dy = _add_transient(plant, tables, rows, s, y, dy, out, following)
-    return _read(plant.resolution[rows], y, out.into("act_p", rows) if direct else None), dy
+    """Actual position and velocity (Plant.response, read) of ``rows`` (whose servos are
+    ``servos``), at every sample of the stretch; ``direct``: into the stretch's own arrays
+    where it can; ``following``: pieces that start inside the stretch (the samples before a
+    row's anchor come out meaningless, to be left out)."""
+    s = np.subtract(out.t, servos.anchor_t, out=out.temporary("s", rows))
+    y, dy = _steady_response(servos, rows, s, out)
+    y, dy = _add_transient(tables, servos.transients, s, y, dy, out, following)
+    return _read(servos, y, out.into("act_p", rows) if direct else None), dy
 
 
 def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileClock | None],
@@ -269,7 +346,8 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
             pieces.append((row, start, end))
             out.anchors[row].append(anchor)
     rows_of = PlantRows.of_pieces(followers, bank.table_index)
-    act_p, act_v = _servo(rows_of, bank.tables, np.arange(len(pieces)), out, direct=False, following=True)
+    every = np.arange(len(pieces))
+    act_p, act_v = _servo(bank.tables, every, _Servos.of(rows_of, every), out, direct=False, following=True)
     shape = (len(pieces), len(t))
     act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
     spans = np.searchsorted(t, [(start, end) for _, start, end in pieces], side="left").tolist()
@@ -278,23 +356,22 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
         out.act_v[row, first:last] = act_v[i, first:last]
 
 
-def _steady_response(plant: PlantRows, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
+def _steady_response(servos: _Servos, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
     """The steady response's polynomials, rows of the same length at once (a constant one
     as a column)."""
-    terms = plant.terms[rows]
-    if (terms == terms[0]).all():
-        return _steady_group(plant, rows, s, int(terms[0]), out.temporary("y", rows))
+    if servos.one_terms >= 0:
+        return _steady_group(servos.steady_y, servos.steady_dy, s, servos.one_terms, out.temporary("y", rows))
+    terms = servos.terms
     y, dy = np.empty_like(s), np.empty_like(s)
     for count in np.unique(terms).tolist():
         group = np.flatnonzero(terms == count)
-        y[group], dy[group] = _steady_group(plant, rows[group], s[group], count, None)
+        y[group], dy[group] = _steady_group(servos.steady_y[group], servos.steady_dy[group], s[group], count, None)
     return y, dy
 
 
-def _steady_group(plant: PlantRows, rows: np.ndarray, s: np.ndarray, terms: int,
+def _steady_group(steady_y: np.ndarray, steady_dy: np.ndarray, s: np.ndarray, terms: int,
                   into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    return (_horner(plant.steady_y[rows, :terms], s, into),
-            _horner(plant.steady_dy[rows, :max(1, terms - 1)], s, None))
+    return _horner(steady_y[:, :terms], s, into), _horner(steady_dy[:, :max(1, terms - 1)], s, None)
 
 
 def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) -> np.ndarray:
@@ -311,29 +388,69 @@ def _horner(coefficients: np.ndarray, s: np.ndarray, into: np.ndarray | None) ->
     return out
 
 
-def _add_transient(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, s: np.ndarray, y: np.ndarray,
-                   dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Plant.response's transient added to the rows that have one."""
-    if following:
+@dataclass(frozen=True, slots=True)
+class _Transients:
+    """The rows with a transient among some rows of PlantRows, and what adding it reads of
+    them (gathered once per bank refresh for the bank's pieces: bank.memo)."""
+
+    where: slice | np.ndarray  # those rows among the rows: all of them (a slice), or their indices
+    rows: np.ndarray  # their rows of PlantRows
+    v0: np.ndarray  # (rows, 1) columns of the Transient's parts
+    m0: np.ndarray
+    v1: np.ndarray
+    m1: np.ndarray
+    decayed: np.ndarray  # (rows, 1): PlantRows.decayed_after
+    vanishing: np.ndarray  # PlantRows.vanishing
+    k0: np.ndarray
+    table: np.ndarray
+    dropped: bool  # may one be dropped once decayed (a finite decayed_after)?
+    first_vanishing: float  # the first sample from which one of them is exact zeros
+    one_table: int  # the free-response table every one reads (-1: not one for all)
+
+    @classmethod
+    def of(cls, plant: PlantRows, rows: np.ndarray) -> _Transients:
         live = plant.decayed_after[rows] > -math.inf
-    else:
-        live = _live_transients(plant, rows, int(out.samples[0]), y, dy, out)
-    if not live.any():
+        where = slice(None) if live.all() else np.flatnonzero(live)
+        picked = rows[where]
+        return cls.gathered(where, picked, plant.v0[picked, None], plant.m0[picked, None], plant.v1[picked, None],
+                            plant.m1[picked, None], plant.decayed_after[picked, None], plant.vanishing[picked],
+                            plant.k0[picked], plant.table[picked])
+
+    @classmethod
+    def gathered(cls, where: slice | np.ndarray, rows: np.ndarray, v0: np.ndarray, m0: np.ndarray, v1: np.ndarray,
+                 m1: np.ndarray, decayed: np.ndarray, vanishing: np.ndarray, k0: np.ndarray,
+                 table: np.ndarray) -> _Transients:
+        one = len(table) > 0 and bool((table == table[0]).all())
+        return cls(where, rows, v0, m0, v1, m1, decayed, vanishing, k0, table, not bool(np.isposinf(decayed).all()),
+                   float(vanishing.min(initial=math.inf)), int(table[0]) if one else -1)
+
+    def kept(self, keep: np.ndarray) -> _Transients:
+        """Those at indices ``keep`` among them."""
+        where = keep if isinstance(self.where, slice) else self.where[keep]
+        return self.gathered(where, self.rows[keep], self.v0[keep], self.m0[keep], self.v1[keep], self.m1[keep],
+                             self.decayed[keep], self.vanishing[keep], self.k0[keep], self.table[keep])
+
+
+def _add_transient(tables: list[_FreeTable], transients: _Transients, s: np.ndarray, y: np.ndarray,
+                   dy: np.ndarray, out: Stretch, following: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Plant.response's transient added to the rows that have one (``transients``)."""
+    added = transients if following else _not_vanished(transients, int(out.samples[0]), y, dy)
+    if added is None or not len(added.rows):
         return y, dy
+    transients = added
     y, dy = _full(y, s.shape, out, "y"), _full(dy, s.shape, out, "dy")
-    sub = slice(None) if live.all() else np.flatnonzero(live)
-    rows, decayed = rows[sub], plant.decayed_after[rows[sub]]
-    p, q = _free(plant, tables, rows, out.samples, out.scratch, following)
-    h0 = np.multiply(p, plant.v0[rows, None], out=out.temporary("h0", rows))
-    h0 += np.multiply(q, plant.m0[rows, None], out=out.temporary("product", rows))
-    h1 = np.multiply(p, plant.v1[rows, None], out=out.temporary("h1", rows))
-    h1 += np.multiply(q, plant.m1[rows, None], out=out.temporary("product", rows))
-    if np.isposinf(decayed).all():
+    sub, rows = transients.where, transients.rows
+    p, q = _free(tables, transients, out.samples, out.scratch, following)
+    h0 = np.multiply(p, transients.v0, out=out.temporary("h0", rows))
+    h0 += np.multiply(q, transients.m0, out=out.temporary("product", rows))
+    h1 = np.multiply(p, transients.v1, out=out.temporary("h1", rows))
+    h1 += np.multiply(q, transients.m1, out=out.temporary("product", rows))
+    if not transients.dropped:
         y[sub] += h0
         dy[sub] += h1
         return y, dy
     # At rest on a constant command the transient is dropped once it has decayed.
-    settled = s[sub] >= decayed[:, None]
+    settled = s[sub] >= transients.decayed
     y[sub] = np.where(settled, y[sub], y[sub] + h0)
     dy[sub] = np.where(settled, dy[sub], dy[sub] + h1)
     return y, dy
@@ -348,54 +465,49 @@ def _full(values: np.ndarray, shape: tuple[int, int], out: Stretch, name: str) -
     return full
 
 
-def _live_transients(plant: PlantRows, rows: np.ndarray, first: int, y: np.ndarray, dy: np.ndarray,
-                     out: Stretch) -> np.ndarray:
-    """Per row: must its transient be added? Not without one; nor where the free response
-    has underflowed to exact zeros over the whole stretch (a long-settled loop), since
-    adding a zero changes nothing, unless a value is itself a zero (whose sign it might
-    flip): there it is added as ever."""
-    live: np.ndarray = plant.decayed_after[rows] > -math.inf
-    if not live.any():
-        return live
-    vanished: np.ndarray = live & (first >= plant.vanishing[rows])
-    if vanished.any():
-        vanished &= ~(_has_zero(y, vanished, out) | _has_zero(dy, vanished, out))
-    added: np.ndarray = live & ~vanished
-    return added
+def _not_vanished(transients: _Transients, first: int, y: np.ndarray, dy: np.ndarray) -> _Transients | None:
+    """The transients that must be added from sample ``first`` on (None: none): not those
+    whose free response has underflowed to exact zeros over the whole stretch (a
+    long-settled loop), since adding a zero changes nothing, unless a value is itself a
+    zero (whose sign it might flip): there it is added as ever."""
+    if first < transients.first_vanishing:  # (none has vanished yet)
+        return transients
+    sub = transients.where
+    vanished: np.ndarray = first >= transients.vanishing
+    vanished &= ~(_has_zero(y[sub]) | _has_zero(dy[sub]))
+    if not vanished.any():
+        return transients
+    return None if vanished.all() else transients.kept(np.flatnonzero(~vanished))
 
 
-def _has_zero(values: np.ndarray, rows: np.ndarray, out: Stretch) -> np.ndarray:
-    """Per row (False where ``rows`` is not set): does it hold a zero?"""
-    has: np.ndarray
-    if values.shape[1] == 1:
-        has = rows & (values[:, 0] == 0.0)
-        return has
-    zero = np.equal(values, 0.0, out=out.scratch.take("zero", values.shape, bool))
-    has = rows & zero.any(axis=1)
+def _has_zero(values: np.ndarray) -> np.ndarray:
+    """Per row: does it hold a zero?"""
+    has: np.ndarray = (values == 0.0).any(axis=1)
     return has
 
 
-def _free(plant: PlantRows, tables: list[_FreeTable], rows: np.ndarray, samples: np.ndarray, scratch: Scratch,
+def _free(tables: list[_FreeTable], transients: _Transients, samples: np.ndarray, scratch: Scratch,
           following: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(p, q) of the free response at every sample of each row, from its loop's table (for
-    ``following`` rows, sample counts before the anchor read as 0)."""
-    which = plant.table[rows]
-    first, n = int(samples[0]), len(samples)
-    if not following and (which == which[0]).all():
-        return tables[int(which[0])].window(first - plant.k0[rows], n, scratch)
-    p, q = np.empty((len(rows), n)), np.empty((len(rows), n))
+    """(p, q) of the free response at every sample of each of ``transients``' rows, from its
+    loop's table (for ``following`` rows, sample counts before the anchor read as 0)."""
+    first, n, k0 = int(samples[0]), len(samples), transients.k0
+    if not following and transients.one_table >= 0:
+        return tables[transients.one_table].window(first - k0, n, scratch)
+    which = transients.table
+    p, q = np.empty((len(k0), n)), np.empty((len(k0), n))
     for index in np.unique(which).tolist():
         group = np.flatnonzero(which == index)
         if following:
-            p[group], q[group] = tables[index].at(np.maximum(samples - plant.k0[rows[group], None], 0))
+            p[group], q[group] = tables[index].at(np.maximum(samples - k0[group, None], 0))
         else:
-            p[group], q[group] = tables[index].window(first - plant.k0[rows[group]], n)
+            p[group], q[group] = tables[index].window(first - k0[group], n)
     return p, q
 
 
-def _read(resolution: np.ndarray, y: np.ndarray, into: np.ndarray | None) -> np.ndarray:
+def _read(servos: _Servos, y: np.ndarray, into: np.ndarray | None) -> np.ndarray:
     """Plant.read, one encoder per row (y/1.0 and x*1.0 are x to the bit: skipped)."""
-    if (resolution == resolution[0]).all():
+    resolution = servos.resolution
+    if servos.one_resolution:
         step = float(resolution[0])
         if step <= 0.0:
             return y
