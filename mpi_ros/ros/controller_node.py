@@ -97,7 +97,8 @@ class ControllerNode(Node):
     <ns>/robot_description (none: not published)."""
 
     def __init__(self, runner: ControllerRunner, settings: RosSettings, joints: Sequence[AxisJoint] | None = None,
-                 robot_description: str | None = None, flash: Path | None = None, **kwargs):
+                 robot_description: str | None = None, flash: Path | None = None,
+                 packer: wire.Packer | None = None, **kwargs):
         super().__init__("controller", namespace=settings.namespace, **kwargs)
         self.runner = runner
         self.settings = settings
@@ -113,6 +114,9 @@ class ControllerNode(Node):
         # the wall-clock time of sample 0 (the suite anchors its controller before building nodes)
         epoch = convert.epoch_of(runner.ctl)
         self.epoch_ns = convert.anchor(runner.ctl) if epoch is None else epoch
+        # the supervisors' statuses hold the same axis snapshots: one Packer for the suite packs
+        # each axis once a sample (wire.Packer)
+        self._packer = packer or wire.Packer(runner.ctl.rate, self.epoch_ns, settings.namespace)
         self._service_group = ReentrantCallbackGroup()
         ns = settings.namespace
         self._ns = ns
@@ -278,9 +282,10 @@ class ControllerNode(Node):
     def _collect_axis_status(self, ctl, at: AtSample):
         # packed straight into CDR and published raw where the interfaces allow (wire.py: the
         # same bytes, a third of the work)
-        encode = wire.axis_status if wire.AVAILABLE else convert.axis_status
+        encode = (self._packer.axis_status if wire.AVAILABLE else
+                  lambda snap: convert.axis_status(snap, ctl.rate, self.epoch_ns, self.settings.namespace))
         publishers = self._pub_axis_status
-        sends = [(publishers[snap.number], encode(snap, ctl.rate, self.epoch_ns, self.settings.namespace))
+        sends = [(publishers[snap.number], encode(snap))
                  for snap in at.taken()[1] if ctl.axes[snap.number].valid and snap.number in publishers]
         return lambda: convert.publish_all(self, sends)
 

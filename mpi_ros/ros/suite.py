@@ -21,7 +21,7 @@ from rclpy.executors import MultiThreadedExecutor
 from .. import description
 from ..config import SuiteConfig
 from ..runner import ControllerRunner
-from . import convert, rcl
+from . import convert, rcl, wire
 from .controller_node import ControllerNode
 from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
@@ -55,14 +55,17 @@ class Suite:
         self.controller = config.build_controller()
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)
         self.runner = ControllerRunner(self.controller, time_scale, publish_period=config.ros.publish_period)
+        # one Packer for every status topic: a supervisor's status holds its axes' bodies as packed
+        # for their own topics, at the same sample (wire.Packer)
+        packer = wire.Packer(self.controller.rate, self.epoch_ns, config.ros.namespace)
         self.controller_node = ControllerNode(self.runner, config.ros, config.axis_joints(), self.robot_description,
-                                              flash=config.flash, context=context)
+                                              flash=config.flash, packer=packer, context=context)
         self.goal_loop: GoalLoop | GoalRelay = (
             GoalRelay(config.ros.namespace, config.ros.executor_threads) if config.ros.goal_process
             else GoalLoop(self.controller_node.context, config.ros.executor_threads))
         self.supervisor_nodes = [
             SupervisorNode(self.runner, spec.number, config.ros, self.goal_loop, spec.lost_client_timeout,
-                           joints=config.axis_joints(), context=context)
+                           joints=config.axis_joints(), packer=packer, context=context)
             for spec in config.supervisors
         ]
         self.configuration = self.controller_node.publish_configuration(config)

@@ -88,9 +88,12 @@ class _RosGoal:
 
 class SupervisorNode(Node):
     def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings, goal_loop: GoalLoop | GoalRelay,
-                 lost_client_timeout: float = 0.0, joints: list[AxisJoint] | None = None, **kwargs):
+                 lost_client_timeout: float = 0.0, joints: list[AxisJoint] | None = None,
+                 packer: wire.Packer | None = None, **kwargs):
         super().__init__(f"ms{number}", namespace=settings.namespace, **kwargs)
         self.runner = runner
+        # the suite's Packer (Suite): an axis' body packed for its own topic is reused here
+        self._packer = packer or wire.Packer(runner.ctl.rate, convert.epoch_of(runner.ctl), settings.namespace)
         self.number = number
         self.settings = settings
         self._shutting_down = False
@@ -191,8 +194,8 @@ class SupervisorNode(Node):
         if snap is None:
             return None
         # packed straight into CDR and published raw where the interfaces allow (wire.py)
-        encode = wire.motion_status if wire.AVAILABLE else convert.motion_status
-        msg = encode(snap, ctl.rate, convert.epoch_of(ctl), self.settings.namespace)
+        msg = (self._packer.motion_status(snap) if wire.AVAILABLE
+               else convert.motion_status(snap, ctl.rate, convert.epoch_of(ctl), self.settings.namespace))
         return lambda: convert.publish(self, self._pub_status, msg)
 
     # -- JointTrajectory commands -----------------------------------------------------
