@@ -15,6 +15,7 @@ from __future__ import annotations
 import sys
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
 
@@ -27,6 +28,7 @@ from .goal_front import GoalRelay
 from .goal_loop import GoalLoop
 from .spinner import Spinner
 from .supervisor_node import SupervisorNode
+from .watchdog import WatchdogTicker
 
 
 class Suite:
@@ -63,9 +65,11 @@ class Suite:
         self.goal_loop: GoalLoop | GoalRelay = (
             GoalRelay(config.ros.namespace, config.ros.executor_threads) if config.ros.goal_process
             else GoalLoop(self.controller_node.context, config.ros.executor_threads))
+        # one timer for every supervisor's lost-client watchdog, on the controller node (watchdog.py)
+        watchdogs = WatchdogTicker(self.controller_node, ReentrantCallbackGroup())
         self.supervisor_nodes = [
             SupervisorNode(self.runner, spec.number, config.ros, self.goal_loop, spec.lost_client_timeout,
-                           joints=config.axis_joints(), packer=packer, context=context)
+                           joints=config.axis_joints(), packer=packer, watchdogs=watchdogs, context=context)
             for spec in config.supervisors
         ]
         self.configuration = self.controller_node.publish_configuration(config)

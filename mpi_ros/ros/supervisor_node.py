@@ -71,7 +71,7 @@ from .goal_loop import GoalLoop
 from .goal_server import ABORT, CANCELED, SUCCEED, Callbacks, GoalServer
 from .goal_tracker import GoalBook, TrackedGoal
 from .stock_goal_server import StockGoalServer
-from .watchdog import LostClientWatchdog
+from .watchdog import LostClientWatchdog, WatchdogTicker
 
 # A goal whose cancel was accepted is still in one of these until its GoalServer has moved it
 # to CANCELING (right after our cancel callback returns); only then may it end CANCELED.
@@ -89,7 +89,7 @@ class _RosGoal:
 class SupervisorNode(Node):
     def __init__(self, runner: ControllerRunner, number: int, settings: RosSettings, goal_loop: GoalLoop | GoalRelay,
                  lost_client_timeout: float = 0.0, joints: list[AxisJoint] | None = None,
-                 packer: wire.Packer | None = None, **kwargs):
+                 packer: wire.Packer | None = None, watchdogs: WatchdogTicker | None = None, **kwargs):
         super().__init__(f"ms{number}", namespace=settings.namespace, **kwargs)
         self.runner = runner
         # the suite's Packer (Suite): an axis' body packed for its own topic is reused here
@@ -144,8 +144,10 @@ class SupervisorNode(Node):
         self.create_subscription(JointTrajectory, gn.JOINT_TRAJECTORY.name(ns, number), self._on_trajectory,
                                  profile(gn.JOINT_TRAJECTORY.qos),
                                  callback_group=self._service_group)
+        # its checks on the suite's one watchdog timer (``watchdogs``, Suite) where there is one
         self.watchdog = (LostClientWatchdog(self, lost_client_timeout, self._running, self._client_lost,
-                                            self._service_group) if lost_client_timeout > 0 else None)
+                                            self._service_group, ticker=watchdogs)
+                         if lost_client_timeout > 0 else None)
 
     def held(self) -> dict[str, int]:
         """What this node holds of its goals (for /diagnostics: none of it may grow without

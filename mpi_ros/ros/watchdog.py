@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
+from rclpy.timer import Timer
 
 PERIOD = 0.1  # s between looks at the graph (shorter for a shorter timeout)
 DETACHED = "_detached"  # the end of a client node's name whose goals are left running on purpose
@@ -73,6 +74,39 @@ def describe(keys: Iterable[bytes]) -> str:
     return ", ".join(key.hex()[:8] for key in keys)
 
 
+class WatchdogTicker:
+    """One timer for every lost-client watchdog of a suite (``add(period, check)``), on one
+    node. Why not a timer per supervisor: each woke its node's executor ten times a second,
+    and rclpy rebuilds a node's wait set (its dozen services, its actions) at every wake; at
+    16 supervisors that was about 10 % of a core (bench/RESULTS.md, "The suite under load").
+    The timer runs at the shortest period asked for: a look at the graph sooner than a
+    watchdog needs changes nothing it decides."""
+
+    def __init__(self, node: Node, group: CallbackGroup):
+        self._node = node
+        self._group = group
+        self._checks: list[Callable[[], None]] = []
+        self._period: float | None = None
+        self._timer: Timer | None = None
+
+    def add(self, period: float, check: Callable[[], None]) -> None:
+        """Call ``check()`` at least every ``period`` s (before the executor spins)."""
+        self._checks.append(check)
+        if self._period is None or period < self._period:
+            if self._timer is not None:
+                self._node.destroy_timer(self._timer)
+            self._period = period
+            self._timer = self._node.create_timer(period, self._tick, callback_group=self._group)
+
+    @property
+    def period(self) -> float | None:
+        return self._period
+
+    def _tick(self) -> None:
+        for check in self._checks:
+            check()
+
+
 class LostClientWatchdog:
     """``watch(goal id, feedback topic)`` when a goal is accepted; ``running(keys)`` answers
     which of them still run (the goal book); ``on_lost(detail)`` is called (from the timer,
@@ -80,7 +114,7 @@ class LostClientWatchdog:
 
     def __init__(self, node: Node, timeout: float, running: Callable[[list[bytes]], set[bytes]],
                  on_lost: Callable[[str], None], group: CallbackGroup,
-                 clock: Callable[[], float] = time.monotonic):
+                 clock: Callable[[], float] = time.monotonic, ticker: WatchdogTicker | None = None):
         self.node = node
         self.timeout = timeout
         self._running = running
@@ -88,7 +122,9 @@ class LostClientWatchdog:
         self._clock = clock
         self._goals: dict[bytes, _Watched] = {}
         self._lock = threading.Lock()
-        self.timer = node.create_timer(min(PERIOD, max(timeout / 4.0, 0.01)), self.check, callback_group=group)
+        # the suite's one timer (WatchdogTicker) where there is one, else a timer of its own
+        self.ticker = ticker or WatchdogTicker(node, group)
+        self.ticker.add(min(PERIOD, max(timeout / 4.0, 0.01)), self.check)
 
     def watch(self, key: bytes, topic: str) -> None:
         subscribers = _subscribers(self.node, topic)

@@ -181,7 +181,7 @@ def test_the_watchdog_times_the_clients_absence_and_forgives_a_return():
     graph.subscribers[topic] = [b"A" * 16, b"B" * 16]
     watchdog = LostClientWatchdog(graph, 1.0, lambda keys: running & set(keys), lost.append, None,
                                   clock=lambda: now[0])
-    assert watchdog.timer.period == 0.1
+    assert watchdog.ticker.period == 0.1
     watchdog.watch(b"g" * 16, topic)
     graph.subscribers[topic] = [b"B" * 16]  # one of the two candidates remains: maybe the sender
     now[0] = 5.0
@@ -268,3 +268,30 @@ def test_a_goal_whose_clients_are_all_detached_is_not_watched():
     watchdog.check()
     assert watchdog.watched == 0
     assert len(lost) == 1
+
+
+def test_the_watchdogs_of_a_suite_share_one_timer_at_the_shortest_period():
+    """One timer for every supervisor's watchdog (WatchdogTicker): a timer each woke every
+    supervisor's executor ten times a second (bench/RESULTS.md). Each tick runs every check."""
+    from mpi_ros.ros.watchdog import LostClientWatchdog, WatchdogTicker
+
+    graph, lost = FakeGraph(), []
+    timers = []
+    graph.create_timer = lambda period, callback, callback_group=None: timers.append(
+        SimpleNamespace(period=period, callback=callback)) or timers[-1]
+    graph.destroy_timer = timers.remove
+    ticker = WatchdogTicker(graph, None)
+    running = {b"a" * 16, b"b" * 16}
+    slow = LostClientWatchdog(graph, 2.0, lambda keys: running & set(keys), lost.append, None,
+                              clock=lambda: 10.0, ticker=ticker)
+    fast = LostClientWatchdog(graph, 0.2, lambda keys: running & set(keys), lost.append, None,
+                              clock=lambda: 10.0, ticker=ticker)
+    assert [t.period for t in timers] == [0.05] and ticker.period == 0.05  # the shorter: 0.2 / 4
+    topics = {b"a" * 16: "/mpi/ms0/motion_start/_action/feedback", b"b" * 16: "/mpi/ms1/motion_start/_action/feedback"}
+    for key, topic in topics.items():
+        graph.subscribers[topic] = [key]
+    slow.watch(b"a" * 16, topics[b"a" * 16])
+    fast.watch(b"b" * 16, topics[b"b" * 16])
+    running.clear()  # both goals ended: one tick has each watchdog forget its own
+    timers[0].callback()
+    assert slow.watched == fast.watched == 0 and not lost
