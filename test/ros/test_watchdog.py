@@ -286,7 +286,8 @@ def test_the_watchdogs_of_a_suite_share_one_timer_at_the_shortest_period():
                               clock=lambda: 10.0, ticker=ticker)
     fast = LostClientWatchdog(graph, 0.2, lambda keys: running & set(keys), lost.append, None,
                               clock=lambda: 10.0, ticker=ticker)
-    assert [t.period for t in timers] == [0.05] and ticker.period == 0.05  # the shorter: 0.2 / 4
+    assert [t.period for t in timers] == [0.05]  # one timer, at the shorter period: 0.2 / 4
+    assert ticker.period == 0.05
     topics = {b"a" * 16: "/mpi/ms0/motion_start/_action/feedback", b"b" * 16: "/mpi/ms1/motion_start/_action/feedback"}
     for key, topic in topics.items():
         graph.subscribers[topic] = [key]
@@ -294,4 +295,5 @@ def test_the_watchdogs_of_a_suite_share_one_timer_at_the_shortest_period():
     fast.watch(b"b" * 16, topics[b"b" * 16])
     running.clear()  # both goals ended: one tick has each watchdog forget its own
     timers[0].callback()
-    assert slow.watched == fast.watched == 0 and not lost
+    assert slow.watched == fast.watched == 0
+    assert not lost
