@@ -44,7 +44,12 @@ class StopSignals:
         """The signal received, or None once ``done()`` is true (asked every ``poll`` s)."""
         while not self.caught and not done():
             received = signal.sigtimedwait(self.signals, poll)
-            if received is not None:
+            # Only a signal of the set counts: CPython 3.11's sigtimedwait, interrupted (EINTR)
+            # after its timeout has run out, answers a siginfo it never filled in (its loop
+            # breaks to fill_siginfo). A profiler or debugger attaching (ptrace) interrupts it:
+            # `py-spy record --native` on the suite ended it with "ValueError: -198506496 is
+            # not a valid Signals". Such an answer is a timeout.
+            if received is not None and received.si_signo in self.signals:
                 return signal.Signals(received.si_signo)
         return self.caught[0] if self.caught else None
 

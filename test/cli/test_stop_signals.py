@@ -97,3 +97,15 @@ def test_after_insist_the_next_signal_has_its_default_action():
         stops.insist()
         assert signal.getsignal(signal.SIGUSR1) == signal.SIG_DFL
         assert not SIGNALS & signal.pthread_sigmask(signal.SIG_BLOCK, [])
+
+
+def test_an_answer_of_sigtimedwait_outside_the_set_is_a_timeout_not_a_crash(monkeypatch):
+    # CPython 3.11's sigtimedwait, interrupted after its timeout ran out (a profiler attaching
+    # by ptrace does it), answers an unfilled siginfo: here the number py-spy's attach gave.
+    garbage = signal.struct_siginfo((-198506496, 0, 0, 0, 0, 0, 0))
+    answers = iter([garbage, signal.struct_siginfo((0, 0, 0, 0, 0, 0, 0)), None])
+    monkeypatch.setattr(signal, "sigtimedwait", lambda signals, timeout: next(answers))
+    polls = iter([False, False, False, True])
+    stops = stop_signals.StopSignals(SIGNALS)
+    assert stops.wait(done=lambda: next(polls), poll=0.01) is None
+    assert next(answers, "all asked") == "all asked"
