@@ -18,6 +18,7 @@ import struct
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
 from rosidl_parser import definition as d
 
 from .cdr import HEADER
@@ -134,3 +135,10 @@ def _execute(program: list[tuple[str, Any]], data: bytes) -> list:
             values.append(struct.unpack_from(f"<{count}{detail}", data, HEADER + pos))
             pos += size * count
     return values
+
+
+def gather(buffer: np.ndarray, at: np.ndarray, dtype: str) -> np.ndarray:
+    """The little-endian values of ``dtype`` at byte offsets ``at`` of ``buffer`` (bytes as
+    uint8, the offsets unaligned): one field of many records read at once."""
+    size = np.dtype(dtype).itemsize
+    return buffer[at[:, None] + np.arange(size)].view(dtype)[:, 0]

@@ -7,6 +7,7 @@ says so in words (replay reports it), and nothing raises for the cut itself.
 
 from __future__ import annotations
 
+import io
 import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -14,16 +15,17 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
 from mcap.reader import make_reader
-from mcap.records import Channel, Chunk, Message, Metadata, Schema
+from mcap.records import Channel, Chunk, ChunkIndex, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader, get_chunk_data_stream
 from mcap_ros2._dynamic import generate_dynamic
 
-from . import schema
+from . import fields, schema
 
 
 def _older(type_name: str, schema_text: str) -> bool:
@@ -291,6 +293,42 @@ class BagReader:
                 if isinstance(record, Message) and record.channel_id in sources:
                     yield sources[record.channel_id], record.sequence, record.log_time, record.data
 
+    def columns(self, topics: Iterable[str]) -> list[Column]:
+        """The messages of ``topics``, a column per channel: what :meth:`payloads` gives,
+        with the positions ordering them as stored. A finished bag's are found by its
+        message indexes (MCAP's "Message Index": where each channel's messages lie in a
+        chunk), read as arrays, one pass per chunk and channel; a bag whose indexes are not
+        all there or do not agree with its chunks is read message by message."""
+        wanted = set(topics)
+        found = self._indexed(wanted) if self._scan is None else None
+        return found if found is not None else _columns(self.payloads(wanted))
+
+    def _indexed(self, wanted: set[str]) -> list[Column] | None:
+        """:meth:`columns` by the message indexes; None where they cannot be trusted: not
+        there for every message the summary's statistics count, or not pointing at a
+        message of their channel inside the chunk."""
+        with open(self.path, "rb") as stream:
+            summary = self._reader(stream).get_summary()
+            if summary is None or summary.statistics is None:
+                return None
+            sources = {cid: _source(summary.schemas[channel.schema_id], channel)
+                       for cid, channel in summary.channels.items()
+                       if channel.topic in wanted and channel.schema_id in summary.schemas}
+            parts: dict[int, list[tuple]] = {cid: [] for cid in sources}
+            base = 0  # the chunk's first position: the records of the chunks before it
+            for index in sorted(summary.chunk_indexes, key=lambda index: index.chunk_start_offset):
+                if sources.keys() & index.message_index_offsets.keys():
+                    for cid, part in _chunk_columns(stream, index, sources.keys()).items():
+                        if part is None:
+                            return None
+                        sequence, log_time, offsets, data = part
+                        parts[cid].append((sequence, log_time, offsets + base, data))
+                base += index.uncompressed_size
+        counts = summary.statistics.channel_message_counts
+        if any(sum(len(part[0]) for part in parts[cid]) != counts.get(cid, 0) for cid in sources):
+            return None
+        return [_column(sources[cid], chunk_parts) for cid, chunk_parts in parts.items()]
+
     def decoded(self, topics: Iterable[str] | None = None) -> Iterator[tuple[Recorded, Any]]:
         for recorded in self.messages(topics):
             yield recorded, recorded.decode()
@@ -326,6 +364,80 @@ def _chunk_payloads(chunk: Chunk, sources: dict[int, Source]) -> Iterator[tuple[
             if source is not None:
                 yield source, sequence, log_time, data[pos + _MESSAGE.size:pos + length]
         pos += length
+
+
+@dataclass(frozen=True, slots=True)
+class Column:
+    """The messages of one channel, in the order they are stored (:meth:`BagReader.columns`)."""
+
+    source: Source
+    sequence: np.ndarray  # int64, the writer's count on the topic
+    log_time: np.ndarray  # int64, ns
+    position: np.ndarray  # int64: orders the messages of every column of a read as they are stored
+    data: list[bytes]  # CDR
+
+
+def _column(source: Source, parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, list[bytes]]]) -> Column:
+    """A column of the parts of a channel's messages (sequences, log times, positions, CDR)."""
+    def joined(k: int) -> np.ndarray:
+        return np.concatenate([part[k] for part in parts]).astype(np.int64) if parts else np.zeros(0, np.int64)
+
+    return Column(source, joined(0), joined(1), joined(2), [data for part in parts for data in part[3]])
+
+
+def _columns(payloads: Iterable[tuple[Source, int, int, bytes]]) -> list[Column]:
+    """Columns of messages read one by one (:meth:`BagReader.payloads`)."""
+    rows: dict[Source, list[tuple[int, int, int, bytes]]] = {}
+    for position, (source, sequence, log_time, data) in enumerate(payloads):
+        rows.setdefault(source, []).append((sequence, log_time, position, data))
+    return [_column(source, [(np.array([row[0] for row in found]), np.array([row[1] for row in found]),
+                              np.array([row[2] for row in found]), [row[3] for row in found])])
+            for source, found in rows.items()]
+
+
+_INDEX_HEAD = struct.Struct("<BQHI")  # a Message Index record: opcode, length, channel id, entries' length
+
+
+def _chunk_columns(stream, index: ChunkIndex, channels: Iterable[int]) -> dict[int, tuple | None]:
+    """(sequence, log time, offset in the chunk, CDR) of the messages of ``channels`` in the
+    chunk of ``index``, by their message indexes (after the chunk, in the same read); None
+    for a channel whose index does not point at its messages."""
+    stream.seek(index.chunk_start_offset)
+    raw = stream.read(index.chunk_length + index.message_index_length)
+    records, end = get_chunk_data_stream(Chunk.read(ReadDataStream(io.BytesIO(raw[_RECORD.size:index.chunk_length]))))
+    data = records.read(end)
+    chunk = np.frombuffer(data, np.uint8)
+    found: dict[int, tuple | None] = {}
+    for cid in channels:
+        at = index.message_index_offsets.get(cid)
+        if at is None:
+            continue
+        at -= index.chunk_start_offset
+        opcode, _, channel, length = _INDEX_HEAD.unpack_from(raw, at)
+        if opcode != Opcode.MESSAGE_INDEX or channel != cid or at + _INDEX_HEAD.size + length > len(raw):
+            found[cid] = None
+            continue
+        # (log time, offset) pairs of uint64: the offsets
+        offsets = np.frombuffer(raw, "<u8", length // 8, at + _INDEX_HEAD.size)[1::2].astype(np.int64)
+        found[cid] = _messages_at(data, chunk, offsets, cid)
+    return found
+
+
+def _messages_at(data: bytes, chunk: np.ndarray, offsets: np.ndarray, cid: int) -> tuple | None:
+    """The Message records of channel ``cid`` at ``offsets`` of a chunk's records, read
+    at their fixed offsets (opcode, length, then _MESSAGE); None if one is not such a record."""
+    if not ((offsets >= 0) & (offsets + _RECORD.size + _MESSAGE.size <= len(data))).all():
+        return None
+    lengths = fields.gather(chunk, offsets + 1, "<u8")
+    ends = offsets + _RECORD.size + lengths.astype(np.int64)
+    channels = fields.gather(chunk, offsets + _RECORD.size, "<u2")
+    if not ((chunk[offsets] == Opcode.MESSAGE).all() and (channels == cid).all()
+            and (lengths >= _MESSAGE.size).all() and (ends <= len(data)).all()):
+        return None
+    starts = offsets + _RECORD.size + _MESSAGE.size
+    sequence = fields.gather(chunk, offsets + _RECORD.size + 2, "<u4").astype(np.int64)
+    log_time = fields.gather(chunk, offsets + _RECORD.size + 6, "<u8").astype(np.int64)
+    return sequence, log_time, offsets, [data[a:b] for a, b in zip(starts.tolist(), ends.tolist(), strict=True)]
 
 
 def _source(schema_: Schema, channel: Channel) -> Source:

@@ -17,11 +17,14 @@ differences; otherwise the report names the first divergence: where, which field
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, NamedTuple
 
+import numpy as np
 from mcap.exceptions import McapError
 
 from .. import config as suite_config
@@ -30,7 +33,7 @@ from ..commands import Command, apply
 from ..mpi.control import MAX_STRETCH
 from ..ros import convert, wire
 from . import fields, schema
-from .reader import BagReader, load_yaml
+from .reader import BagReader, Column, Source, load_yaml
 from .recorder import COMMAND_TYPE, COMMANDS_TOPIC, CONFIGURATION_TYPE, METADATA_NAME, NOT_REPLAYED, commands_topic
 
 _SKIPPED_FIELDS = frozenset({"stamp"})  # derived from the sample; compared when the bag has the epoch
@@ -238,25 +241,27 @@ def replay(path: str | Path, overrides: dict | None = None, tolerance: float = 0
     replayed_events: list = []
     ctl.listeners.append(lambda e: replayed_events.append(e) if e.type_name not in NOT_REPLAYED else None)
     report = ReplayReport(str(path), truncated=reader.truncated)
-    timeline, recorded_events, first_recorded = _timeline(reader, recording)
+    timeline = _timeline(reader, recording)
     statuses = _Statuses(ctl, recording, tolerance)
     report.last_sample = ctl.sample
-    runs = list(_runs(timeline))
-    for entries, following in zip(runs, [*runs[1:], None], strict=True):
-        if entries[0][1] == 1:
-            _apply(ctl, report, entries[0])
+    steps = list(_steps(timeline))
+    for step, following in zip(steps, [*steps[1:], None], strict=True):
+        if isinstance(step, _Command):
+            _apply(ctl, report, step)
             # where stepping entry by entry would have left the controller
-            report.last_sample = max(report.last_sample, entries[0][0])
+            report.last_sample = max(report.last_sample, step.sample)
         else:
+            samples = timeline.statuses.sample[step]
             # on to where a command follows in the same go: a stretch fewer than stepping there apart
-            until = following[0][0] if following is not None and following[0][1] == 1 else entries[-1][0]
-            statuses.take(list(dict.fromkeys(entry[0] for entry in entries)), until)
-            statuses.compare_run(report, entries, stop_at_first)
+            until = following.sample if isinstance(following, _Command) else samples[-1]
+            statuses.take(list(dict.fromkeys(samples)), until)
+            statuses.compare_run(report, timeline.statuses, step, stop_at_first)
         if stop_at_first and report.first is not None:
             break
     # a recording of the graph holds the events from when it started; mpi-ros record has them all
-    since = (first_recorded if first_recorded is not None else report.last_sample + 1) if recording.graph else 0
-    _compare_events(report, recorded_events, replayed_events, ctl.rate, tolerance, recording.epoch_ns,
+    first = timeline.first_recorded
+    since = (first if first is not None else report.last_sample + 1) if recording.graph else 0
+    _compare_events(report, timeline.events, replayed_events, ctl.rate, tolerance, recording.epoch_ns,
                     statuses.skipped, since, recording.namespace)
     return report
 
@@ -269,40 +274,130 @@ _STATUS_KEYS: dict[str, Callable[[bytes], tuple]] = {
     for name in STATUS_TYPES}
 
 
-def _timeline(reader: BagReader, recording: Recording) -> tuple[list[tuple], list, int | None]:
-    """What replay does in order, sorted: (controller sample, 0 status / 1 command, then what
-    orders them: sequence, log time, position; the Source, the CDR, the status' supervisor or
-    axis number (None for a command), the message decoded); the recorded events in the order
-    they were written; the first sample the recording saw (a graph recording may start late).
+class _Command(NamedTuple):
+    """A recorded command, applied while the controller is at ``sample`` (the one before it
+    took effect at); then what orders commands of the same sample: as they were written."""
+
+    sample: int
+    sequence: int
+    log_time: int
+    position: int
+    topic: str
+    msg: Any
+
+
+@dataclass(frozen=True, slots=True)
+class _Recorded:
+    """The recorded statuses in the order they are compared, a list per field (no object a
+    status: a recording's are many, and the garbage collector would go through each): the
+    sample, whether a MotionStatus (else an AxisStatus), the supervisor's or axis' number,
+    the CDR, the source (an index into ``sources``) and, for a status decoded to find its
+    sample (a bag recorded before the type changed), the message by its index."""
+
+    sample: list[int]
+    motion: list[bool]
+    number: list[int]
+    data: list[bytes]
+    source: list[int]
+    sources: list[Source]
+    decoded: dict[int, Any]
+
+    def message(self, index: int):
+        """The ``index``-th status, decoded."""
+        found = self.decoded.get(index)
+        return found if found is not None else self.sources[self.source[index]].recorded(0, self.data[index]).decode()
+
+
+@dataclass(frozen=True, slots=True)
+class _Timeline:
+    """What replay compares and applies, each in order: the statuses by sample (those of a
+    sample in the order written), the commands by the sample they are applied at, the
+    recorded events as written, and the first sample the recording saw (a graph recording
+    may start late)."""
+
+    statuses: _Recorded
+    commands: list[_Command]
+    events: list
+    first_recorded: int | None
+
+
+def _timeline(reader: BagReader, recording: Recording) -> _Timeline:
+    """The bag's statuses, commands and events, read a column per topic (BagReader.columns).
 
     Statuses are most of a recording: their sample and number are read from the CDR and the
-    message is decoded only if the replayed bytes differ (None until then). The messages
-    are read in the order they are stored (the order they were written in), several times
-    faster than in log-time order; the sequence, log time and position sort them as
-    log-time order did."""
-    recorded_events = []
-    timeline: list[tuple] = []
-    commands = set(recording.commands)
-    wanted = [*recording.commands, *recording.statuses] + ([recording.events] if recording.events else [])
-    for position, (source, sequence, log_time, data) in enumerate(reader.payloads(wanted)):
-        if source.topic in commands:
-            msg = source.recorded(log_time, data, sequence).decode()
-            # applied while the controller was one sample before the one it took effect at
-            timeline.append((msg.sample - 1, 1, sequence, log_time, position, source, data, None, msg))
+    message is decoded only if the replayed bytes differ; they are sorted as arrays, by
+    sample, then as they were written (sequence, log time, and where stored)."""
+    columns = reader.columns([*recording.commands, *recording.statuses]
+                             + ([recording.events] if recording.events else []))
+    commands, recorded_events = [], []
+    status_columns = []
+    for column in columns:
+        source = column.source
+        rows = zip(column.sequence.tolist(), column.log_time.tolist(), column.position.tolist(), column.data,
+                   strict=True)
+        if source.topic in recording.commands:
+            for sequence, log_time, position, data in rows:
+                msg = source.recorded(log_time, data, sequence).decode()
+                commands.append(_Command(msg.sample - 1, sequence, log_time, position, source.topic, msg))
         elif source.topic == recording.events:
-            recorded_events.append(((sequence, log_time, position), source.recorded(log_time, data, sequence).decode()))
-        elif source.older:
-            msg = source.recorded(log_time, data, sequence).decode()
-            timeline.append((msg.sample, 0, sequence, log_time, position, source, data, msg.number, msg))
+            recorded_events += [((sequence, log_time, position), source.recorded(log_time, data, sequence).decode())
+                                for sequence, log_time, position, data in rows]
         else:
-            sample, number = _STATUS_KEYS[source.type](data)
-            # statuses at a sample were taken before commands given at that sample
-            timeline.append((sample, 0, sequence, log_time, position, source, data, number, None))
-    timeline.sort()  # no two entries have the same position: the sort never compares what follows it
-    seen = [entry[0] for entry in timeline if entry[1] == 0] + [msg.sample for _, msg in recorded_events]
+            status_columns.append(column)
+    commands.sort()  # no two have the same position: the sort never compares what follows it
+    statuses = _sorted_statuses(status_columns)
+    seen = statuses.sample[:1] + [msg.sample for _, msg in recorded_events]
     # the order they were written in, which ties in log time may not keep
     events = [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0]) if msg.type not in NOT_REPLAYED]
-    return timeline, events, min(seen, default=None)
+    return _Timeline(statuses, commands, events, min(seen, default=None))
+
+
+def _sorted_statuses(columns: list[Column]) -> _Recorded:
+    """The statuses of ``columns`` (status topics), sorted by (sample, sequence, log time,
+    position)."""
+    keys, decoded = [], []
+    for column in columns:
+        source = column.source
+        if source.older:
+            msgs = [source.recorded(0, data).decode() for data in column.data]
+            keys.append(np.array([(msg.sample, msg.number) for msg in msgs], np.int64).reshape(-1, 2))
+            decoded += msgs
+        else:
+            keys.append(_status_keys(source.type, column.data))
+            decoded += [None] * len(column.data)
+
+    def joined(arrays: list[np.ndarray]) -> np.ndarray:
+        return np.concatenate(arrays or [np.zeros(0, np.int64)])
+
+    samples, numbers = joined([key[:, 0] for key in keys]), joined([key[:, 1] for key in keys])
+    order = np.lexsort((joined([column.position for column in columns]),
+                        joined([column.log_time for column in columns]),
+                        joined([column.sequence for column in columns]), samples))
+    which = np.repeat(np.arange(len(columns)), [len(column.data) for column in columns])[order]
+    motion = np.array([column.source.type == STATUS_TYPES[0] for column in columns], bool)
+    data = [x for column in columns for x in column.data]
+    at = order.tolist()
+    return _Recorded(samples[order].tolist(), motion[which].tolist(), numbers[order].tolist(),
+                     [data[i] for i in at], which.tolist(), [column.source for column in columns],
+                     {k: decoded[i] for k, i in enumerate(at) if decoded[i] is not None})
+
+
+def _status_keys(type_name: str, data: list[bytes]) -> np.ndarray:
+    """The (sample, number) of statuses of type ``type_name`` (CDR), as rows: read together
+    where wire.sample_and_number reads one (after the header's stamp and frame_id, the
+    uint64 sample 8-aligned, then the int32 number); one by one by _STATUS_KEYS where that
+    does not hold (other interfaces, or bytes not laid out so: it says what is wrong)."""
+    lengths = np.fromiter(map(len, data), np.int64, len(data))
+    starts = np.cumsum(lengths) - lengths
+    joined = np.frombuffer(b"".join(data), np.uint8)
+    head = len(wire.HEADER)
+    if wire.AVAILABLE and (lengths >= head + 12).all():
+        frame = fields.gather(joined, starts + head + 8, "<u4").astype(np.int64)
+        at = starts + head + ((12 + frame + 7) & -8)
+        if (at + 12 <= starts + lengths).all() and (joined[starts + 1] == wire.HEADER[1]).all():
+            return np.stack([fields.gather(joined, at, "<u8").astype(np.int64),
+                             fields.gather(joined, at + 8, "<i4").astype(np.int64)], axis=1)
+    return np.array(list(map(_STATUS_KEYS[type_name], data)), np.int64).reshape(-1, 2)
 
 
 class _Statuses:
@@ -334,34 +429,33 @@ class _Statuses:
         taken = ctl.step_snapshots(max(wanted[-1], until) - ctl.sample, wanted)
         self.taken = {sample: taken[at] for sample, at in zip(samples, wanted, strict=True)}
 
-    def compare_run(self, report: ReplayReport, entries: list[tuple], stop_at_first: bool) -> None:
-        """Compare a run's statuses (timeline entries, in order; their snapshots taken by
+    def compare_run(self, report: ReplayReport, recorded: _Recorded, run: slice, stop_at_first: bool) -> None:
+        """Compare a run of the recorded statuses (in order; their snapshots taken by
         :meth:`take`): their bytes, or their fields where the bytes differ; with
         ``stop_at_first``, up to the first difference."""
-        packer, motion_type = self.packer, STATUS_TYPES[0]
-        for entry in entries:
-            sample, _, _, _, _, source, data, number, msg = entry
-            # where stepping entry by entry would have left the controller
+        packer = self.packer
+        for index, sample, motion, number, data in zip(range(run.start, run.stop), recorded.sample[run],
+                                                       recorded.motion[run], recorded.number[run], recorded.data[run],
+                                                       strict=True):
+            # where stepping status by status would have left the controller
             report.last_sample = max(report.last_sample, sample)
             report.statuses += 1
-            motion = source.type == motion_type
             snap = self._snapshot(sample, motion, number)
-            if msg is None and packer is not None and data == (
+            if packer is not None and index not in recorded.decoded and data == (
                     packer.motion_status(snap) if motion else packer.axis_status(snap)):
                 report.values += self._leaves(motion, snap)
                 continue
-            self._compare_fields(report, entry, motion, snap)
+            self._compare_fields(report, recorded, index, snap)
             if stop_at_first and report.first is not None:
                 return
 
-    def _compare_fields(self, report: ReplayReport, entry: tuple, motion: bool, snap) -> None:
-        """One status (a timeline entry) and its snapshot, field by field."""
-        sample, _, sequence, log_time, _, source, data, _, msg = entry
-        ctl = self.ctl
-        replayed = (convert.motion_status if motion else convert.axis_status)(snap, ctl.rate, self.epoch or 0,
+    def _compare_fields(self, report: ReplayReport, recorded: _Recorded, index: int, snap) -> None:
+        """The ``index``-th recorded status and its snapshot, field by field."""
+        motion = recorded.motion[index]
+        replayed = (convert.motion_status if motion else convert.axis_status)(snap, self.ctl.rate, self.epoch or 0,
                                                                                 self.namespace)
-        recorded = msg if msg is not None else source.recorded(log_time, data, sequence).decode()
-        _compare(report, sample, source.topic, recorded, replayed, self.tolerance, self.skipped)
+        _compare(report, recorded.sample[index], recorded.sources[recorded.source[index]].topic,
+                 recorded.message(index), replayed, self.tolerance, self.skipped)
 
     def _snapshot(self, sample: int, motion: bool, number: int):
         """The replayed snapshot of supervisor or axis ``number`` at ``sample``."""
@@ -388,33 +482,34 @@ def _step_to(ctl, sample: int) -> None:
         ctl.step(sample - ctl.sample)
 
 
-def _apply(ctl, report: ReplayReport, entry: tuple) -> None:
+def _apply(ctl, report: ReplayReport, command: _Command) -> None:
     """A recorded command, applied at the sample before the one it took effect at."""
-    sample, _, _, _, _, source, _, _, msg = entry
-    topic = source.topic
-    _step_to(ctl, sample)
+    msg = command.msg
+    _step_to(ctl, command.sample)
     reply = apply(ctl, Command.from_json(msg.operation, msg.supervisor, msg.axis, msg.request))
     report.commands += 1
     if reply.message.name != msg.message:
-        report.record(Divergence(msg.sample, topic, f"{msg.operation}.message", msg.message, reply.message.name))
+        report.record(Divergence(msg.sample, command.topic, f"{msg.operation}.message", msg.message,
+                                 reply.message.name))
 
 
-def _runs(timeline: list[tuple]) -> Iterator[list[tuple]]:
-    """The timeline in runs: each command alone, and the statuses between two commands in
-    runs of at most RUN samples. A run of statuses is stepped through at once, its
-    snapshots taken inside the controller's stretches (Controller.step_snapshots): a stretch
-    costs about the same whatever its length, and was cut at every status (issue 35)."""
-    run: list[tuple] = []
-    for entry in timeline:
-        if run and (entry[1] == 1 or entry[0] - run[0][0] > RUN):
-            yield run
-            run = []
-        if entry[1] == 1:
-            yield [entry]
-        else:
-            run.append(entry)
-    if run:
-        yield run
+def _steps(timeline: _Timeline) -> Iterator[_Command | slice]:
+    """The timeline in steps: each command alone, and the statuses between two commands
+    (slices of timeline.statuses) in runs of at most RUN samples. A run of statuses is
+    stepped through at once, its snapshots taken inside the controller's stretches
+    (Controller.step_snapshots): a stretch costs about the same whatever its length, and
+    was cut at every status (issue 35)."""
+    samples = timeline.statuses.sample
+    start = 0
+    for command in [*timeline.commands, None]:
+        # the statuses before a command: those of samples up to the one it is applied at
+        stop = len(samples) if command is None else bisect.bisect_right(samples, command.sample, lo=start)
+        while start < stop:
+            end = bisect.bisect_right(samples, samples[start] + RUN, start, stop)
+            yield slice(start, end)
+            start = end
+        if command is not None:
+            yield command
 
 
 def _compare_events(report: ReplayReport, recorded, replayed, rate: float, tolerance: float,
