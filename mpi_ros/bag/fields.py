@@ -70,6 +70,12 @@ def _run_structs(codes: list[str]) -> tuple[tuple[struct.Struct, int], ...]:
     return tuple(table)
 
 
+def field_names(msg_class: Any) -> list[str]:
+    """Every field of a message, nested ones flattened (dotted names, e.g. "header.stamp.sec"),
+    in the order of its CDR."""
+    return [name for name, _, _ in _layout(msg_class)]
+
+
 def field_reader(msg_class: Any, wanted: Sequence[str]) -> Callable[[bytes], tuple]:
     """A function of a message's CDR (as recorded, header included) giving the ``wanted``
     fields in that order (dotted names for nested ones, e.g. "stamp.sec"; a sequence as a

@@ -21,6 +21,7 @@ import bisect
 import math
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from operator import attrgetter
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -274,16 +275,72 @@ _STATUS_KEYS: dict[str, Callable[[bytes], tuple]] = {
     for name in STATUS_TYPES}
 
 
+# What replay reads of a recorded command: when it took effect, and what it asked and was answered
+_COMMAND_FIELDS = ("sample", "operation", "supervisor", "axis", "request", "message")
+
+
 class _Command(NamedTuple):
     """A recorded command, applied while the controller is at ``sample`` (the one before it
-    took effect at); then what orders commands of the same sample: as they were written."""
+    took effect at); then what orders commands of the same sample: as they were written;
+    its topic and its _COMMAND_FIELDS."""
 
     sample: int
     sequence: int
     log_time: int
     position: int
     topic: str
-    msg: Any
+    fields: tuple
+
+
+class _Event(NamedTuple):
+    """A recorded event: its sample and type, every field of it (fields.field_names of the
+    installed type; None where the bag's definition is another: compared field by field)
+    and its CDR."""
+
+    sample: int
+    type: str
+    values: tuple | None
+    source: Source
+    data: bytes
+
+    def message(self):
+        return self.source.recorded(0, self.data).decode()
+
+
+def _reader(source: Source, names: Sequence[str]) -> Callable[[bytes], tuple | None]:
+    """``names`` (dotted) of a message of ``source``, read from its CDR without building it
+    (fields.field_reader: neither rclpy's serialization nor the type's support loaded);
+    None where they cannot be read so (a bag recorded before the type changed)."""
+    try:
+        read = None if source.older else fields.field_reader(schema.message_class(source.type), names)
+    except fields.Unreadable:
+        read = None
+
+    def values(data: bytes) -> tuple | None:
+        try:
+            return read(data) if read is not None else None
+        except fields.Unreadable:  # big-endian CDR
+            return None
+
+    return values
+
+
+def _command(source: Source, sequence: int, log_time: int, position: int, data: bytes,
+             read: Callable[[bytes], tuple | None]) -> _Command:
+    found = read(data)
+    if found is None:
+        found = attrgetter(*_COMMAND_FIELDS)(source.recorded(log_time, data, sequence).decode())
+    return _Command(found[0] - 1, sequence, log_time, position, source.topic, found)
+
+
+def _event(source: Source, data: bytes, read: Callable[[bytes], tuple | None], sample_and_type: tuple[int, int]
+           ) -> _Event:
+    """A recorded event; ``sample_and_type``: where its sample and type are among what ``read`` reads."""
+    values = read(data)
+    if values is None:
+        msg = source.recorded(0, data).decode()
+        return _Event(msg.sample, msg.type, None, source, data)
+    return _Event(values[sample_and_type[0]], values[sample_and_type[1]], values, source, data)
 
 
 @dataclass(frozen=True, slots=True)
@@ -329,26 +386,29 @@ def _timeline(reader: BagReader, recording: Recording) -> _Timeline:
     sample, then as they were written (sequence, log time, and where stored)."""
     columns = reader.columns([*recording.commands, *recording.statuses]
                              + ([recording.events] if recording.events else []))
-    commands, recorded_events = [], []
+    commands: list[_Command] = []
+    recorded_events: list[tuple[tuple[int, int, int], _Event]] = []
     status_columns = []
     for column in columns:
         source = column.source
         rows = zip(column.sequence.tolist(), column.log_time.tolist(), column.position.tolist(), column.data,
                    strict=True)
         if source.topic in recording.commands:
-            for sequence, log_time, position, data in rows:
-                msg = source.recorded(log_time, data, sequence).decode()
-                commands.append(_Command(msg.sample - 1, sequence, log_time, position, source.topic, msg))
+            read = _reader(source, _COMMAND_FIELDS)
+            commands += [_command(source, *row, read) for row in rows]
         elif source.topic == recording.events:
-            recorded_events += [((sequence, log_time, position), source.recorded(log_time, data, sequence).decode())
+            names = fields.field_names(schema.message_class(source.type))
+            read, at = _reader(source, names), (names.index("sample"), names.index("type"))
+            recorded_events += [((sequence, log_time, position), _event(source, data, read, at))
                                 for sequence, log_time, position, data in rows]
         else:
             status_columns.append(column)
     commands.sort()  # no two have the same position: the sort never compares what follows it
     statuses = _sorted_statuses(status_columns)
-    seen = statuses.sample[:1] + [msg.sample for _, msg in recorded_events]
+    seen = statuses.sample[:1] + [event.sample for _, event in recorded_events]
     # the order they were written in, which ties in log time may not keep
-    events = [msg for _, msg in sorted(recorded_events, key=lambda pair: pair[0]) if msg.type not in NOT_REPLAYED]
+    events = [event for _, event in sorted(recorded_events, key=lambda pair: pair[0])
+              if event.type not in NOT_REPLAYED]
     return _Timeline(statuses, commands, events, min(seen, default=None))
 
 
@@ -484,13 +544,12 @@ def _step_to(ctl, sample: int) -> None:
 
 def _apply(ctl, report: ReplayReport, command: _Command) -> None:
     """A recorded command, applied at the sample before the one it took effect at."""
-    msg = command.msg
+    sample, operation, supervisor, axis, request, message = command.fields
     _step_to(ctl, command.sample)
-    reply = apply(ctl, Command.from_json(msg.operation, msg.supervisor, msg.axis, msg.request))
+    reply = apply(ctl, Command.from_json(operation, supervisor, axis, request))
     report.commands += 1
-    if reply.message.name != msg.message:
-        report.record(Divergence(msg.sample, command.topic, f"{msg.operation}.message", msg.message,
-                                 reply.message.name))
+    if reply.message.name != message:
+        report.record(Divergence(sample, command.topic, f"{operation}.message", message, reply.message.name))
 
 
 def _steps(timeline: _Timeline) -> Iterator[_Command | slice]:
@@ -523,9 +582,16 @@ def _compare_events(report: ReplayReport, recorded, replayed, rate: float, toler
         horizon -= 1
     replayed = [convert.motion_event(e, rate, epoch or 0, namespace) for e in replayed if since <= e.sample <= horizon]
     recorded = [e for e in recorded if e.sample <= horizon]
+    if replayed:
+        # an event has no sequence of messages: as many values each, counted once
+        leaves = sum(1 for _ in _flatten(convert.to_dict(replayed[0]), skipped=skipped))
+        values = attrgetter(*fields.field_names(type(replayed[0])))
     # pairs up to the shorter list: a difference in count is a divergence of its own (below)
     for i, (old, new) in enumerate(zip(recorded, replayed, strict=False)):
         report.events += 1
-        _compare(report, old.sample, f"event[{i}]", old, new, tolerance, skipped)
+        if old.values is not None and old.values == values(new):  # every field exact (false for a NaN)
+            report.values += leaves
+        else:
+            _compare(report, old.sample, f"event[{i}]", old.message(), new, tolerance, skipped)
     if len(recorded) != len(replayed):
         report.record(Divergence(horizon, "events", "count", len(recorded), len(replayed)))

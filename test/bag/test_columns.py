@@ -122,3 +122,21 @@ def test_statuses_whose_bytes_are_not_laid_out_as_expected_are_read_one_by_one()
     data[3] = data[3][:12] + struct.pack("<I", 10_000) + data[3][16:]
     with pytest.raises(struct.error):
         replay_module._status_keys(column.source.type, data)
+
+
+@pytest.mark.parametrize("name", ["two_supervisors", "faults"])
+def test_commands_and_events_read_from_their_bytes_are_what_decoding_gives(name: str):
+    """Replay reads what it uses of the commands and every field of the events from their
+    CDR (fields.field_reader), without rclpy's serialization."""
+    from operator import attrgetter
+
+    from mpi_ros.bag import fields, schema
+
+    reader = BagReader(BAGS / name)
+    for column in reader.columns(["/mpi/commands", "/mpi/events"]):
+        names = (replay_module._COMMAND_FIELDS if column.source.topic == "/mpi/commands"
+                 else tuple(fields.field_names(schema.message_class(column.source.type))))
+        read = replay_module._reader(column.source, names)
+        assert [read(data) for data in column.data] == [
+            attrgetter(*names)(column.source.recorded(0, data).decode()) for data in column.data]
+        assert len(column.data) > 1

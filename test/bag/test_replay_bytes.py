@@ -111,3 +111,20 @@ def test_a_changed_axis_inside_a_motion_status_is_reported_there_only(tmp_path: 
     first = report.first
     assert (first.sample, first.topic, first.field) == (sample, "/mpi/ms0/status", "axes[1].settled")
     assert first.recorded != first.replayed
+
+
+def test_a_changed_event_is_reported_at_its_sample_and_field(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    """Events equal as messages are counted without comparing their fields one by one: one
+    that differs is still reported, as the field-by-field comparison of every event did."""
+    def renumbered(msg) -> None:
+        msg.move_id += 1
+
+    copy, sample = _with_one_status_changed(tmp_path, "two_supervisors", "/mpi/events", 3, renumbered)
+    report = replay(copy)
+    assert report.differences == 1, report.summary()
+    first = report.first
+    assert (first.sample, first.topic, first.field) == (sample, "event[3]", "move_id")
+    assert first.difference == 1
+    monkeypatch.setattr(replay_module.convert.MotionEvent, "__eq__", lambda self, other: False)
+    assert _figures(report) == _figures(replay(copy))
+    assert _figures(replay(BAGS / "two_supervisors"))[2] == _figures(replay(copy))[2]  # the values counted
