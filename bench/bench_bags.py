@@ -75,11 +75,13 @@ print(json.dumps({"wall": wall, "cpu": cpu, "identical": report.identical, "summ
 
 
 # Where a replay's thread CPU time goes: each phase's functions wrapped with a timer (the
-# snapshots are inside the stepping's figure; "the rest" is what no phase covers).
+# snapshots, their templates and the objects built from them, are inside the stepping's
+# figure, and so is the garbage collector's time there; "the rest" is what no phase covers).
 _PARTS = """
 import json, sys, time
 sys.path.insert(0, sys.argv[1])
 from mpi_ros.bag import replay as R
+from mpi_ros.mpi import snapshots
 from mpi_ros.mpi.control import Controller
 spent = {}
 def timed(name, run):
@@ -92,7 +94,9 @@ def timed(name, run):
     return wrapper
 R._timeline = timed("reading the bag (timeline)", R._timeline)
 R._Statuses.take = timed("stepping with snapshots", R._Statuses.take)
-Controller.motion_snapshots = timed("of which the snapshots", Controller.motion_snapshots)
+for owner, name in ((Controller, "status_template"), (getattr(snapshots, "StatusTemplate", None), "at")):
+    if hasattr(owner, name):  # where the snapshots of a stretch are made
+        setattr(owner, name, timed("of which the snapshots", getattr(owner, name)))
 R._Statuses.compare_run = timed("packing and comparing the statuses", R._Statuses.compare_run)
 R._apply = timed("the commands (stepping to them, applying)", R._apply)
 start = time.thread_time()
