@@ -92,8 +92,10 @@ def check_running_type(running: MPIMotionType) -> Outcome:
 def check_attributes(
     motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool
 ) -> Outcome:
-    bad = Message.MPIMotionMessageATTRIBUTE_INVALID
     bits = int(attrs)
+    if not bits:  # (the usual start or modify: every check below is of an attribute given)
+        return OK
+    bad = Message.MPIMotionMessageATTRIBUTE_INVALID
     disallowed = bits & (_DISALLOWED_BITS.get(motion_type, 0) | _FORBIDDEN_BITS.get(motion_type, 0))
     if disallowed:
         return _bad(bad, f"{motion_type.name} moves may not have {MotionAttr(disallowed).names()}")
