@@ -9,7 +9,7 @@ which carries one. :class:`MoveEnd` is an outcome of a move with where its axes 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from mpi_ros.mpi.base.messages import Message
 
@@ -24,10 +24,12 @@ class Outcome:
 
     message: Message
     detail: str = ""
+    # The message is OK: kept with the outcome, as a field, since every check of every command
+    # asks (a property would be a Python call each time); not compared, shown or given.
+    ok: bool = field(init=False, repr=False, compare=False)
 
-    @property
-    def ok(self) -> bool:
-        return self.message is _OK
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "ok", self.message is _OK)  # (the frozen dataclass' way to set it)
 
     def prefixed(self, prefix: str) -> Outcome:
         """The same outcome with ``prefix`` before the field it names (for nested structs)."""

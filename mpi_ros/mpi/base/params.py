@@ -163,6 +163,42 @@ def check_duration(name: str, value: object, positive: bool = False) -> Outcome:
     return check_range(name, value, 0.0, MAX_DURATION, above_low=positive)
 
 
+def _magnitudes(struct: object, limits: tuple[tuple[str, float], ...]) -> Outcome:
+    """check_magnitude of each (field, limit) of ``struct`` in turn: the first refusal, else
+    VALID. A finite float within its limit, nearly every value, passes on one test here (abs
+    of a NaN or an infinity is not <= a limit); any other is check_magnitude's to answer."""
+    for name, limit in limits:
+        value = getattr(struct, name)
+        if type(value) is not float or not abs(value) <= limit:
+            verdict = check_magnitude(name, value, limit)
+            if not verdict.ok:
+                return verdict
+    return VALID
+
+
+def _longs(struct: object, names: tuple[str, ...]) -> Outcome:
+    """check_long of each field ``names`` of ``struct`` in turn: the first refusal, else VALID
+    (a plain int in range passes on one test, as in check_integer)."""
+    for name in names:
+        value = getattr(struct, name)
+        if type(value) is not int or not LONG_MIN <= value <= LONG_MAX:
+            verdict = check_long(name, value)
+            if not verdict.ok:
+                return verdict
+    return VALID
+
+
+def _each_magnitude(name: str, values: Iterable[object], limit: float) -> Outcome:
+    """:func:`_each` with check_magnitude at ``limit``, a finite float within it passing on one
+    test (as in :func:`_magnitudes`)."""
+    for i, value in enumerate(values):
+        if type(value) is not float or not abs(value) <= limit:
+            verdict = check_magnitude(f"{name}[{i}]", value, limit)
+            if not verdict.ok:
+                return verdict
+    return VALID
+
+
 def _each(name: str, values: Iterable[object], check: Callable[[str, object], Outcome]) -> Outcome:
     """The first of ``values`` that ``check`` refuses, named by its index ("position[3]: ..."),
     else VALID. The indexed name is made for a refusal only: every value of every start and
@@ -188,12 +224,10 @@ def _each_struct(name: str, structs: Iterable[_Validated]) -> Outcome:
     return VALID
 
 
-def _check_velocity(name: str, value: object) -> Outcome:
-    return check_magnitude(name, value, MAX_VELOCITY)
-
-
-def _check_ratio(name: str, value: object) -> Outcome:
-    return check_magnitude(name, value, MAX_RATIO)
+# Trajectory's fields and the magnitude each may have
+_TRAJECTORY_LIMITS = (("velocity", MAX_VELOCITY), ("acceleration", MAX_ACCELERATION),
+                      ("deceleration", MAX_ACCELERATION), ("jerk_percent", 100.0),
+                      ("acceleration_jerk", MAX_JERK), ("deceleration_jerk", MAX_JERK))
 
 
 @dataclass(slots=True)
@@ -217,14 +251,11 @@ class Trajectory:
         type and is checked with the move (validate.check_params): VELOCITY ignores the
         deceleration, the jerk types the jerk percentage (MPI 000, MPIMotionSCurve and
         MPIMotionVelocity: the trajectory parameters each type reads)."""
-        return first_refusal((
-            check_magnitude("velocity", self.velocity, MAX_VELOCITY),
-            check_magnitude("acceleration", self.acceleration, MAX_ACCELERATION),
-            check_magnitude("deceleration", self.deceleration, MAX_ACCELERATION),
-            check_magnitude("jerk_percent", self.jerk_percent, 100.0),
-            check_magnitude("acceleration_jerk", self.acceleration_jerk, MAX_JERK),
-            check_magnitude("deceleration_jerk", self.deceleration_jerk, MAX_JERK),
-        ))
+        return _magnitudes(self, _TRAJECTORY_LIMITS)
+
+
+
+_HOLD_LONGS = ("gate", "number", "address", "mask", "pattern")
 
 
 @dataclass(slots=True)
@@ -245,10 +276,13 @@ class Hold:
         source (gate, word, motor, axis) is checked against the controller's objects with
         the move (validate.check_params)."""
         return first_refusal((
-            *(check_long(name, getattr(self, name)) for name in ("gate", "number", "address", "mask", "pattern")),
+            _longs(self, _HOLD_LONGS),
             check_position("position", self.position),
             check_duration("timeout", self.timeout),
         ))
+
+
+_OUTPUT_LONGS = ("motor", "address", "on_mask", "off_mask", "point_index")
 
 
 @dataclass(slots=True)
@@ -265,8 +299,7 @@ class Output:
     def validate(self) -> Outcome:
         """C longs (32 bits, as the ROS interface's int32); the motor or I/O word is checked
         against the controller's objects with the move (validate.check_params)."""
-        return first_refusal(check_long(name, getattr(self, name))
-                             for name in ("motor", "address", "on_mask", "off_mask", "point_index"))
+        return _longs(self, _OUTPUT_LONGS)
 
 
 @dataclass(slots=True)
@@ -287,6 +320,10 @@ class UserFrame:
             check_magnitude("jerk", self.jerk, MAX_JERK),
             check_duration("time", self.time),
         ))
+
+
+# (empty_count: any value, <= 0 disables, MotionParams.empty_count_disabled)
+_PARAMS_LONGS = ("empty_count", "id", "master_start", "repeat_from", "behavior", "low_count", "expected_axes")
 
 
 @dataclass(slots=True)
@@ -340,20 +377,14 @@ class MotionParams:
 
         bits = _EVERY_ATTRIBUTE if attributes is None else int(attributes)
         return first_refusal((
-            _each("position", self.position, check_position) if position else VALID,
+            _each_magnitude("position", self.position, MAX_POSITION) if position else VALID,
             _each_struct("trajectory", self.trajectory),
             check_bool("final", self.final),
             check_bool("retain", self.retain),
-            check_long("empty_count", self.empty_count),  # any value: <= 0 disables (empty_count_disabled)
-            check_long("id", self.id),
-            check_long("master_start", self.master_start),
-            check_long("repeat_from", self.repeat_from),
-            check_long("behavior", self.behavior),
-            check_long("low_count", self.low_count),
-            check_long("expected_axes", self.expected_axes),
+            _longs(self, _PARAMS_LONGS),
             _each("element_id", self.element_id, check_long),
             _each("delay", self.delay, check_duration) if bits & _DELAY else VALID,
-            _each("final_velocity", self.final_velocity, _check_velocity) if bits & _FINAL_VEL else VALID,
+            _each_magnitude("final_velocity", self.final_velocity, MAX_VELOCITY) if bits & _FINAL_VEL else VALID,
             _each_struct("hold", self.hold) if bits & _HOLDS else VALID,
             _each_struct("output", self.output) if bits & _OUTPUT else VALID,
             self._path_data() if path_data else VALID,
@@ -362,12 +393,12 @@ class MotionParams:
     def _path_data(self) -> Outcome:
         """Path, cam and frame data (read only by those types)."""
         return first_refusal((
-            _each("point_velocity", self.point_velocity, _check_velocity),
+            _each_magnitude("point_velocity", self.point_velocity, MAX_VELOCITY),
             _each("time", self.time, check_duration),
-            _each("feedforward", self.feedforward, _check_velocity),
-            _each("master_distance", self.master_distance, check_position),
-            _each("slave_position", self.slave_position, check_position),
-            _each("gear_ratio", self.gear_ratio, _check_ratio),
+            _each_magnitude("feedforward", self.feedforward, MAX_VELOCITY),
+            _each_magnitude("master_distance", self.master_distance, MAX_POSITION),
+            _each_magnitude("slave_position", self.slave_position, MAX_POSITION),
+            _each_magnitude("gear_ratio", self.gear_ratio, MAX_RATIO),
             _each_struct("frames", self.frames),
         ))
 

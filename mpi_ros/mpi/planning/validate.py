@@ -37,6 +37,8 @@ _SYNC_BITS = int(A.SYNC_START | A.SYNC_END)
 _DELAY, _FINAL_VEL, _OUTPUT, _ELEMENT_ID = int(A.DELAY), int(A.FINAL_VEL), int(A.OUTPUT), int(A.ELEMENT_ID)
 _NO_BACKTRACK, _NO_BACKTRACK_HOLD = int(A.NO_BACKTRACK), int(A.NO_BACKTRACK_HOLD)
 _HOLD_LESS, _HOLD_GREATER = int(A.HOLD_LESS), int(A.HOLD_GREATER)
+# The attributes whose data _check_attribute_data reads
+_ATTRIBUTE_DATA = _DELAY | _FINAL_VEL | _HOLD_BITS | _OUTPUT | _ELEMENT_ID
 # The arrays of pointCount x axes values each path type reads (MPIMotionPT .. MPIMotionPVTF)
 _POINT_ARRAYS = {t: tuple(name for name in POINT_ARRAYS if name in f.fields) for t, f in FAMILIES.items()}
 # The most values one path request may carry (positions, or frames, over all its axes): a
@@ -90,8 +92,10 @@ def check_running_type(running: MPIMotionType) -> Outcome:
 def check_attributes(
     motion_type: MPIMotionType, attrs: MotionAttr, params: MotionParams, modify: bool
 ) -> Outcome:
-    bad = Message.MPIMotionMessageATTRIBUTE_INVALID
     bits = int(attrs)
+    if not bits:  # (the usual start or modify: every check below is of an attribute given)
+        return OK
+    bad = Message.MPIMotionMessageATTRIBUTE_INVALID
     disallowed = bits & (_DISALLOWED_BITS.get(motion_type, 0) | _FORBIDDEN_BITS.get(motion_type, 0))
     if disallowed:
         return _bad(bad, f"{motion_type.name} moves may not have {MotionAttr(disallowed).names()}")
@@ -168,8 +172,10 @@ def _check_attribute_data(attrs: MotionAttr, params: MotionParams, axis_count: i
                           axes: int, points: int) -> Outcome:
     """The arrays the attributes read, for a move of ``points`` points (1 for a
     point-to-point or velocity move)."""
-    bad = Message.MPIMessagePARAM_INVALID
     bits = int(attrs)
+    if not bits & _ATTRIBUTE_DATA:  # (the usual move: none of the arrays below is read)
+        return OK
+    bad = Message.MPIMessagePARAM_INVALID
     for name, attr, values in (
         ("delay", _DELAY, params.delay),
         ("final_velocity", _FINAL_VEL, params.final_velocity),
@@ -336,8 +342,9 @@ def _check_trajectory(family: Family, traj: Trajectory) -> Outcome:
     """The limits the family's profile divides by must be > 0 (MPI 000, MPITrajectory)."""
     bad = Message.MPIMessagePARAM_INVALID
     for names in (family.limits, family.jerk_limits):
-        if any(getattr(traj, name) <= 0.0 for name in names):
-            return _bad(bad, f"{_listed(names)} must be > 0")
+        for name in names:
+            if getattr(traj, name) <= 0.0:
+                return _bad(bad, f"{_listed(names)} must be > 0")
     if not family.jerk_limits and not 0.0 <= traj.jerk_percent <= 100.0:
         return _bad(bad, "jerk_percent must be within 0..100")
     return OK

@@ -42,7 +42,7 @@ from mpi_ros.mpi.base.types import (
 from mpi_ros.mpi.host import SupervisorHost
 from mpi_ros.mpi.planning import blend, cams, paths, validate
 from mpi_ros.mpi.planning.families import FAMILIES, Kind
-from mpi_ros.mpi.planning.frames import AxisPlan, Move, frames_needed
+from mpi_ros.mpi.planning.frames import AxisPlan, Move
 from mpi_ros.mpi.planning.planner import PlanNotes, compile_move
 from mpi_ros.mpi.planning.start import AxisStart
 from mpi_ros.mpi.supervisor.actions import Actions
@@ -67,7 +67,7 @@ _START_ONLY = (MotionAttr.APPEND | MotionAttr.AUTO_START | MotionAttr.DELAY | Mo
 ActionCallback = Callable[["MotionSupervisor", MPIMotionType, str], object]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class _Admitted:
     """How a start or modify was admitted: the state it found, whether a modify from IDLE
     starts (AUTO_START), whether it queues behind what runs or is pending (APPEND), and the
@@ -518,10 +518,11 @@ class MotionSupervisor:
         self._notify_action(motion_type, "MODIFY" if modify else "START")
         if not self._axis_list.listed:
             return NO_AXES
-        disabled = [n for n in self._axis_list.listed if not self._host.axes[n].enabled]
-        if disabled:  # MPI 000, MPIMessageOBJECT_NOT_ENABLED: "axis is not an enabled axis"
-            return Outcome(Message.MPIMessageOBJECT_NOT_ENABLED,
-                           f"axis {disabled[0]} is not enabled (its amplifier is off): enable it first")
+        axes = self._host.axes
+        for n in self._axis_list.listed:
+            if not axes[n].enabled:  # MPI 000, MPIMessageOBJECT_NOT_ENABLED: "axis is not an enabled axis"
+                return Outcome(Message.MPIMessageOBJECT_NOT_ENABLED,
+                               f"axis {n} is not enabled (its amplifier is off): enable it first")
         bits = int(attrs)
         append = bool(bits & _APPEND)
         verdict = validate.check_type(motion_type, modify, self._host.config.firmware_option_21, append=append)
@@ -693,22 +694,24 @@ class MotionSupervisor:
         """Where the new profile of each axis starts."""
         starts = []
         last = self._moves.queue[-1] if self._moves.queue else self._moves.current
+        # The feedrate the axes' velocities are read through (the same for all of them): a modify
+        # in motion goes on at the feedrate now, a start runs at the normal one from now on
+        f = self._state.clock.feedrate(self._host.time) if moving else self._state.config.normal_feedrate
         for n in self._axis_list.listed:
             axis = self._axis(n)
             plan = last.plan_for(n) if queued and last is not None else None
             if plan is not None:
                 starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.turn_origin(plan.target)))
-            elif moving:
-                f = self._state.clock.feedrate(self._host.time)
+                continue
+            position = axis.cmd_p
+            if moving:
                 velocity = axis.cmd_v / f if f > 0.0 else 0.0
                 acceleration = axis.cmd_a / (f * f) if f > 0.0 else 0.0
-                starts.append(AxisStart(n, axis.cmd_p, velocity, axis.turn_origin(axis.cmd_p), acceleration))
             else:
-                # A start runs at the normal feedrate from now on. The axis may still move (STOPPED
-                # at a non-zero pauseFeedrate, or past a FINAL_VEL move): start from that velocity.
-                f = self._state.config.normal_feedrate
-                starts.append(AxisStart(n, axis.cmd_p, axis.cmd_v / f, axis.turn_origin(axis.cmd_p),
-                                        axis.cmd_a / (f * f)))
+                # The axis may still move (STOPPED at a non-zero pauseFeedrate, or past a FINAL_VEL
+                # move): the start goes on from that velocity.
+                velocity, acceleration = axis.cmd_v / f, axis.cmd_a / (f * f)
+            starts.append(AxisStart(n, position, velocity, axis.turn_origin(position), acceleration))
         return starts
 
     def _cam_masters(self) -> list[tuple[AxisMaster, float, float]]:
@@ -728,9 +731,13 @@ class MotionSupervisor:
         """Do the moves fit the frame buffer? A path's points need not: the library holds
         what does not fit and loads it as the buffer drains (MPI 001, LOW_COUNT)."""
         size = self._host.config.frame_buffer_size_of
-        loaded = [move for move in moves if move.stream is None]
+        needs: dict[int, int] = {}  # frames per axis, over the moves
+        for move in moves:
+            if move.stream is None:
+                for plan in move.plans:
+                    needs[plan.axis] = needs.get(plan.axis, 0) + plan.frame_count
         for n in self._axis_list.listed:
-            needed = frames_needed(loaded, n)
+            needed = needs.get(n, 0)
             if needed > size(n):
                 return Outcome(Message.MPIMotionMessageFRAME_BUFFER_TOO_SMALL,
                                f"the move does not fit in the frame buffer: axis {n} needs {needed} frames "

@@ -19,7 +19,7 @@ from mpi_ros.mpi.axes.status import StatusMode
 from mpi_ros.mpi.base.clock import ProfileClock
 from mpi_ros.mpi.base.events import MPIEventType
 from mpi_ros.mpi.base.messages import Message
-from mpi_ros.mpi.base.outcome import MoveEnd, Outcome
+from mpi_ros.mpi.base.outcome import VALID, MoveEnd, Outcome
 from mpi_ros.mpi.base.params import Hold, Output
 from mpi_ros.mpi.base.types import STATE_SEVERITY, ActionSource, HoldType, IoSpace, MotionAttr, MPIState, OutputType
 from mpi_ros.mpi.host import SupervisorHost
@@ -31,6 +31,7 @@ from mpi_ros.mpi.supervisor.state import SupervisorState
 from mpi_ros.mpi.supervisor.status import Progress
 
 OK = Message.MPIMessageOK
+_ID = int(MotionAttr.ID)  # (an IntFlag's ``in`` is a Python call, an int's & is not)
 
 
 class Moves:
@@ -264,7 +265,7 @@ class Moves:
         self.holds.clear()
         if previous is not None:
             move.serial = previous.serial
-            if MotionAttr.ID not in move.attributes:
+            if not int(move.attributes) & _ID:
                 move.id = previous.id
             if previous.stream is not None:  # points appended to the path are replaced too
                 for serial, _ in previous.stream.chunks:
@@ -302,7 +303,8 @@ class Moves:
                 self.fire_outputs(plan)
         if announce:
             self.emit(MPIEventType.MOTION_START, move=move)
-        self.release_holds()
+        if self.holds:
+            self.release_holds()
 
     def next_move(self) -> bool:
         """The current move is done: the next queued one runs from now; False if none."""
@@ -367,7 +369,7 @@ class Moves:
         (MPI 000, MPIMotionConfig): dropping its plan would stop it dead in one sample."""
         moving = [n for n in numbers if self.axis(n).cmd_v != 0.0]
         if self._state.own_state is not MPIState.STOPPED or not moving:
-            return Outcome(OK)
+            return VALID
         return Outcome(Message.MPIMotionMessageSTOPPED,
                        f"axis {moving[0]} still moves at pauseFeedrate {self._state.config.pause_feedrate:g}: "
                        "ending the stopped motion would stop it dead; RESUME, or E_STOP (it decelerates) and RESET")
@@ -381,8 +383,10 @@ class Moves:
         keep a plan no supervisor runs. Refused while such an axis still moves (a non-zero
         pauseFeedrate), by the rule RESET follows too (:meth:`still_creeping`)."""
         move, state = self.current, self._state
-        leaving = self._axis_list.leaving([p.axis for p in move.plans]) if move is not None else []
-        if leaving and state.own_state is MPIState.STOPPED:
+        # (only a stopped motion is dropped: the axes a running one leaves are not asked for)
+        stopped = move is not None and state.own_state is MPIState.STOPPED
+        leaving = self._axis_list.leaving(move.plan_axes) if stopped and move is not None else []
+        if leaving:
             creeping = self.still_creeping(leaving)
             if not creeping.ok:
                 return creeping
@@ -390,4 +394,4 @@ class Moves:
             self.drop_pending(Message.MPIMotionMessageSTOPPED, "dropped: its axes were remapped")
             state.enter(MPIState.IDLE, "MAP", state.action_source)
         state.config.axis_numbers = list(self._axis_list.commit_mapping())
-        return Outcome(OK)
+        return VALID
