@@ -699,7 +699,9 @@ class Controller:
         happens), so the supervisors, plans, faults and queues of every sample before it are
         those of its first. The values, status bits and profile times come from the
         stretch's arrays, and the events latched by each sample are read as its snapshot is
-        taken. Answers that template (None: no snapshot was wanted)."""
+        taken. Answers that template (None: no snapshot was wanted), with the axes' snapshots
+        at the stop kept on it when that sample is wanted (StatusTemplate.keep): built in the
+        same pass, they serve the snapshot after the stretch if nothing discrete happens there."""
         found = sorted(self._edge_events(stop, stretch, status), key=lambda e: e[:3])
         emitted = 0
         inside = self._wanted_before(stop, stretch, taken)
