@@ -5,7 +5,8 @@ supervisors: 8 axes in 4 and 32 axes in 16. Per case, in microseconds a call:
 ``step(20)`` (the stepping alone), ``motion_snapshots()`` (the live status of every
 supervisor and axis) and ``step_snapshots(20, 10 stops)`` (the same 20 samples, with the
 status of every second one: what publishing at 1 kHz from a 2 kHz controller in 10 ms
-batches asks).
+batches asks), and ``pack a sample`` (wire.Packer: the CDR of every axis' and supervisor's
+status of one sample, as the status topics pack them, from snapshots not packed before).
 
 The machines are shared and noisy: each tree (this one and ``--baseline``, extracted with git
 archive) runs every case in a fresh process, the trees alternating ``--rounds`` times; a
@@ -23,12 +24,16 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run with -P: the sibling bench_controller
 from bench_controller import compared_trees, measure_in
 
+if TYPE_CHECKING:
+    from mpi_ros.mpi import Controller
+
 CASES = [(8, 4), (32, 16)]
-CALLS = ("step(20)", "motion_snapshots()", "step_snapshots(20, 10 stops)")
+CALLS = ("step(20)", "motion_snapshots()", "step_snapshots(20, 10 stops)", "pack a sample")
 BATCH, EVERY = 20, 2  # samples a call steps; a status every EVERY samples
 
 
@@ -57,7 +62,30 @@ def measure(axes: int, supervisors: int) -> dict[str, float]:
 
     return {"step(20)": _best(lambda: ctl.step(BATCH), number),
             "motion_snapshots()": _best(ctl.motion_snapshots, number),
-            "step_snapshots(20, 10 stops)": _best(lambda: ctl.step_snapshots(BATCH, stops()), number)}
+            "step_snapshots(20, 10 stops)": _best(lambda: ctl.step_snapshots(BATCH, stops()), number),
+            "pack a sample": _packing(ctl, number)}
+
+
+def _packing(ctl: Controller, number: int, repeat: int = 7) -> float:
+    """The best CPU time of packing every status of one sample, in microseconds: each axis'
+    AxisStatus, then each supervisor's MotionStatus (which holds its axes' again), as the
+    controller and supervisor nodes do, each sample's snapshots new to the packer."""
+    from mpi_ros.ros import wire
+
+    samples = [ctl.step_snapshots(BATCH, range(ctl.sample + 1, ctl.sample + BATCH + 1)) for _ in range(repeat)]
+    best = float("inf")
+    for taken in samples:
+        batch = list(taken.values())
+        packer = wire.Packer(ctl.rate, 1_795_000_000_123_456_789)
+        start = time.process_time()
+        for _ in range(max(1, number // len(batch))):
+            for motions, axes in batch:
+                for axis in axes:
+                    packer.axis_status(axis)
+                for motion in motions.values():
+                    packer.motion_status(motion)
+        best = min(best, (time.process_time() - start) / (max(1, number // len(batch)) * len(batch)))
+    return best * 1e6
 
 
 def main(baseline: str, rounds: int) -> list[str]:

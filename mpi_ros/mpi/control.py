@@ -51,7 +51,7 @@ from mpi_ros.mpi.base.types import ActionSource, IoSpace, MPIAction, MPIState
 from mpi_ros.mpi.base.wrap import wrap_positions
 from mpi_ros.mpi.faults.monitor import FaultMonitor
 from mpi_ros.mpi.move_log import MoveLog
-from mpi_ros.mpi.snapshots import AxisTemplate, Snapshots, StatusTemplate
+from mpi_ros.mpi.snapshots import REL, AxisTemplate, Snapshots, StatusTemplate
 from mpi_ros.mpi.supervisor.motion import HANDLE_INVALID, MotionSupervisor
 
 MAX_STRETCH = 4096  # samples computed at once
@@ -501,7 +501,7 @@ class Controller:
 
     def _snapshots_now(self, template: StatusTemplate) -> Snapshots:
         """The snapshots of ``template`` at the current sample, from the bank's values and bits."""
-        return template.at(self.sample, self.bank.values.T.tolist(), self.bank.bits.T.tolist())
+        return template.at(self.sample, self.bank.values, self.bank.bits)
 
     def status_template(self) -> StatusTemplate:
         """What the status of every axis and supervisor holds until the next discrete change
@@ -699,21 +699,29 @@ class Controller:
         happens), so the supervisors, plans, faults and queues of every sample before it are
         those of its first. The values, status bits and profile times come from the
         stretch's arrays, and the events latched by each sample are read as its snapshot is
-        taken. Answers that template (None: no snapshot was wanted)."""
+        taken. Answers that template (None: no snapshot was wanted), with the axes' snapshots
+        at the stop kept on it when that sample is wanted (StatusTemplate.keep): built in the
+        same pass, they serve the snapshot after the stretch if nothing discrete happens there."""
         found = sorted(self._edge_events(stop, stretch, status), key=lambda e: e[:3])
         emitted = 0
         inside = self._wanted_before(stop, stretch, taken)
+        at_stop = taken.get(int(stretch.samples[stop]), ()) is None
         template = None
-        if inside:
+        if inside or at_stop:
             template = self.status_template()
-            values = stretch.values[:, :, inside].transpose(2, 1, 0).tolist()
-            bits = status.bits[:, :, inside].transpose(2, 1, 0).tolist()
-            for i, v, b in zip(inside, values, bits, strict=True):
+            rows = [*inside, stop] if at_stop else inside
+            samples = stretch.samples[rows].tolist()
+            values = stretch.values[:, :, rows].transpose(0, 2, 1)
+            axes = template.axes_at(samples, values, status.bits[:, :, rows].transpose(0, 2, 1))
+            rel = values[REL].tolist()
+            if at_stop:  # for the snapshot after the stretch, if nothing discrete happens at its stop
+                template.keep(samples.pop(), axes.pop())
+                rel.pop()
+            for i, sample, axes_then, rel_then in zip(inside, samples, axes, rel, strict=True):
                 while emitted < len(found) and found[emitted][0] <= i:
                     self._emit_found(found[emitted], stretch)
                     emitted += 1
-                sample = int(stretch.samples[i])
-                taken[sample] = template.at(sample, v, b)
+                taken[sample] = template.motions_at(sample, axes_then, rel_then), axes_then
         for item in found[emitted:]:
             self._emit_found(item, stretch)
         return template

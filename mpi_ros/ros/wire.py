@@ -221,8 +221,8 @@ class Packer:
     (the body starts 8-aligned wherever the status does: only the header's padding differs).
 
     An axis' body is kept by the snapshot's identity (the snapshot kept with it, so the
-    identity is not reused): a snapshot is frozen, so its bytes do not change. What is kept
-    is the latest sample's only."""
+    identity is not reused): a snapshot is a value nobody assigns to (base/snapshot.py), so
+    its bytes do not change. What is kept is the latest sample's only."""
 
     def __init__(self, rate: float, epoch_ns: int | None = None, namespace: str = DEFAULT_NAMESPACE):
         self.rate = rate

@@ -25,6 +25,8 @@ from mpi_ros.mpi import (
     MPIMotionType,
     Trajectory,
 )
+from mpi_ros.mpi.axes.plant import Plant, servo_effort
+from mpi_ros.mpi.base.params import PlantConfig
 
 SAMPLES = 1600
 TRAJ = Trajectory(4000.0, 40000.0, 30000.0, 40.0)
@@ -188,3 +190,30 @@ def test_the_live_snapshots_are_one_definition():
     assert [ctl.frame_count(n) for n in range(4)] == [a.frame_count for a in axes]
     assert axes[0].element_id in (11, 12, 13, 14)
     assert axes[0].feedforward != 0.0
+
+
+def test_the_servo_effort_computed_for_a_stretch_at_once_is_each_axis_own():
+    """A stretch's axis snapshots are computed for every sample and axis at once, the servo
+    effort together for the axes whose plants are alike: each equals plant.servo_effort of
+    its own plant and values, one at a time, whatever its plant (three kinds here, one of
+    them twice) and its amplifier (0 once off)."""
+    ctl = _controller()
+    plants = [PlantConfig(bandwidth_hz=45.0, damping=0.9), PlantConfig(), PlantConfig(bandwidth_hz=45.0, damping=0.9),
+              PlantConfig(velocity_feedforward=0.5, acceleration_feedforward=0.25)]
+    for axis, plant in zip(ctl.axes, plants, strict=True):
+        axis.plant = Plant(plant)
+    for kind, who in (("s_curve", 0), ("velocity", 1), ("cam", 2)):
+        _apply(ctl, kind, who, 700.0, -300.0)
+    ctl.step(150)
+    taken = ctl.step_snapshots(20, range(ctl.sample + 1, ctl.sample + 21))
+    assert ctl.axis_amp_enable_set(3, False).ok
+    taken |= ctl.step_snapshots(20, range(ctl.sample + 1, ctl.sample + 21))
+    assert len(taken) == 40
+    for _, axes in taken.values():
+        for snap, plant in zip(axes, plants, strict=True):
+            effort = servo_effort(plant, snap.position_error, snap.command_velocity, snap.actual_velocity,
+                                  snap.command_acceleration, snap.feedforward) if snap.amp_enabled else 0.0
+            assert _same(snap.servo_effort, effort), (snap.number, snap.servo_effort, effort)
+    first = next(iter(taken.values()))[1]
+    assert all(a.amp_enabled and a.servo_effort != 0.0 for a in first)
+    assert [a.amp_enabled for a in axes] == [True, True, True, False]

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -32,6 +32,7 @@ from mpi_ros.mpi.base.params import PlantConfig
 if TYPE_CHECKING:
     from mpi_ros.mpi.axes.scratch import Scratch
 
+Effort = TypeVar("Effort", float, npt.NDArray[np.float64])  # servo_effort's values: one, or arrays of them
 _MAX_DEGREE = 6  # cubic segments composed with a quadratic feedrate time warp
 _QUIET = 1e-12  # homogeneous amplitude below which the loop counts as settled (counts)
 
@@ -300,14 +301,16 @@ class Plant:
         return np.floor(y / self._resolution + 0.5) * self._resolution
 
 
-def servo_effort(config: PlantConfig, error: float, cmd_v: float, act_v: float, cmd_a: float,
-                 feedforward: float) -> float:
+def servo_effort(config: PlantConfig, error: Effort, cmd_v: Effort, act_v: Effort, cmd_a: Effort,
+                 feedforward: float) -> Effort:
     """The position loop's control effort, in counts/s^2: ``w^2 (u - y) + 2 zeta w (kv u' -
     y') + ka u''`` (u the command, y the motor; w, zeta, kv, ka the bandwidth, damping and
     feed-forwards), the acceleration it demands of a motor of unit inertia, which is what the
     simulated motor then does; a PTF/PVTF feedforward adds its DAC counts times
     ``dac_acceleration``. Computed as a real servo computes it: from the encoder's reading of
-    the position (``error``, so it carries the encoder's quantisation) and the actual velocity."""
+    the position (``error``, so it carries the encoder's quantisation) and the actual velocity.
+    The values may be arrays (one feedforward for them all): the same operations, element by
+    element, give the same bits as one at a time (status snapshots take a stretch's at once)."""
     w = 2.0 * math.pi * config.bandwidth_hz
     effort = (w * w * error + 2.0 * config.damping * w * (config.velocity_feedforward * cmd_v - act_v)
               + config.acceleration_feedforward * cmd_a)

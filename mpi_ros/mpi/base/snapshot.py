@@ -7,8 +7,16 @@ from dataclasses import dataclass, field
 from mpi_ros.mpi.base.types import MPIState
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class AxisSnapshot:
+    """mpiAxisStatus of one axis at one sample.
+
+    A value nobody assigns to: the same snapshot is shared between the status topics, the
+    supervisors' snapshots that hold it, the Packer's cache (wire.Packer) and replay. Not
+    frozen only because a frozen dataclass sets every field through object.__setattr__, which
+    cost more than the rest of building it (docs/architecture.md, "Status snapshots"); not
+    hashable either (eq without frozen: a snapshot is never a set member or a key)."""
+
     sample: int
     number: int
     state: MPIState
@@ -37,8 +45,11 @@ class AxisSnapshot:
     servo_effort: float = 0.0  # the position loop's effort, counts/s^2 (plant.servo_effort; 0 with the amp off)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class MotionSnapshot:
+    """mpiMotionStatus of one supervisor at one sample: a value nobody assigns to, as
+    :class:`AxisSnapshot` (not frozen for the same reason)."""
+
     sample: int
     number: int
     state: MPIState
