@@ -389,8 +389,8 @@ class _FreeTable:
 
     def window(self, m0: np.ndarray, n: int, scratch: Scratch | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(p, q) of Phi((m0_r + i) dt) for rows r and 0 <= i < n <= _TABLE: for each row
-        what :meth:`at` gives for m0_r + arange(n). Rows read the table directly while
-        every count stays below _TABLE, else as blocks x remainders; the two agree where
+        what :meth:`at` gives for m0_r + arange(n). Rows read the long table directly while
+        every count stays inside it, else as blocks x remainders; the two agree where
         both apply (block 0 is exactly Phi(0) = I), so any mix of rows is exact. The
         arrays come from ``scratch`` (stretch.Scratch) if given."""
         def take(name: str, *shape: int) -> np.ndarray | None:

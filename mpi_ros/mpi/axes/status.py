@@ -253,8 +253,18 @@ class StretchStatus:
 class _Arrays:
     """Named scratch arrays of a stretch's shape (stretch.Scratch), reused by the next one."""
 
-    def __init__(self, scratch: Scratch, shape: tuple[int, int]) -> None:
+    def __init__(self, scratch: Scratch, shape: tuple[int, int], cmd_v: np.ndarray) -> None:
         self.scratch, self.shape = scratch, shape
+        self._cmd_v = cmd_v
+        self._stopped: np.ndarray | None = None
+
+    def stopped(self) -> np.ndarray:
+        """|command velocity| < _STOPPED_VELOCITY: made the first time it is read (a stop's
+        TC and DONE, AT_TARGET, the settling at rest; none of them during velocity moves)."""
+        if self._stopped is None:
+            speed = np.abs(self._cmd_v, out=self.real("speed"))
+            self._stopped = np.less(speed, _STOPPED_VELOCITY, out=self.flag("stopped"))
+        return self._stopped
 
     def real(self, name: str) -> np.ndarray:
         return self.scratch.take("status." + name, self.shape)
@@ -273,15 +283,14 @@ def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scr
     arrays cmd_p, cmd_v, act_p, act_v, rel; ``counters`` the (3, axes) carried runs). A
     criterion that cannot hold anywhere (say, no trajectory complete) is not computed."""
     col = rows.col
-    work = _Arrays(scratch, trace.cmd_p.shape)
+    work = _Arrays(scratch, trace.cmd_p.shape, trace.cmd_v)
     bits = scratch.take("status.bits", (len(BITS), *trace.cmd_p.shape), bool)
     velocity_ok = np.less(work.absolute_difference(trace.cmd_v, trace.act_v), col["velocity_tol"],
                           out=work.flag("velocity_ok"))
-    stopped = np.less(np.abs(trace.cmd_v, out=work.real("difference")), _STOPPED_VELOCITY, out=work.flag("stopped"))
-    tc = _trajectory_complete(trace.rel, stopped, rows, bits[TC])
+    tc = _trajectory_complete(trace.rel, work, rows, bits[TC])
     complete = bool(tc.any())
     # Note 1: at rest on the command (SETTLED; IN_FINE after a stop with settling on).
-    at_rest = np.logical_and(tc, stopped, out=work.flag("at_rest")) if complete else None
+    at_rest = np.logical_and(tc, work.stopped(), out=work.flag("at_rest")) if complete else None
     if at_rest is not None and at_rest.any():
         at_rest &= np.less(work.absolute_difference(trace.cmd_p, trace.act_p), col["fine"], out=work.flag("near"))
         at_rest &= velocity_ok
@@ -298,21 +307,21 @@ def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scr
     # SYNC_START move that arrives early is at its target while the others still move.
     if rows.any("at_target_ok"):
         at_target = np.equal(trace.cmd_p, col["target"], out=bits[AT_TARGET])
-        at_target &= stopped
+        at_target &= work.stopped()
         at_target &= col["at_target_ok"]
     else:
         bits[AT_TARGET] = False
-    _done(rows, tc if complete else None, stopped, bits)
+    _done(rows, tc if complete else None, work, bits)
     return StretchStatus(bits, (fine_runs, settled_runs, velocity_runs))
 
 
-def _trajectory_complete(rel: np.ndarray, stopped: np.ndarray, rows: StatusRows, out: np.ndarray) -> np.ndarray:
+def _trajectory_complete(rel: np.ndarray, work: _Arrays, rows: StatusRows, out: np.ndarray) -> np.ndarray:
     """TC: every frame executed (after a stop: the command has stopped)."""
     np.greater_equal(rel, rows.col["tc_after"], out=out)
     if rows.any("tc_always"):
         out |= rows.col["tc_always"]
     if rows.any("stop"):
-        np.copyto(out, stopped, where=rows.col["stop"])
+        np.copyto(out, work.stopped(), where=rows.col["stop"])
     return out
 
 
@@ -353,7 +362,7 @@ def _at_velocity(trace: Stretch, rows: StatusRows, tc: np.ndarray | None, veloci
     return settle(ramp_done, counters[VELOCITY_RUN], rows.need, bits[AT_VELOCITY])
 
 
-def _done(rows: StatusRows, tc: np.ndarray | None, stopped: np.ndarray, bits: np.ndarray) -> None:
+def _done(rows: StatusRows, tc: np.ndarray | None, work: _Arrays, bits: np.ndarray) -> None:
     """DONE: TC (None: complete nowhere) and IN_FINE after a move; after a stop, command
     velocity = 0 (or, settling on, IN_FINE); always after ABORT."""
     col = rows.col
@@ -364,7 +373,7 @@ def _done(rows: StatusRows, tc: np.ndarray | None, stopped: np.ndarray, bits: np
         np.logical_and(tc, bits[IN_FINE], out=done)
         done &= col["moving"]
     if rows.any("stop"):
-        done |= col["stop"] & ~col["settle_on"] & stopped
+        done |= col["stop"] & ~col["settle_on"] & work.stopped()
         done |= col["settle_on"] & bits[IN_FINE]
     if rows.any("abort"):
         done |= col["abort"]
