@@ -28,7 +28,6 @@ from mpi_ros.mpi.base.clock import ProfileClock
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
 
-    from mpi_ros.mpi.axes.scratch import Scratch
     from mpi_ros.mpi.planning.frames import AxisPlan
 
 VALUES = ("cmd_p", "cmd_v", "cmd_a", "act_p", "act_v", "rel")  # an axis' values at a sample
@@ -217,12 +216,15 @@ class ClockRows:
         self.f0[number], self.f1[number], self.rate[number] = clock.f0, clock.f1, clock.rate
 
     def columns(self, numbers: np.ndarray) -> ClockColumns:
-        """Clocks ``numbers`` as (clocks, 1) columns (kept by the bank until a clock changes)."""
+        """The clocks ``numbers`` (one per row: each planned row's own) as (rows, 1) columns
+        (kept by the bank until a clock changes). A row computes its clock's values by the
+        same operations as the clock's own row would: the same bits."""
         t0, tau0, f0, f1 = (a[numbers, None] for a in (self.t0, self.tau0, self.f0, self.f1))
         t_end, rate = self.t_end[numbers, None], self.rate[numbers, None]
         dt = t_end - t0
         tau_end = tau0 + dt * (f0 + 0.5 * rate * dt)  # as ProfileClock.tau sums it at t >= t_end
-        return ClockColumns(t0, tau0, f0, f1, t_end, rate, tau_end, float(t_end.max()), np.zeros_like(f1))
+        return ClockColumns(t0, tau0, f0, f1, t_end, rate, tau_end, float(t_end.max(initial=-math.inf)),
+                            np.zeros_like(f1), bool((f1 >= 0.0).all()))
 
 
 @dataclass(frozen=True, slots=True)
@@ -236,21 +238,27 @@ class ClockColumns:
     tau_end: np.ndarray
     last_end: float
     no_slope: np.ndarray
+    forward: bool  # is every final feedrate >= 0 (tau never decreases past the ramps)?
 
-    def evaluate(self, t: np.ndarray, scratch: Scratch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def ramping(self, t: np.ndarray) -> bool:
+        """Does a clock ramp at a time of ``t`` (sorted)?"""
+        return bool(t[0] < self.last_end)
+
+    def evaluate(self, t: np.ndarray, into: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """tau, feedrate and its slope at times ``t``, each element computed exactly as
-        ProfileClock.tau and .feedrates compute it: tau as (clocks, samples), the feedrate
-        and slope as (clocks, 1) columns where no clock ramps."""
-        if t[0] >= self.last_end:
+        ProfileClock.tau and .feedrates compute it: tau as (rows, samples) (``into``), the
+        feedrate and slope as (rows, 1) columns where no clock ramps (the same arrays every
+        time)."""
+        if not self.ramping(t):
             # Past every ramp min(t, t_end) is t_end and max(t - t_end, 0) is t - t_end, to the
             # bit: tau = tau_end + f1 (t - t_end).
-            tau = np.subtract(t, self.t_end, out=scratch.take("tau", (len(self.t0), len(t))))
+            tau = np.subtract(t, self.t_end, out=into)
             tau *= self.f1
             tau += self.tau_end
             return tau, self.f1, self.no_slope
         t0, f0, f1, t_end, rate = self.t0, self.f0, self.f1, self.t_end, self.rate
         dt = np.minimum(t, t_end) - t0
-        tau = self.tau0 + dt * (f0 + 0.5 * rate * dt)
+        tau = np.add(self.tau0, dt * (f0 + 0.5 * rate * dt), out=into)
         tau += f1 * np.maximum(t - t_end, 0.0)
         in_ramp = t < t_end
         f = np.where(in_ramp, f0 + rate * (t - t0), f1)
@@ -290,6 +298,8 @@ class AxisBank:
     def refresh(self, refresh_row: Callable[[int], None], reanchor_row: Callable[[int], None]) -> None:
         """Rebuild the stale rows (``refresh_row(number)`` does an axis), and those of the
         axes whose anchor moved (``reanchor_row(number)``)."""
+        if not (self.stale.any() or self.moved.any()):  # (most stretches: one test each)
+            return
         stale, moved = np.flatnonzero(self.stale), np.flatnonzero(self.moved & ~self.stale)
         if len(stale):
             self._command_memo.clear()

@@ -332,6 +332,7 @@ def _first_sample(t: float, rate: float) -> int:
 _TABLES: dict[tuple[float, float, float, float], _FreeTable] = {}  # shared by identical loops
 _TABLE = 4096  # samples of free response tabulated; further ones are products of two
 _BLOCKS_WATCHED = 64  # blocks of _TABLE samples searched for an exact underflow (about 2 min at 2 kHz)
+_LONG_BLOCKS = 8  # blocks of Phi kept as one table (16 s at 2 kHz), or up to its underflow if sooner
 
 
 class _FreeTable:
@@ -339,7 +340,8 @@ class _FreeTable:
     from the C library's scalar functions (the same on every CPU); beyond, products
     Phi((a + b) dt) = Phi(a dt) Phi(b dt), using M^2 = kappa I."""
 
-    __slots__ = ("_bp", "_bq", "_pq", "_pq2", "_vanishing", "block_k", "block_p", "block_q", "k", "kappa", "p", "q")
+    __slots__ = ("_bp", "_bq", "_long", "_pq", "_pq2", "_vanishing", "block_k", "block_p", "block_q", "k", "kappa", "p",
+                 "q")
 
     def __init__(
         self, p: npt.NDArray[np.float64], q: npt.NDArray[np.float64], k: npt.NDArray[np.float64], kappa: float,
@@ -356,6 +358,7 @@ class _FreeTable:
         self._bp = np.array(self.block_p)
         self._bq = np.array(self.block_q)
         self._vanishing: float | None = None
+        self._long: np.ndarray | None = None
 
     @classmethod
     def build(cls, plant: Plant, rate: float) -> _FreeTable:
@@ -389,14 +392,15 @@ class _FreeTable:
 
     def window(self, m0: np.ndarray, n: int, scratch: Scratch | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(p, q) of Phi((m0_r + i) dt) for rows r and 0 <= i < n <= _TABLE: for each row
-        what :meth:`at` gives for m0_r + arange(n). Rows read the table directly while
-        every count stays below _TABLE, else as blocks x remainders; the two agree where
+        what :meth:`at` gives for m0_r + arange(n). Rows read the long table directly while
+        every count stays inside it, else as blocks x remainders; the two agree where
         both apply (block 0 is exactly Phi(0) = I), so any mix of rows is exact. The
         arrays come from ``scratch`` (stretch.Scratch) if given."""
         def take(name: str, *shape: int) -> np.ndarray | None:
             return None if scratch is None else scratch.take("free." + name, (*shape, len(m0), n))
-        if int(m0.max()) + n <= _TABLE:
-            p, q = _windows(self._pq, m0, n, take("pq", 2))
+        long = self._long_table()
+        if int(m0.max()) + n <= long.shape[1]:
+            p, q = _windows(long, m0, n, take("pq", 2))
             return p, q
         blocks, r0 = np.divmod(m0, _TABLE)
         self._blocks(int(blocks.max()) + 1)
@@ -408,6 +412,17 @@ class _FreeTable:
         q = np.multiply(bp, qr, out=take("q"))
         q += np.multiply(bq, pr, out=take("product"))
         return p, q
+
+    def _long_table(self) -> npt.NDArray[np.float64]:
+        """(p, q) of Phi(m dt) as two rows for m below _LONG_BLOCKS blocks, or below the
+        underflow (from which they are zeros): the table, then the products :meth:`at` and
+        the blocks of :meth:`window` compute beyond it (the same operations element for
+        element), computed once, so that a window that stays below reads them directly."""
+        if self._long is None:
+            end = int(min(self.vanishing_count(), _LONG_BLOCKS * _TABLE))
+            beyond = np.stack(self.at(np.arange(_TABLE, max(end, _TABLE), dtype=np.int64)))
+            self._long = np.concatenate((self._pq[:, :_TABLE], beyond), axis=1)
+        return self._long
 
     def vanishing_count(self) -> float:
         """The sample count from which Phi(m dt) is exactly zero: the start of the first block

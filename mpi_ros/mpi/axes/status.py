@@ -142,8 +142,10 @@ def settle(criterion: np.ndarray | None, carry: np.ndarray, need: np.ndarray, ou
     # scalar (np.bool | NDArray[np.bool])
     every: np.ndarray = criterion.all(axis=1)  # type: ignore[assignment]
     # A row that holds throughout has run carry + i + 1 at sample i: on from i = need - 1 - carry.
-    first = np.where(every, need - 1 - carry, n)
-    np.greater_equal(np.arange(n), first[:, None], out=out)
+    if every.all():  # (every row holds throughout: a steady bank, often)
+        _on_from(need - 1 - carry, n, out)
+        return Runs(carry, every, _NONE, _NONE)
+    _on_from(np.where(every, need - 1 - carry, n), n, out)
     mixed = np.flatnonzero(criterion.any(axis=1) & ~every)
     if not len(mixed):
         return Runs(carry, every, mixed, _NONE)
@@ -153,6 +155,11 @@ def settle(criterion: np.ndarray | None, carry: np.ndarray, need: np.ndarray, ou
 
 
 _FLAGS = ("stop", "abort", "settle_on", "moving", "velocity", "point_to_point", "tc_always", "at_target_ok")
+
+
+def _on_from(first: np.ndarray, n: int, out: np.ndarray) -> None:
+    """``out`` = per row, true from sample ``first`` on, over ``n`` samples."""
+    np.greater_equal(np.arange(n), first[:, None], out=out)
 
 
 @dataclass(slots=True)
@@ -246,8 +253,18 @@ class StretchStatus:
 class _Arrays:
     """Named scratch arrays of a stretch's shape (stretch.Scratch), reused by the next one."""
 
-    def __init__(self, scratch: Scratch, shape: tuple[int, int]) -> None:
+    def __init__(self, scratch: Scratch, shape: tuple[int, int], cmd_v: np.ndarray) -> None:
         self.scratch, self.shape = scratch, shape
+        self._cmd_v = cmd_v
+        self._stopped: np.ndarray | None = None
+
+    def stopped(self) -> np.ndarray:
+        """|command velocity| < _STOPPED_VELOCITY: made the first time it is read (a stop's
+        TC and DONE, AT_TARGET, the settling at rest; none of them during velocity moves)."""
+        if self._stopped is None:
+            speed = np.abs(self._cmd_v, out=self.real("speed"))
+            self._stopped = np.less(speed, _STOPPED_VELOCITY, out=self.flag("stopped"))
+        return self._stopped
 
     def real(self, name: str) -> np.ndarray:
         return self.scratch.take("status." + name, self.shape)
@@ -266,15 +283,14 @@ def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scr
     arrays cmd_p, cmd_v, act_p, act_v, rel; ``counters`` the (3, axes) carried runs). A
     criterion that cannot hold anywhere (say, no trajectory complete) is not computed."""
     col = rows.col
-    work = _Arrays(scratch, trace.cmd_p.shape)
+    work = _Arrays(scratch, trace.cmd_p.shape, trace.cmd_v)
     bits = scratch.take("status.bits", (len(BITS), *trace.cmd_p.shape), bool)
     velocity_ok = np.less(work.absolute_difference(trace.cmd_v, trace.act_v), col["velocity_tol"],
                           out=work.flag("velocity_ok"))
-    stopped = np.less(np.abs(trace.cmd_v, out=work.real("difference")), _STOPPED_VELOCITY, out=work.flag("stopped"))
-    tc = _trajectory_complete(trace.rel, stopped, rows, bits[TC])
+    tc = _trajectory_complete(trace.rel, work, rows, bits[TC])
     complete = bool(tc.any())
     # Note 1: at rest on the command (SETTLED; IN_FINE after a stop with settling on).
-    at_rest = np.logical_and(tc, stopped, out=work.flag("at_rest")) if complete else None
+    at_rest = np.logical_and(tc, work.stopped(), out=work.flag("at_rest")) if complete else None
     if at_rest is not None and at_rest.any():
         at_rest &= np.less(work.absolute_difference(trace.cmd_p, trace.act_p), col["fine"], out=work.flag("near"))
         at_rest &= velocity_ok
@@ -286,26 +302,26 @@ def compute(trace: Stretch, rows: StatusRows, counters: np.ndarray, scratch: Scr
         # After a stop with settling on, IN_FINE is the note-1 criterion.
         np.copyto(bits[IN_FINE], bits[SETTLED], where=rows.col["settle_on"])
         fine_runs = _PickedRuns(rows.settle_on, settled_runs, in_position_runs)
-    velocity_runs = _at_velocity(trace, rows, tc, velocity_ok, counters, bits, work)
+    velocity_runs = _at_velocity(trace, rows, tc if complete else None, velocity_ok, counters, bits, work)
     # AT_TARGET: "TRUE when command = target" (002's table), at rest there; an axis of a
     # SYNC_START move that arrives early is at its target while the others still move.
     if rows.any("at_target_ok"):
         at_target = np.equal(trace.cmd_p, col["target"], out=bits[AT_TARGET])
-        at_target &= stopped
+        at_target &= work.stopped()
         at_target &= col["at_target_ok"]
     else:
         bits[AT_TARGET] = False
-    _done(rows, tc, stopped, bits)
+    _done(rows, tc if complete else None, work, bits)
     return StretchStatus(bits, (fine_runs, settled_runs, velocity_runs))
 
 
-def _trajectory_complete(rel: np.ndarray, stopped: np.ndarray, rows: StatusRows, out: np.ndarray) -> np.ndarray:
+def _trajectory_complete(rel: np.ndarray, work: _Arrays, rows: StatusRows, out: np.ndarray) -> np.ndarray:
     """TC: every frame executed (after a stop: the command has stopped)."""
     np.greater_equal(rel, rows.col["tc_after"], out=out)
     if rows.any("tc_always"):
         out |= rows.col["tc_always"]
     if rows.any("stop"):
-        np.copyto(out, stopped, where=rows.col["stop"])
+        np.copyto(out, work.stopped(), where=rows.col["stop"])
     return out
 
 
@@ -332,26 +348,32 @@ def _in_position(trace: Stretch, rows: StatusRows, tc: np.ndarray, complete: boo
     return runs
 
 
-def _at_velocity(trace: Stretch, rows: StatusRows, tc: np.ndarray, velocity_ok: np.ndarray, counters: np.ndarray,
-                 bits: np.ndarray, work: _Arrays) -> Runs:
-    """AT_VELOCITY (velocity moves): the ramp done, at the velocity for the settling time."""
+def _at_velocity(trace: Stretch, rows: StatusRows, tc: np.ndarray | None, velocity_ok: np.ndarray,
+                 counters: np.ndarray, bits: np.ndarray, work: _Arrays) -> Runs:
+    """AT_VELOCITY (velocity moves): the ramp done, at the velocity for the settling time,
+    the trajectory not complete (``tc``; None: complete nowhere)."""
     ramp_done = None
     if rows.any("velocity"):
         ramp_done = np.greater_equal(trace.rel, rows.col["ramp_end"], out=work.flag("ramp_done"))
-        ramp_done &= np.logical_not(tc, out=work.flag("incomplete"))
+        if tc is not None:
+            ramp_done &= np.logical_not(tc, out=work.flag("incomplete"))
         ramp_done &= velocity_ok
         ramp_done &= rows.col["velocity"]
     return settle(ramp_done, counters[VELOCITY_RUN], rows.need, bits[AT_VELOCITY])
 
 
-def _done(rows: StatusRows, tc: np.ndarray, stopped: np.ndarray, bits: np.ndarray) -> None:
-    """DONE: TC and IN_FINE after a move; after a stop, command velocity = 0 (or, settling
-    on, IN_FINE); always after ABORT."""
+def _done(rows: StatusRows, tc: np.ndarray | None, work: _Arrays, bits: np.ndarray) -> None:
+    """DONE: TC (None: complete nowhere) and IN_FINE after a move; after a stop, command
+    velocity = 0 (or, settling on, IN_FINE); always after ABORT."""
     col = rows.col
-    done = np.logical_and(tc, bits[IN_FINE], out=bits[DONE])
-    done &= col["moving"]
+    done = bits[DONE]
+    if tc is None:
+        done[...] = False
+    else:
+        np.logical_and(tc, bits[IN_FINE], out=done)
+        done &= col["moving"]
     if rows.any("stop"):
-        done |= col["stop"] & ~col["settle_on"] & stopped
+        done |= col["stop"] & ~col["settle_on"] & work.stopped()
         done |= col["settle_on"] & bits[IN_FINE]
     if rows.any("abort"):
         done |= col["abort"]

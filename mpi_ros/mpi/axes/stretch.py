@@ -14,6 +14,10 @@ if TYPE_CHECKING:
     from mpi_ros.mpi.axes.plant import PlantState
 
 
+_NO_ROWS = np.zeros(0, dtype=np.int64)
+_NO_ROWS.flags.writeable = False
+
+
 @dataclass(slots=True)
 class Stretch:
     """Every sample of one stretch of every axis (raw positions), ``values[axis, i]``."""
@@ -28,7 +32,7 @@ class Stretch:
     rel: np.ndarray  # profile time into the plan (nan without one)
     values: np.ndarray  # the six above as one (6, axes, samples) block, in bank.VALUES order
     scratch: Scratch
-    pieces: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # rows of one piece
+    pieces: np.ndarray = field(default_factory=lambda: _NO_ROWS)  # rows of one piece
     anchors: dict[int, list[PlantState]] = field(default_factory=dict)  # plant anchors of the others
 
     def __len__(self) -> int:

@@ -52,9 +52,11 @@ def trace(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis], ProfileCl
         act_p, act_v = _servo(bank.tables, rows, servos, out, direct=True)
         out.place("act_p", rows, act_p)
         out.place("act_v", rows, act_v)
-        ending = t[-1] >= servos.piece_end
-        out.pieces = rows[~ending]
-        if ending.any():
+        if t[-1] < servos.first_end:  # (no piece ends inside the stretch: nearly always)
+            out.pieces = rows
+        else:
+            ending = t[-1] >= servos.piece_end
+            out.pieces = rows[~ending]
             _following_pieces(bank, axes, clock_of, rows[ending], out)
     for row in _sampled_order(bank.of_kind(Kind.SAMPLED).tolist(), axes):
         axis = axes[row]
@@ -128,29 +130,54 @@ class _Plans:
 def _planned(bank: AxisBank, plans: _Plans, out: Stretch) -> None:
     """Plans read through their supervisor's clock (Axis._command_arrays, AxisPlan.evaluate)."""
     cmd, rows = bank.command, plans.rows
-    which, clocks = bank.clock_memo(plans.clocks, lambda: _clocks_of(bank, cmd.clock[rows]))
-    tau, f, df = clocks.evaluate(out.t, out.scratch)
-    rel = np.take(tau, which, axis=0, out=out.target("rel", rows))
+    clocks = bank.clock_memo(plans.clocks, lambda: bank.clocks.columns(cmd.clock[rows]))
+    rel, f, df = clocks.evaluate(out.t, out.target("rel", rows))
     rel -= plans.tau_start
-    lo, hi = rel.min(axis=1), rel.max(axis=1)
-    duration = plans.duration
-    # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
-    single = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
-    if single.all():
-        # (after the segments _in_one_segment chose)
-        segments = bank.memo("segments", lambda: _Segments.of(cmd, rows))
-        p, dp, ddp = _segment(cmd, rows, segments, rel, lo, hi, out)
+    lo, hi = _extremes(rel, clocks, out.t)
+    segments = bank.memo("segments", lambda: _Segments.of(cmd, rows))
+    if segments.inner(lo, hi):  # (nearly every stretch)
+        p, dp, ddp = _polynomials(segments, segments.linear, rel, out.into("cmd_p", rows))
+        if segments.all_linear and not clocks.ramping(out.t):
+            # Constant velocities on clocks past their ramps: the same rates every stretch,
+            # until a row changes (forgotten with the segments).
+            velocity, acceleration = bank.memo("rates", lambda: _rates(dp, ddp, f, df, out, rows))
+        else:
+            velocity, acceleration = _rates(dp, ddp, f, df, out, rows)
     else:
-        p, dp, ddp = _segments(bank, rows, rel, lo, hi, single, out)
-    f, df = f[which], df[which]
+        # AxisPlan.evaluate reads the table at min(rel, duration): its extremes are these.
+        duration = plans.duration
+        single = _in_one_segment(bank, rows, np.minimum(lo, duration), np.minimum(hi, duration))
+        if single.all():
+            # (after the segments _in_one_segment chose)
+            segments = bank.memo("segments", lambda: _Segments.of(cmd, rows))
+            p, dp, ddp = _segment(cmd, rows, segments, rel, lo, hi, out)
+        else:
+            p, dp, ddp = _segments(bank, rows, rel, lo, hi, single, out)
+        velocity, acceleration = _rates(dp, ddp, f, df, out, rows)
     out.place("cmd_p", rows, p)
-    out.place("cmd_v", rows, np.multiply(dp, f, out=out.into_if_full("cmd_v", rows, dp, f)))
-    # ddp f f + dp df; dp and ddp are both columns or both full, f and df likewise.
+    out.place("cmd_v", rows, velocity)
+    out.place("cmd_a", rows, acceleration)
+    out.place("rel", rows, rel)
+
+
+def _extremes(rel: np.ndarray, clocks: ClockColumns, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's least and greatest profile time over the stretch."""
+    if clocks.forward and not clocks.ramping(t):
+        # tau = tau_end + f1 (t - t_end) never decreases along the sorted times (each step
+        # rounds monotonically, f1 >= 0), nor does rel: its extremes are its ends.
+        return rel[:, 0], rel[:, -1]
+    return rel.min(axis=1), rel.max(axis=1)
+
+
+def _rates(dp: np.ndarray, ddp: np.ndarray, f: np.ndarray, df: np.ndarray, out: Stretch,
+           rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The command's velocity dp f and acceleration ddp f f + dp df (columns if all their
+    operands are; dp and ddp are both columns or both full, f and df likewise)."""
+    velocity = np.multiply(dp, f, out=out.into_if_full("cmd_v", rows, dp, f))
     acceleration = np.multiply(ddp, f, out=out.into_if_full("cmd_a", rows, ddp, f))
     acceleration *= f
     acceleration += dp * df
-    out.place("cmd_a", rows, acceleration)
-    out.place("rel", rows, rel)
+    return velocity, acceleration
 
 
 def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -170,12 +197,6 @@ def _segments(bank: AxisBank, rows: np.ndarray, rel: np.ndarray, lo: np.ndarray,
     return p, dp, ddp
 
 
-def _clocks_of(bank: AxisBank, numbers: np.ndarray) -> tuple[np.ndarray, ClockColumns]:
-    """Each row's index among the clocks (``numbers``: each row's) its rows run on, and those clocks."""
-    distinct, which = np.unique(numbers, return_inverse=True)
-    return which, bank.clocks.columns(distinct)
-
-
 def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """Per row: does the whole stretch (profile times ``lo`` .. ``hi`` in the table) fall in
     one segment of the plan? A row that moved on to another segment gets it here (one axis
@@ -186,6 +207,7 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
     if keep.all():
         return keep
     bank.forget("segments")  # (a row may move on to its next segment)
+    bank.forget("rates")
     for i in np.flatnonzero(~keep).tolist():
         row = int(rows[i])
         plan = bank.plans[row]
@@ -214,16 +236,34 @@ class _Segments:
     v: np.ndarray
     a: np.ndarray
     j: np.ndarray
+    velocity: np.ndarray  # v + 0.0, a linear segment's velocity (see _linear)
+    zeros: np.ndarray  # its acceleration
+    # Every row inside its segment and its plan all the stretch, when its profile times
+    # are in [inner_lo, inner_hi): [max(lo, start), min(hi, duration)), where the tests
+    # of _in_one_segment, _linear and _segment all come out the same way (one way each)
+    inner_lo: np.ndarray
+    inner_hi: np.ndarray
+    all_linear: bool
 
     @classmethod
     def of(cls, cmd: CommandRows, rows: np.ndarray) -> _Segments:
-        return cls(cmd.seg_lo[rows], cmd.seg_hi[rows], cmd.linear[rows], cmd.duration[rows],
-                   *(x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
+        return cls.gathered(cmd.seg_lo[rows], cmd.seg_hi[rows], cmd.linear[rows], cmd.duration[rows],
+                            *(x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
+
+    @classmethod
+    def gathered(cls, lo: np.ndarray, hi: np.ndarray, linear: np.ndarray, duration: np.ndarray, start: np.ndarray,
+                 p: np.ndarray, v: np.ndarray, a: np.ndarray, j: np.ndarray) -> _Segments:
+        return cls(lo, hi, linear, duration, start, p, v, a, j, v + 0.0, np.zeros_like(v), np.maximum(lo, start[:, 0]),
+                   np.minimum(hi, duration), bool(linear.all()))
+
+    def inner(self, lo: np.ndarray, hi: np.ndarray) -> bool:
+        """Does every row stay inside (``lo``, ``hi``: the extremes of its profile times)?"""
+        return bool((lo >= self.inner_lo).all() and (hi < self.inner_hi).all())
 
     def of_group(self, group: np.ndarray) -> _Segments:
         """Those of the rows ``group`` (a mask) picks."""
-        return _Segments(self.lo[group], self.hi[group], self.linear[group], self.duration[group], self.start[group],
-                         self.p[group], self.v[group], self.a[group], self.j[group])
+        return _Segments.gathered(self.lo[group], self.hi[group], self.linear[group], self.duration[group],
+                                  self.start[group], self.p[group], self.v[group], self.a[group], self.j[group])
 
 
 def _segment(cmd: CommandRows, rows: np.ndarray, segments: _Segments, rel: np.ndarray, lo: np.ndarray,
@@ -235,15 +275,7 @@ def _segment(cmd: CommandRows, rows: np.ndarray, segments: _Segments, rel: np.nd
     duration = segments.duration
     inside = rel if (hi < duration).all() else np.minimum(rel, duration[:, None])
     linear = _linear(segments, np.minimum(lo, duration))
-    position = out.into("cmd_p", rows) if out is not None else None
-    if linear.all():
-        pos, vel, acc = _linear_segment(segments, inside, position)
-    elif not linear.any():
-        pos, vel, acc = _cubic_segment(segments, inside, position)
-    else:
-        pos, vel, acc = np.empty_like(rel), np.empty_like(rel), np.empty_like(rel)
-        for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
-            pos[group], vel[group], acc[group] = evaluate(segments.of_group(group), inside[group], None)
+    pos, vel, acc = _polynomials(segments, linear, inside, out.into("cmd_p", rows) if out is not None else None)
     if (hi >= duration).any():
         duration = duration[:, None]
         complete = rel >= duration
@@ -252,6 +284,20 @@ def _segment(cmd: CommandRows, rows: np.ndarray, segments: _Segments, rel: np.nd
         pos = np.where(complete, target + final * extra, pos)
         vel = np.where(complete, final, vel)
         acc = np.where(complete, 0.0, acc)
+    return pos, vel, acc
+
+
+def _polynomials(segments: _Segments, linear: np.ndarray, inside: np.ndarray,
+                 into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """SegmentTable.evaluate of each row's segment at profile times ``inside`` (in it),
+    the ``linear`` rows' (see :func:`_linear`) by the sums they reduce to."""
+    if linear.all():
+        return _linear_segment(segments, inside, into)
+    if not linear.any():
+        return _cubic_segment(segments, inside, into)
+    pos, vel, acc = np.empty_like(inside), np.empty_like(inside), np.empty_like(inside)
+    for group, evaluate in ((linear, _linear_segment), (~linear, _cubic_segment)):
+        pos[group], vel[group], acc[group] = evaluate(segments.of_group(group), inside[group], None)
     return pos, vel, acc
 
 
@@ -266,11 +312,10 @@ def _linear(segments: _Segments, lo: np.ndarray) -> np.ndarray:
 
 def _linear_segment(segments: _Segments, inside: np.ndarray,
                     into: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    velocity = segments.v + 0.0
     pos = np.subtract(inside, segments.start, out=into)
-    pos *= velocity
+    pos *= segments.velocity
     pos += segments.p
-    return pos, velocity, np.zeros_like(velocity)
+    return pos, segments.velocity, segments.zeros
 
 
 def _cubic_segment(segments: _Segments, inside: np.ndarray,
@@ -301,6 +346,7 @@ class _Servos:
 
     anchor_t: np.ndarray  # (rows, 1)
     piece_end: np.ndarray
+    first_end: float  # the first of them
     terms: np.ndarray
     one_terms: int  # the coefficients every row uses (-1: not the same for all)
     steady_y: np.ndarray  # (rows, _MAX_TERMS)
@@ -313,9 +359,10 @@ class _Servos:
     def of(cls, plant: PlantRows, rows: np.ndarray) -> _Servos:
         terms, resolution = plant.terms[rows], plant.resolution[rows]
         one_terms = int(terms[0]) if len(terms) and (terms == terms[0]).all() else -1
-        return cls(plant.anchor_t[rows, None], plant.piece_end[rows], terms, one_terms, plant.steady_y[rows],
-                   plant.steady_dy[rows], resolution, len(rows) > 0 and bool((resolution == resolution[0]).all()),
-                   _Transients.of(plant, rows))
+        piece_end = plant.piece_end[rows]
+        one_resolution = len(rows) > 0 and bool((resolution == resolution[0]).all())
+        return cls(plant.anchor_t[rows, None], piece_end, float(piece_end.min(initial=math.inf)), terms, one_terms,
+                   plant.steady_y[rows], plant.steady_dy[rows], resolution, one_resolution, _Transients.of(plant, rows))
 
 
 def _servo(tables: list[_FreeTable], rows: np.ndarray, servos: _Servos, out: Stretch, direct: bool,
@@ -405,6 +452,7 @@ class _Transients:
     table: np.ndarray
     dropped: bool  # may one be dropped once decayed (a finite decayed_after)?
     first_vanishing: float  # the first sample from which one of them is exact zeros
+    last_vanishing: float  # the first from which every one is
     one_table: int  # the free-response table every one reads (-1: not one for all)
 
     @classmethod
@@ -422,7 +470,8 @@ class _Transients:
                  table: np.ndarray) -> _Transients:
         one = len(table) > 0 and bool((table == table[0]).all())
         return cls(where, rows, v0, m0, v1, m1, decayed, vanishing, k0, table, not bool(np.isposinf(decayed).all()),
-                   float(vanishing.min(initial=math.inf)), int(table[0]) if one else -1)
+                   float(vanishing.min(initial=math.inf)), float(vanishing.max(initial=-math.inf)),
+                   int(table[0]) if one else -1)
 
     def kept(self, keep: np.ndarray) -> _Transients:
         """Those at indices ``keep`` among them."""
@@ -473,11 +522,17 @@ def _not_vanished(transients: _Transients, first: int, y: np.ndarray, dy: np.nda
     if first < transients.first_vanishing:  # (none has vanished yet)
         return transients
     sub = transients.where
+    if first >= transients.last_vanishing and not (_zero_in(y[sub]) or _zero_in(dy[sub])):
+        return None  # (every one has vanished and no value is a zero: a settled bank, nearly always)
     vanished: np.ndarray = first >= transients.vanishing
     vanished &= ~(_has_zero(y[sub]) | _has_zero(dy[sub]))
     if not vanished.any():
         return transients
     return None if vanished.all() else transients.kept(np.flatnonzero(~vanished))
+
+
+def _zero_in(values: np.ndarray) -> bool:
+    return bool((values == 0.0).any())
 
 
 def _has_zero(values: np.ndarray) -> np.ndarray:

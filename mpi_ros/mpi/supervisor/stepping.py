@@ -90,6 +90,8 @@ class Transitions:
             else:
                 conditions[Condition.ERROR, -1] = self._stop_complete(stretch.t, status,
                                                                       lambda a: a.in_position.settle_on_estop)
+        if not conditions:  # (a move under way that nothing can end in this stretch)
+            return None
         firsts = [int(np.argmax(fired)) for fired in conditions.values() if fired.any()]
         return min(firsts) if firsts else None
 

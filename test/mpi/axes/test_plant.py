@@ -56,3 +56,17 @@ def test_coasting_decays_like_the_exponential():
         decay = math.exp(-(k / RATE - state.t) / 0.5)
         assert dyk == pytest.approx(100.0 * decay, rel=1e-12)
         assert yk == pytest.approx(1.0 + 100.0 * 0.5 * (1.0 - decay), rel=1e-12)
+
+
+@pytest.mark.parametrize("config", [PlantConfig(), PlantConfig(bandwidth_hz=0.5, damping=0.3)])  # underflows, rings on
+def test_a_window_of_the_free_response_is_what_at_gives_bit_for_bit(config):
+    """Windows read the table, the long table (block products tabulated once) or block
+    products per window, by where they start: each element is what ``at`` gives."""
+    table = Plant(config).table(RATE)
+    for starts in ([0, 4000], [4090, 100], [5000, 12000], [12280, 8], [32760, 40000], [70000, 3]):
+        m0 = np.array(starts, dtype=np.int64)
+        p, q = table.window(m0, 20)
+        for row, start in enumerate(starts):
+            want_p, want_q = table.at(np.arange(start, start + 20, dtype=np.int64))
+            assert p[row].tobytes() == want_p.tobytes()
+            assert q[row].tobytes() == want_q.tobytes()
