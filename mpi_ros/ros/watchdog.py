@@ -28,12 +28,23 @@ on the graph at all (killed before the suite discovered its subscription, which 
 machine can take tens of milliseconds to do) counts as lost from its arrival once
 DISCOVERY_GRACE more has passed: no client that could cancel it was ever there.
 
+When it looks: a look at the graph costs tens to hundreds of microseconds (the whole graph
+cache is walked), and the timer would look at every watched topic ten times a second. rclpy
+offers no graph-change signal (ros2/rclpy#929), but the node's own publisher on a feedback
+topic has a *matched* event (PublisherEventCallbacks), which fires whenever a subscriber of
+the topic appears or leaves: a topic whose changes are so signalled (``signalled(topic)``,
+then ``changed(topic)`` from the event) is looked at only after a signal, on every tick until
+a look SETTLE after it (the event may come just before the graph shows the change), and at
+least every REFRESH otherwise (a subscriber that never matches the publisher, such as one of
+incompatible QoS, signals nothing). A topic without the signal is looked at on every tick.
+
 The STOP is a command (commands.CLIENT_LOST) through the runner, like any other: it is on
 <ns>/commands, in bags, and replays exactly.
 """
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -46,6 +57,8 @@ from rclpy.timer import Timer
 PERIOD = 0.1  # s between looks at the graph (shorter for a shorter timeout)
 DETACHED = "_detached"  # the end of a client node's name whose goals are left running on purpose
 DISCOVERY_GRACE = 1.0  # s a goal's client may take to appear on the graph after its goal
+SETTLE = 0.5  # s after a signalled change during which a topic is looked at on every tick
+REFRESH = 1.0  # s: the longest a signalled topic goes without a look while its goals are watched
 
 
 @dataclass(slots=True)
@@ -121,16 +134,32 @@ class LostClientWatchdog:
         self._on_lost = on_lost
         self._clock = clock
         self._goals: dict[bytes, _Watched] = {}
+        self._seen: dict[str, tuple[float, _Subscribers]] = {}  # each topic's last look: when, what
+        self._changed: dict[str, float] = {}  # signalled topics: the time of their last change
         self._lock = threading.Lock()
         # the suite's one timer (WatchdogTicker) where there is one, else a timer of its own
         self.ticker = ticker or WatchdogTicker(node, group)
         self.ticker.add(min(PERIOD, max(timeout / 4.0, 0.01)), self.check)
 
+    def signalled(self, topic: str) -> None:
+        """Every change of ``topic``'s subscribers will be signalled by ``changed(topic)``."""
+        with self._lock:
+            self._changed.setdefault(topic, -math.inf)
+
+    def changed(self, topic: str) -> None:
+        """A subscriber of ``topic`` appeared or left (its publisher's matched event)."""
+        now = self._clock()
+        with self._lock:
+            self._changed[topic] = now
+
     def watch(self, key: bytes, topic: str) -> None:
+        now = self._clock()
         subscribers = _subscribers(self.node, topic)
+        with self._lock:
+            self._seen[topic] = (now, subscribers)
         if subscribers.detached:
             return  # sent by a client that leaves it running on purpose (only such were there)
-        watched = _Watched(key, topic, subscribers.gids, self._clock())
+        watched = _Watched(key, topic, subscribers.gids, now)
         with self._lock:
             self._goals[key] = watched
 
@@ -149,7 +178,7 @@ class LostClientWatchdog:
                 self._forget(watched.key)
                 continue
             if watched.topic not in present:
-                present[watched.topic] = _subscribers(self.node, watched.topic)
+                present[watched.topic] = self._look(watched.topic, now)
             if not watched.clients and present[watched.topic].detached:  # its client, seen late, is detached
                 self._forget(watched.key)
                 continue
@@ -159,6 +188,17 @@ class LostClientWatchdog:
         if lost:
             self._on_lost(f"the client of goal {describe(w.key for w in lost)} left the graph: STOP after "
                           f"{self.timeout:g} s without it (lost_client_timeout)")
+
+    def _look(self, topic: str, now: float) -> _Subscribers:
+        """The topic's subscribers: from the graph, or as last seen when nothing changed since."""
+        with self._lock:
+            seen, changed = self._seen.get(topic), self._changed.get(topic)
+        if seen is not None and changed is not None and now - seen[0] < REFRESH and seen[0] > changed + SETTLE:
+            return seen[1]
+        subscribers = _subscribers(self.node, topic)
+        with self._lock:
+            self._seen[topic] = (now, subscribers)
+        return subscribers
 
     def _gone(self, watched: _Watched, present: frozenset, now: float) -> bool:
         if not watched.clients:  # its client's subscription was not discovered yet when it came

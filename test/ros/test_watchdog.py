@@ -297,3 +297,48 @@ def test_the_watchdogs_of_a_suite_share_one_timer_at_the_shortest_period():
     timers[0].callback()
     assert slow.watched == fast.watched == 0
     assert not lost
+
+
+def test_a_signalled_topic_is_looked_at_only_after_a_change_or_a_refresh():
+    """A topic whose subscribers' changes are signalled (the feedback publisher's matched event)
+    is looked at on the graph after a signal, on every tick until a look SETTLE after it (the
+    event may precede the graph), and every REFRESH otherwise; the decisions are the same."""
+    from mpi_ros.ros.watchdog import REFRESH, SETTLE, LostClientWatchdog
+
+    graph, now, lost = FakeGraph(), [0.0], []
+    looks = []
+    query = graph.get_subscriptions_info_by_topic
+    graph.get_subscriptions_info_by_topic = lambda topic: looks.append(now[0]) or query(topic)
+    topic = "/mpi/ms0/motion_start/_action/feedback"
+    graph.subscribers[topic] = [b"A" * 16]
+    watchdog = LostClientWatchdog(graph, 1.0, lambda keys: set(keys), lost.append, None, clock=lambda: now[0])
+    watchdog.signalled(topic)
+    watchdog.watch(b"g" * 16, topic)
+    assert looks == [0.0]
+    now[0] = 0.1
+    watchdog.check()
+    assert looks == [0.0]  # nothing changed: the look at the goal's arrival holds
+    watchdog.changed(topic)  # the client leaves: its event comes before the graph shows it gone
+    watchdog.check()
+    assert looks == [0.0, 0.1]
+    graph.subscribers[topic] = []
+    now[0] = 0.2
+    watchdog.check()  # looked at again within SETTLE: now it is gone
+    assert looks == [0.0, 0.1, 0.2]
+    assert "gone for 0.00 s" in watchdog.describe_watched()[0]
+    now[0] = 0.1 + SETTLE + 0.05
+    watchdog.check()  # the first look past SETTLE
+    now[0] = 0.1 + SETTLE + 0.1
+    watchdog.check()
+    assert looks == [0.0, 0.1, 0.2, 0.1 + SETTLE + 0.05]
+    now[0] = 1.2
+    watchdog.check()
+    assert len(lost) == 1  # the STOP at T = 1 s after the look that saw it gone, as when looking every tick
+    watchdog.watch(b"h" * 16, topic)  # a client was never seen: the same grace, with a look every REFRESH
+    count = len(looks)
+    now[0] = 1.2 + REFRESH - 0.01
+    watchdog.check()
+    assert len(looks) == count
+    now[0] = 1.2 + REFRESH
+    watchdog.check()
+    assert len(looks) == count + 1
