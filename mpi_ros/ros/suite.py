@@ -65,8 +65,8 @@ class Suite:
         self.goal_loop: GoalLoop | GoalRelay = (
             GoalRelay(config.ros.namespace, config.ros.executor_threads) if config.ros.goal_process
             else GoalLoop(self.controller_node.context, config.ros.executor_threads))
-        # one timer for every supervisor's lost-client watchdog, on the controller node (watchdog.py)
-        watchdogs = WatchdogTicker(self.controller_node, ReentrantCallbackGroup())
+        # one timer for every supervisor's lost-client watchdog, on the first one's node (watchdog.py)
+        watchdogs = WatchdogTicker(ReentrantCallbackGroup())
         self.supervisor_nodes = [
             SupervisorNode(self.runner, spec.number, config.ros, self.goal_loop, spec.lost_client_timeout,
                            joints=config.axis_joints(), packer=packer, watchdogs=watchdogs, context=context)

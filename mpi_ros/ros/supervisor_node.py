@@ -26,7 +26,9 @@ from functools import partial
 from action_msgs.msg import GoalStatus
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.event_handler import PublisherEventCallbacks, UnsupportedEventTypeError
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.serialization import serialize_message
 from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
@@ -112,10 +114,13 @@ class SupervisorNode(Node):
         for server in self._servers.values():
             if isinstance(server, GoalServer):
                 goal_loop.add(server)
+        # its checks on the suite's one watchdog timer (``watchdogs``, Suite) where there is one
+        self.watchdog = (LostClientWatchdog(self, lost_client_timeout, self._running, self._client_lost,
+                                            self._service_group, ticker=watchdogs)
+                         if lost_client_timeout > 0 else None)
         # Feedback goes out pre-serialized on the actions' own feedback topics (see _collect_feedback).
-        self._feedback_pubs = {action_type: self.create_publisher(action_type.Impl.FeedbackMessage,
-                                                                  gn.action_feedback(name), profile(gn.FEEDBACK_QOS))
-                               for action_type, name, _ in actions}
+        self._feedback_pubs = {action_type: self._feedback_publisher(action_type, self._feedback_topics[action_type])
+                               for action_type in self._feedback_topics}
         self._service(MotionAction, gn.MOTION_ACTION, self._on_action)
         for endpoint, action in gn.TRIGGERS.values():
             self._service(Trigger, endpoint, lambda req, resp, a=action: self._on_trigger(a, resp))
@@ -144,10 +149,6 @@ class SupervisorNode(Node):
         self.create_subscription(JointTrajectory, gn.JOINT_TRAJECTORY.name(ns, number), self._on_trajectory,
                                  profile(gn.JOINT_TRAJECTORY.qos),
                                  callback_group=self._service_group)
-        # its checks on the suite's one watchdog timer (``watchdogs``, Suite) where there is one
-        self.watchdog = (LostClientWatchdog(self, lost_client_timeout, self._running, self._client_lost,
-                                            self._service_group, ticker=watchdogs)
-                         if lost_client_timeout > 0 else None)
 
     def held(self) -> dict[str, int]:
         """What this node holds of its goals (for /diagnostics: none of it may grow without
@@ -281,6 +282,21 @@ class SupervisorNode(Node):
         self.runner.submit(Command(Operation.ACTION, self.number, request={"action": "STOP"}))
 
     # -- the lost-client watchdog (watchdog.py; its timer, service group) ---------------
+    def _feedback_publisher(self, action_type, topic: str) -> Publisher:
+        """The feedback topic's publisher; with a watchdog, its matched event (a client's
+        subscription came or left) tells the watchdog when to look at the topic on the graph."""
+        qos = profile(gn.FEEDBACK_QOS)
+        watchdog = self.watchdog
+        if watchdog is None:
+            return self.create_publisher(action_type.Impl.FeedbackMessage, topic, qos)
+        events = PublisherEventCallbacks(matched=lambda _status: watchdog.changed(topic))
+        try:
+            publisher = self.create_publisher(action_type.Impl.FeedbackMessage, topic, qos, event_callbacks=events)
+        except UnsupportedEventTypeError:  # a middleware without the event: the watchdog looks at every tick
+            return self.create_publisher(action_type.Impl.FeedbackMessage, topic, qos)
+        watchdog.signalled(topic)
+        return publisher
+
     def _running(self, keys: list[bytes]) -> set[bytes]:
         """Which of these goals have not ended."""
         def read(_ctl) -> set[bytes]:

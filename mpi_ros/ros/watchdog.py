@@ -28,24 +28,38 @@ on the graph at all (killed before the suite discovered its subscription, which 
 machine can take tens of milliseconds to do) counts as lost from its arrival once
 DISCOVERY_GRACE more has passed: no client that could cancel it was ever there.
 
+When it looks: a look at the graph costs tens to hundreds of microseconds (the whole graph
+cache is walked), and the timer would look at every watched topic ten times a second. rclpy
+offers no graph-change signal (ros2/rclpy#929), but the node's own publisher on a feedback
+topic has a *matched* event (PublisherEventCallbacks), which fires whenever a subscriber of
+the topic appears or leaves: a topic whose changes are so signalled (``signalled(topic)``,
+then ``changed(topic)`` from the event) is looked at only after a signal, on every tick until
+a look SETTLE after it (the event may come just before the graph shows the change), and at
+least every REFRESH otherwise (a subscriber that never matches the publisher, such as one of
+incompatible QoS, signals nothing). A topic without the signal is looked at on every tick.
+
 The STOP is a command (commands.CLIENT_LOST) through the runner, like any other: it is on
 <ns>/commands, in bags, and replays exactly.
 """
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from rclpy.callback_groups import CallbackGroup
+from rclpy.guard_condition import GuardCondition
 from rclpy.node import Node
 from rclpy.timer import Timer
 
 PERIOD = 0.1  # s between looks at the graph (shorter for a shorter timeout)
 DETACHED = "_detached"  # the end of a client node's name whose goals are left running on purpose
 DISCOVERY_GRACE = 1.0  # s a goal's client may take to appear on the graph after its goal
+SETTLE = 0.5  # s after a signalled change during which a topic is looked at on every tick
+REFRESH = 1.0  # s: the longest a signalled topic goes without a look while its goals are watched
 
 
 @dataclass(slots=True)
@@ -75,36 +89,71 @@ def describe(keys: Iterable[bytes]) -> str:
 
 
 class WatchdogTicker:
-    """One timer for every lost-client watchdog of a suite (``add(period, check)``), on one
-    node. Why not a timer per supervisor: each woke its node's executor ten times a second,
-    and rclpy rebuilds a node's wait set (its dozen services, its actions) at every wake; at
-    16 supervisors that was about 10 % of a core (bench/RESULTS.md, "The suite under load").
-    The timer runs at the shortest period asked for: a look at the graph sooner than a
-    watchdog needs changes nothing it decides."""
+    """One timer for every lost-client watchdog of a suite (``add(node, period, check)``),
+    ticking only while some watchdog watches a goal (``wake``). Each tick wakes the executor
+    of the timer's node, and rclpy rebuilds that node's whole wait set at every wake: a timer
+    per supervisor cost about 10 % of a core at 16 supervisors, and one on the controller node
+    (hundreds of services at 32 axes) about 5 % ticking with nothing to watch
+    (bench/RESULTS.md, "The suite under load"). So the timer goes on the first watchdog's node
+    (a supervisor), is cancelled when no goal is watched, and a guard condition wakes its
+    executor when it is started again (a wait in progress did not count a cancelled timer).
+    It runs at the shortest period asked for: a look sooner than a watchdog needs changes
+    nothing it decides."""
 
-    def __init__(self, node: Node, group: CallbackGroup):
-        self._node = node
+    def __init__(self, group: CallbackGroup):
         self._group = group
-        self._checks: list[Callable[[], None]] = []
+        self._node: Node | None = None
+        self._checks: list[Callable[[], bool]] = []
         self._period: float | None = None
         self._timer: Timer | None = None
+        self._wake: GuardCondition | None = None
+        self._lock = threading.Lock()
+        self._woken = False  # a watchdog began watching since the tick began
 
-    def add(self, period: float, check: Callable[[], None]) -> None:
-        """Call ``check()`` at least every ``period`` s (before the executor spins)."""
+    def add(self, node: Node, period: float, check: Callable[[], bool]) -> None:
+        """Call ``check()`` at least every ``period`` s while any check answers that it still
+        watches a goal, from the first ``wake`` on. Before the executor spins."""
+        self._node = self._node or node
         self._checks.append(check)
+        if self._wake is None:
+            self._wake = self._node.create_guard_condition(_nothing, callback_group=self._group)
         if self._period is None or period < self._period:
+            ticking = self._timer is not None and not self._timer.is_canceled()
             if self._timer is not None:
                 self._node.destroy_timer(self._timer)
             self._period = period
-            self._timer = self._node.create_timer(period, self._tick, callback_group=self._group)
+            self._timer = self._node.create_timer(period, self._tick, callback_group=self._group, autostart=ticking)
 
     @property
     def period(self) -> float | None:
         return self._period
 
+    @property
+    def ticking(self) -> bool:
+        return self._timer is not None and not self._timer.is_canceled()
+
+    def wake(self) -> None:
+        """A watchdog began watching a goal: tick (from a period on) until none is watched."""
+        assert self._timer is not None and self._wake is not None
+        with self._lock:
+            self._woken = True
+            if self._timer.is_canceled():
+                self._timer.reset()
+                self._wake.trigger()
+
     def _tick(self) -> None:
-        for check in self._checks:
-            check()
+        with self._lock:
+            self._woken = False
+        watching = [check() for check in self._checks]  # every check, each forgets its ended goals
+        if not any(watching):
+            with self._lock:
+                if not self._woken:  # (else a goal came after its watchdog's check)
+                    assert self._timer is not None
+                    self._timer.cancel()
+
+
+def _nothing() -> None:
+    """The guard condition's callback: the wake itself is what it is for."""
 
 
 class LostClientWatchdog:
@@ -121,25 +170,43 @@ class LostClientWatchdog:
         self._on_lost = on_lost
         self._clock = clock
         self._goals: dict[bytes, _Watched] = {}
+        self._seen: dict[str, tuple[float, _Subscribers]] = {}  # each topic's last look: when, what
+        self._changed: dict[str, float] = {}  # signalled topics: the time of their last change
         self._lock = threading.Lock()
         # the suite's one timer (WatchdogTicker) where there is one, else a timer of its own
-        self.ticker = ticker or WatchdogTicker(node, group)
-        self.ticker.add(min(PERIOD, max(timeout / 4.0, 0.01)), self.check)
+        self.ticker = ticker or WatchdogTicker(group)
+        self.ticker.add(node, min(PERIOD, max(timeout / 4.0, 0.01)), self.check)
+
+    def signalled(self, topic: str) -> None:
+        """Every change of ``topic``'s subscribers will be signalled by ``changed(topic)``."""
+        with self._lock:
+            self._changed.setdefault(topic, -math.inf)
+
+    def changed(self, topic: str) -> None:
+        """A subscriber of ``topic`` appeared or left (its publisher's matched event)."""
+        now = self._clock()
+        with self._lock:
+            self._changed[topic] = now
 
     def watch(self, key: bytes, topic: str) -> None:
+        now = self._clock()
         subscribers = _subscribers(self.node, topic)
+        with self._lock:
+            self._seen[topic] = (now, subscribers)
         if subscribers.detached:
             return  # sent by a client that leaves it running on purpose (only such were there)
-        watched = _Watched(key, topic, subscribers.gids, self._clock())
+        watched = _Watched(key, topic, subscribers.gids, now)
         with self._lock:
             self._goals[key] = watched
+        self.ticker.wake()
 
-    def check(self) -> None:
-        """The timer: forget ended goals, time the ones whose client is gone, STOP at T."""
+    def check(self) -> bool:
+        """The timer: forget ended goals, time the ones whose client is gone, STOP at T.
+        Whether it still watches a goal."""
         with self._lock:
             goals = list(self._goals.values())
         if not goals:
-            return
+            return False
         still = self._running([w.key for w in goals])
         present: dict[str, _Subscribers] = {}
         now = self._clock()
@@ -149,7 +216,7 @@ class LostClientWatchdog:
                 self._forget(watched.key)
                 continue
             if watched.topic not in present:
-                present[watched.topic] = _subscribers(self.node, watched.topic)
+                present[watched.topic] = self._look(watched.topic, now)
             if not watched.clients and present[watched.topic].detached:  # its client, seen late, is detached
                 self._forget(watched.key)
                 continue
@@ -159,6 +226,18 @@ class LostClientWatchdog:
         if lost:
             self._on_lost(f"the client of goal {describe(w.key for w in lost)} left the graph: STOP after "
                           f"{self.timeout:g} s without it (lost_client_timeout)")
+        return self.watched > 0
+
+    def _look(self, topic: str, now: float) -> _Subscribers:
+        """The topic's subscribers: from the graph, or as last seen when nothing changed since."""
+        with self._lock:
+            seen, changed = self._seen.get(topic), self._changed.get(topic)
+        if seen is not None and changed is not None and now - seen[0] < REFRESH and seen[0] > changed + SETTLE:
+            return seen[1]
+        subscribers = _subscribers(self.node, topic)
+        with self._lock:
+            self._seen[topic] = (now, subscribers)
+        return subscribers
 
     def _gone(self, watched: _Watched, present: frozenset, now: float) -> bool:
         if not watched.clients:  # its client's subscription was not discovered yet when it came

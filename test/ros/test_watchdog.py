@@ -12,6 +12,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -164,13 +165,33 @@ class FakeGraph:
     def __init__(self):
         self.subscribers: dict[str, list[bytes]] = {}
         self.names: dict[bytes, str] = {}  # node names by GID ("client" when not given)
+        self.woken = 0  # guard condition triggers (the ticker waking its executor)
 
     def get_subscriptions_info_by_topic(self, topic):
         return [SimpleNamespace(endpoint_gid=list(gid), node_name=self.names.get(gid, "client"))
                 for gid in self.subscribers.get(topic, [])]
 
-    def create_timer(self, period, callback, callback_group=None):
-        return SimpleNamespace(period=period, callback=callback)
+    def create_timer(self, period, callback, callback_group=None, autostart=True):
+        return FakeTimer(period, callback, not autostart)
+
+    def create_guard_condition(self, callback, callback_group=None):
+        return SimpleNamespace(trigger=lambda: setattr(self, "woken", self.woken + 1))
+
+
+@dataclass
+class FakeTimer:
+    period: float
+    callback: Callable[[], None]
+    canceled: bool
+
+    def is_canceled(self) -> bool:
+        return self.canceled
+
+    def cancel(self) -> None:
+        self.canceled = True
+
+    def reset(self) -> None:
+        self.canceled = False
 
 
 def test_the_watchdog_times_the_clients_absence_and_forgives_a_return():
@@ -277,10 +298,10 @@ def test_the_watchdogs_of_a_suite_share_one_timer_at_the_shortest_period():
 
     graph, lost = FakeGraph(), []
     timers = []
-    graph.create_timer = lambda period, callback, callback_group=None: timers.append(
-        SimpleNamespace(period=period, callback=callback)) or timers[-1]
+    graph.create_timer = lambda period, callback, callback_group=None, autostart=True: timers.append(
+        FakeTimer(period, callback, not autostart)) or timers[-1]
     graph.destroy_timer = timers.remove
-    ticker = WatchdogTicker(graph, None)
+    ticker = WatchdogTicker(None)
     running = {b"a" * 16, b"b" * 16}
     slow = LostClientWatchdog(graph, 2.0, lambda keys: running & set(keys), lost.append, None,
                               clock=lambda: 10.0, ticker=ticker)
@@ -296,4 +317,80 @@ def test_the_watchdogs_of_a_suite_share_one_timer_at_the_shortest_period():
     running.clear()  # both goals ended: one tick has each watchdog forget its own
     timers[0].callback()
     assert slow.watched == fast.watched == 0
+    assert not lost
+
+
+def test_a_signalled_topic_is_looked_at_only_after_a_change_or_a_refresh():
+    """A topic whose subscribers' changes are signalled (the feedback publisher's matched event)
+    is looked at on the graph after a signal, on every tick until a look SETTLE after it (the
+    event may precede the graph), and every REFRESH otherwise; the decisions are the same."""
+    from mpi_ros.ros.watchdog import REFRESH, SETTLE, LostClientWatchdog
+
+    graph, now, lost = FakeGraph(), [0.0], []
+    looks = []
+    query = graph.get_subscriptions_info_by_topic
+    graph.get_subscriptions_info_by_topic = lambda topic: looks.append(now[0]) or query(topic)
+    topic = "/mpi/ms0/motion_start/_action/feedback"
+    graph.subscribers[topic] = [b"A" * 16]
+    watchdog = LostClientWatchdog(graph, 1.0, lambda keys: set(keys), lost.append, None, clock=lambda: now[0])
+    watchdog.signalled(topic)
+    watchdog.watch(b"g" * 16, topic)
+    assert looks == [0.0]
+    now[0] = 0.1
+    watchdog.check()
+    assert looks == [0.0]  # nothing changed: the look at the goal's arrival holds
+    watchdog.changed(topic)  # the client leaves: its event comes before the graph shows it gone
+    watchdog.check()
+    assert looks == [0.0, 0.1]
+    graph.subscribers[topic] = []
+    now[0] = 0.2
+    watchdog.check()  # looked at again within SETTLE: now it is gone
+    assert looks == [0.0, 0.1, 0.2]
+    assert "gone for 0.00 s" in watchdog.describe_watched()[0]
+    now[0] = 0.1 + SETTLE + 0.05
+    watchdog.check()  # the first look past SETTLE
+    now[0] = 0.1 + SETTLE + 0.1
+    watchdog.check()
+    assert looks == [0.0, 0.1, 0.2, 0.1 + SETTLE + 0.05]
+    now[0] = 1.2
+    watchdog.check()
+    assert len(lost) == 1  # the STOP at T = 1 s after the look that saw it gone, as when looking every tick
+    watchdog.watch(b"h" * 16, topic)  # a client was never seen: the same grace, with a look every REFRESH
+    count = len(looks)
+    now[0] = 1.2 + REFRESH - 0.01
+    watchdog.check()
+    assert len(looks) == count
+    now[0] = 1.2 + REFRESH
+    watchdog.check()
+    assert len(looks) == count + 1
+
+
+def test_the_ticker_ticks_only_while_a_goal_is_watched():
+    """Every tick wakes the executor of the timer's node, which rebuilds its wait set: with
+    no goal watched the timer is cancelled, and a goal watched starts it again and wakes the
+    executor (its wait in progress did not count a cancelled timer)."""
+    from mpi_ros.ros.watchdog import LostClientWatchdog
+
+    graph, lost, running = FakeGraph(), [], {b"g" * 16}
+    topic = "/mpi/ms0/motion_start/_action/feedback"
+    graph.subscribers[topic] = [b"A" * 16]
+    watchdog = LostClientWatchdog(graph, 1.0, lambda keys: running & set(keys), lost.append, None,
+                                  clock=lambda: 0.0)
+    ticker = watchdog.ticker
+    assert not ticker.ticking
+    watchdog.watch(b"g" * 16, topic)
+    assert ticker.ticking
+    assert graph.woken == 1
+    watchdog.watch(b"h" * 16, topic)  # already ticking: no wake needed
+    assert graph.woken == 1
+    ticker._tick()
+    assert ticker.ticking  # "g" still runs
+    running.clear()
+    ticker._tick()
+    assert not ticker.ticking
+    assert watchdog.watched == 0
+    running.add(b"i" * 16)
+    watchdog.watch(b"i" * 16, topic)
+    assert ticker.ticking
+    assert graph.woken == 2
     assert not lost
