@@ -82,24 +82,10 @@ def test_a_damaged_message_index_is_not_trusted(tmp_path: Path):
     assert replay(copy).identical
 
 
-def test_a_bag_without_message_indexes_is_read_one_by_one(tmp_path: Path):
+def test_a_bag_without_message_indexes_is_read_one_by_one(unchunked_bag: Path):
     """Written without chunks (no chunk indexes, so no message indexes): the statistics count
     messages the indexes do not hold."""
-    from mcap.writer import Writer
-
-    source = BagReader(BAGS / "two_supervisors")
-    path = tmp_path / "flat.mcap"
-    with open(path, "wb") as stream:
-        writer = Writer(stream, use_chunking=False)
-        writer.start(profile="ros2", library="test")
-        channels: dict[str, int] = {}
-        for recorded in source.messages():
-            if recorded.topic not in channels:
-                schema_id = writer.register_schema(recorded.type, "ros2msg", recorded.schema_text.encode())
-                channels[recorded.topic] = writer.register_channel(recorded.topic, "cdr", schema_id)
-            writer.add_message(channels[recorded.topic], recorded.log_time, recorded.data, recorded.log_time,
-                               recorded.sequence)
-        writer.finish()
+    path = unchunked_bag
     reader = BagReader(path)
     topics = _topics(reader)
     assert reader._indexed(set(topics)) is None

@@ -171,25 +171,13 @@ def test_reading_in_stored_order_gives_what_mcap_gives(name):
     assert len(fast) > 100
 
 
-def test_reading_a_bag_without_chunks_in_stored_order_gives_what_mcap_gives(tmp_path: Path):
+def test_reading_a_bag_without_chunks_in_stored_order_gives_what_mcap_gives(unchunked_bag: Path):
     """Where the summary has no chunk indexes (an MCAP written without chunks), the records
     are read one by one from the start."""
     from mcap.reader import make_reader
-    from mcap.writer import Writer
 
-    source = BagReader(BAGS / "two_supervisors")
-    path = tmp_path / "flat.mcap"
-    with open(path, "wb") as stream:
-        writer = Writer(stream, use_chunking=False)
-        writer.start(profile="ros2", library="test")
-        channels: dict[str, int] = {}
-        for recorded in source.messages():
-            if recorded.topic not in channels:
-                schema_id = writer.register_schema(recorded.type, "ros2msg", recorded.schema_text.encode())
-                channels[recorded.topic] = writer.register_channel(recorded.topic, "cdr", schema_id)
-            writer.add_message(channels[recorded.topic], recorded.log_time, recorded.data, recorded.log_time,
-                               recorded.sequence)
-        writer.finish()
+    source = BagReader(BAGS / "two_supervisors")  # what unchunked_bag was written from
+    path = unchunked_bag
     with open(path, "rb") as stream:
         assert not make_reader(stream).get_summary().chunk_indexes
     reader = BagReader(path)
