@@ -530,23 +530,24 @@ def serve_profiled(out: str, argv: list[str]) -> int:
     import functools
 
     from mpi_ros.cli import main as cli_main
-    from mpi_ros.ros.suite import Suite
+    from mpi_ros.ros.spinner import Spinner
     from mpi_ros.runner import ControllerRunner
 
-    def profiled(method, name: str):
+    def profiled(method, name):
         @functools.wraps(method)
-        def wrapper(*args, **kwargs):
+        def wrapper(self, *args, **kwargs):
             profile = cProfile.Profile()
             profile.enable()
             try:
-                return method(*args, **kwargs)
+                return method(self, *args, **kwargs)
             finally:
                 profile.disable()
-                profile.dump_stats(f"{out}.{name}.prof")
+                profile.dump_stats(f"{out}.{name(self)}.prof")
         return wrapper
 
-    ControllerRunner._loop = profiled(ControllerRunner._loop, "clock")
-    Suite.spin = profiled(Suite.spin, "executor")
+    ControllerRunner._loop = profiled(ControllerRunner._loop, lambda _runner: "clock")
+    # One executor thread per node (mpi_ros.ros.spinner): one profile each.
+    Spinner._run = profiled(Spinner._run, lambda spinner: f"executor-{spinner.name}")
     return cli_main(["run", *argv])
 
 
@@ -656,9 +657,9 @@ def profile(case: Case, seconds: float, out: Path, time_scale: float, top: int =
     result = run_case(case, seconds, command, subscribers=subscribers)
     print(f"Under cProfile, time scale {time_scale:g} (rates scale with it):")
     print("\n".join(report([result])))
-    for name in ("clock", "executor"):
-        stats = pstats.Stats(f"{out}.{name}.prof")
-        print(f"\n== {name} thread ==")
+    for path in sorted(out.parent.glob(f"{out.name}.*.prof")):
+        stats = pstats.Stats(str(path))
+        print(f"\n== {path.name.removeprefix(out.name + '.').removesuffix('.prof')} thread ==")
         stats.sort_stats("tottime").print_stats(top)
         stats.sort_stats("cumulative").print_stats(top)
 
