@@ -5,7 +5,7 @@ The nodes, the recorder, replay, the client, discovery and the console read them
 Pure data: no rclpy, so the client, the bag tools and the tests can import it anywhere;
 :func:`mpi_ros.ros.qos.profile` turns a :class:`Qos` into rclpy's QoSProfile.
 
-Names follow the ROS contract (docs/architecture.md, "The ROS contract"): supervisor ``n`` is
+Names follow the ROS contract (docs/decisions.md, "The ROS contract"): supervisor ``n`` is
 node ``<ns>/ms<n>``, axis ``k``'s endpoints are under ``<ns>/axis<k>``, the controller's
 under ``<ns>``; /joint_states (for the default namespace), /diagnostics and /clock are at the root.
 """

@@ -138,7 +138,7 @@ class RosSettings:
     clock_rate: float = _rate(100.0, "/clock is published", parameter=True)
     # The clock thread steps the statuses due within it in one stretch (runner.py); a stretch costs
     # about the same whatever its length, so at 1 kHz status this saves most of the stepping, at a
-    # few ms of latency (docs/decisions.md, "Status publications in stretches").
+    # few ms of latency (docs/decisions.md, "Statuses are stepped in stretches").
     publish_period: float = setting(0.005, "how long a status (MotionStatus, AxisStatus, /joint_states, /clock) may "
                                     "wait past its sample before it is published; 0: each as it falls due",
                                     unit="s", low=0.0, high=1.0, parameter=True)

@@ -13,7 +13,7 @@ from mpi_ros import graph_names as gn
 
 PACKAGE = Path(__file__).resolve().parents[1] / "mpi_ros"
 
-# The ROS contract (docs/architecture.md, "The ROS contract"), written out by hand: full name
+# The ROS contract (docs/decisions.md, "The ROS contract"), written out by hand: full name
 # in the default namespace, for supervisor 0 and axis 1, -> interface type.
 CONTRACT = {
     "/mpi/ms0/motion_start": "mpi_ros/action/MotionStart",

@@ -193,8 +193,8 @@ def _serve(args, prog: str, stops: stop_signals.StopSignals) -> int:
     # long-lived objects (goals kept for result_timeout, requests waiting) made each young
     # collection promote more and each full one walk them all. At 800 modify goals a second
     # the collector held the interpreter 12.6 s in a minute (23 full collections of ~350 ms,
-    # each a stall of the clock); so set, 4.1 s (3 full collections). bench/RESULTS.md, "The
-    # collector and the goal queue".
+    # each a stall of the clock); so set, 4.1 s (3 full collections). docs/reliability.md, "The
+    # goal path".
     gc.set_threshold(*GC_THRESHOLDS)
     release_large_buffers()
     suite.start()

@@ -4,7 +4,7 @@ Why not the nodes' executors: rclpy's executor rebuilds its wait set in Python f
 entity of its node on every round (about 0.6 ms for a supervisor node's 36 entities), and a
 goal costs at least two rounds (its request, its result request) plus the task that serves
 it. Under a stream of modifies those rounds took more of the suite's CPU than applying the
-commands did (bench/RESULTS.md, "The goal path without the executors"). This loop's wait set
+commands did (docs/reliability.md, "The goal path"). This loop's wait set
 holds only the goal servers' services (three each) and a guard condition: made once,
 refilled each round with a few C calls; each round also lets the servers forget expired
 results. What a round takes is served on a pool of threads (a goal's command waits there for
