@@ -28,7 +28,7 @@ from mpi_ros.mpi.axes.status import AT_TARGET, AT_VELOCITY, DONE, IN_COARSE, IN_
 from mpi_ros.mpi.base.params import PlantConfig
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.mpi.base.types import MPIState
-from mpi_ros.mpi.base.wrap import wrap_positions
+from mpi_ros.mpi.base.wrap import wrap_position, wrap_positions
 from mpi_ros.mpi.planning.frames import AxisPlan
 from mpi_ros.mpi.supervisor.motion import MotionSupervisor
 from mpi_ros.mpi.supervisor.status import MotionTemplate
@@ -67,21 +67,22 @@ class AxisTemplate:
         """The template of ``axis`` now, commanded by supervisor ``number`` (-1: none),
         ``owner`` (None: none, or not a supervisor of this controller)."""
         plan = axis.plan
+        # (positional, in field order: keywords cost more than the rest of a template)
         return cls(
-            axis=axis,
-            plan=plan,
-            state=owner.own_state if owner is not None else MPIState.IDLE,
-            supervisor=number,
+            axis,
+            plan,
+            owner.own_state if owner is not None else MPIState.IDLE,
+            number,
             # A velocity move has no target: NaN, rather than the end of its long frame.
-            target_position=math.nan if plan is not None and plan.is_velocity else axis.target_position,
-            origin=axis.origin,
-            amp_enabled=axis.amp_enabled,
-            move_id=axis.move_id,
-            frames_queued=owner.frames_queued(axis.number) if owner is not None else 0,
-            frame_buffer_size=frame_buffer_size,
-            faults=faults,
-            feedforward=axis.feedforward_at(math.nan) if plan is None or plan.feedforward is None else None,
-            element_id=axis.element_id_at(math.nan) if plan is None or not plan.element_ids else None,
+            math.nan if plan is not None and plan.is_velocity else axis.target_position,
+            axis.origin,
+            axis.amp_enabled,
+            axis.move_id,
+            owner.frames_queued(axis.number) if owner is not None else 0,
+            frame_buffer_size,
+            faults,
+            axis.feedforward_at(math.nan) if plan is None or plan.feedforward is None else None,
+            axis.element_id_at(math.nan) if plan is None or not plan.element_ids else None,
         )
 
     def frame_count(self, rel: float) -> int:
@@ -93,13 +94,16 @@ class AxisTemplate:
             count += self.plan.frames_left(rel if math.isfinite(rel) else 0.0)
         return min(count, self.frame_buffer_size)
 
-    def frame_counts(self, rel: list[float], low: float, high: float) -> int | list[int]:
-        """:meth:`frame_count` at each profile time of ``rel``, or one count for them all;
-        ``low`` and ``high``: the least and the greatest of them that frame_count reads (a
-        profile time not finite reads as 0). A plan's frames left never grow with its
-        profile time, so a count equal at both holds at every one between."""
+    def frame_counts(self, rel: list[float]) -> int | list[int]:
+        """:meth:`frame_count` at each profile time of ``rel``, or one count for them all. A
+        plan's frames left never grow with its profile time, so a count equal at the least
+        and the greatest of them holds at every one between."""
+        if self.plan is None or len(rel) == 1:
+            return self.frame_count(rel[0])
+        reached = [r if math.isfinite(r) else 0.0 for r in rel]  # (what frame_count reads)
+        low, high = min(reached), max(reached)
         first = self.frame_count(low)
-        if self.plan is None or low == high or first == self.frame_count(high):
+        if low == high or first == self.frame_count(high):
             return first
         return [self.frame_count(r) for r in rel]
 
@@ -115,17 +119,42 @@ class AxisTemplate:
             return self.element_id
         return [self.axis.element_id_at(r) for r in rel]
 
+    def along(self, rel: list[float]) -> list[tuple[float, int, int]]:
+        """The feedforward, element id and frame count at each profile time of ``rel``."""
+        varying = self.feedforwards(rel), self.element_ids(rel), self.frame_counts(rel)
+        if isinstance(varying[0], list) or isinstance(varying[1], list) or isinstance(varying[2], list):
+            return list(zip(*(v if isinstance(v, list) else [v] * len(rel) for v in varying), strict=True))
+        return [varying] * len(rel)  # type: ignore[list-item]  # (none of them a list)
+
     def at(self, sample: int, values: Sequence[float], bits: Sequence[bool]) -> AxisSnapshot:
         """The snapshot at ``sample`` from the axis' values there (bank.VALUES order) and its
         status bits (status.BITS order)."""
-        return axis_snapshots((self,), [sample], np.array(values, dtype=float)[:, None, None],
-                              np.array(bits, dtype=bool)[:, None, None])[0]
+        return self.snapshot(sample, values, [bits[i] for i in _BIT_ROWS], *self.along([values[REL]])[0])
+
+    def snapshot(self, sample: int, values: Sequence[float], bits: Sequence[bool], feedforward: float,
+                 element_id: int, frame_count: int) -> AxisSnapshot:
+        """The snapshot at ``sample`` from the axis' values there (bank.VALUES order), its
+        status bits (those of _BIT_FIELDS, in that order) and what follows the profile time
+        there (:meth:`along`): value by value, the operations axis_snapshots' columns do
+        element by element (so the same bits)."""
+        cmd_p, cmd_v, cmd_a, act_p, act_v, _ = values
+        done, at_target, in_fine, in_coarse, settled, at_velocity, complete = bits
+        error = cmd_p - act_p
+        effort = (servo_effort(self.axis.plant.config, error, cmd_v, act_v, cmd_a, feedforward)
+                  if self.amp_enabled else 0.0)
+        origin = self.origin
+        # (positional, in AxisSnapshot's field order: keywords cost more than the rest of it)
+        return AxisSnapshot(sample, self.axis.number, self.state, wrap_position(cmd_p - origin),
+                            wrap_position(act_p - origin), error, self.target_position, origin, cmd_v, act_v, cmd_a,
+                            done, at_target, in_fine, in_coarse, settled, at_velocity, complete, self.amp_enabled,
+                            self.move_id, element_id, frame_count, self.supervisor, feedforward, self.faults, effort)
 
 
 _FIELDS = tuple(f.name for f in fields(AxisSnapshot))  # AxisSnapshot's positional order
 _BIT_FIELDS = {"done": DONE, "at_target": AT_TARGET, "in_fine_position": IN_FINE, "in_coarse_position": IN_COARSE,
                "settled": SETTLED, "at_velocity": AT_VELOCITY, "trajectory_complete": TC}
 _BIT_ROWS = list(_BIT_FIELDS.values())
+_FEW = 64  # snapshots (samples x axes) up to which plain floats cost less than the columns' arrays
 _PLANT_VALUES = attrgetter(*(f.name for f in fields(PlantConfig)))  # plants alike: the same effort
 _HELD = ("state", "target_position", "origin", "amp_enabled", "move_id", "supervisor", "faults")
 _HELD_OF = attrgetter(*_HELD)
@@ -146,6 +175,8 @@ def axis_snapshots(templates: Sequence[AxisTemplate], samples: Sequence[int], va
     and the snapshots are built from those lists in one pass."""
     if not templates:
         return []
+    if len(samples) * len(templates) <= _FEW:
+        return _one_by_one(templates, samples, values, bits)
     stops, rel = len(samples), values[REL]
     by_axis = rel.T.tolist()  # each axis' profile times
     held = list(zip(*map(_HELD_OF, templates), strict=True))  # each of _HELD, by axis
@@ -158,10 +189,20 @@ def axis_snapshots(templates: Sequence[AxisTemplate], samples: Sequence[int], va
     columns["sample"] = [s for s in samples for _ in templates]
     columns["feedforward"] = _column(feedforward, stops)
     columns["element_id"] = _column([t.element_ids(r) for t, r in zip(templates, by_axis, strict=True)], stops)
-    reached = np.where(np.isfinite(rel), rel, 0.0)  # (what frame_count reads)
-    columns["frame_count"] = _column([t.frame_counts(r, low, high) for t, r, low, high in zip(
-        templates, by_axis, reached.min(axis=0).tolist(), reached.max(axis=0).tolist(), strict=True)], stops)
+    columns["frame_count"] = _column([t.frame_counts(r) for t, r in zip(templates, by_axis, strict=True)], stops)
     return list(map(AxisSnapshot, *(columns[name] for name in _FIELDS)))
+
+
+def _one_by_one(templates: Sequence[AxisTemplate], samples: Sequence[int], values: np.ndarray,
+                bits: np.ndarray) -> list[AxisSnapshot]:
+    """axis_snapshots, snapshot by snapshot from plain floats: a few snapshots cost less so
+    than the fixed costs of the columns' numpy calls."""
+    along = [t.along(r) for t, r in zip(templates, values[REL].T.tolist(), strict=True)]
+    rows = values.transpose(1, 2, 0).tolist()  # samples x templates x VALUES
+    flags = bits[_BIT_ROWS].transpose(1, 2, 0).tolist()  # samples x templates x _BIT_FIELDS
+    return [t.snapshot(sample, v, b, *a[i])
+            for i, (sample, by_axis, bits_by_axis) in enumerate(zip(samples, rows, flags, strict=True))
+            for t, v, b, a in zip(templates, by_axis, bits_by_axis, along, strict=True)]
 
 
 def _floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Sequence[float],
