@@ -119,35 +119,11 @@ class AxisTemplate:
             return self.element_id
         return [self.axis.element_id_at(r) for r in rel]
 
-    def along(self, rel: list[float]) -> list[tuple[float, int, int]]:
-        """The feedforward, element id and frame count at each profile time of ``rel``."""
-        varying = self.feedforwards(rel), self.element_ids(rel), self.frame_counts(rel)
-        if isinstance(varying[0], list) or isinstance(varying[1], list) or isinstance(varying[2], list):
-            return list(zip(*(v if isinstance(v, list) else [v] * len(rel) for v in varying), strict=True))
-        return [varying] * len(rel)  # type: ignore[list-item]  # (none of them a list)
-
     def at(self, sample: int, values: Sequence[float], bits: Sequence[bool]) -> AxisSnapshot:
         """The snapshot at ``sample`` from the axis' values there (bank.VALUES order) and its
         status bits (status.BITS order)."""
-        return self.snapshot(sample, values, [bits[i] for i in _BIT_ROWS], *self.along([values[REL]])[0])
-
-    def snapshot(self, sample: int, values: Sequence[float], bits: Sequence[bool], feedforward: float,
-                 element_id: int, frame_count: int) -> AxisSnapshot:
-        """The snapshot at ``sample`` from the axis' values there (bank.VALUES order), its
-        status bits (those of _BIT_FIELDS, in that order) and what follows the profile time
-        there (:meth:`along`): value by value, the operations axis_snapshots' columns do
-        element by element (so the same bits)."""
-        cmd_p, cmd_v, cmd_a, act_p, act_v, _ = values
-        done, at_target, in_fine, in_coarse, settled, at_velocity, complete = bits
-        error = cmd_p - act_p
-        effort = (servo_effort(self.axis.plant.config, error, cmd_v, act_v, cmd_a, feedforward)
-                  if self.amp_enabled else 0.0)
-        origin = self.origin
-        # (positional, in AxisSnapshot's field order: keywords cost more than the rest of it)
-        return AxisSnapshot(sample, self.axis.number, self.state, wrap_position(cmd_p - origin),
-                            wrap_position(act_p - origin), error, self.target_position, origin, cmd_v, act_v, cmd_a,
-                            done, at_target, in_fine, in_coarse, settled, at_velocity, complete, self.amp_enabled,
-                            self.move_id, element_id, frame_count, self.supervisor, feedforward, self.faults, effort)
+        return axis_snapshots((self,), [sample], np.array(values, dtype=float)[:, None, None],
+                              np.array(bits, dtype=bool)[:, None, None])[0]
 
 
 _FIELDS = tuple(f.name for f in fields(AxisSnapshot))  # AxisSnapshot's positional order
@@ -170,39 +146,29 @@ def axis_snapshots(templates: Sequence[AxisTemplate], samples: Sequence[int], va
     (bank.VALUES x samples x templates) and status bits (status.BITS x samples x templates):
     those of the first sample first, in the order of ``templates``.
 
-    What follows the values is computed for every sample and axis at once, in arrays; each
-    field is then one list in the snapshots' order (what holds along the stretch repeated),
-    and the snapshots are built from those lists in one pass."""
+    What follows the values is computed for every sample and axis at once, in arrays (in
+    plain floats for a few snapshots); each field is then one list in the snapshots' order
+    (what holds along the stretch repeated), and the snapshots are built from those lists in
+    one pass."""
     if not templates:
         return []
-    if len(samples) * len(templates) <= _FEW:
-        return _one_by_one(templates, samples, values, bits)
     stops, rel = len(samples), values[REL]
     by_axis = rel.T.tolist()  # each axis' profile times
     held = list(zip(*map(_HELD_OF, templates), strict=True))  # each of _HELD, by axis
     columns = {name: list(column) * stops for name, column in zip(_HELD, held, strict=True)}
     feedforward = [t.feedforwards(r) for t, r in zip(templates, by_axis, strict=True)]
-    columns.update(zip(_FLOATS, _flat(_floats(templates, values, held[_HELD.index("origin")], feedforward)),
-                       strict=True))
+    columns["feedforward"] = _column(feedforward, stops)
+    origin = held[_HELD.index("origin")]
+    if stops * len(templates) <= _FEW:
+        columns.update(zip(_FLOATS, _plain_floats(templates, values, origin, columns["feedforward"]), strict=True))
+    else:
+        columns.update(zip(_FLOATS, _flat(_floats(templates, values, origin, feedforward)), strict=True))
     columns.update(zip(_BIT_FIELDS, _flat(bits[_BIT_ROWS]), strict=True))
     columns["number"] = [t.axis.number for t in templates] * stops
     columns["sample"] = [s for s in samples for _ in templates]
-    columns["feedforward"] = _column(feedforward, stops)
     columns["element_id"] = _column([t.element_ids(r) for t, r in zip(templates, by_axis, strict=True)], stops)
     columns["frame_count"] = _column([t.frame_counts(r) for t, r in zip(templates, by_axis, strict=True)], stops)
     return list(map(AxisSnapshot, *(columns[name] for name in _FIELDS)))
-
-
-def _one_by_one(templates: Sequence[AxisTemplate], samples: Sequence[int], values: np.ndarray,
-                bits: np.ndarray) -> list[AxisSnapshot]:
-    """axis_snapshots, snapshot by snapshot from plain floats: a few snapshots cost less so
-    than the fixed costs of the columns' numpy calls."""
-    along = [t.along(r) for t, r in zip(templates, values[REL].T.tolist(), strict=True)]
-    rows = values.transpose(1, 2, 0).tolist()  # samples x templates x VALUES
-    flags = bits[_BIT_ROWS].transpose(1, 2, 0).tolist()  # samples x templates x _BIT_FIELDS
-    return [t.snapshot(sample, v, b, *a[i])
-            for i, (sample, by_axis, bits_by_axis) in enumerate(zip(samples, rows, flags, strict=True))
-            for t, v, b, a in zip(templates, by_axis, bits_by_axis, along, strict=True)]
 
 
 def _floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Sequence[float],
@@ -214,6 +180,21 @@ def _floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Seque
     floats[2] -= act_p
     floats[6] = _efforts(templates, feedforward, floats[2], cmd_v, act_v, cmd_a)
     return floats
+
+
+def _plain_floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Sequence[float],
+                  feedforward: list[float]) -> list[list[float]]:
+    """:func:`_floats` as lists (sample by sample) for a few snapshots, where numpy's fixed
+    costs exceed the arithmetic: element by element, the same operations (the same bits);
+    ``feedforward``: the feedforward column."""
+    cmd_p, cmd_v, cmd_a, act_p, act_v, _ = _flat(values)
+    stops = len(cmd_p) // len(templates)
+    origins, every = list(origin) * stops, list(templates) * stops
+    error = [c - a for c, a in zip(cmd_p, act_p, strict=True)]
+    effort = [servo_effort(t.axis.plant.config, e, v, w, a, f) if t.amp_enabled else 0.0
+              for t, e, v, w, a, f in zip(every, error, cmd_v, act_v, cmd_a, feedforward, strict=True)]
+    return [[wrap_position(p - o) for p, o in zip(cmd_p, origins, strict=True)],
+            [wrap_position(p - o) for p, o in zip(act_p, origins, strict=True)], error, cmd_v, act_v, cmd_a, effort]
 
 
 def _flat(arrays: np.ndarray) -> list[list[Any]]:
