@@ -7,6 +7,10 @@ supervisor and axis) and ``step_snapshots(20, 10 stops)`` (the same 20 samples, 
 status of every second one: what publishing at 1 kHz from a 2 kHz controller in 10 ms
 batches asks), and ``pack a sample`` (wire.Packer: the CDR of every axis' and supervisor's
 status of one sample, as the status topics pack them, from snapshots not packed before).
+Then the stretches the suite steps (issue 35, bench_suite --phases): ``step_snapshots(20, 1
+stop)`` (32 axes at 100 Hz: one status at the end of 20 samples) and ``step_snapshots(10, 5
+stops)`` (8 axes at 1 kHz in 5 ms batches) beside ``step(10)``, and what their snapshots
+alone cost: ``snapshots of ...``, the call minus the stepping of the same samples.
 
 The machines are shared and noisy: each tree (this one and ``--baseline``, extracted with git
 archive) runs every case in a fresh process, the trees alternating ``--rounds`` times; a
@@ -33,7 +37,11 @@ if TYPE_CHECKING:
     from mpi_ros.mpi import Controller
 
 CASES = [(8, 4), (32, 16)]
-CALLS = ("step(20)", "motion_snapshots()", "step_snapshots(20, 10 stops)", "pack a sample")
+CALLS = ("step(20)", "motion_snapshots()", "step_snapshots(20, 10 stops)", "pack a sample",
+         "step_snapshots(20, 1 stop)", "step(10)", "step_snapshots(10, 5 stops)")
+# what the snapshots alone cost: a call minus the stepping of the same samples
+PARTS = {"snapshots of 1 stop in 20": ("step_snapshots(20, 1 stop)", "step(20)"),
+         "snapshots of 5 stops in 10": ("step_snapshots(10, 5 stops)", "step(10)")}
 BATCH, EVERY = 20, 2  # samples a call steps; a status every EVERY samples
 
 
@@ -57,13 +65,17 @@ def measure(axes: int, supervisors: int) -> dict[str, float]:
     _velocity(ctl)
     number = max(20, 800 // axes)
 
-    def stops() -> range:
-        return range(ctl.sample + EVERY, ctl.sample + BATCH + 1, EVERY)
+    def stepping(samples: int, every: int) -> Callable[[], object]:
+        """step_snapshots of ``samples`` samples, with the status of every ``every``-th."""
+        return lambda: ctl.step_snapshots(samples, range(ctl.sample + every, ctl.sample + samples + 1, every))
 
     return {"step(20)": _best(lambda: ctl.step(BATCH), number),
             "motion_snapshots()": _best(ctl.motion_snapshots, number),
-            "step_snapshots(20, 10 stops)": _best(lambda: ctl.step_snapshots(BATCH, stops()), number),
-            "pack a sample": _packing(ctl, number)}
+            "step_snapshots(20, 10 stops)": _best(stepping(BATCH, EVERY), number),
+            "pack a sample": _packing(ctl, number),
+            "step_snapshots(20, 1 stop)": _best(stepping(BATCH, BATCH), number),
+            "step(10)": _best(lambda: ctl.step(10), number),
+            "step_snapshots(10, 5 stops)": _best(stepping(10, EVERY), number)}
 
 
 def _packing(ctl: Controller, number: int, repeat: int = 7) -> float:
@@ -99,7 +111,9 @@ def main(baseline: str, rounds: int) -> list[str]:
                 for tree, name in trees:
                     runs[name].append(measure_in(tree, case, "bench_snapshots"))
             best = {name: {call: min(run[call] for run in found) for call in CALLS} for name, found in runs.items()}
-            for call in CALLS:
+            for figures in best.values():
+                figures.update({part: figures[call] - figures[step] for part, (call, step) in PARTS.items()})
+            for call in [*CALLS, *PARTS]:
                 new = best["this tree"][call]
                 old = best[baseline][call] if baseline in best else float("nan")
                 rows.append(f"| {case[0]} / {case[1]} | {call} | {new:,.0f} | {old:,.0f} | {new / old:.2f} |")

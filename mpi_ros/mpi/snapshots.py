@@ -28,7 +28,7 @@ from mpi_ros.mpi.axes.status import AT_TARGET, AT_VELOCITY, DONE, IN_COARSE, IN_
 from mpi_ros.mpi.base.params import PlantConfig
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.mpi.base.types import MPIState
-from mpi_ros.mpi.base.wrap import wrap_positions
+from mpi_ros.mpi.base.wrap import wrap_position, wrap_positions
 from mpi_ros.mpi.planning.frames import AxisPlan
 from mpi_ros.mpi.supervisor.motion import MotionSupervisor
 from mpi_ros.mpi.supervisor.status import MotionTemplate
@@ -67,21 +67,22 @@ class AxisTemplate:
         """The template of ``axis`` now, commanded by supervisor ``number`` (-1: none),
         ``owner`` (None: none, or not a supervisor of this controller)."""
         plan = axis.plan
+        # (positional, in field order: keywords cost more than the rest of a template)
         return cls(
-            axis=axis,
-            plan=plan,
-            state=owner.own_state if owner is not None else MPIState.IDLE,
-            supervisor=number,
+            axis,
+            plan,
+            owner.own_state if owner is not None else MPIState.IDLE,
+            number,
             # A velocity move has no target: NaN, rather than the end of its long frame.
-            target_position=math.nan if plan is not None and plan.is_velocity else axis.target_position,
-            origin=axis.origin,
-            amp_enabled=axis.amp_enabled,
-            move_id=axis.move_id,
-            frames_queued=owner.frames_queued(axis.number) if owner is not None else 0,
-            frame_buffer_size=frame_buffer_size,
-            faults=faults,
-            feedforward=axis.feedforward_at(math.nan) if plan is None or plan.feedforward is None else None,
-            element_id=axis.element_id_at(math.nan) if plan is None or not plan.element_ids else None,
+            math.nan if plan is not None and plan.is_velocity else axis.target_position,
+            axis.origin,
+            axis.amp_enabled,
+            axis.move_id,
+            owner.frames_queued(axis.number) if owner is not None else 0,
+            frame_buffer_size,
+            faults,
+            axis.feedforward_at(math.nan) if plan is None or plan.feedforward is None else None,
+            axis.element_id_at(math.nan) if plan is None or not plan.element_ids else None,
         )
 
     def frame_count(self, rel: float) -> int:
@@ -93,13 +94,16 @@ class AxisTemplate:
             count += self.plan.frames_left(rel if math.isfinite(rel) else 0.0)
         return min(count, self.frame_buffer_size)
 
-    def frame_counts(self, rel: list[float], low: float, high: float) -> int | list[int]:
-        """:meth:`frame_count` at each profile time of ``rel``, or one count for them all;
-        ``low`` and ``high``: the least and the greatest of them that frame_count reads (a
-        profile time not finite reads as 0). A plan's frames left never grow with its
-        profile time, so a count equal at both holds at every one between."""
+    def frame_counts(self, rel: list[float]) -> int | list[int]:
+        """:meth:`frame_count` at each profile time of ``rel``, or one count for them all. A
+        plan's frames left never grow with its profile time, so a count equal at the least
+        and the greatest of them holds at every one between."""
+        if self.plan is None or len(rel) == 1:
+            return self.frame_count(rel[0])
+        reached = [r if math.isfinite(r) else 0.0 for r in rel]  # (what frame_count reads)
+        low, high = min(reached), max(reached)
         first = self.frame_count(low)
-        if self.plan is None or low == high or first == self.frame_count(high):
+        if low == high or first == self.frame_count(high):
             return first
         return [self.frame_count(r) for r in rel]
 
@@ -126,6 +130,7 @@ _FIELDS = tuple(f.name for f in fields(AxisSnapshot))  # AxisSnapshot's position
 _BIT_FIELDS = {"done": DONE, "at_target": AT_TARGET, "in_fine_position": IN_FINE, "in_coarse_position": IN_COARSE,
                "settled": SETTLED, "at_velocity": AT_VELOCITY, "trajectory_complete": TC}
 _BIT_ROWS = list(_BIT_FIELDS.values())
+_FEW = 64  # snapshots (samples x axes) up to which plain floats cost less than the columns' arrays
 _PLANT_VALUES = attrgetter(*(f.name for f in fields(PlantConfig)))  # plants alike: the same effort
 _HELD = ("state", "target_position", "origin", "amp_enabled", "move_id", "supervisor", "faults")
 _HELD_OF = attrgetter(*_HELD)
@@ -141,9 +146,10 @@ def axis_snapshots(templates: Sequence[AxisTemplate], samples: Sequence[int], va
     (bank.VALUES x samples x templates) and status bits (status.BITS x samples x templates):
     those of the first sample first, in the order of ``templates``.
 
-    What follows the values is computed for every sample and axis at once, in arrays; each
-    field is then one list in the snapshots' order (what holds along the stretch repeated),
-    and the snapshots are built from those lists in one pass."""
+    What follows the values is computed for every sample and axis at once, in arrays (in
+    plain floats for a few snapshots); each field is then one list in the snapshots' order
+    (what holds along the stretch repeated), and the snapshots are built from those lists in
+    one pass."""
     if not templates:
         return []
     stops, rel = len(samples), values[REL]
@@ -151,16 +157,17 @@ def axis_snapshots(templates: Sequence[AxisTemplate], samples: Sequence[int], va
     held = list(zip(*map(_HELD_OF, templates), strict=True))  # each of _HELD, by axis
     columns = {name: list(column) * stops for name, column in zip(_HELD, held, strict=True)}
     feedforward = [t.feedforwards(r) for t, r in zip(templates, by_axis, strict=True)]
-    columns.update(zip(_FLOATS, _flat(_floats(templates, values, held[_HELD.index("origin")], feedforward)),
-                       strict=True))
+    columns["feedforward"] = _column(feedforward, stops)
+    origin = held[_HELD.index("origin")]
+    if stops * len(templates) <= _FEW:
+        columns.update(zip(_FLOATS, _plain_floats(templates, values, origin, columns["feedforward"]), strict=True))
+    else:
+        columns.update(zip(_FLOATS, _flat(_floats(templates, values, origin, feedforward)), strict=True))
     columns.update(zip(_BIT_FIELDS, _flat(bits[_BIT_ROWS]), strict=True))
     columns["number"] = [t.axis.number for t in templates] * stops
     columns["sample"] = [s for s in samples for _ in templates]
-    columns["feedforward"] = _column(feedforward, stops)
     columns["element_id"] = _column([t.element_ids(r) for t, r in zip(templates, by_axis, strict=True)], stops)
-    reached = np.where(np.isfinite(rel), rel, 0.0)  # (what frame_count reads)
-    columns["frame_count"] = _column([t.frame_counts(r, low, high) for t, r, low, high in zip(
-        templates, by_axis, reached.min(axis=0).tolist(), reached.max(axis=0).tolist(), strict=True)], stops)
+    columns["frame_count"] = _column([t.frame_counts(r) for t, r in zip(templates, by_axis, strict=True)], stops)
     return list(map(AxisSnapshot, *(columns[name] for name in _FIELDS)))
 
 
@@ -173,6 +180,21 @@ def _floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Seque
     floats[2] -= act_p
     floats[6] = _efforts(templates, feedforward, floats[2], cmd_v, act_v, cmd_a)
     return floats
+
+
+def _plain_floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Sequence[float],
+                  feedforward: list[float]) -> list[list[float]]:
+    """:func:`_floats` as lists (sample by sample) for a few snapshots, where numpy's fixed
+    costs exceed the arithmetic: element by element, the same operations (the same bits);
+    ``feedforward``: the feedforward column."""
+    cmd_p, cmd_v, cmd_a, act_p, act_v, _ = _flat(values)
+    stops = len(cmd_p) // len(templates)
+    origins, every = list(origin) * stops, list(templates) * stops
+    error = [c - a for c, a in zip(cmd_p, act_p, strict=True)]
+    effort = [servo_effort(t.axis.plant.config, e, v, w, a, f) if t.amp_enabled else 0.0
+              for t, e, v, w, a, f in zip(every, error, cmd_v, act_v, cmd_a, feedforward, strict=True)]
+    return [[wrap_position(p - o) for p, o in zip(cmd_p, origins, strict=True)],
+            [wrap_position(p - o) for p, o in zip(act_p, origins, strict=True)], error, cmd_v, act_v, cmd_a, effort]
 
 
 def _flat(arrays: np.ndarray) -> list[list[Any]]:

@@ -24,6 +24,7 @@ from mpi_ros.mpi import (
     MPIAction,
     MPIMotionType,
     Trajectory,
+    snapshots,
 )
 from mpi_ros.mpi.axes.plant import Plant, servo_effort
 from mpi_ros.mpi.base.params import PlantConfig
@@ -100,9 +101,10 @@ def _stepped(script, wanted: list[int]) -> tuple[dict[int, object], list]:
     return {s: taken[s] for s in wanted}, _events(ctl)
 
 
-def _in_stretches(script, wanted: list[int]) -> tuple[dict[int, object], list]:
-    """From command to command, one step_snapshots for the samples between."""
-    ctl, pending, taken = _controller(), list(script), {}
+def _in_stretches(script, wanted: list[int], ctl: Controller | None = None) -> tuple[dict[int, object], list]:
+    """From command to command, one step_snapshots for the samples between (on ``ctl``, a
+    new _controller() by default)."""
+    ctl, pending, taken = ctl or _controller(), list(script), {}
     while True:
         end = pending[0][0] if pending else SAMPLES
         at = [s for s in wanted if ctl.sample <= s <= end and s not in taken]
@@ -217,3 +219,30 @@ def test_the_servo_effort_computed_for_a_stretch_at_once_is_each_axis_own():
     first = next(iter(taken.values()))[1]
     assert all(a.amp_enabled and a.servo_effort != 0.0 for a in first)
     assert [a.amp_enabled for a in axes] == [True, True, True, False]
+
+
+
+def test_a_few_snapshots_from_plain_floats_are_those_from_arrays(monkeypatch):
+    """Up to snapshots._FEW snapshots of a stretch take their float fields from plain floats,
+    more from numpy arrays: the same operations element by element, so the same bits,
+    whatever the path (feedforward, a cam, a fault, an amplifier off) and across the 32-bit
+    wrap of the reported positions (axis 2's origin puts its velocity move across 2^31)."""
+    script = [(0, "ptf", 0, 1200.0, -800.0), (0, "cam", 2, 500.0, 300.0), (0, "velocity", 1, 900.0, 0.0),
+              (260, "STOP", 0, 0.0, 0.0), (700, "RESET", 0, 0.0, 0.0), (710, "pvt", 0, -600.0, 400.0),
+              (900, "fault", 2, 0.0, 0.0), (1000, "amp_off", 3, 0.0, 0.0), (1200, "append", 0, 300.0, 200.0)]
+    wanted = list(range(SAMPLES))
+
+    def taken(few: int) -> tuple[dict[int, object], list]:
+        monkeypatch.setattr(snapshots, "_FEW", few)
+        ctl = _controller()
+        assert ctl.axis_origin_set(2, -(2.0**31) + 100.0).ok  # a command past 100 reads across the wrap
+        return _in_stretches(script, wanted, ctl)
+
+    plain, plain_events = taken(10**9)
+    arrays, array_events = taken(0)
+    assert plain_events == array_events
+    assert not [d for s in wanted for d in differences(plain[s], arrays[s], f"sample {s}")][:5]
+    reported = [axes[2].command_position for _, axes in plain.values()]
+    assert max(reported) > 2.0**31 - 1000.0
+    assert min(reported) < -(2.0**31) + 1000.0
+    assert any(not a.amp_enabled for _, axes in plain.values() for a in axes)

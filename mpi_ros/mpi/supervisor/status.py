@@ -25,18 +25,19 @@ RelOf = Callable[[int], float]  # an axis' profile time (Axis.rel) at the sample
 AxisSnapshots = Sequence[AxisSnapshot] | Mapping[int, AxisSnapshot]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Progress:
     """0..1 along a move as its axes' profile times give it: the smallest of ``fixed`` (an
     axis not running its plan of the move yet: 0; a move over: 1) and, for each axis that
     runs its plan, its profile time over ``span`` (the plan's duration, or a velocity move's
-    ramp), clipped to 0..1 (1 for a span of 0). 0 without any."""
+    ramp), clipped to 0..1 (1 for a span of 0). 0 without any. (Part of a template, so not
+    frozen either: frozen costs a call a field.)"""
 
     fixed: tuple[float, ...]
     spans: tuple[tuple[int, float], ...]  # (axis number, span)
 
     def __post_init__(self) -> None:
-        if any(not 0.0 <= f <= 1.0 for f in self.fixed):
+        if self.fixed and any(not 0.0 <= f <= 1.0 for f in self.fixed):  # (a move in progress: none)
             raise ValueError(f"progress fractions must be within 0..1, not {self.fixed}")
 
     def at(self, rel: RelOf) -> float:
@@ -78,24 +79,25 @@ class MotionTemplate:
         events latched by then."""
         axes = tuple([axis_snapshots[n] for n in self.axis_numbers])
         element = self.element_axis
+        # (positional, in MotionSnapshot's field order: keywords cost more than the rest)
         return MotionSnapshot(
-            sample=sample,
-            number=self.number,
-            state=self._reported_state(sample),
-            axis_numbers=self.axis_numbers,
-            axes=axes,
-            done=all([a.done for a in axes]) and not self.own_moving,  # (all of none: True)
-            at_target=all([a.at_target for a in axes]),
-            settled=all([a.settled for a in axes]),
-            move_id=self.move_id,
-            element_id=self.element_id if element is None else element.element_id_at(rel(element.number)),
-            feedrate=self.clock.feedrate(sample / self.rate),
-            last_action=self.last_action,
-            action_source=self.action_source,
-            moves_pending=self.moves_pending,
-            motion_type=self.motion_type,
-            progress=self.progress.at(rel),
-            latched_events=latched_events,
+            sample,
+            self.number,
+            self._reported_state(sample),
+            self.axis_numbers,
+            axes,
+            all([a.done for a in axes]) and not self.own_moving,  # (all of none: True)
+            all([a.at_target for a in axes]),
+            all([a.settled for a in axes]),
+            self.move_id,
+            self.element_id if element is None else element.element_id_at(rel(element.number)),
+            self.clock.feedrate(sample / self.rate),
+            self.last_action,
+            self.action_source,
+            self.moves_pending,
+            self.motion_type,
+            self.progress.at(rel),
+            latched_events,
         )
 
     def _reported_state(self, sample: int) -> MPIState:
