@@ -67,22 +67,21 @@ class AxisTemplate:
         """The template of ``axis`` now, commanded by supervisor ``number`` (-1: none),
         ``owner`` (None: none, or not a supervisor of this controller)."""
         plan = axis.plan
-        # (positional, in field order: keywords cost more than the rest of a template)
         return cls(
-            axis,
-            plan,
-            owner.own_state if owner is not None else MPIState.IDLE,
-            number,
+            axis=axis,
+            plan=plan,
+            state=owner.own_state if owner is not None else MPIState.IDLE,
+            supervisor=number,
             # A velocity move has no target: NaN, rather than the end of its long frame.
-            math.nan if plan is not None and plan.is_velocity else axis.target_position,
-            axis.origin,
-            axis.amp_enabled,
-            axis.move_id,
-            owner.frames_queued(axis.number) if owner is not None else 0,
-            frame_buffer_size,
-            faults,
-            axis.feedforward_at(math.nan) if plan is None or plan.feedforward is None else None,
-            axis.element_id_at(math.nan) if plan is None or not plan.element_ids else None,
+            target_position=math.nan if plan is not None and plan.is_velocity else axis.target_position,
+            origin=axis.origin,
+            amp_enabled=axis.amp_enabled,
+            move_id=axis.move_id,
+            frames_queued=owner.frames_queued(axis.number) if owner is not None else 0,
+            frame_buffer_size=frame_buffer_size,
+            faults=faults,
+            feedforward=axis.feedforward_at(math.nan) if plan is None or plan.feedforward is None else None,
+            element_id=axis.element_id_at(math.nan) if plan is None or not plan.element_ids else None,
         )
 
     def frame_count(self, rel: float) -> int:

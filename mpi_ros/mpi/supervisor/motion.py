@@ -849,23 +849,22 @@ class MotionSupervisor:
         moves, state = self._moves, self._state
         move = moves.current or moves.last_move
         element_axis, element_id = moves.element_of(move)
-        # (positional, in field order: keywords cost more than the rest of a template)
         return MotionTemplate(
-            self.number,
-            self.state,
-            state.own_state is MPIState.MOVING,
-            state.unacknowledged,
-            tuple(self._axis_list.mapped),
-            move.id if move else 0,
-            element_axis,
-            element_id,
-            move.type.name if move else "",
-            len(moves.queue),
-            state.last_action,
-            state.action_source.value,
-            moves.progress_of(),
-            state.clock,
-            self._host.rate,
+            number=self.number,
+            state=self.state,
+            own_moving=state.own_state is MPIState.MOVING,
+            unacknowledged=state.unacknowledged,
+            axis_numbers=tuple(self._axis_list.mapped),
+            move_id=move.id if move else 0,
+            element_axis=element_axis,
+            element_id=element_id,
+            motion_type=move.type.name if move else "",
+            moves_pending=len(moves.queue),
+            last_action=state.last_action,
+            action_source=state.action_source.value,
+            progress=moves.progress_of(),
+            clock=state.clock,
+            rate=self._host.rate,
         )
 
 

@@ -79,25 +79,24 @@ class MotionTemplate:
         events latched by then."""
         axes = tuple([axis_snapshots[n] for n in self.axis_numbers])
         element = self.element_axis
-        # (positional, in MotionSnapshot's field order: keywords cost more than the rest)
         return MotionSnapshot(
-            sample,
-            self.number,
-            self._reported_state(sample),
-            self.axis_numbers,
-            axes,
-            all([a.done for a in axes]) and not self.own_moving,  # (all of none: True)
-            all([a.at_target for a in axes]),
-            all([a.settled for a in axes]),
-            self.move_id,
-            self.element_id if element is None else element.element_id_at(rel(element.number)),
-            self.clock.feedrate(sample / self.rate),
-            self.last_action,
-            self.action_source,
-            self.moves_pending,
-            self.motion_type,
-            self.progress.at(rel),
-            latched_events,
+            sample=sample,
+            number=self.number,
+            state=self._reported_state(sample),
+            axis_numbers=self.axis_numbers,
+            axes=axes,
+            done=all([a.done for a in axes]) and not self.own_moving,  # (all of none: True)
+            at_target=all([a.at_target for a in axes]),
+            settled=all([a.settled for a in axes]),
+            move_id=self.move_id,
+            element_id=self.element_id if element is None else element.element_id_at(rel(element.number)),
+            feedrate=self.clock.feedrate(sample / self.rate),
+            last_action=self.last_action,
+            action_source=self.action_source,
+            moves_pending=self.moves_pending,
+            motion_type=self.motion_type,
+            progress=self.progress.at(rel),
+            latched_events=latched_events,
         )
 
     def _reported_state(self, sample: int) -> MPIState:
