@@ -396,11 +396,16 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
     every = np.arange(len(pieces))
     act_p, act_v = _servo(bank.tables, every, _Servos.of(rows_of, every), out, direct=False, following=True)
     shape = (len(pieces), len(t))
-    act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
+    act_p, act_v = _as_rows(act_p, shape), _as_rows(act_v, shape)  # constants may be columns
     spans = np.searchsorted(t, [(start, end) for _, start, end in pieces], side="left").tolist()
     for i, ((row, _, _), (first, last)) in enumerate(zip(pieces, spans, strict=True)):
         out.act_p[row, first:last] = act_p[i, first:last]
         out.act_v[row, first:last] = act_v[i, first:last]
+
+
+def _as_rows(values: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """``values`` read as ``shape`` (a column broadcast; full rows as they are, nearly always)."""
+    return values if values.shape == shape else np.broadcast_to(values, shape)
 
 
 def _steady_response(servos: _Servos, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
@@ -410,7 +415,7 @@ def _steady_response(servos: _Servos, rows: np.ndarray, s: np.ndarray, out: Stre
         return _steady_group(servos.steady_y, servos.steady_dy, s, servos.one_terms, out.temporary("y", rows))
     terms = servos.terms
     y, dy = np.empty_like(s), np.empty_like(s)
-    for count in np.unique(terms).tolist():
+    for count in sorted(set(terms.tolist())):  # (np.unique sorts in Python-level code: a few rows)
         group = np.flatnonzero(terms == count)
         y[group], dy[group] = _steady_group(servos.steady_y[group], servos.steady_dy[group], s[group], count, None)
     return y, dy
@@ -546,11 +551,14 @@ def _free(tables: list[_FreeTable], transients: _Transients, samples: np.ndarray
     """(p, q) of the free response at every sample of each of ``transients``' rows, from its
     loop's table (for ``following`` rows, sample counts before the anchor read as 0)."""
     first, n, k0 = int(samples[0]), len(samples), transients.k0
-    if not following and transients.one_table >= 0:
-        return tables[transients.one_table].window(first - k0, n, scratch)
+    one = transients.one_table
+    if one >= 0:  # (one loop for all: nearly always)
+        if following:
+            return tables[one].at(np.maximum(samples - k0[:, None], 0))
+        return tables[one].window(first - k0, n, scratch)
     which = transients.table
     p, q = np.empty((len(k0), n)), np.empty((len(k0), n))
-    for index in np.unique(which).tolist():
+    for index in sorted(set(which.tolist())):  # (as np.unique gives them)
         group = np.flatnonzero(which == index)
         if following:
             p[group], q[group] = tables[index].at(np.maximum(samples - k0[group, None], 0))
