@@ -123,7 +123,7 @@ class _Plans:
     def of(cls, command: CommandRows, rows: np.ndarray) -> _Plans:
         planned = command.planned[rows]
         chosen = rows[planned]
-        return cls(rows[~planned], chosen, command.clock[chosen].tobytes(), command.tau_start[chosen, None],
+        return cls(rows[~planned], chosen, command.clock[chosen].tobytes(), _column(command.tau_start, chosen),
                    command.duration[chosen])
 
 
@@ -248,7 +248,7 @@ class _Segments:
     @classmethod
     def of(cls, cmd: CommandRows, rows: np.ndarray) -> _Segments:
         return cls.gathered(cmd.seg_lo[rows], cmd.seg_hi[rows], cmd.linear[rows], cmd.duration[rows],
-                            *(x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
+                            *(_column(x, rows) for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
 
     @classmethod
     def gathered(cls, lo: np.ndarray, hi: np.ndarray, linear: np.ndarray, duration: np.ndarray, start: np.ndarray,
@@ -358,11 +358,26 @@ class _Servos:
     @classmethod
     def of(cls, plant: PlantRows, rows: np.ndarray) -> _Servos:
         terms, resolution = plant.terms[rows], plant.resolution[rows]
-        one_terms = int(terms[0]) if len(terms) and (terms == terms[0]).all() else -1
+        one_terms = _one_of(terms)
         piece_end = plant.piece_end[rows]
-        one_resolution = len(rows) > 0 and bool((resolution == resolution[0]).all())
-        return cls(plant.anchor_t[rows, None], piece_end, float(piece_end.min(initial=math.inf)), terms, one_terms,
-                   plant.steady_y[rows], plant.steady_dy[rows], resolution, one_resolution, _Transients.of(plant, rows))
+        return cls(_column(plant.anchor_t, rows), piece_end, min(piece_end.tolist(), default=math.inf), terms,
+                   -1 if one_terms is None else int(one_terms), plant.steady_y[rows], plant.steady_dy[rows],
+                   resolution, _one_of(resolution) is not None, _Transients.of(plant, rows))
+
+
+def _one_of(values: np.ndarray) -> float | None:
+    """The value all of ``values`` have (None: they differ, or there are none). On the few
+    rows of a bank, a set of their Python numbers costs less than numpy's comparison and
+    reduction (the values are counts, indices and validated resolutions: no NaN)."""
+    distinct = set(values.tolist())
+    return distinct.pop() if len(distinct) == 1 else None
+
+
+def _column(values: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``values[rows, None]``: the rows' values as a column (gathered, then viewed as one:
+    numpy's mixed index costs several times more)."""
+    column: np.ndarray = values[rows][:, None]
+    return column
 
 
 def _servo(tables: list[_FreeTable], rows: np.ndarray, servos: _Servos, out: Stretch, direct: bool,
@@ -465,18 +480,21 @@ class _Transients:
         live = plant.decayed_after[rows] > -math.inf
         where = slice(None) if live.all() else np.flatnonzero(live)
         picked = rows[where]
-        return cls.gathered(where, picked, plant.v0[picked, None], plant.m0[picked, None], plant.v1[picked, None],
-                            plant.m1[picked, None], plant.decayed_after[picked, None], plant.vanishing[picked],
-                            plant.k0[picked], plant.table[picked])
+        return cls.gathered(where, picked, _column(plant.v0, picked), _column(plant.m0, picked),
+                            _column(plant.v1, picked), _column(plant.m1, picked),
+                            _column(plant.decayed_after, picked), plant.vanishing[picked], plant.k0[picked],
+                            plant.table[picked])
 
     @classmethod
     def gathered(cls, where: slice | np.ndarray, rows: np.ndarray, v0: np.ndarray, m0: np.ndarray, v1: np.ndarray,
                  m1: np.ndarray, decayed: np.ndarray, vanishing: np.ndarray, k0: np.ndarray,
                  table: np.ndarray) -> _Transients:
-        one = len(table) > 0 and bool((table == table[0]).all())
-        return cls(where, rows, v0, m0, v1, m1, decayed, vanishing, k0, table, not bool(np.isposinf(decayed).all()),
-                   float(vanishing.min(initial=math.inf)), float(vanishing.max(initial=-math.inf)),
-                   int(table[0]) if one else -1)
+        one = _one_of(table)
+        ends = vanishing.tolist()
+        # dropped: one decays (not every decayed_after is inf; a NaN is not inf either)
+        return cls(where, rows, v0, m0, v1, m1, decayed, vanishing, k0, table,
+                   bool(set(decayed[:, 0].tolist()) - {math.inf}), min(ends, default=math.inf),
+                   max(ends, default=-math.inf), -1 if one is None else int(one))
 
     def kept(self, keep: np.ndarray) -> _Transients:
         """Those at indices ``keep`` among them."""
