@@ -347,8 +347,7 @@ class _Servos:
     anchor_t: np.ndarray  # (rows, 1)
     piece_end: np.ndarray
     first_end: float  # the first of them
-    terms: np.ndarray
-    one_terms: int  # the coefficients every row uses (-1: not the same for all)
+    terms: int  # the longest row's count of coefficients (see _steady_response)
     steady_y: np.ndarray  # (rows, _MAX_TERMS)
     steady_dy: np.ndarray
     resolution: np.ndarray
@@ -357,11 +356,9 @@ class _Servos:
 
     @classmethod
     def of(cls, plant: PlantRows, rows: np.ndarray) -> _Servos:
-        terms, resolution = plant.terms[rows], plant.resolution[rows]
-        one_terms = _one_of(terms)
-        piece_end = plant.piece_end[rows]
-        return cls(_column(plant.anchor_t, rows), piece_end, min(piece_end.tolist(), default=math.inf), terms,
-                   -1 if one_terms is None else int(one_terms), plant.steady_y[rows], plant.steady_dy[rows],
+        resolution, piece_end = plant.resolution[rows], plant.piece_end[rows]
+        return cls(_column(plant.anchor_t, rows), piece_end, min(piece_end.tolist(), default=math.inf),
+                   max(plant.terms[rows].tolist(), default=1), plant.steady_y[rows], plant.steady_dy[rows],
                    resolution, _one_of(resolution) is not None, _Transients.of(plant, rows))
 
 
@@ -424,16 +421,13 @@ def _as_rows(values: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
 
 
 def _steady_response(servos: _Servos, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
-    """The steady response's polynomials, rows of the same length at once (a constant one
-    as a column)."""
-    if servos.one_terms >= 0:
-        return _steady_group(servos.steady_y, servos.steady_dy, s, servos.one_terms, out.temporary("y", rows))
-    terms = servos.terms
-    y, dy = np.empty_like(s), np.empty_like(s)
-    for count in sorted(set(terms.tolist())):  # (np.unique sorts in Python-level code: a few rows)
-        group = np.flatnonzero(terms == count)
-        y[group], dy[group] = _steady_group(servos.steady_y[group], servos.steady_dy[group], s[group], count, None)
-    return y, dy
+    """The steady response's polynomials, every row at once to the longest row's count of
+    coefficients (constants as a column where every row is one). A shorter row comes out as
+    plant.poly_eval gives it: Horner's scheme carries its zero padding as +0.0 (+0.0 s + 0.0,
+    s >= +0) to its own top coefficient c, where +0.0 s + c is c, as no coefficient is -0.0
+    (Plant.prepare's sums start from +0.0 and trim_leading_zeros leaves none). (A following
+    piece's samples before its anchor, s < 0, are left out.)"""
+    return _steady_group(servos.steady_y, servos.steady_dy, s, servos.terms, out.temporary("y", rows))
 
 
 def _steady_group(steady_y: np.ndarray, steady_dy: np.ndarray, s: np.ndarray, terms: int,
