@@ -20,7 +20,10 @@ controller's public API (MotionSupervisor.modify: validation, planning, loading)
 ruckig's calculate() for the same problem (the cross-check's mapping of the plan the modify
 loaded, bench_planning.ruckig_input), in one process, the two calls alternating; a fresh
 process per run, ``--rounds`` runs of this tree and of ``--baseline`` ("none": this tree only)
-alternating.
+alternating. Beside them, the step(20) that follows each modify (what the new plan costs the
+stepping: its bank refresh, the pieces it starts inside the stretch) and the two together, as
+a user sees a modify; "values" says whether the axis values after every step agree with
+the first run's.
 
     python -P bench/bench_modify.py [--baseline b39be10] [--rounds 3] [--batches 1 2 5 20]
     python -P bench/bench_modify.py --ruckig 2000 [--baseline none] [--rounds 3]
@@ -111,9 +114,13 @@ def measure_ruckig(count: int) -> dict:
     trajectory = [Trajectory(5000.0, 100000.0, 100000.0, 50.0)]
     assert ms.start(MPIMotionType.S_CURVE, MotionAttr.NONE, MotionParams(trajectory=trajectory, position=[2000.0])).ok
     otg, solved = Ruckig(1), RuckigTrajectory(1)
-    ours, theirs, clock = [], [], time.perf_counter
+    ours, theirs, after, clock = [], [], [], time.perf_counter
+    digest = hashlib.sha256()
     for i in range(count):
+        t0 = clock()
         ctl.step(20)  # moving: each modify starts from the velocity and acceleration of the last one
+        after.append(clock() - t0)
+        digest.update(ctl.bank.values.tobytes())
         params = MotionParams(trajectory=trajectory, position=[2000.0 if i % 2 else -2000.0])
         t0 = clock()
         done = ms.modify(MPIMotionType.S_CURVE, MotionAttr.NONE, params)
@@ -130,15 +137,19 @@ def measure_ruckig(count: int) -> dict:
     def figures(times: list[float]) -> list[float]:
         return [statistics.median(times) * 1e6, statistics.quantiles(times, n=10)[-1] * 1e6]
 
-    return {"modify": figures(ours), "ruckig": figures(theirs)}
+    # the stepping after a modify: each step but the first follows one
+    with_step = [mod + step for mod, step in zip(ours, after[1:], strict=False)]
+    return {"modify": figures(ours), "ruckig": figures(theirs), "after": figures(after[1:]),
+            "with_step": figures(with_step), "digest": digest.hexdigest()}
 
 
 def beside_ruckig(count: int, baseline: str | None, rounds: int) -> list[str]:
     """The table of :func:`measure_ruckig`, a fresh process per run, ``rounds`` runs of this tree
     and (``baseline``) of the package at that commit, alternating."""
     rows = ["| tree | modifies | modify median us | modify p90 us | ruckig median us | ruckig p90 us | "
-            "modify / ruckig (medians) |",
-            "| --- | --- | --- | --- | --- | --- | --- |"]
+            "modify / ruckig (medians) | next step(20) median us | modify + next step(20) median us | values |",
+            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    digests: dict[str, str] = {}
     with tempfile.TemporaryDirectory() as scratch:
         trees = [(REPO, "this tree")]
         old = baseline_tree(baseline, Path(scratch)) if baseline else None
@@ -148,8 +159,10 @@ def beside_ruckig(count: int, baseline: str | None, rounds: int) -> list[str]:
             for tree, name in trees:
                 run = measure_in(tree, [count], "bench_modify", "measure_ruckig")
                 (ours, ours_p90), (ruckig, ruckig_p90) = run["modify"], run["ruckig"]
+                first = digests.setdefault("first", run["digest"])
                 rows.append(f"| {name} | {count} | {ours:.1f} | {ours_p90:.1f} | {ruckig:.2f} | {ruckig_p90:.2f} | "
-                            f"{ours / ruckig:.1f}x |")
+                            f"{ours / ruckig:.1f}x | {run['after'][0]:.1f} | {run['with_step'][0]:.1f} | "
+                            f"{'same' if run['digest'] == first else '**DIFFER**'} |")
     return rows
 
 

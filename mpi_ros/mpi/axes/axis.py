@@ -172,6 +172,7 @@ class Axis:
         self.rest = 0.0
         self.mode = CommandMode.SERVO
         self.holding = False
+        self._owner = -1  # (the bank's column, as a Python int: a command asks it many times)
         self.owner = -1
         self.move_id = 0
         self.element_id = 0
@@ -185,10 +186,11 @@ class Axis:
     @property
     def owner(self) -> int:
         """The supervisor commanding the axis (-1: none); its clock drives the plan."""
-        return int(self._bank.owner[self.number])
+        return self._owner
 
     @owner.setter
     def owner(self, number: int) -> None:
+        self._owner = number
         self._bank.owner[self.number] = number
         self._bank.stale[self.number] = True
 
@@ -199,6 +201,11 @@ class Axis:
     @status.setter
     def status(self, bits: AxisStatusBits) -> None:
         self._bank.bits[:, self.number] = column_of(bits)
+
+    def command_values(self) -> tuple[float, float, float]:
+        """The command's raw position, velocity and acceleration now (one read of the bank)."""
+        p, v, a = self._bank.values[:3, self.number].tolist()  # (VALUES order: cmd_p, cmd_v, cmd_a)
+        return p, v, a
 
     # -- positions (user coordinates) ------------------------------------------------
     # What the controller reports is 32-bit (wrap.py): the command_/actual_/target_position
@@ -316,14 +323,23 @@ class Axis:
     # -- command ---------------------------------------------------------------------
     def rebase(self, t: float, clock: ProfileClock | None = None) -> None:
         """Re-anchor the plant at ``t``: a command takes effect from here on."""
-        if t == self.state.t:
-            return
         state = self.state
-        for _start, end, forced in self._pieces(state.t, t, clock):
-            stop = min(end, t)
-            state = self._advance_piece(state, forced, stop)
+        if t == state.t:
+            return
+        if self.mode is CommandMode.COAST:
+            self.state = self.plant.coast_to(state, t)
+            return
+        # piece by piece (those of _pieces), up to the one in force at t
+        command = self._command_of(clock)
+        times = self._boundary_times(command, clock)
+        i = bisect.bisect_right(times, state.t)
+        start = state.t
+        while True:
+            end = times[i] if i < len(times) else math.inf
+            state = self.plant.advance(state, self._forced(command, start, end, clock), min(end, t))
             if end >= t:
                 break
+            start, i = end, i + 1
         self.state = state
 
     def _advance_piece(self, state: PlantState, forced: Forced | None, t: float) -> PlantState:
@@ -355,7 +371,10 @@ class Axis:
     def feedforward(self) -> float:
         """The PTF/PVTF feedforward (raw DAC counts) now: interpolated along the plan that has
         one, else the value the last one left (MPI 000, MPIMotionPTF: not zeroed by other moves)."""
-        return self.feedforward_at(self.rel)
+        plan = self.plan
+        if plan is None or plan.feedforward is None:  # (the held value: no profile time to read)
+            return self._held_feedforward
+        return plan.feedforward_at(self.rel, self._held_feedforward)
 
     def feedforward_at(self, rel: float) -> float:
         """:attr:`feedforward` at profile time ``rel`` of the plan."""

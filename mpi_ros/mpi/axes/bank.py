@@ -167,7 +167,8 @@ PieceRow = tuple[list[float], list[float], float, float, int, int, float, float,
 def _piece_row(anchor: PlantState, end: float, forced: Forced, plant: Plant, rate: float,
                table_index: Callable[[_FreeTable], int]) -> PieceRow:
     """A piece's row of PlantRows: the steady response's coefficients (zero-padded: rows are
-    evaluated in groups of the same length, exactly as plant.poly_eval evaluates one), then
+    evaluated together to the longest one's length, exactly as plant.poly_eval evaluates one:
+    trace._steady_response), then
     the values of _PIECE_COLUMNS; without a transient, k0 and the transient's parts 0,
     decayed_after -inf (none), vanishing inf and table 0 (unread)."""
     y, dy = trim_leading_zeros(forced.y), trim_leading_zeros(forced.dy)

@@ -123,7 +123,7 @@ class _Plans:
     def of(cls, command: CommandRows, rows: np.ndarray) -> _Plans:
         planned = command.planned[rows]
         chosen = rows[planned]
-        return cls(rows[~planned], chosen, command.clock[chosen].tobytes(), command.tau_start[chosen, None],
+        return cls(rows[~planned], chosen, command.clock[chosen].tobytes(), _column(command.tau_start, chosen),
                    command.duration[chosen])
 
 
@@ -248,7 +248,7 @@ class _Segments:
     @classmethod
     def of(cls, cmd: CommandRows, rows: np.ndarray) -> _Segments:
         return cls.gathered(cmd.seg_lo[rows], cmd.seg_hi[rows], cmd.linear[rows], cmd.duration[rows],
-                            *(x[rows, None] for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
+                            *(_column(x, rows) for x in (cmd.seg_start, cmd.p, cmd.v, cmd.a, cmd.j)))
 
     @classmethod
     def gathered(cls, lo: np.ndarray, hi: np.ndarray, linear: np.ndarray, duration: np.ndarray, start: np.ndarray,
@@ -347,8 +347,7 @@ class _Servos:
     anchor_t: np.ndarray  # (rows, 1)
     piece_end: np.ndarray
     first_end: float  # the first of them
-    terms: np.ndarray
-    one_terms: int  # the coefficients every row uses (-1: not the same for all)
+    terms: int  # the longest row's count of coefficients (see _steady_response)
     steady_y: np.ndarray  # (rows, _MAX_TERMS)
     steady_dy: np.ndarray
     resolution: np.ndarray
@@ -357,12 +356,25 @@ class _Servos:
 
     @classmethod
     def of(cls, plant: PlantRows, rows: np.ndarray) -> _Servos:
-        terms, resolution = plant.terms[rows], plant.resolution[rows]
-        one_terms = int(terms[0]) if len(terms) and (terms == terms[0]).all() else -1
-        piece_end = plant.piece_end[rows]
-        one_resolution = len(rows) > 0 and bool((resolution == resolution[0]).all())
-        return cls(plant.anchor_t[rows, None], piece_end, float(piece_end.min(initial=math.inf)), terms, one_terms,
-                   plant.steady_y[rows], plant.steady_dy[rows], resolution, one_resolution, _Transients.of(plant, rows))
+        resolution, piece_end = plant.resolution[rows], plant.piece_end[rows]
+        return cls(_column(plant.anchor_t, rows), piece_end, min(piece_end.tolist(), default=math.inf),
+                   max(plant.terms[rows].tolist(), default=1), plant.steady_y[rows], plant.steady_dy[rows],
+                   resolution, _one_of(resolution) is not None, _Transients.of(plant, rows))
+
+
+def _one_of(values: np.ndarray) -> float | None:
+    """The value all of ``values`` have (None: they differ, or there are none). On the few
+    rows of a bank, a set of their Python numbers costs less than numpy's comparison and
+    reduction (the values are counts, indices and validated resolutions: no NaN)."""
+    distinct = set(values.tolist())
+    return distinct.pop() if len(distinct) == 1 else None
+
+
+def _column(values: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``values[rows, None]``: the rows' values as a column (gathered, then viewed as one:
+    numpy's mixed index costs several times more)."""
+    column: np.ndarray = values[rows][:, None]
+    return column
 
 
 def _servo(tables: list[_FreeTable], rows: np.ndarray, servos: _Servos, out: Stretch, direct: bool,
@@ -396,24 +408,26 @@ def _following_pieces(bank: AxisBank, axes: list[Axis], clock_of: Callable[[Axis
     every = np.arange(len(pieces))
     act_p, act_v = _servo(bank.tables, every, _Servos.of(rows_of, every), out, direct=False, following=True)
     shape = (len(pieces), len(t))
-    act_p, act_v = np.broadcast_to(act_p, shape), np.broadcast_to(act_v, shape)  # constants may be columns
+    act_p, act_v = _as_rows(act_p, shape), _as_rows(act_v, shape)  # constants may be columns
     spans = np.searchsorted(t, [(start, end) for _, start, end in pieces], side="left").tolist()
     for i, ((row, _, _), (first, last)) in enumerate(zip(pieces, spans, strict=True)):
         out.act_p[row, first:last] = act_p[i, first:last]
         out.act_v[row, first:last] = act_v[i, first:last]
 
 
+def _as_rows(values: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """``values`` read as ``shape`` (a column broadcast; full rows as they are, nearly always)."""
+    return values if values.shape == shape else np.broadcast_to(values, shape)
+
+
 def _steady_response(servos: _Servos, rows: np.ndarray, s: np.ndarray, out: Stretch) -> tuple[np.ndarray, np.ndarray]:
-    """The steady response's polynomials, rows of the same length at once (a constant one
-    as a column)."""
-    if servos.one_terms >= 0:
-        return _steady_group(servos.steady_y, servos.steady_dy, s, servos.one_terms, out.temporary("y", rows))
-    terms = servos.terms
-    y, dy = np.empty_like(s), np.empty_like(s)
-    for count in np.unique(terms).tolist():
-        group = np.flatnonzero(terms == count)
-        y[group], dy[group] = _steady_group(servos.steady_y[group], servos.steady_dy[group], s[group], count, None)
-    return y, dy
+    """The steady response's polynomials, every row at once to the longest row's count of
+    coefficients (constants as a column where every row is one). A shorter row comes out as
+    plant.poly_eval gives it: Horner's scheme carries its zero padding as +0.0 (+0.0 s + 0.0,
+    s >= +0) to its own top coefficient c, where +0.0 s + c is c, as no coefficient is -0.0
+    (Plant.prepare's sums start from +0.0 and trim_leading_zeros leaves none). (A following
+    piece's samples before its anchor, s < 0, are left out.)"""
+    return _steady_group(servos.steady_y, servos.steady_dy, s, servos.terms, out.temporary("y", rows))
 
 
 def _steady_group(steady_y: np.ndarray, steady_dy: np.ndarray, s: np.ndarray, terms: int,
@@ -460,18 +474,21 @@ class _Transients:
         live = plant.decayed_after[rows] > -math.inf
         where = slice(None) if live.all() else np.flatnonzero(live)
         picked = rows[where]
-        return cls.gathered(where, picked, plant.v0[picked, None], plant.m0[picked, None], plant.v1[picked, None],
-                            plant.m1[picked, None], plant.decayed_after[picked, None], plant.vanishing[picked],
-                            plant.k0[picked], plant.table[picked])
+        return cls.gathered(where, picked, _column(plant.v0, picked), _column(plant.m0, picked),
+                            _column(plant.v1, picked), _column(plant.m1, picked),
+                            _column(plant.decayed_after, picked), plant.vanishing[picked], plant.k0[picked],
+                            plant.table[picked])
 
     @classmethod
     def gathered(cls, where: slice | np.ndarray, rows: np.ndarray, v0: np.ndarray, m0: np.ndarray, v1: np.ndarray,
                  m1: np.ndarray, decayed: np.ndarray, vanishing: np.ndarray, k0: np.ndarray,
                  table: np.ndarray) -> _Transients:
-        one = len(table) > 0 and bool((table == table[0]).all())
-        return cls(where, rows, v0, m0, v1, m1, decayed, vanishing, k0, table, not bool(np.isposinf(decayed).all()),
-                   float(vanishing.min(initial=math.inf)), float(vanishing.max(initial=-math.inf)),
-                   int(table[0]) if one else -1)
+        one = _one_of(table)
+        ends = vanishing.tolist()
+        # dropped: one decays (not every decayed_after is inf; a NaN is not inf either)
+        return cls(where, rows, v0, m0, v1, m1, decayed, vanishing, k0, table,
+                   bool(set(decayed[:, 0].tolist()) - {math.inf}), min(ends, default=math.inf),
+                   max(ends, default=-math.inf), -1 if one is None else int(one))
 
     def kept(self, keep: np.ndarray) -> _Transients:
         """Those at indices ``keep`` among them."""
@@ -546,11 +563,14 @@ def _free(tables: list[_FreeTable], transients: _Transients, samples: np.ndarray
     """(p, q) of the free response at every sample of each of ``transients``' rows, from its
     loop's table (for ``following`` rows, sample counts before the anchor read as 0)."""
     first, n, k0 = int(samples[0]), len(samples), transients.k0
-    if not following and transients.one_table >= 0:
-        return tables[transients.one_table].window(first - k0, n, scratch)
+    one = transients.one_table
+    if one >= 0:  # (one loop for all: nearly always)
+        if following:
+            return tables[one].at(np.maximum(samples - k0[:, None], 0))
+        return tables[one].window(first - k0, n, scratch)
     which = transients.table
     p, q = np.empty((len(k0), n)), np.empty((len(k0), n))
-    for index in np.unique(which).tolist():
+    for index in sorted(set(which.tolist())):  # (as np.unique gives them)
         group = np.flatnonzero(which == index)
         if following:
             p[group], q[group] = tables[index].at(np.maximum(samples - k0[group, None], 0))

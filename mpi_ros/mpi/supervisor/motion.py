@@ -703,14 +703,14 @@ class MotionSupervisor:
             if plan is not None:
                 starts.append(AxisStart(n, plan.target, plan.final_velocity, axis.turn_origin(plan.target)))
                 continue
-            position = axis.cmd_p
+            position, cmd_v, cmd_a = axis.command_values()
             if moving:
-                velocity = axis.cmd_v / f if f > 0.0 else 0.0
-                acceleration = axis.cmd_a / (f * f) if f > 0.0 else 0.0
+                velocity = cmd_v / f if f > 0.0 else 0.0
+                acceleration = cmd_a / (f * f) if f > 0.0 else 0.0
             else:
                 # The axis may still move (STOPPED at a non-zero pauseFeedrate, or past a FINAL_VEL
                 # move): the start goes on from that velocity.
-                velocity, acceleration = axis.cmd_v / f, axis.cmd_a / (f * f)
+                velocity, acceleration = cmd_v / f, cmd_a / (f * f)
             starts.append(AxisStart(n, position, velocity, axis.turn_origin(position), acceleration))
         return starts
 

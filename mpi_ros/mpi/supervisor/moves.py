@@ -219,9 +219,11 @@ class Moves:
     def rebase(self, t: float) -> None:
         """The supervisor's axes take their state at ``t`` as the start of their pieces (before
         its clock or their plans change)."""
-        for axis in self.axes:
-            if axis.owner == self._state.number:
-                axis.rebase(t, self._state.clock)
+        axes, number, clock = self._host.axes, self._state.number, self._state.clock
+        for n in self._axis_list.mapped:
+            axis = axes[n]
+            if axis.owner == number:
+                axis.rebase(t, clock)
 
     def drop_pending(self, message: Message, detail: str) -> None:
         """End the move in progress and the queued ones. Every axis that runs (or waits to
@@ -286,7 +288,8 @@ class Moves:
             axis.owner = state.number
             axis.move_id = move.id
             axis.element_id = move.element_id
-            axis.mode = CommandMode.SERVO if axis.amp_enabled else axis.mode
+            if axis.amp_enabled:
+                axis.mode = CommandMode.SERVO
             axis.status_mode = StatusMode.VELOCITY if plan.is_velocity else StatusMode.POINT_TO_POINT
             if plan.hold is not None:
                 axis.unload(t, self.clock_of(axis))
