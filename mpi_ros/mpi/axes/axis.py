@@ -323,23 +323,14 @@ class Axis:
     # -- command ---------------------------------------------------------------------
     def rebase(self, t: float, clock: ProfileClock | None = None) -> None:
         """Re-anchor the plant at ``t``: a command takes effect from here on."""
+        if t == self.state.t:
+            return
         state = self.state
-        if t == state.t:
-            return
-        if self.mode is CommandMode.COAST:
-            self.state = self.plant.coast_to(state, t)
-            return
-        # piece by piece (those of _pieces), up to the one in force at t
-        command = self._command_of(clock)
-        times = self._boundary_times(command, clock)
-        i = bisect.bisect_right(times, state.t)
-        start = state.t
-        while True:
-            end = times[i] if i < len(times) else math.inf
-            state = self.plant.advance(state, self._forced(command, start, end, clock), min(end, t))
+        for _start, end, forced in self._pieces(state.t, t, clock):
+            stop = min(end, t)
+            state = self._advance_piece(state, forced, stop)
             if end >= t:
                 break
-            start, i = end, i + 1
         self.state = state
 
     def _advance_piece(self, state: PlantState, forced: Forced | None, t: float) -> PlantState:
