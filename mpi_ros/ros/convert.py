@@ -20,7 +20,8 @@ from __future__ import annotations
 import math
 import time
 import weakref
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
+from operator import attrgetter
 from typing import Any
 
 from builtin_interfaces.msg import Time
@@ -188,14 +189,28 @@ def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
     """Every axis' (actual position, actual velocity, servo effort): what /joint_states
     carries (the effort: the simulated servo's, plant.servo_effort). ``snapshots``: every
     axis' AxisSnapshot at the sample published, if they were taken (runner.AtSample)."""
-    if snapshots is None:
-        position, velocity, effort = ctl.joint_values()
-    else:
-        axes = [snapshots[n] for n in range(len(ctl.axes))]
-        position = [s.actual_position for s in axes]
-        velocity = [s.actual_velocity for s in axes]
-        effort = [s.servo_effort for s in axes]
-    return [float(x) for x in position], [float(v) for v in velocity], [_finite(e) for e in effort]
+    if snapshots is not None:
+        return joint_readings([snapshots[n] for n in range(len(ctl.axes))])
+    position, velocity, effort = ctl.joint_values()
+    return _joint_floats(position, velocity, effort)
+
+
+_JOINT_READING = attrgetter("actual_position", "actual_velocity", "servo_effort")
+
+
+def joint_readings(snaps: Sequence[AxisSnapshot]) -> tuple[list[float], list[float], list[float]]:
+    """:func:`joint_values` of these axes' snapshots."""
+    if not snaps:
+        return [], [], []
+    position, velocity, effort = zip(*map(_JOINT_READING, snaps), strict=True)
+    return _joint_floats(position, velocity, effort)
+
+
+def _joint_floats(position: Sequence[float], velocity: Sequence[float], effort: Sequence[float]
+                  ) -> tuple[list[float], list[float], list[float]]:
+    # the sum is finite only if every effort is: one check for the usual case
+    efforts = list(map(float, effort)) if math.isfinite(sum(effort)) else [_finite(e) for e in effort]
+    return list(map(float, position)), list(map(float, velocity)), efforts
 
 
 def joint_names(ctl, prefix: str = "") -> list[str]:
