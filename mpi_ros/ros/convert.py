@@ -25,6 +25,7 @@ from operator import attrgetter
 from typing import Any
 
 from builtin_interfaces.msg import Time
+from rclpy.exceptions import InvalidHandle
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
 
@@ -297,12 +298,12 @@ def publish(node, publisher, msg) -> None:
 
 
 def publish_all(node, sends: Iterable[tuple[Any, Any]]) -> None:
-    """``publish`` for each (publisher, message) of one node, the context checked once."""
-    if not node.context.ok():
-        return
+    """``publish`` for each (publisher, message) of one node. The context is looked at only
+    when publishing fails: once it has shut down, rcl refuses to publish ("publisher's context
+    is invalid") or the publisher is gone with its node, and what is left is not published."""
     try:
         for publisher, msg in sends:
             publisher.publish(msg)
-    except rcl.RCLError:
+    except (rcl.RCLError, InvalidHandle):
         if node.context.ok():
             raise
