@@ -5,9 +5,9 @@ node its MotionStatus (which holds its axes' again), and the controller node the
 and the clock (controller_node.py, supervisor_node.py; the CDR of mpi_ros/ros/wire.py). Timed
 here without ROS, as the nodes' callbacks encode them, from the snapshots of samples new to
 the packer (every axis in a VELOCITY move: bench_controller's _controller and _velocity; 8
-axes in 4 supervisors, 32 in 16). A tree without ``Packer.axis_statuses`` packs the axes one by
-one, one without ``convert.joint_readings`` reads the joints as its node did (a dict of the
-snapshots, convert.joint_values), one without ``wire.clock`` builds a rosgraph_msgs/Clock.
+axes in 4 supervisors, 32 in 16). A tree without ``convert.joint_readings`` reads the joints as
+its node did (a dict of the snapshots, convert.joint_values), one without ``wire.clock`` builds
+a rosgraph_msgs/Clock (the message only: rclpy converts it again when it publishes).
 
 Each tree (this one and ``--baseline``, extracted with git archive) runs every case in a
 fresh process, the trees alternating ``--rounds`` times; a figure is the best CPU time
@@ -44,8 +44,6 @@ def _encoders(ctl) -> dict[str, Callable]:
     names = convert.joint_names(ctl)
 
     def axes(motions, snaps):
-        if hasattr(packer, "axis_statuses"):
-            return packer.axis_statuses(snaps)
         return [packer.axis_status(snap) for snap in snaps]
 
     def joints(motions, snaps):

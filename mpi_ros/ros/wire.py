@@ -34,7 +34,6 @@ import math
 import struct
 from collections.abc import Sequence
 from functools import cache, lru_cache
-from itertools import chain
 from operator import attrgetter, itemgetter
 
 from rosgraph_msgs.msg import Clock
@@ -124,17 +123,9 @@ _HEAD_SIZE = struct.calcsize("<" + _HEAD)
 _MOTION_HEAD = struct.Struct("<" + _HEAD)
 # An AxisStatus' body is its head, its state's name (a string padded to the next double), its
 # doubles, flags and int32s from command_position to feedforward (8-aligned wherever the name
-# ends: the same 96 bytes after any name) and its faults (last). So the fields of every axis
-# of a sample but the two strings pack in one struct call, and the strings, a few distinct
-# values, are packed once each.
-_AXIS_FIXED = _HEAD + "8d8?4id"
-_AXIS_FIXED_SIZE = struct.calcsize("<" + _AXIS_FIXED)
-
-
-@lru_cache(maxsize=64)
-def _axis_fixed(count: int) -> struct.Struct:
-    """The fixed fields (_AXIS_FIXED) of ``count`` axes, one after the other."""
-    return struct.Struct("<" + _AXIS_FIXED * count)
+# ends: the same 96 bytes after any name) and its faults (last). So its numbers pack with one
+# struct whatever its strings, and the strings, a few distinct values, are packed once each.
+_AXIS_FIXED = struct.Struct("<" + _HEAD + "8d8?4id")
 
 
 def _strings(*texts: str) -> bytes:
@@ -221,7 +212,8 @@ def _finite(x: float) -> float:
     return float(x) if math.isfinite(x) else 0.0  # as convert.axis_status sets the field
 
 
-# An AxisStatus' values in _AXIS_FIXED's order (its fields but the strings), read at once
+# An AxisStatus' values in _AXIS_FIXED's order (its fields but the strings), read at once (one
+# C call, not 24 attribute reads)
 _AXIS_VALUES = attrgetter(
     "sample", "number", "state", "command_position", "actual_position", "position_error", "target_position",
     "origin", "command_velocity", "actual_velocity", "command_acceleration", "done", "at_target",
@@ -236,20 +228,16 @@ def _sent(values: tuple) -> tuple:
     return tuple(_finite(x) if i in _FINITE else x for i, x in enumerate(values))
 
 
-def _axis_bodies(snaps: Sequence[AxisSnapshot]) -> list[bytes]:
-    """Each snapshot's AxisStatus from its sample on (the same bytes wherever the status
-    starts), the fixed fields of all of them packed in one call."""
-    values = list(map(_AXIS_VALUES, snaps))
+def _axis_body(snap: AxisSnapshot) -> bytes:
+    """An AxisStatus from its sample on: the same bytes wherever the status starts."""
+    values = _AXIS_VALUES(snap)
     # the sum is finite only if every value is: one check for the usual case
-    if not math.isfinite(sum(chain.from_iterable(map(_SENT_FINITE, values)))):
-        values = list(map(_sent, values))
-    fixed = _axis_fixed(len(values)).pack(*chain.from_iterable(values))
-    return [b"".join((fixed[at:at + _HEAD_SIZE], _axis_state_name(snap.state),
-                      fixed[at + _HEAD_SIZE:at + _AXIS_FIXED_SIZE], _axis_faults(snap.faults)))
-            for at, snap in zip(range(0, len(fixed), _AXIS_FIXED_SIZE), snaps, strict=True)]
+    if not math.isfinite(sum(_SENT_FINITE(values))):
+        values = _sent(values)
+    fixed = _AXIS_FIXED.pack(*values)
+    return b"".join((fixed[:_HEAD_SIZE], _axis_state_name(snap.state), fixed[_HEAD_SIZE:], _axis_faults(snap.faults)))
 
 
-_SAMPLE = attrgetter("sample")
 _MOTION_HEAD_VALUES = attrgetter("sample", "number", "state")
 _MOTION_TAIL_VALUES = attrgetter("done", "at_target", "settled", "move_id", "element_id", "feedrate")
 _PADDING = tuple(bytes(n) for n in range(4))
@@ -260,8 +248,7 @@ class Packer:
     packed as CDR, keeping what the statuses of a sample share: the stamp and each axis
     snapshot's body (its AxisStatus from its sample on), which every MotionStatus holding
     the same snapshot repeats byte for byte (the body starts 8-aligned wherever the status does:
-    only the header's padding differs). The axes of a sample are packed together
-    (:meth:`axis_statuses`: their fields but the strings in one struct call).
+    only the header's padding differs).
 
     An axis' body is kept by the snapshot's identity (the snapshot kept with it, so the
     identity is not reused): a snapshot is a value nobody assigns to (base/snapshot.py), so
@@ -291,27 +278,11 @@ class Packer:
         """A snapshot's body: kept, else packed (and kept if of the sample kept)."""
         body = self._bodies.get(id(snap))
         if body is None:
-            (body,) = _axis_bodies((snap,))
+            body = _axis_body(snap)
             if snap.sample == self._sample:
-                self._keep((snap,), (body,))
+                self._bodies[id(snap)] = body
+                self._kept.append(snap)
         return body
-
-    def _keep(self, snaps: Sequence[AxisSnapshot], bodies: Sequence[bytes]) -> None:
-        """Keep the bodies of snapshots of the sample kept."""
-        self._bodies.update(zip(map(id, snaps), bodies, strict=True))
-        self._kept += snaps
-
-    def axis_statuses(self, snaps: Sequence[AxisSnapshot]) -> list[bytes]:
-        """The CDR of ``convert.axis_status(snap, rate, epoch_ns, namespace)`` for each of
-        ``snaps``: the axes of a sample are packed together (a status for every axis, each a
-        new snapshot, is the usual call)."""
-        if len(set(map(_SAMPLE, snaps))) != 1:
-            return [self.axis_status(snap) for snap in snaps]
-        head = HEADER + self._at(snaps[0].sample)
-        bodies = _axis_bodies(snaps)
-        self._keep(snaps, bodies)
-        return [b"".join((head, _frame(self.namespace, -1, snap.number, 0), body))
-                for snap, body in zip(snaps, bodies, strict=True)]
 
     def axis_status(self, snap: AxisSnapshot) -> bytes:
         """The CDR of ``convert.axis_status(snap, rate, epoch_ns, namespace)``."""

@@ -169,19 +169,22 @@ def test_the_clock_bytes_equal_the_canonical_cdr_of_a_clock_message():
         assert wire.clock(sample, 2000.0, EPOCH) == expected
 
 
-def test_the_axes_of_a_sample_packed_together_are_the_axes_packed_one_by_one():
-    """Packer.axis_statuses (what the controller node publishes) and axis_status give the
-    same bytes, also for snapshots of several samples and snapshots with faults."""
+def test_a_packer_packs_snapshots_with_faults_and_of_other_samples_as_convert():
+    """The faults' strings and the state's name are packed once per value; a snapshot of
+    another sample than the one kept (inside a MotionStatus, say) is packed, not kept."""
     ctl = _controller()
-    packer, alone = wire.Packer(ctl.rate, EPOCH), wire.Packer(ctl.rate, EPOCH)
+    packer = wire.Packer(ctl.rate, EPOCH)
     for step, moving in enumerate(_moving_states(ctl)):
-        _, axes = moving.motion_snapshots()
+        motions, axes = moving.motion_snapshots()
         if step % 7 == 3:
             axes = [*axes[:2], dataclasses.replace(axes[2], sample=axes[2].sample - 5, faults=("AMP_FAULT", "X")),
-                    *axes[3:]]
-        assert packer.axis_statuses(axes) == [alone.axis_status(snap) for snap in axes]
-        expected = [cdr.serialize(convert.axis_status(snap, ctl.rate, EPOCH)) for snap in axes]
-        assert packer.axis_statuses(axes) == expected
+                    dataclasses.replace(axes[3], faults=("LIMIT_HW_POS",)), *axes[4:]]
+            motions = {n: dataclasses.replace(m, axes=tuple(axes[k] for k in m.axis_numbers))
+                       for n, m in motions.items()}
+        for snap in [*axes, *motions.values(), *axes]:
+            make = convert.axis_status if snap in axes else convert.motion_status
+            expected = cdr.serialize(make(snap, ctl.rate, EPOCH))
+            assert (packer.axis_status(snap) if snap in axes else packer.motion_status(snap)) == expected
 
 
 def test_publishing_after_the_context_shut_down_publishes_nothing_and_raises_nothing(ros_context):
