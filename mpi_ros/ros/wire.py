@@ -17,15 +17,16 @@ data after the header; a string is a uint32 length (with the NUL), its UTF-8 byt
 NUL; a sequence is a uint32 count and its elements; nested messages are inline and have
 no alignment of their own (an AxisStatus inside a MotionStatus is laid out by where it
 starts). The layout of a run of fields depends only on where it starts (mod 8) and on the
-lengths of its strings, so each is one struct.Struct, built once per case and cached. A
-std_msgs/Header is its stamp (int32 sec, uint32 nanosec) and its frame_id (a string). A
+lengths of its strings, so each is one struct.Struct, built once per case and cached; the
+strings take a handful of values (frame_ids, state names, faults, a MotionStatus' last
+strings), each packed once. A std_msgs/Header is its stamp (int32 sec, uint32 nanosec) and its frame_id (a string). A
 status' uint64 sample after its header is always 8-aligned, so everything from it on (its
 "body") has the same bytes wherever the status starts: :class:`Packer` packs an axis' body
 once for its own status and the supervisors' that hold it (replay packs every status of
 every sample it compares; docs/recording.md, "Replay"). If the
 installed interfaces differ from these layouts (built from older .msg files), :data:`AVAILABLE`
-is False, the nodes build messages with convert.py instead and the controller node says so in
-its log.
+is False, the nodes build messages with convert.py instead (and /clock a rosgraph_msgs/Clock,
+here its stamp's 8 bytes) and the controller node says so in its log.
 """
 
 from __future__ import annotations
