@@ -291,10 +291,8 @@ class ControllerNode(Node):
 
     def _collect_joints(self, ctl, at: AtSample):
         joints, rows = self._joints_of(ctl)  # the valid axes change by commands only, never within a stretch
-        values = convert.joint_values(ctl, {snap.number: snap for snap in at.taken()[1]})
-        if len(rows) < len(self._axis_joints):
-            values = ([values[0][r] for r in rows], [values[1][r] for r in rows], [values[2][r] for r in rows])
-        position, velocity, effort = joints.convert(*values)
+        snaps = at.taken()[1]  # every axis', by number
+        position, velocity, effort = joints.convert(*convert.joint_readings([snaps[row] for row in rows]))
         if wire.AVAILABLE:  # packed straight into CDR
             msg = wire.joint_state(at.sample, ctl.rate, self.epoch_ns, joints.names, position, velocity, effort)
         else:
@@ -312,7 +310,8 @@ class ControllerNode(Node):
         return self.joints, rows
 
     def _collect_clock(self, ctl, at: AtSample):
-        msg = Clock(clock=convert.stamp(at.sample, ctl.rate, self.epoch_ns))
+        msg = (wire.clock(at.sample, ctl.rate, self.epoch_ns) if wire.AVAILABLE  # packed straight into CDR
+               else Clock(clock=convert.stamp(at.sample, ctl.rate, self.epoch_ns)))
         return lambda: convert.publish(self, self._pub_clock, msg)
 
     def _collect_diagnostics(self, ctl):

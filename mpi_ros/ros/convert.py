@@ -20,10 +20,12 @@ from __future__ import annotations
 import math
 import time
 import weakref
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
+from operator import attrgetter
 from typing import Any
 
 from builtin_interfaces.msg import Time
+from rclpy.exceptions import InvalidHandle
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
 
@@ -188,14 +190,28 @@ def joint_values(ctl, snapshots: Mapping[int, AxisSnapshot] | None = None
     """Every axis' (actual position, actual velocity, servo effort): what /joint_states
     carries (the effort: the simulated servo's, plant.servo_effort). ``snapshots``: every
     axis' AxisSnapshot at the sample published, if they were taken (runner.AtSample)."""
-    if snapshots is None:
-        position, velocity, effort = ctl.joint_values()
-    else:
-        axes = [snapshots[n] for n in range(len(ctl.axes))]
-        position = [s.actual_position for s in axes]
-        velocity = [s.actual_velocity for s in axes]
-        effort = [s.servo_effort for s in axes]
-    return [float(x) for x in position], [float(v) for v in velocity], [_finite(e) for e in effort]
+    if snapshots is not None:
+        return joint_readings([snapshots[n] for n in range(len(ctl.axes))])
+    position, velocity, effort = ctl.joint_values()
+    return _joint_floats(position, velocity, effort)
+
+
+_JOINT_READING = attrgetter("actual_position", "actual_velocity", "servo_effort")
+
+
+def joint_readings(snaps: Sequence[AxisSnapshot]) -> tuple[list[float], list[float], list[float]]:
+    """:func:`joint_values` of these axes' snapshots."""
+    if not snaps:
+        return [], [], []
+    position, velocity, effort = zip(*map(_JOINT_READING, snaps), strict=True)
+    return _joint_floats(position, velocity, effort)
+
+
+def _joint_floats(position: Sequence[float], velocity: Sequence[float], effort: Sequence[float]
+                  ) -> tuple[list[float], list[float], list[float]]:
+    # the sum is finite only if every effort is: one check for the usual case
+    efforts = list(map(float, effort)) if math.isfinite(sum(effort)) else [_finite(e) for e in effort]
+    return list(map(float, position)), list(map(float, velocity)), efforts
 
 
 def joint_names(ctl, prefix: str = "") -> list[str]:
@@ -282,12 +298,12 @@ def publish(node, publisher, msg) -> None:
 
 
 def publish_all(node, sends: Iterable[tuple[Any, Any]]) -> None:
-    """``publish`` for each (publisher, message) of one node, the context checked once."""
-    if not node.context.ok():
-        return
+    """``publish`` for each (publisher, message) of one node. The context is looked at only
+    when publishing fails: once it has shut down, rcl refuses to publish ("publisher's context
+    is invalid") or the publisher is gone with its node, and what is left is not published."""
     try:
         for publisher, msg in sends:
             publisher.publish(msg)
-    except rcl.RCLError:
+    except (rcl.RCLError, InvalidHandle):
         if node.context.ok():
             raise

@@ -17,15 +17,16 @@ data after the header; a string is a uint32 length (with the NUL), its UTF-8 byt
 NUL; a sequence is a uint32 count and its elements; nested messages are inline and have
 no alignment of their own (an AxisStatus inside a MotionStatus is laid out by where it
 starts). The layout of a run of fields depends only on where it starts (mod 8) and on the
-lengths of its strings, so each is one struct.Struct, built once per case and cached. A
-std_msgs/Header is its stamp (int32 sec, uint32 nanosec) and its frame_id (a string). A
+lengths of its strings, so each is one struct.Struct, built once per case and cached; the
+strings take a handful of values (frame_ids, state names, faults, a MotionStatus' last
+strings), each packed once. A std_msgs/Header is its stamp (int32 sec, uint32 nanosec) and its frame_id (a string). A
 status' uint64 sample after its header is always 8-aligned, so everything from it on (its
 "body") has the same bytes wherever the status starts: :class:`Packer` packs an axis' body
 once for its own status and the supervisors' that hold it (replay packs every status of
 every sample it compares; docs/recording.md, "Replay"). If the
 installed interfaces differ from these layouts (built from older .msg files), :data:`AVAILABLE`
-is False, the nodes build messages with convert.py instead and the controller node says so in
-its log.
+is False, the nodes build messages with convert.py instead (and /clock a rosgraph_msgs/Clock,
+here its stamp's 8 bytes) and the controller node says so in its log.
 """
 
 from __future__ import annotations
@@ -34,8 +35,9 @@ import math
 import struct
 from collections.abc import Sequence
 from functools import cache, lru_cache
-from operator import attrgetter
+from operator import attrgetter, itemgetter
 
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from mpi_ros.config import DEFAULT_NAMESPACE
@@ -70,7 +72,8 @@ _JOINT_FIELDS = {"header": "std_msgs/Header", "name": "sequence<string>", "posit
                  "velocity": "sequence<double>", "effort": "sequence<double>"}
 AVAILABLE = (AxisStatus.get_fields_and_field_types() == _AXIS_FIELDS
              and MotionStatus.get_fields_and_field_types() == _MOTION_FIELDS
-             and JointState.get_fields_and_field_types() == _JOINT_FIELDS)
+             and JointState.get_fields_and_field_types() == _JOINT_FIELDS
+             and Clock.get_fields_and_field_types() == {"clock": "builtin_interfaces/Time"})
 
 
 class _Layout:
@@ -86,18 +89,22 @@ class _Layout:
         self.pos += pad + size * count
         return self
 
+    def bytes(self, length: int) -> _Layout:
+        """``length`` bytes as they are (no alignment)."""
+        self.fmt += f"{length}s"
+        self.pos += length
+        return self
+
     def string(self, length: int) -> _Layout:
         """uint32 length, then the bytes and their NUL (``s`` pads the NUL)."""
-        self.add("I", 4)
-        self.fmt += f"{length + 1}s"
-        self.pos += length + 1
-        return self
+        return self.add("I", 4).bytes(length + 1)
 
     def struct(self) -> struct.Struct:
         return struct.Struct(self.fmt)
 
 
 _STAMP = struct.Struct("<iI")  # a header's stamp: sec, nanosec
+_LENGTH = struct.Struct("<I")
 
 
 @lru_cache(maxsize=1024)
@@ -110,35 +117,61 @@ def _frame(namespace: str, supervisor: int, axis: int, start: int) -> bytes:
     return layout.add("x", 1, -layout.pos % 8).struct().pack(len(frame) + 1, frame)
 
 
-def _body_head(name_length: int) -> _Layout:
-    """A status from its sample to its state name, from an 8-aligned start."""
-    return _Layout(0).add("Q", 8).add("i", 4).add("B", 1).string(name_length)
+# A status from its sample to its state (uint64, int32, uint8), from an 8-aligned start: the
+# first 16 bytes of an AxisStatus' and a MotionStatus' body, the state's name after them.
+_HEAD = "QiB3x"
+_HEAD_SIZE = struct.calcsize("<" + _HEAD)
+_MOTION_HEAD = struct.Struct("<" + _HEAD)
+# An AxisStatus' body is its head, its state's name (a string padded to the next double), its
+# doubles, flags and int32s from command_position to feedforward (8-aligned wherever the name
+# ends: the same 96 bytes after any name) and its faults (last). So its numbers pack with one
+# struct whatever its strings, and the strings, a few distinct values, are packed once each.
+_AXIS_FIXED = struct.Struct("<" + _HEAD + "8d8?4id")
+
+
+def _strings(*texts: str) -> bytes:
+    """CDR strings one after the other, from a 4-aligned start (only 4-alignments within)."""
+    encoded = [text.encode("utf-8") for text in texts]
+    layout = _Layout(0)
+    for text in encoded:
+        layout.string(len(text))
+    return layout.struct().pack(*(x for text in encoded for x in (len(text) + 1, text)))
 
 
 @cache
-def _axis_body(name_length: int, faults: tuple[int, ...]) -> struct.Struct:
-    """An AxisStatus from its sample to its end (an 8-aligned start, so the same bytes wherever
-    the status starts), with a state name and faults of those lengths."""
-    layout = _body_head(name_length).add("d", 8, 8).add("?", 1, 8).add("i", 4, 4).add("d", 8).add("I", 4)
-    for length in faults:
-        layout.string(length)
-    return layout.struct()
+def _axis_state_name(state: MPIState) -> bytes:
+    """An AxisStatus' state_name after its head, with the padding to the double after it."""
+    packed = _strings(state.name)
+    return packed + bytes(-len(packed) % 8)
 
 
-@cache
-def _motion_body(name_length: int, axes: int) -> struct.Struct:
-    """A MotionStatus from its sample to the count of its axes (an 8-aligned start)."""
-    return _body_head(name_length).add("I", 4).add("i", 4, axes).add("I", 4).struct()
+@lru_cache(maxsize=256)
+def _axis_faults(faults: tuple[str, ...]) -> bytes:
+    """An AxisStatus' faults, a sequence of strings (from a 4-aligned start)."""
+    return _LENGTH.pack(len(faults)) + _strings(*faults)
 
 
-@cache
-def _motion_tail(start: int, last_action: int, action_source: int, motion_type: int) -> struct.Struct:
-    """A MotionStatus after its axes, from ``start`` (mod 8), with strings of those lengths."""
-    layout = _Layout(start).add("?", 1, 3).add("i", 4, 2).add("d", 8)
-    return layout.string(last_action).string(action_source).add("i", 4).string(motion_type).struct()
+@lru_cache(maxsize=256)
+def _motion_middle(state: MPIState, axis_numbers: tuple[int, ...], axes: int) -> bytes:
+    """A MotionStatus after its head (from an 8-aligned start) to the count of its axes: the
+    state's name and the axis numbers; a supervisor's are the same for many samples."""
+    name = state.name.encode("utf-8")
+    layout = _Layout(_HEAD_SIZE).string(len(name)).add("I", 4).add("i", 4, len(axis_numbers)).add("I", 4)
+    return layout.struct().pack(len(name) + 1, name, len(axis_numbers), *axis_numbers, axes)
 
 
-_LENGTH = struct.Struct("<I")
+@lru_cache(maxsize=256)
+def _motion_tail(start: int, last_action: str, action_source: str, motion_type: str
+                 ) -> tuple[struct.Struct, bytes, bytes]:
+    """A MotionStatus after its axes, from ``start`` (mod 8): the struct of done, at_target,
+    settled, move_id, element_id, feedrate, the strings before moves_pending, moves_pending
+    and the string after it; and those strings' bytes (the strings after feedrate start
+    8-aligned: their bytes do not depend on ``start``)."""
+    before, after = _strings(last_action, action_source), _strings(motion_type)
+    layout = _Layout(start).add("?", 1, 3).add("i", 4, 2).add("d", 8).bytes(len(before)).add("i", 4)
+    return layout.bytes(len(after)).struct(), before, after
+
+
 _KEY = struct.Struct("<Qi")
 
 
@@ -180,45 +213,43 @@ def _finite(x: float) -> float:
     return float(x) if math.isfinite(x) else 0.0  # as convert.axis_status sets the field
 
 
-_STATE_NAMES = {state: state.name.encode("utf-8") for state in MPIState}
-
-
-def _state_name(state: MPIState) -> bytes:
-    found = _STATE_NAMES.get(state)
-    return found if found is not None else state.name.encode("utf-8")
-
-
-# An AxisStatus' values from its sample on, in the message's order but for the state's name
-# (after the state) and the faults (last); read at once (one C call, not 24 attribute reads).
+# An AxisStatus' values in _AXIS_FIXED's order (its fields but the strings), read at once (one
+# C call, not 24 attribute reads)
 _AXIS_VALUES = attrgetter(
     "sample", "number", "state", "command_position", "actual_position", "position_error", "target_position",
     "origin", "command_velocity", "actual_velocity", "command_acceleration", "done", "at_target",
     "in_fine_position", "in_coarse_position", "settled", "at_velocity", "trajectory_complete", "amp_enabled",
     "move_id", "element_id", "frame_count", "supervisor", "feedforward")
 _FINITE = frozenset({3, 4, 5, 7, 8, 9, 10, 23})  # the doubles sent finite (target_position may be NaN)
+_SENT_FINITE = itemgetter(*sorted(_FINITE))
 
 
-def _axis_body_bytes(snap: AxisSnapshot) -> bytes:
-    """An AxisStatus from its sample on: the same wherever the status starts (_axis_body)."""
+def _sent(values: tuple) -> tuple:
+    """An axis' values as convert.axis_status sets the fields."""
+    return tuple(_finite(x) if i in _FINITE else x for i, x in enumerate(values))
+
+
+def _axis_body(snap: AxisSnapshot) -> bytes:
+    """An AxisStatus from its sample on: the same bytes wherever the status starts."""
     values = _AXIS_VALUES(snap)
     # the sum is finite only if every value is: one check for the usual case
-    if not math.isfinite(sum(values[3:6]) + sum(values[7:11]) + values[23]):
-        values = tuple(_finite(x) if i in _FINITE else x for i, x in enumerate(values))
-    name = _state_name(values[2])
-    if not snap.faults:
-        return _axis_body(len(name), ()).pack(*values[:3], len(name) + 1, name, *values[3:], 0)
-    faults = [text.encode("utf-8") for text in snap.faults]
-    return _axis_body(len(name), tuple(map(len, faults))).pack(
-        *values[:3], len(name) + 1, name, *values[3:], len(faults),
-        *(x for text in faults for x in (len(text) + 1, text)))
+    if not math.isfinite(sum(_SENT_FINITE(values))):
+        values = _sent(values)
+    fixed = _AXIS_FIXED.pack(*values)
+    return b"".join((fixed[:_HEAD_SIZE], _axis_state_name(snap.state), fixed[_HEAD_SIZE:], _axis_faults(snap.faults)))
+
+
+_MOTION_HEAD_VALUES = attrgetter("sample", "number", "state")
+_MOTION_TAIL_VALUES = attrgetter("done", "at_target", "settled", "move_id", "element_id", "feedrate")
+_PADDING = tuple(bytes(n) for n in range(4))
 
 
 class Packer:
     """The statuses of one controller (its sample rate, its stamps' epoch, its namespace)
-    packed as CDR, keeping what statuses of the same sample share: the stamp, each header
-    (stamp and frame_id, by where it starts mod 8), and each axis snapshot's body, which
-    its AxisStatus and every MotionStatus holding the same snapshot repeat byte for byte
-    (the body starts 8-aligned wherever the status does: only the header's padding differs).
+    packed as CDR, keeping what the statuses of a sample share: the stamp and each axis
+    snapshot's body (its AxisStatus from its sample on), which every MotionStatus holding
+    the same snapshot repeats byte for byte (the body starts 8-aligned wherever the status does:
+    only the header's padding differs).
 
     An axis' body is kept by the snapshot's identity (the snapshot kept with it, so the
     identity is not reused): a snapshot is a value nobody assigns to (base/snapshot.py), so
@@ -230,49 +261,53 @@ class Packer:
         self.namespace = namespace
         self._sample = -1
         self._stamp = b""
-        self._bodies: dict[int, tuple[AxisSnapshot, bytes]] = {}
+        self._bodies: dict[int, bytes] = {}  # by id() of a snapshot in _kept
+        self._kept: list[AxisSnapshot] = []
 
-    def _at(self, sample: int) -> None:
-        """Start keeping the statuses of ``sample`` (its stamp), forgetting the last one's."""
-        self._sample, self._stamp = sample, _STAMP.pack(*_time(sample, self.rate, self.epoch_ns))
-        self._bodies.clear()
+    def _stamp_of(self, sample: int) -> bytes:
+        return _STAMP.pack(*_time(sample, self.rate, self.epoch_ns))
 
-    def _axis(self, snap: AxisSnapshot, start: int) -> bytes:
-        """An AxisStatus' bytes (no encapsulation header) from ``start`` (mod 8)."""
-        if snap.sample != self._sample:  # its own stamp, even inside a MotionStatus of another sample
-            self._at(snap.sample)
-        kept = self._bodies.get(id(snap))
-        if kept is None or kept[0] is not snap:
-            kept = self._bodies[id(snap)] = (snap, _axis_body_bytes(snap))
-        # the stamp's int32 is 4-aligned: after an AxisStatus whose faults' last string ends
-        # anywhere, the next one inside a MotionStatus starts with padding
-        pad = -start % 4
-        return b"\x00" * pad + self._stamp + _frame(self.namespace, -1, snap.number, start + pad) + kept[1]
+    def _at(self, sample: int) -> bytes:
+        """Keep the statuses of ``sample`` from now (forgetting the last one's); its stamp."""
+        if sample != self._sample:
+            self._sample, self._stamp = sample, self._stamp_of(sample)
+            self._bodies.clear()
+            self._kept.clear()
+        return self._stamp
+
+    def _body(self, snap: AxisSnapshot) -> bytes:
+        """A snapshot's body: kept, else packed (and kept if of the sample kept)."""
+        body = self._bodies.get(id(snap))
+        if body is None:
+            body = _axis_body(snap)
+            if snap.sample == self._sample:
+                self._bodies[id(snap)] = body
+                self._kept.append(snap)
+        return body
 
     def axis_status(self, snap: AxisSnapshot) -> bytes:
         """The CDR of ``convert.axis_status(snap, rate, epoch_ns, namespace)``."""
-        return HEADER + self._axis(snap, 0)
+        stamp = self._at(snap.sample)
+        return b"".join((HEADER, stamp, _frame(self.namespace, -1, snap.number, 0), self._body(snap)))
 
     def motion_status(self, snap: MotionSnapshot) -> bytes:
         """The CDR of ``convert.motion_status(snap, rate, epoch_ns, namespace)``."""
-        if snap.sample != self._sample:
-            self._at(snap.sample)
-        name = _state_name(snap.state)
-        body = _motion_body(len(name), len(snap.axis_numbers)).pack(
-            snap.sample, snap.number, snap.state, len(name) + 1, name,
-            len(snap.axis_numbers), *snap.axis_numbers, len(snap.axes))
-        parts = [HEADER, self._stamp, _frame(self.namespace, snap.number, -1, 0), body]
-        at = len(self._stamp) + len(parts[2]) + len(body)  # in the data after the encapsulation header
+        stamp = self._at(snap.sample)
+        middle = _motion_middle(snap.state, snap.axis_numbers, len(snap.axes))
+        parts = [HEADER, stamp, _frame(self.namespace, snap.number, -1, 0),
+                 _MOTION_HEAD.pack(*_MOTION_HEAD_VALUES(snap)), middle]
+        at = len(middle) % 8  # in the data after the encapsulation header: what precedes it ends 8-aligned
+        sample = snap.sample
         for axis in snap.axes:
-            packed = self._axis(axis, at % 8)
-            parts.append(packed)
-            at += len(packed)
-        last_action, action_source = snap.last_action.encode("utf-8"), snap.action_source.encode("utf-8")
-        motion_type = snap.motion_type.encode("utf-8")
-        parts.append(_motion_tail(at % 8, len(last_action), len(action_source), len(motion_type)).pack(
-            snap.done, snap.at_target, snap.settled, snap.move_id, snap.element_id, float(snap.feedrate),
-            len(last_action) + 1, last_action, len(action_source) + 1, action_source, snap.moves_pending,
-            len(motion_type) + 1, motion_type))
+            # the stamp's int32 is 4-aligned: after an AxisStatus whose faults' last string ends
+            # anywhere, the next one starts with padding; its frame_id pads to its body
+            pad = -at % 4
+            body = self._body(axis)
+            parts += (_PADDING[pad], stamp if axis.sample == sample else self._stamp_of(axis.sample),
+                      _frame(self.namespace, -1, axis.number, (at + pad) % 8), body)
+            at = len(body) % 8
+        tail, before, after = _motion_tail(at, snap.last_action, snap.action_source, snap.motion_type)
+        parts.append(tail.pack(*_MOTION_TAIL_VALUES(snap), before, snap.moves_pending, after))
         return b"".join(parts)
 
 
@@ -294,8 +329,11 @@ def joint_state(sample: int, rate: float, epoch_ns: int | None, names: Sequence[
     builds it; the values are floats."""
     prefix = _joint_names(tuple(names))
     count = len(names)
-    out = bytearray(HEADER)
-    out += struct.pack("<iI", *_time(sample, rate, epoch_ns))
-    out += prefix
-    out += _joint_values((8 + len(prefix)) % 8, count).pack(count, *position, count, *velocity, count, *effort)
-    return bytes(out)
+    values = _joint_values((_STAMP.size + len(prefix)) % 8, count).pack(count, *position, count, *velocity,
+                                                                         count, *effort)
+    return b"".join((HEADER, _STAMP.pack(*_time(sample, rate, epoch_ns)), prefix, values))
+
+
+def clock(sample: int, rate: float, epoch_ns: int | None) -> bytes:
+    """The CDR of a rosgraph_msgs/Clock of ``sample``'s stamp (convert.stamp)."""
+    return HEADER + _STAMP.pack(*_time(sample, rate, epoch_ns))

@@ -159,3 +159,43 @@ def test_a_status_sample_and_number_are_read_where_the_fields_reader_finds_them(
         assert wire.sample_and_number(data) == readers[MotionStatus](data) == (ctl.sample, snap.number)
     with pytest.raises(ValueError, match="little-endian"):
         wire.sample_and_number(b"\x00\x00" + data[2:])
+
+
+def test_the_clock_bytes_equal_the_canonical_cdr_of_a_clock_message():
+    from rosgraph_msgs.msg import Clock
+
+    for sample in (0, 1, 1999, 2**33 + 7):
+        expected = cdr.serialize(Clock(clock=convert.stamp(sample, 2000.0, EPOCH)))
+        assert wire.clock(sample, 2000.0, EPOCH) == expected
+
+
+def test_a_packer_packs_snapshots_with_faults_and_of_other_samples_as_convert():
+    """The faults' strings and the state's name are packed once per value; a snapshot of
+    another sample than the one kept (inside a MotionStatus, say) is packed, not kept."""
+    ctl = _controller()
+    packer = wire.Packer(ctl.rate, EPOCH)
+    for step, moving in enumerate(_moving_states(ctl)):
+        motions, axes = moving.motion_snapshots()
+        if step % 7 == 3:
+            axes = [*axes[:2], dataclasses.replace(axes[2], sample=axes[2].sample - 5, faults=("AMP_FAULT", "X")),
+                    dataclasses.replace(axes[3], faults=("LIMIT_HW_POS",)), *axes[4:]]
+            motions = {n: dataclasses.replace(m, axes=tuple(axes[k] for k in m.axis_numbers))
+                       for n, m in motions.items()}
+        for snap in [*axes, *motions.values(), *axes]:
+            make = convert.axis_status if snap in axes else convert.motion_status
+            expected = cdr.serialize(make(snap, ctl.rate, EPOCH))
+            assert (packer.axis_status(snap) if snap in axes else packer.motion_status(snap)) == expected
+
+
+def test_publishing_after_the_context_shut_down_publishes_nothing_and_raises_nothing(ros_context):
+    import rclpy
+    from rosgraph_msgs.msg import Clock
+
+    node = rclpy.create_node("publish_after_shutdown", context=ros_context)
+    publisher = node.create_publisher(Clock, "clock_after_shutdown", 1)
+    data = wire.clock(5, 2000.0, EPOCH)
+    convert.publish_all(node, [(publisher, data)])  # published while the context is up
+    ros_context.shutdown()
+    convert.publish_all(node, [(publisher, data), (publisher, data)])  # rcl refuses: quietly nothing
+    node.destroy_node()
+    convert.publish(node, publisher, data)  # the publisher gone with its node: quietly nothing
