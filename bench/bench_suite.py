@@ -60,6 +60,7 @@ import math
 import os
 import queue
 import random
+import shutil
 import signal
 import statistics
 import struct
@@ -122,6 +123,23 @@ def suite_yaml(case: Case, directory: Path, tree: Path = REPO) -> Path:
     path = directory / f"suite_{case.name}.yaml"
     path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
     return path
+
+
+def suite_environment(tree: Path, directory: Path) -> dict[str, str]:
+    """The environment of ``tree``'s suite: its source first, and its own Fast DDS profile
+    (config/fastdds_discovery.xml, as an installation of that tree would have). The suite
+    would take the venv's installed copy, whichever tree runs, and replace a profile it
+    finds in a place it looks itself (mpi_ros.dds_profile): a copy in ``directory`` is one of
+    the operator's, which it keeps."""
+    from mpi_ros import dds_profile
+
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    profile = tree / "config" / dds_profile.SUITE
+    if profile.is_file() and not any(os.environ.get(v) for v in dds_profile.PROFILE_VARIABLES):  # else: the operator's
+        copy = directory / dds_profile.SUITE
+        shutil.copyfile(profile, copy)
+        env[dds_profile.PROFILE_VARIABLES[0]] = str(copy)
+    return env
 
 
 # -- /proc ---------------------------------------------------------------------------------------
@@ -588,7 +606,7 @@ def run_case(case: Case, seconds: float, command: list[str] | None = None, marks
         argv = command or [sys.executable, "-P", "-m", "mpi_ros.cli", "run", "--time-scale", "1"]
         with open(Path(tmp) / "suite.log", "w") as log:
             suite = _child([*argv, "--config", str(config)], cwd=tmp, stdout=subprocess.DEVNULL,
-                           stderr=log, env={**os.environ, "PYTHONPATH": str(tree)})
+                           stderr=log, env=suite_environment(tree, Path(tmp)))
         topics = case_topics(case)
         try:
             readers = Subscribers(list(topics), subscribers, Path(tmp))

@@ -64,6 +64,23 @@ def test_the_client_profile_declares_a_large_udp_receive_buffer_and_keeps_shared
     assert participant.findtext("p:rtps/p:useBuiltinTransports", namespaces=NS) == "false"
 
 
+def test_the_suite_profile_lets_its_writers_wake_the_event_thread_once_a_burst():
+    # The tree's own file (config_paths.find may give an installed copy of another tree's).
+    root = ET.parse(REPO / "config" / dds_profile.SUITE).getroot()
+    writer = root.find("p:data_writer", NS)
+    assert writer is not None
+    assert writer.get("is_default_profile") == "true"  # every writer rmw_fastrtps creates starts from it
+    window = writer.find("p:times/p:nackSupressionDuration", NS)
+    assert window is not None
+    seconds = int(window.findtext("p:sec", namespaces=NS)) + int(window.findtext("p:nanosec", namespaces=NS)) / 1e9
+    # no longer than a Fast DDS reader waits before it answers a heartbeat (heartbeatResponseDelay,
+    # 5 ms by default): a NACK of a lost sample never arrives while the sample is still underway
+    assert seconds == 0.005
+    announcement = root.find("p:participant/p:rtps/p:builtin/p:discovery_config/p:leaseAnnouncement", NS)
+    assert announcement is not None
+    assert announcement.findtext("p:nanosec", namespaces=NS) == "100000000"
+
+
 def test_a_profile_of_ours_from_another_place_it_is_looked_for_counts_as_ours():
     # e.g. a tool that found the source tree's copy, a suite that finds the installed one
     for place in config_paths.candidates(dds_profile.CLIENT):
