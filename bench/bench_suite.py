@@ -2,15 +2,20 @@
 
 Separate processes, so that every figure is the suite's and not the GIL of a shared probe:
 - the suite: ``mpi-ros run --time-scale 1 --config <generated YAML>`` (this source tree);
-- this process: it starts a VELOCITY move on every supervisor through its MotionStart
-  action (mpi_ros.client.MotionClient, the public client) and waits until every axis is at
-  its velocity;
 - the subscribers, which count the messages of every status topic, /joint_states and
   /clock against the wall clock over a window. By default (``--subscribers rclpy``, issue
   35: "as a user sees it") three plain rclpy subscriber processes, each with a share of the
   topics, the generated message types and rclpy's executor: every message deserialized,
-  its stamp read from its header. ``--subscribers raw``: the probe of earlier figures, in
-  this process, which takes the CDR bytes and deserializes nothing.
+  its stamp read from its header. ``--subscribers raw``: the probe of earlier figures, one
+  process that takes the CDR bytes and deserializes nothing.
+- the goals: a process that starts a VELOCITY move on every supervisor through its
+  MotionStart action (mpi_ros.client.MotionClient, the public client) and says when each
+  axis is at its velocity.
+
+This process uses no ROS itself: it starts the others, reads /proc and waits on each of
+them with a time limit, so a hang in any of them (Fast DDS once deadlocked here while a
+client's participant was destroyed) ends the bench with a message naming it, and every
+process it started ends with it, however it ends (PR_SET_PDEATHSIG).
 
 Figures per case:
 - real time: controller time (the stamps of /mpi/ms0/status, ``epoch + sample / rate``)
@@ -49,10 +54,13 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import ctypes
 import json
 import math
 import os
+import queue
 import random
+import shutil
 import signal
 import statistics
 import struct
@@ -115,6 +123,23 @@ def suite_yaml(case: Case, directory: Path, tree: Path = REPO) -> Path:
     path = directory / f"suite_{case.name}.yaml"
     path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
     return path
+
+
+def suite_environment(tree: Path, directory: Path) -> dict[str, str]:
+    """The environment of ``tree``'s suite: its source first, and its own Fast DDS profile
+    (config/fastdds_discovery.xml, as an installation of that tree would have). The suite
+    would take the venv's installed copy, whichever tree runs, and replace a profile it
+    finds in a place it looks itself (mpi_ros.dds_profile): a copy in ``directory`` is one of
+    the operator's, which it keeps."""
+    from mpi_ros import dds_profile
+
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    profile = tree / "config" / dds_profile.SUITE
+    if profile.is_file() and not any(os.environ.get(v) for v in dds_profile.PROFILE_VARIABLES):  # else: the operator's
+        copy = directory / dds_profile.SUITE
+        shutil.copyfile(profile, copy)
+        env[dds_profile.PROFILE_VARIABLES[0]] = str(copy)
+    return env
 
 
 # -- /proc ---------------------------------------------------------------------------------------
@@ -211,11 +236,34 @@ def real_time(topic: Topic, start: int, end: int) -> tuple[float, float]:
     return (stamp1 - stamp0) / (sent1 - sent0), (max(lags) - min(lags)) / 1e9
 
 
+class BenchStalled(RuntimeError):
+    """A process of the bench did not answer within its time limit (it was killed)."""
+
+
+def _die_with_parent() -> None:
+    """Run in every child before it executes: the kernel kills it (SIGKILL) when the bench's
+    process ends, however that ends (prctl PR_SET_PDEATHSIG), so no suite at real time or
+    subscriber outlives a bench that was killed or stopped on a stall."""
+    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG
+
+
+def _child(argv: list[str], **kwargs) -> subprocess.Popen:
+    """A process of the bench: it ends when the bench does (_die_with_parent). (A preexec_fn
+    is unsafe while other threads hold locks; the bench starts its processes while its only
+    other thread, start_moves' reader, is not running.)"""
+    return subprocess.Popen(argv, preexec_fn=_die_with_parent, **kwargs)
+
+
+def _serve(option: str, *args: str) -> list[str]:
+    """The command line of this script in one of its child roles (--serve-...)."""
+    return [sys.executable, "-P", str(Path(__file__).resolve()), option, *args]
+
+
 class Probe:
-    """A node of its own (in this process) that counts every topic, raw. rclpy's executor
-    takes one message per subscription and wait, through a task each: too slow for 14,000
-    messages a second on a shared core. Here one thread waits on every subscription and
-    takes everything queued at each wake."""
+    """A node of its own that counts every topic, raw (the --subscribers raw process).
+    rclpy's executor takes one message per subscription and wait, through a task each: too
+    slow for 14,000 messages a second on a shared core. Here one thread waits on every
+    subscription and takes everything queued at each wake."""
 
     def __init__(self, context, topics: list[tuple[type, str, Any]]):
         """``topics``: (message type, topic name, what counts its messages: on_message(data, info))."""
@@ -269,17 +317,19 @@ class Probe:
 
 
 class Subscribers:
-    """Plain rclpy subscriber processes, what a user's node is: each subscribes to its share
-    of the topics with the generated message types, and rclpy's executor deserializes every
-    message and calls back with it and its message info (the middleware's source and
-    reception timestamps); the stamp is read from the message. Each writes what it counted
-    to a file when told to stop (serve_subscribers)."""
+    """The processes that count the topics (serve_subscribers). rclpy: plain rclpy subscriber
+    processes, what a user's node is: each subscribes to its share of the topics with the
+    generated message types, and rclpy's executor deserializes every message and calls back
+    with it and its message info (the middleware's source and reception timestamps); the stamp
+    is read from the message. raw: one Probe process. Each writes what it counted to a file
+    when told to stop."""
 
-    def __init__(self, names: list[str], processes: int, directory: Path):
+    def __init__(self, names: list[str], kind: str, directory: Path):
         self.directory = directory
+        processes = SUBSCRIBER_PROCESSES if kind == "rclpy" else 1
         self.shares = [names[i::processes] for i in range(processes)]
-        self.procs = [subprocess.Popen([sys.executable, "-P", str(Path(__file__).resolve()), "--serve-subscribers",
-                                        str(directory / f"subscriber{i}"), "--", *share])
+        self.procs = [_child(_serve("--serve-subscribers", str(directory / f"subscriber{i}"), "--kind", kind,
+                                    "--", *share))
                       for i, share in enumerate(self.shares)]
 
     @property
@@ -289,36 +339,62 @@ class Subscribers:
     def wait_ready(self) -> None:
         deadline = time.monotonic() + WAIT
         while not all((self.directory / f"subscriber{i}.ready").exists() for i in range(len(self.procs))):
-            if time.monotonic() > deadline or any(proc.poll() is not None for proc in self.procs):
-                raise RuntimeError("the rclpy subscriber processes did not come up")
+            if any(proc.poll() is not None for proc in self.procs):
+                raise RuntimeError("a subscriber process ended before it subscribed")
+            if time.monotonic() > deadline:
+                raise BenchStalled(f"the subscriber processes did not subscribe within {WAIT:g} s")
             threading.Event().wait(0.05)
 
     def close(self, topics: dict[str, Topic]) -> None:
-        """Stop them and put what each counted into ``topics``."""
+        """Stop them and put what each counted into ``topics``; a process that does not stop
+        within WAIT is killed (and what it counted is lost: BenchStalled)."""
         for i in range(len(self.procs)):
             (self.directory / f"subscriber{i}.stop").touch()
+        stalled = []
         for i, proc in enumerate(self.procs):
             try:
                 proc.wait(timeout=WAIT)
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
-                raise RuntimeError(f"subscriber process {i} did not stop") from None
+                stalled.append(i)
+                continue
             counted = json.loads((self.directory / f"subscriber{i}.json").read_text(encoding="utf-8"))
             for name, messages in counted.items():
                 topics[name].messages = [tuple(m) for m in messages]
+        if stalled:
+            raise BenchStalled(f"subscriber process(es) {stalled} did not stop within {WAIT:g} s (killed)")
 
 
-def serve_subscribers(out: str, names: list[str]) -> int:
-    """One subscriber process (Subscribers): an rclpy node spun by rclpy's executor, a
-    subscription per topic; <out>.ready once subscribed, counts until <out>.stop exists,
-    then writes {topic: [[sent, received, stamp], ...]} to <out>.json."""
+def serve_subscribers(out: str, names: list[str], kind: str) -> int:
+    """One subscriber process (Subscribers), subscribed to ``names``: <out>.ready once
+    subscribed, counts until <out>.stop exists, then writes {topic: [[sent, received, stamp],
+    ...]} to <out>.json. rclpy: a node spun by rclpy's executor, a subscription per topic;
+    raw: a Probe."""
     import rclpy
+
+    rclpy.init()
+    stop = Path(f"{out}.stop")
+    if kind == "raw":
+        topics = {name: Topic(name, 0.0) for name in names}
+        probe = Probe(rclpy.get_default_context(), [(topic_type(name), name, topic) for name, topic in topics.items()])
+        Path(f"{out}.ready").touch()
+        while not stop.exists():
+            threading.Event().wait(0.05)
+        probe.close()
+        counted = {name: topic.messages for name, topic in topics.items()}
+    else:
+        counted = _spin_subscriptions(names, Path(f"{out}.ready"), stop)
+    Path(f"{out}.json").write_text(json.dumps(counted), encoding="utf-8")
+    rclpy.try_shutdown()
+    return 0
+
+
+def _spin_subscriptions(names: list[str], ready: Path, stop: Path) -> dict[str, list[tuple[int, int, int]]]:
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
     from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-    rclpy.init()
     node = Node(f"bench_suite_subscriber_{os.getpid()}")
     counted: dict[str, list[tuple[int, int, int]]] = {name: [] for name in names}
 
@@ -337,14 +413,11 @@ def serve_subscribers(out: str, names: list[str]) -> int:
         node.create_subscription(topic_type(name), name, counter(name), QoSProfile(depth=1000, reliability=reliability))
     executor = SingleThreadedExecutor()
     executor.add_node(node)
-    Path(f"{out}.ready").touch()
-    stop = Path(f"{out}.stop")
+    ready.touch()
     while not stop.exists():
         executor.spin_once(timeout_sec=0.1)
-    Path(f"{out}.json").write_text(json.dumps(counted), encoding="utf-8")
     node.destroy_node()
-    rclpy.shutdown()
-    return 0
+    return counted
 
 
 def case_topics(case: Case) -> dict[str, Topic]:
@@ -368,26 +441,73 @@ def topic_type(name: str) -> type:
     return AxisStatus if "/axis" in name else MotionStatus
 
 
-def start_moves(context, case: Case) -> int:
-    """A VELOCITY move on every supervisor, through its MotionStart action; returns how many
-    goals succeeded within WAIT (a VELOCITY goal succeeds when its axes are at velocity).
+def start_moves(case: Case) -> int:
+    """A VELOCITY move on every supervisor, in a process of its own (serve_moves); returns how
+    many goals succeeded within WAIT (a VELOCITY goal succeeds when its axes are at velocity).
     A suite that cannot keep up may answer late: its moves run all the same (a goal's
     command is applied as it is accepted; one whose request is not taken in time does not
-    move), and the window shows how far behind."""
+    move), and the window shows how far behind.
+
+    The process answers a line per goal; one that says nothing for longer than a goal may
+    take (the server's discovery and the goal, WAIT each) has stalled: it is killed and the
+    run stops (BenchStalled). A process that answered every goal but does not exit (its ROS
+    teardown hung) is killed: its answers stand."""
+    proc = _child(_serve("--serve-moves", str(case.supervisors)), stdout=subprocess.PIPE, text=True)
+    lines: queue.Queue[str | None] = queue.Queue()
+
+    def read() -> None:
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            lines.put(line)
+        lines.put(None)
+
+    threading.Thread(target=read, daemon=True).start()
+    at_velocity = 0
+    try:
+        for n in range(case.supervisors):
+            line = lines.get(timeout=2 * WAIT + 5.0)
+            if line is None:
+                raise RuntimeError(f"the goals' process ended (exit status {proc.wait()}) before ms{n}'s goal")
+            at_velocity += json.loads(line)["at_velocity"]
+    except queue.Empty:
+        proc.kill()
+        raise BenchStalled(f"the goals' process (a MotionClient per supervisor) said nothing about ms{n}'s goal "
+                           f"for {2 * WAIT + 5.0:g} s (killed)") from None
+    finally:
+        try:
+            proc.wait(timeout=WAIT)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+    return at_velocity
+
+
+def serve_moves(supervisors: int) -> int:
+    """The goals' process (start_moves): a line {"at_velocity": 0 or 1} per supervisor, in order.
+    Every client shares one DDS participant, which a node of its own keeps from one client's
+    close to the next (each client alone would create and destroy a participant)."""
+    import rclpy
+
     from mpi_ros.client import MotionClient
     from mpi_ros.errors import NoResponse
 
-    at_velocity = 0
-    for n in range(case.supervisors):
-        with MotionClient(n, context=context, timeout=WAIT, node_name=f"bench_suite_ms{n}") as client:
-            assert client.wait_for_server(WAIT), f"/mpi/ms{n} did not come up"
+    rclpy.init()
+    keeper = rclpy.create_node("bench_suite_goals")
+    for n in range(supervisors):
+        answered = False
+        with MotionClient(n, timeout=WAIT, node_name=f"bench_suite_ms{n}") as client:
+            if not client.wait_for_server(WAIT):
+                raise RuntimeError(f"/mpi/ms{n} did not come up within {WAIT:g} s")
             try:
                 goal = client.start({"type": "VELOCITY",
                                      "trajectory": [{"velocity": 1000.0 + 10.0 * n, "acceleration": 100_000.0}]})
-                at_velocity += goal.wait(WAIT).detail == "at velocity"
+                answered = goal.wait(WAIT).detail == "at velocity"
             except NoResponse:
                 pass  # the goal's answer or its result came too late
-    return at_velocity
+        print(json.dumps({"at_velocity": int(answered)}), flush=True)
+    keeper.destroy_node()
+    rclpy.try_shutdown()
+    return 0
 
 
 # -- one case --------------------------------------------------------------------------------------
@@ -479,36 +599,25 @@ def run_case(case: Case, seconds: float, command: list[str] | None = None, marks
     """One run of ``case``; ``command`` starts the suite (default: mpi-ros run at time scale 1)
     from the source ``tree`` (the installed package supplies the generated interfaces);
     ``marks``: create <marks>.start and <marks>.end when the window begins and ends (serve_phases);
-    ``subscribers``: who counts the topics, rclpy subscriber processes (Subscribers) or the
-    raw probe in this process (Probe)."""
-    import rclpy
-
+    ``subscribers``: who counts the topics, rclpy subscriber processes or a raw probe
+    (Subscribers). Every process it starts is stopped before it returns or raises."""
     with tempfile.TemporaryDirectory(prefix="bench_suite_") as tmp:
         config = suite_yaml(case, Path(tmp), tree)
         argv = command or [sys.executable, "-P", "-m", "mpi_ros.cli", "run", "--time-scale", "1"]
         with open(Path(tmp) / "suite.log", "w") as log:
-            suite = subprocess.Popen([*argv, "--config", str(config)], cwd=tmp, stdout=subprocess.DEVNULL,
-                                     stderr=log, env={**os.environ, "PYTHONPATH": str(tree)})
-        context = rclpy.Context()
-        rclpy.init(context=context)
-        probe: Probe | None = None
-        readers: Subscribers | None = None
+            suite = _child([*argv, "--config", str(config)], cwd=tmp, stdout=subprocess.DEVNULL,
+                           stderr=log, env=suite_environment(tree, Path(tmp)))
         topics = case_topics(case)
         try:
-            if subscribers == "rclpy":
-                readers = Subscribers(list(topics), SUBSCRIBER_PROCESSES, Path(tmp))
+            readers = Subscribers(list(topics), subscribers, Path(tmp))
+            try:
                 readers.wait_ready()
-            else:
-                probe = Probe(context, [(topic_type(name), name, topic) for name, topic in topics.items()])
-            at_velocity = start_moves(context, case)
-            threading.Event().wait(SETTLE)
-            window = _window(suite.pid, seconds, marks, readers.pids if readers is not None else [])
-        finally:
-            if probe is not None:
-                probe.close()
-            if readers is not None:
+                at_velocity = start_moves(case)
+                threading.Event().wait(SETTLE)
+                window = _window(suite.pid, seconds, marks, readers.pids)
+            finally:
                 readers.close(topics)
-            context.try_shutdown()
+        finally:
             stopped = _stop(suite)
         if stopped is None and suite.returncode != 0:
             raise RuntimeError(f"the suite exited with {suite.returncode}:\n{(Path(tmp) / 'suite.log').read_text()}")
@@ -753,12 +862,16 @@ def main() -> None:
     parser.add_argument("--serve-profiled", metavar="OUT", help=argparse.SUPPRESS)  # the profiled suite's process
     parser.add_argument("--serve-phases", metavar="OUT", help=argparse.SUPPRESS)  # the timed suite's process
     parser.add_argument("--serve-subscribers", metavar="OUT", help=argparse.SUPPRESS)  # a subscriber process
+    parser.add_argument("--kind", choices=("rclpy", "raw"), help=argparse.SUPPRESS)  # ... of this kind
+    parser.add_argument("--serve-moves", type=int, metavar="SUPERVISORS", help=argparse.SUPPRESS)  # the goals' process
     parser.add_argument("run_args", nargs="*", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.serve_profiled:
         sys.exit(serve_profiled(args.serve_profiled, args.run_args))
     if args.serve_subscribers:
-        sys.exit(serve_subscribers(args.serve_subscribers, args.run_args))
+        sys.exit(serve_subscribers(args.serve_subscribers, args.run_args, args.kind))
+    if args.serve_moves is not None:
+        sys.exit(serve_moves(args.serve_moves))
     if args.serve_phases:
         sys.exit(serve_phases(args.serve_phases, args.run_args))
     if args.phases:
@@ -768,10 +881,19 @@ def main() -> None:
         profile(CASES[args.profile], args.seconds, Path(args.profile_out), args.profile_time_scale,
                 subscribers=args.subscribers)
         return
+    results: list[Result] = []
+    stalled: BenchStalled | None = None
     with tempfile.TemporaryDirectory(prefix="bench_suite_baseline_") as tmp:
         trees = compared_trees(args.baseline, Path(tmp), "working tree")
-        results = [run_case(CASES[name], args.seconds, tree=tree, label=label, subscribers=args.subscribers)
-                   for _ in range(args.rounds) for name in args.case or CASES for tree, label in trees]
+        runs = [(CASES[name], tree, label) for _ in range(args.rounds) for name in args.case or CASES
+                for tree, label in trees]
+        for case, tree, label in runs:
+            try:
+                results.append(run_case(case, args.seconds, tree=tree, label=label, subscribers=args.subscribers))
+            except BenchStalled as exc:  # its processes are stopped: say so, show what was measured, end
+                stalled = exc
+                print(f"bench_suite: case {case.name} of {label} stalled: {exc}; the bench stops here.", flush=True)
+                break
     cases = "".join(f" --case {name}" for name in args.case or ())
     print(f"`python -P bench/bench_suite.py --seconds {args.seconds:g} --rounds {args.rounds}{cases} "
           f"--subscribers {args.subscribers} --baseline {args.baseline}` on "
@@ -780,6 +902,8 @@ def main() -> None:
     print("\n".join(summary(results)))
     print()
     print("\n".join(report(results)))
+    if stalled is not None:
+        sys.exit(f"bench_suite: stopped after {len(results)} of {len(runs)} runs: {stalled}")
 
 
 if __name__ == "__main__":

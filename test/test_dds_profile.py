@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from mpi_ros import config_paths, dds_profile
+from mpi_ros import graph_names as gn
 
 REPO = Path(__file__).resolve().parents[1]
 NS = {"p": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
@@ -62,6 +63,25 @@ def test_the_client_profile_declares_a_large_udp_receive_buffer_and_keeps_shared
     assert participant.get("is_default_profile") == "true"
     assert [t.text for t in participant.iterfind("p:rtps/p:userTransports/p:transport_id", NS)] == list(kinds)
     assert participant.findtext("p:rtps/p:useBuiltinTransports", namespaces=NS) == "false"
+
+
+def test_the_suite_profile_lets_its_writers_wake_the_event_thread_once_a_burst():
+    # The tree's own file (config_paths.find may give an installed copy of another tree's).
+    root = ET.parse(REPO / "config" / dds_profile.SUITE).getroot()
+    writer = root.find("p:data_writer", NS)
+    assert writer is not None
+    assert writer.get("is_default_profile") == "true"  # every writer rmw_fastrtps creates starts from it
+    window = writer.find("p:times/p:nackSupressionDuration", NS)
+    assert window is not None
+    seconds = int(window.findtext("p:sec", namespaces=NS)) + int(window.findtext("p:nanosec", namespaces=NS)) / 1e9
+    # longer than a status period at 100 Hz (one wake for a burst of them), a tenth at most of
+    # what a status writer keeps at the fastest status rate: a NACK-ed status can be sent again
+    fastest = 1000.0  # Hz: ros.status_rate's upper bound (mpi_ros/settings.py)
+    assert 1 / 100.0 < seconds <= gn.MOTION_STATUS.qos.depth / fastest / 10
+    assert gn.AXIS_STATUS.qos.depth == gn.MOTION_STATUS.qos.depth
+    announcement = root.find("p:participant/p:rtps/p:builtin/p:discovery_config/p:leaseAnnouncement", NS)
+    assert announcement is not None
+    assert announcement.findtext("p:nanosec", namespaces=NS) == "100000000"
 
 
 def test_a_profile_of_ours_from_another_place_it_is_looked_for_counts_as_ours():

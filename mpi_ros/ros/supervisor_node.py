@@ -374,8 +374,10 @@ class SupervisorNode(Node):
         service needs."""
         review = self._review(ctl)
         running = list(self._book.running())
+        if not running:
+            return review
         now = ctl.motion_feedback(self.number)
-        if not running or now is None:
+        if now is None:
             return review
         templates = {}
         sends = []
