@@ -114,6 +114,17 @@ def measure_in(source: Path, case: tuple | list, bench: str = "bench_controller"
     return json.loads(done.stdout)
 
 
+def least_side_by_side(trees: list[tuple[Path, str]], case: tuple | list, bench: str,
+                       rounds: int) -> dict[str, dict[str, float]]:
+    """``<bench>.measure(*case)`` ``rounds`` times in each tree, the trees alternating so that
+    both see the same load; each figure's least over the rounds, by tree name."""
+    runs: dict[str, list[dict[str, float]]] = {name: [] for _, name in trees}
+    for _ in range(rounds):
+        for tree, name in trees:
+            runs[name].append(measure_in(tree, case, bench))
+    return {name: {key: min(run[key] for run in found) for key in found[0]} for name, found in runs.items()}
+
+
 # -- the table ------------------------------------------------------------------------------
 def baseline_tree(revision: str, into: Path) -> Path | None:
     """The package at ``revision`` and its config/ (git archive), or None where there is no

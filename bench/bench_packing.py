@@ -26,7 +26,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run with -P: the sibling bench_controller
-from bench_controller import compared_trees, measure_in
+from bench_controller import compared_trees, least_side_by_side
 
 CASES = [(8, 4), (32, 16)]
 PARTS = ("axis statuses", "motion statuses", "joint state", "clock", "a sample")
@@ -93,11 +93,7 @@ def main(baseline: str, rounds: int) -> list[str]:
     with tempfile.TemporaryDirectory() as scratch:
         trees = compared_trees(baseline, Path(scratch))
         for case in CASES:
-            runs: dict[str, list[dict[str, float]]] = {name: [] for _, name in trees}
-            for _ in range(rounds):  # alternate, so both trees see the same load
-                for tree, name in trees:
-                    runs[name].append(measure_in(tree, case, "bench_packing"))
-            best = {name: {part: min(run[part] for run in found) for part in PARTS} for name, found in runs.items()}
+            best = least_side_by_side(trees, case, "bench_packing", rounds)
             for part in PARTS:
                 new = best["this tree"][part]
                 old = best[baseline][part] if baseline in best else float("nan")

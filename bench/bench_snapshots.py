@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run with -P: the sibling bench_controller
-from bench_controller import compared_trees, measure_in
+from bench_controller import compared_trees, least_side_by_side
 
 if TYPE_CHECKING:
     from mpi_ros.mpi import Controller
@@ -106,11 +106,7 @@ def main(baseline: str, rounds: int) -> list[str]:
     with tempfile.TemporaryDirectory() as scratch:
         trees = compared_trees(baseline, Path(scratch))
         for case in CASES:
-            runs: dict[str, list[dict[str, float]]] = {name: [] for _, name in trees}
-            for _ in range(rounds):  # alternate, so both trees see the same load
-                for tree, name in trees:
-                    runs[name].append(measure_in(tree, case, "bench_snapshots"))
-            best = {name: {call: min(run[call] for run in found) for call in CALLS} for name, found in runs.items()}
+            best = least_side_by_side(trees, case, "bench_snapshots", rounds)
             for figures in best.values():
                 figures.update({part: figures[call] - figures[step] for part, (call, step) in PARTS.items()})
             for call in [*CALLS, *PARTS]:
