@@ -22,14 +22,14 @@ the simulated controller, so it runs wherever the suite is reachable over DDS.
 
 Refusals raise the exception of the spec's message (``mpi_ros.errors.MPIMotionMessageMOVING``
 ...); a missing answer raises ``mpi_ros.errors.NoResponse``. Every client spins its own node
-in a background thread; action goals are sent from that thread (rclpy's ActionClient is not
-safe to send from another thread while spinning). :class:`Watcher` follows the whole suite
+in a background thread (ros/spinner.py's Spinner, which stops it before the node goes); action
+goals are sent from that thread (rclpy's ActionClient is not safe to send from another thread
+while spinning). :class:`Watcher` follows the whole suite
 (every supervisor's and axis' status, the events, any topic), as ``mpi-ros status`` does.
 """
 
 from __future__ import annotations
 
-import contextlib
 import threading
 import time
 import uuid
@@ -45,7 +45,7 @@ from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
 from rclpy.action.client import ClientGoalHandle
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from unique_identifier_msgs.msg import UUID
 
@@ -60,6 +60,7 @@ from .errors import NoResponse, NoSuchSupervisor, SuiteNotFound, raise_for
 from .graph_names import DEFAULT_NAMESPACE
 from .message_dicts import fill, message_class, to_dict
 from .qos import action_qos, matching, profile
+from .ros.spinner import Spinner
 
 ACTION_QOS = action_qos(gn.ACTION_SERVICE_QOS)
 STATUS_QOS = profile(gn.STATUS_READER_QOS)
@@ -364,19 +365,16 @@ class _Endpoint:
         self.node = Node(node_name, context=context)
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, name=f"mpi-ros-{node_name}", daemon=True)
+        self._spinner = Spinner(self.node, self._executor)
 
     def _start_spinning(self) -> None:
-        self._thread.start()
-
-    def _spin(self) -> None:
-        # ExternalShutdownException: the context was shut down under us (Ctrl-C in the owner): nothing left to serve
-        with contextlib.suppress(ExternalShutdownException):
-            self._executor.spin()
+        self._spinner.start()
 
     def close(self) -> None:
+        # The spinning thread ends first: Executor.shutdown while a thread still spins the
+        # executor destroys the guard condition that thread is about to trigger (spinner.py).
+        self._spinner.stop(timeout=2.0)
         self._executor.shutdown(timeout_sec=2.0)
-        self._thread.join(timeout=2.0)
         # destroy_node leaves a node's action clients (and their feedback and status
         # subscriptions) on the graph until they are garbage collected: a closed client would
         # still look present, to the suite's lost-client watchdog among others

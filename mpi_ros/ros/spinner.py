@@ -18,7 +18,7 @@ import threading
 import traceback
 
 from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import Executor
+from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 
 from . import rcl
@@ -64,6 +64,8 @@ class Spinner:
         try:
             while not self._stopping and self.executor.context.ok():
                 self.executor.spin_once()
+        except ExternalShutdownException:
+            pass  # the context shut down between the check and the wait: nothing left to serve
         except rcl.RCLError as exc:
             # The context shut down between the executor's check and its wait: it cannot make
             # the wait set any more. Anything else is a real error.

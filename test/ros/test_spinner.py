@@ -65,3 +65,28 @@ def test_a_callback_that_raises_ends_the_spinner_with_its_error(node_and_executo
     assert spinner.join(WAIT)
     assert spinner.ended
     assert isinstance(spinner.error, ZeroDivisionError)
+
+
+def test_a_context_shut_down_under_a_spinner_ends_it_without_an_error():
+    """A client's owner shutting rclpy down (Ctrl-C) ends its spinner quietly: nothing is
+    left to serve, and that is not a failure of the node."""
+    import rclpy
+    from rclpy.context import Context
+
+    from mpi_ros.ros.spinner import Spinner
+
+    context = Context()
+    rclpy.init(context=context)
+    node = rclpy.create_node("spinner_shutdown_test", context=context, start_parameter_services=False)
+    executor = MultiThreadedExecutor(num_threads=2, context=context)
+    executor.add_node(node)
+    spinner = Spinner(node, executor)
+    spinner.start()
+    try:
+        context.shutdown()
+        assert spinner.join(WAIT), "the spinner ends when its context shuts down"
+        assert spinner.error is None
+    finally:
+        spinner.stop(WAIT)
+        executor.shutdown(timeout_sec=WAIT)
+        node.destroy_node()
