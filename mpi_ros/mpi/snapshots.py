@@ -28,7 +28,7 @@ from mpi_ros.mpi.axes.status import AT_TARGET, AT_VELOCITY, DONE, IN_COARSE, IN_
 from mpi_ros.mpi.base.params import PlantConfig
 from mpi_ros.mpi.base.snapshot import AxisSnapshot, MotionSnapshot
 from mpi_ros.mpi.base.types import MPIState
-from mpi_ros.mpi.base.wrap import wrap_position, wrap_positions
+from mpi_ros.mpi.base.wrap import wrap_positions
 from mpi_ros.mpi.planning.frames import AxisPlan
 from mpi_ros.mpi.supervisor.motion import MotionSupervisor
 from mpi_ros.mpi.supervisor.status import MotionTemplate
@@ -129,7 +129,6 @@ _FIELDS = tuple(f.name for f in fields(AxisSnapshot))  # AxisSnapshot's position
 _BIT_FIELDS = {"done": DONE, "at_target": AT_TARGET, "in_fine_position": IN_FINE, "in_coarse_position": IN_COARSE,
                "settled": SETTLED, "at_velocity": AT_VELOCITY, "trajectory_complete": TC}
 _BIT_ROWS = list(_BIT_FIELDS.values())
-_FEW = 64  # snapshots (samples x axes) up to which plain floats cost less than the columns' arrays
 _PLANT_VALUES = attrgetter(*(f.name for f in fields(PlantConfig)))  # plants alike: the same effort
 _HELD = ("state", "target_position", "origin", "amp_enabled", "move_id", "supervisor", "faults")
 _HELD_OF = attrgetter(*_HELD)
@@ -145,10 +144,9 @@ def axis_snapshots(templates: Sequence[AxisTemplate], samples: Sequence[int], va
     (bank.VALUES x samples x templates) and status bits (status.BITS x samples x templates):
     those of the first sample first, in the order of ``templates``.
 
-    What follows the values is computed for every sample and axis at once, in arrays (in
-    plain floats for a few snapshots); each field is then one list in the snapshots' order
-    (what holds along the stretch repeated), and the snapshots are built from those lists in
-    one pass."""
+    What follows the values is computed for every sample and axis at once, in arrays; each
+    field is then one list in the snapshots' order (what holds along the stretch repeated),
+    and the snapshots are built from those lists in one pass."""
     if not templates:
         return []
     stops, rel = len(samples), values[REL]
@@ -158,10 +156,7 @@ def axis_snapshots(templates: Sequence[AxisTemplate], samples: Sequence[int], va
     feedforward = [t.feedforwards(r) for t, r in zip(templates, by_axis, strict=True)]
     columns["feedforward"] = _column(feedforward, stops)
     origin = held[_HELD.index("origin")]
-    if stops * len(templates) <= _FEW:
-        columns.update(zip(_FLOATS, _plain_floats(templates, values, origin, columns["feedforward"]), strict=True))
-    else:
-        columns.update(zip(_FLOATS, _flat(_floats(templates, values, origin, feedforward)), strict=True))
+    columns.update(zip(_FLOATS, _flat(_floats(templates, values, origin, feedforward)), strict=True))
     columns.update(zip(_BIT_FIELDS, _flat(bits[_BIT_ROWS]), strict=True))
     columns["number"] = [t.axis.number for t in templates] * stops
     columns["sample"] = [s for s in samples for _ in templates]
@@ -179,21 +174,6 @@ def _floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Seque
     floats[2] -= act_p
     floats[6] = _efforts(templates, feedforward, floats[2], cmd_v, act_v, cmd_a)
     return floats
-
-
-def _plain_floats(templates: Sequence[AxisTemplate], values: np.ndarray, origin: Sequence[float],
-                  feedforward: list[float]) -> list[list[float]]:
-    """:func:`_floats` as lists (sample by sample) for a few snapshots, where numpy's fixed
-    costs exceed the arithmetic: element by element, the same operations (the same bits);
-    ``feedforward``: the feedforward column."""
-    cmd_p, cmd_v, cmd_a, act_p, act_v, _ = _flat(values)
-    stops = len(cmd_p) // len(templates)
-    origins, every = list(origin) * stops, list(templates) * stops
-    error = [c - a for c, a in zip(cmd_p, act_p, strict=True)]
-    effort = [servo_effort(t.axis.plant.config, e, v, w, a, f) if t.amp_enabled else 0.0
-              for t, e, v, w, a, f in zip(every, error, cmd_v, act_v, cmd_a, feedforward, strict=True)]
-    return [[wrap_position(p - o) for p, o in zip(cmd_p, origins, strict=True)],
-            [wrap_position(p - o) for p, o in zip(act_p, origins, strict=True)], error, cmd_v, act_v, cmd_a, effort]
 
 
 def _flat(arrays: np.ndarray) -> list[list[Any]]:

@@ -24,7 +24,6 @@ from mpi_ros.mpi import (
     MPIAction,
     MPIMotionType,
     Trajectory,
-    snapshots,
 )
 from mpi_ros.mpi.axes.plant import Plant, servo_effort
 from mpi_ros.mpi.base.params import PlantConfig
@@ -88,10 +87,10 @@ def _apply(ctl: Controller, kind: str, who: int, x: float, y: float) -> None:
         ctl.axis_amp_enable_set(axis, kind == "amp_on")
 
 
-def _stepped(script, wanted: list[int]) -> tuple[dict[int, object], list]:
+def _stepped(script, wanted: list[int], ctl: Controller | None = None) -> tuple[dict[int, object], list]:
     """Step to each wanted sample and take motion_snapshots() there (before the commands
-    given at that sample)."""
-    ctl, pending, taken = _controller(), list(script), {}
+    given at that sample), on ``ctl`` (a new _controller() by default)."""
+    ctl, pending, taken = ctl or _controller(), list(script), {}
     for sample in [*wanted, SAMPLES]:
         while pending and pending[0][0] < sample:
             ctl.step(max(0, pending[0][0] - ctl.sample))
@@ -222,27 +221,25 @@ def test_the_servo_effort_computed_for_a_stretch_at_once_is_each_axis_own():
 
 
 
-def test_a_few_snapshots_from_plain_floats_are_those_from_arrays(monkeypatch):
-    """Up to snapshots._FEW snapshots of a stretch take their float fields from plain floats,
-    more from numpy arrays: the same operations element by element, so the same bits,
-    whatever the path (feedforward, a cam, a fault, an amplifier off) and across the 32-bit
-    wrap of the reported positions (axis 2's origin puts its velocity move across 2^31)."""
+def test_snapshots_in_stretches_across_the_32_bit_wrap_are_those_of_stepping_there():
+    """Feedforward, a cam, a fault and an amplifier turned off, with axis 2's reported
+    position crossing the 32-bit wrap (its origin puts its velocity move across 2^31):
+    every snapshot taken inside stretches is the one stepping there gives, to the bit."""
     script = [(0, "ptf", 0, 1200.0, -800.0), (0, "cam", 2, 500.0, 300.0), (0, "velocity", 1, 900.0, 0.0),
               (260, "STOP", 0, 0.0, 0.0), (700, "RESET", 0, 0.0, 0.0), (710, "pvt", 0, -600.0, 400.0),
               (900, "fault", 2, 0.0, 0.0), (1000, "amp_off", 3, 0.0, 0.0), (1200, "append", 0, 300.0, 200.0)]
     wanted = list(range(SAMPLES))
 
-    def taken(few: int) -> tuple[dict[int, object], list]:
-        monkeypatch.setattr(snapshots, "_FEW", few)
+    def across_the_wrap() -> Controller:
         ctl = _controller()
         assert ctl.axis_origin_set(2, -(2.0**31) + 100.0).ok  # a command past 100 reads across the wrap
-        return _in_stretches(script, wanted, ctl)
+        return ctl
 
-    plain, plain_events = taken(10**9)
-    arrays, array_events = taken(0)
-    assert plain_events == array_events
-    assert not [d for s in wanted for d in differences(plain[s], arrays[s], f"sample {s}")][:5]
-    reported = [axes[2].command_position for _, axes in plain.values()]
+    stretches, stretch_events = _in_stretches(script, wanted, across_the_wrap())
+    stepped, stepped_events = _stepped(script, wanted, across_the_wrap())
+    assert stretch_events == stepped_events
+    assert not [d for s in wanted for d in differences(stretches[s], stepped[s], f"sample {s}")][:5]
+    reported = [axes[2].command_position for _, axes in stretches.values()]
     assert max(reported) > 2.0**31 - 1000.0
     assert min(reported) < -(2.0**31) + 1000.0
-    assert any(not a.amp_enabled for _, axes in plain.values() for a in axes)
+    assert any(not a.amp_enabled for _, axes in stretches.values() for a in axes)
