@@ -172,7 +172,6 @@ class Axis:
         self.rest = 0.0
         self.mode = CommandMode.SERVO
         self.holding = False
-        self._owner = -1  # (the bank's column, as a Python int: a command asks it many times)
         self.owner = -1
         self.move_id = 0
         self.element_id = 0
@@ -186,11 +185,10 @@ class Axis:
     @property
     def owner(self) -> int:
         """The supervisor commanding the axis (-1: none); its clock drives the plan."""
-        return self._owner
+        return int(self._bank.owner[self.number])
 
     @owner.setter
     def owner(self, number: int) -> None:
-        self._owner = number
         self._bank.owner[self.number] = number
         self._bank.stale[self.number] = True
 
