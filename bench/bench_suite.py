@@ -718,8 +718,8 @@ def serve_phases(out: str, argv: list[str]) -> int:
         return f"{type(owner).__name__}.{callback.__name__}" if owner is not None else callback.__qualname__
 
     add_periodic, on_change, loop = ControllerRunner.add_periodic, ControllerRunner.on_change, ControllerRunner._loop
-    ControllerRunner.add_periodic = lambda self, rate, callback: add_periodic(
-        self, rate, phases.producer(f"periodic {named(callback)}", callback))
+    ControllerRunner.add_periodic = lambda self, rate, callback, **wanted: add_periodic(  # (older trees: no wanted)
+        self, rate, phases.producer(f"periodic {named(callback)}", callback), **wanted)
     ControllerRunner.on_change = lambda self, hook: on_change(self, phases.producer(f"change hook {named(hook)}", hook))
     Controller.step = phases.timed("Controller.step (the core)", Controller.step)
     if hasattr(ControllerRunner, "add_status"):  # statuses stepped in stretches (issue 35)

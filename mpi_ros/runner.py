@@ -17,7 +17,8 @@ samples in one stretch (Controller.step_snapshots, which answers the snapshots o
 to stepping there) and calls each callback with its sample's snapshots, in sample order. How
 long a status may wait for the stretch that carries it is ``publish_period`` (the setting
 ros.publish_period; 0: each ends a stretch as it falls due). Periodic work that reads the live
-controller (``add_periodic``: feedback, diagnostics) still ends a stretch at its stop.
+controller (``add_periodic``: feedback, diagnostics) still ends a stretch at its stop, while
+it has something to do (``wanted``: feedback only while goals are tracked).
 
 Modes: ``time_scale`` 1 = real time, >1 faster, 0 = as fast as possible, None = manual
 (nothing runs by itself; ``step`` advances, as tests and replay do).
@@ -84,13 +85,19 @@ LiveCallback = Callable[[Controller], Output | None]
 StatusCallback = Callable[[Controller, AtSample], Output | None]
 
 
-@dataclass(slots=True)
+@dataclass(eq=False, slots=True)
 class _Periodic:
     every: int
     next_sample: int
     live: LiveCallback | None = None  # reads the controller now: its stop ends a stretch
     status: StatusCallback | None = None  # reads its sample's snapshots: may wait in a stretch
     snapshots: bool = False  # the status callback reads the snapshots (not only the sample)
+    wanted: Callable[[], bool] | None = None  # (live) whether it has anything to do now; None: always
+
+    def passes(self, end: int) -> None:
+        """Its next stop moved past sample ``end`` without calling it."""
+        if self.next_sample <= end:
+            self.next_sample += self.every * ((end - self.next_sample) // self.every + 1)
 
 
 @dataclass(order=True, slots=True)
@@ -134,10 +141,17 @@ class ControllerRunner:
         controller.listeners.append(self._on_event)
 
     # -- configuration ---------------------------------------------------------------
-    def add_periodic(self, rate_hz: float, callback: LiveCallback) -> None:
+    def add_periodic(self, rate_hz: float, callback: LiveCallback, wanted: Callable[[], bool] | None = None) -> None:
         """Call ``callback(controller)`` (under the lock) every 1/rate_hz of controller time,
-        at exact samples; what it returns is run after the lock is released."""
-        self._add(rate_hz, _Periodic(0, 0, live=callback))
+        at exact samples; what it returns is run after the lock is released.
+
+        ``wanted()`` (under the lock, before each stretch) tells whether the callback has
+        anything to do: while it answers False, its stops pass without it, so they neither
+        call it nor end a stretch (each stretch costs the controller a fixed amount; the
+        feedback of a supervisor without goals cut the stepping 20 times a second for
+        nothing). A stop is kept, or passed, as the stretch that reaches it begins; a command
+        that makes it wanted is applied between stretches, so it counts from the next."""
+        self._add(rate_hz, _Periodic(0, 0, live=callback, wanted=wanted))
 
     def add_status(self, rate_hz: float, callback: StatusCallback, snapshots: bool = True) -> None:
         """Call ``callback(controller, at)`` (under the lock) every 1/rate_hz of controller
@@ -162,6 +176,10 @@ class ControllerRunner:
             return 0
         fastest = min(everies)
         return int(self.publish_period * self.ctl.rate + 1e-9) // fastest * fastest
+
+    def _active(self) -> list[_Periodic]:
+        """The periodic work that has anything to do now (``add_periodic``'s wanted)."""
+        return [p for p in self._periodic if p.wanted is None or p.wanted()]
 
     def _deadline(self, periodic: _Periodic, hold: int) -> int:
         """The sample by which ``periodic``'s next stop must have been stepped to."""
@@ -251,21 +269,23 @@ class ControllerRunner:
         Behind by more than CATCH_UP wake periods (an overloaded machine), it catches up in
         pieces of that size and publishes between them: caught up in one batch, the topics
         would fall silent, and the work held for after it grow, for as long as it lasts."""
-        if not self._periodic or not self.time_scale:
+        active = self._active()
+        if not active or not self.time_scale:
             return due
         wake = period * self.time_scale * self.ctl.rate  # samples per wake
         limit = min(due, self.ctl.sample + max(1, int(CATCH_UP * wake)))
-        last = max(p.next_sample + p.every * ((limit - p.next_sample) // p.every) for p in self._periodic)
+        last = max(p.next_sample + p.every * ((limit - p.next_sample) // p.every) for p in active)
         return last if limit - last < wake else limit
 
     def _until_next_stop(self, period: float) -> float:
         """Seconds until the next periodic stop is due (at most ``period``): the clock thread
         wakes as it becomes due, steps to it and publishes at once."""
         scale = self.time_scale
-        if not self._periodic or self._anchor_wall is None or not scale:  # manual or as fast as possible
+        active = self._active()  # (unlocked: a wake too early or late by a command, which wakes it anyway)
+        if not active or self._anchor_wall is None or not scale:  # manual or as fast as possible
             return period
         hold = self._hold()
-        ahead = min(self._deadline(p, hold) for p in self._periodic) - self._anchor_sample
+        ahead = min(self._deadline(p, hold) for p in active) - self._anchor_sample
         due_at = self._anchor_wall + ahead / (scale * self.ctl.rate)
         # a little late rather than early: early, the sample due would still be the one before
         return min(period, max(0.0, due_at - time.monotonic() + _WAKE_MARGIN))
@@ -301,10 +321,11 @@ class ControllerRunner:
         hold = self._hold()
         while ctl.sample < target:
             self._apply_scheduled()
-            self._skip_passed()
-            end = min([target] + [self._deadline(p, hold) for p in self._periodic]
+            active = self._active()
+            self._skip_passed(active)
+            end = min([target] + [self._deadline(p, hold) for p in active]
                       + [entry.sample for entry in self._scheduled[:1]])
-            stops = self._stops(end)
+            stops = self._stops(end, active)
             wanted = [sample for sample, due in stops.items() if any(p.snapshots for p in due)]
             taken = ctl.step_snapshots(end - ctl.sample, wanted) if end > ctl.sample else {}
             for sample, due in stops.items():
@@ -312,26 +333,32 @@ class ControllerRunner:
         self._apply_scheduled()
         self._changed()
 
-    def _stops(self, end: int) -> dict[int, list[_Periodic]]:
-        """The periodic stops up to ``end``, in sample order, each with its due callbacks in
-        the order they were added; every one's next stop moved past ``end``."""
+    def _stops(self, end: int, active: list[_Periodic]) -> dict[int, list[_Periodic]]:
+        """The stops of the ``active`` periodic work up to ``end``, in sample order, each with
+        its due callbacks in the order they were added; every one's next stop moved past
+        ``end`` (the others' without a call)."""
         stops: dict[int, list[_Periodic]] = {}
         for periodic in self._periodic:
+            if periodic not in active:
+                periodic.passes(end)
+                continue
             while periodic.next_sample <= end:
                 stops.setdefault(periodic.next_sample, []).append(periodic)
                 periodic.next_sample += periodic.every
         order = {id(p): i for i, p in enumerate(self._periodic)}
         return {sample: sorted(stops[sample], key=lambda p: order[id(p)]) for sample in sorted(stops)}
 
-    def _skip_passed(self) -> None:
+    def _skip_passed(self, active: list[_Periodic]) -> None:
         """Periodic stops the controller has passed without the runner (stepped directly):
-        each such callback runs once, now, and its next stop is the first one ahead."""
+        each such callback of the ``active`` work runs once, now, and every next stop is the
+        first one ahead."""
         ctl = self.ctl
         passed = [p for p in self._periodic if p.next_sample <= ctl.sample]
+        for periodic in passed:
+            periodic.passes(ctl.sample)
+        passed = [p for p in passed if p in active]
         if not passed:
             return
-        for periodic in passed:
-            periodic.next_sample += periodic.every * ((ctl.sample - periodic.next_sample) // periodic.every + 1)
         wanted = any(p.snapshots for p in passed)
         self._call(passed, ctl.sample, ctl.motion_snapshots() if wanted else None)
 

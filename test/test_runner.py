@@ -256,3 +256,27 @@ def test_a_status_period_shorter_than_its_rate_waits_for_nothing():
 def test_a_negative_publish_period_is_refused():
     with pytest.raises(ValueError, match=re.escape("publish_period must be >= 0 s, got -0.001")):
         ControllerRunner(config.load().build_controller(), time_scale=None, publish_period=-0.001)
+
+
+def test_live_periodic_work_with_nothing_to_do_neither_runs_nor_ends_a_stretch():
+    # Feedback without a goal: its stops pass without a call and without cutting the stepping;
+    # once wanted, it runs at its own exact samples again (add_periodic's wanted).
+    runner = ControllerRunner(config.load().build_controller(), time_scale=None, publish_period=0.005)
+    wanted, live, stretches = [False], [], []
+    step_snapshots = runner.ctl.step_snapshots
+    runner.ctl.step_snapshots = lambda samples, at: stretches.append(samples) or step_snapshots(samples, at)
+    runner.add_status(1000.0, lambda ctl, at: None)  # every 2 samples, gathered 10 samples at a time
+    runner.add_periodic(100.0, lambda ctl: live.append(ctl.sample), wanted=lambda: wanted[0])  # every 20
+    runner.step(105)
+    assert live == []
+    # the status' stretches alone: each to a status' sample + 10 (12, 24, ... 96), none cut at 20, 40, ...
+    assert stretches == [12] * 8 + [9]
+    wanted[0] = True
+    stretches.clear()
+    runner.step(60)
+    assert live == [120, 140, 160]
+    # cut at each of them: 105 -> 116 (status 106 + 10), 120, 132, 140, 152, 160, 165
+    assert stretches == [11, 4, 12, 8, 12, 8, 5]
+    wanted[0] = False
+    runner.step(40)
+    assert live == [120, 140, 160]

@@ -141,7 +141,8 @@ class SupervisorNode(Node):
         self._pub_status = self.create_publisher(MotionStatus, gn.MOTION_STATUS.name(ns, number),
                                                  profile(gn.MOTION_STATUS.qos))
         runner.add_status(settings.status_rate, self._collect_status)
-        runner.add_periodic(settings.feedback_rate, self._collect_feedback)
+        # without a goal tracked, a feedback stop would find nothing to do
+        runner.add_periodic(settings.feedback_rate, self._collect_feedback, wanted=lambda: len(self._book) > 0)
         runner.on_change(self._review)
         # JointTrajectory commands in SI units (trajectory_feed.py, docs/trajectories.md)
         self.trajectories = TrajectoryFeed(runner, number, joints or [], convert.epoch_of(runner.ctl) or 0,
