@@ -32,6 +32,9 @@ Figures per case:
 - the subscribers' (or probe's) own CPU, to judge what they take from the suite on a
   2-core machine.
 
+``--busy N`` runs N busy processes beside every run: the same figures on a loaded machine,
+reproducibly (a shared machine's load comes and goes).
+
 Cases: 32 axes in 16 two-axis supervisors with status and joint states at 100 Hz; 8 axes
 in 4 two-axis supervisors with status and joint states at 1 kHz, at the default sample
 rate (2 kHz) and at 4 kHz (``8x1000@4k``).
@@ -70,6 +73,7 @@ import tempfile
 import threading
 import time
 from collections import Counter
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -245,6 +249,17 @@ def _die_with_parent() -> None:
     process ends, however that ends (prctl PR_SET_PDEATHSIG), so no suite at real time or
     subscriber outlives a bench that was killed or stopped on a stall."""
     ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG
+
+
+@contextlib.contextmanager
+def _ended(processes: list[subprocess.Popen]) -> Iterator[None]:
+    """Kill ``processes`` (and reap them) when the block ends."""
+    try:
+        yield
+    finally:
+        for process in processes:
+            process.kill()
+            process.wait()
 
 
 def _child(argv: list[str], **kwargs) -> subprocess.Popen:
@@ -852,6 +867,9 @@ def main() -> None:
                              "(default: what a user's nodes are) or a raw probe in this process")
     parser.add_argument("--baseline", default=BASELINE,
                         help=f"also run the suite of this revision, alternating (default {BASELINE}; 'none': not)")
+    parser.add_argument("--busy", type=int, default=0, metavar="N",
+                        help="N busy processes (a Python loop each) beside every run: a loaded machine, "
+                             "reproducibly (default 0)")
     parser.add_argument("--profile", choices=sorted(CASES), help="run this case with the suite under cProfile")
     parser.add_argument("--phases", choices=sorted(CASES),
                         help="run this case with the clock thread's CPU split by phase (in real time)")
@@ -883,7 +901,9 @@ def main() -> None:
         return
     results: list[Result] = []
     stalled: BenchStalled | None = None
-    with tempfile.TemporaryDirectory(prefix="bench_suite_baseline_") as tmp:
+    # (each ends with this process: _child)
+    busy = [_child([sys.executable, "-c", "while True: pass"]) for _ in range(args.busy)]
+    with tempfile.TemporaryDirectory(prefix="bench_suite_baseline_") as tmp, _ended(busy):
         trees = compared_trees(args.baseline, Path(tmp), "working tree")
         runs = [(CASES[name], tree, label) for _ in range(args.rounds) for name in args.case or CASES
                 for tree, label in trees]
@@ -894,7 +914,7 @@ def main() -> None:
                 stalled = exc
                 print(f"bench_suite: case {case.name} of {label} stalled: {exc}; the bench stops here.", flush=True)
                 break
-    cases = "".join(f" --case {name}" for name in args.case or ())
+    cases = "".join(f" --case {name}" for name in args.case or ()) + (f" --busy {args.busy}" if args.busy else "")
     print(f"`python -P bench/bench_suite.py --seconds {args.seconds:g} --rounds {args.rounds}{cases} "
           f"--subscribers {args.subscribers} --baseline {args.baseline}` on "
           f"{time.strftime('%Y-%m-%d')}, {os.cpu_count()} cores; the runs alternate between the trees.")
