@@ -37,7 +37,9 @@ reproducibly (a shared machine's load comes and goes).
 
 Cases: 32 axes in 16 two-axis supervisors with status and joint states at 100 Hz; 8 axes
 in 4 two-axis supervisors with status and joint states at 1 kHz, at the default sample
-rate (2 kHz) and at 4 kHz (``8x1000@4k``).
+rate (2 kHz) and at 4 kHz (``8x1000@4k``); and, asked for by name, ``8x1000+fifo``: the clock
+thread under SCHED_FIFO (ros.clock_priority 10; run it with ``--busy``, ``--baseline none`` for
+a tree without that setting).
 
 The machines are shared and noisy, so each case also runs the suite of a baseline revision
 (``--baseline``, extracted with git archive), alternating with this tree, ``--rounds`` times;
@@ -105,6 +107,7 @@ class Case:
     axes: int
     status_rate: float  # Hz: MotionStatus, AxisStatus and JointState
     sample_rate: float = 2000.0  # Hz: the controller's
+    ros: tuple[tuple[str, Any], ...] = ()  # more settings of the ros section (a tree that knows them)
 
     @property
     def supervisors(self) -> int:
@@ -112,7 +115,10 @@ class Case:
 
 
 CASES = {case.name: case for case in (Case("32x100", 32, 100.0), Case("8x1000", 8, 1000.0),
-                                      Case("8x1000@4k", 8, 1000.0, 4000.0))}
+                                      Case("8x1000@4k", 8, 1000.0, 4000.0),
+                                      # the clock thread under SCHED_FIFO (ros.clock_priority): with --busy
+                                      Case("8x1000+fifo", 8, 1000.0, ros=(("clock_priority", 10),)))}
+DEFAULT_CASES = [name for name, case in CASES.items() if not case.ros]  # (any tree knows their settings)
 SUBSCRIBER_PROCESSES = 3  # --subscribers rclpy: the status topics are shared out among these
 
 
@@ -122,7 +128,7 @@ def suite_yaml(case: Case, directory: Path, tree: Path = REPO) -> Path:
     raw = yaml.safe_load((tree / "config" / "default.yaml").read_text(encoding="utf-8"))
     raw["axes"]["count"] = case.axes
     raw["supervisors"] = [{"number": n, "axes": [2 * n, 2 * n + 1]} for n in range(case.supervisors)]
-    raw["ros"].update(status_rate=case.status_rate, joint_states_rate=case.status_rate)
+    raw["ros"].update(status_rate=case.status_rate, joint_states_rate=case.status_rate, **dict(case.ros))
     raw["controller"]["sample_rate"] = case.sample_rate
     path = directory / f"suite_{case.name}.yaml"
     path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
@@ -813,7 +819,8 @@ def rows(result: Result) -> list[str]:
     case = result.case
     worst = result.worst
     lost = sum(t.lost for t in result.topics)
-    status = f"status and joint states at {case.status_rate:g} Hz, sample rate {case.sample_rate / 1000:g} kHz"
+    status = (f"status and joint states at {case.status_rate:g} Hz, sample rate {case.sample_rate / 1000:g} kHz"
+              + "".join(f", ros.{key}: {value}" for key, value in case.ros))
     return [
         f"| {case.axes} axes, {case.supervisors} supervisors, {status}, every axis moving "
         f"({len(result.topics)} topics, {result.seconds:.1f} s; load {result.load_before} -> {result.load_after}) "
@@ -859,7 +866,7 @@ def summary(results: list[Result]) -> list[str]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--case", action="append", choices=sorted(CASES), help="default: every case")
+    parser.add_argument("--case", action="append", choices=sorted(CASES), help="default: every case but 8x1000+fifo")
     parser.add_argument("--seconds", type=float, default=20.0, help="the measuring window (default 20)")
     parser.add_argument("--rounds", type=int, default=2, help="runs of each case and tree (default 2)")
     parser.add_argument("--subscribers", choices=("rclpy", "raw"), default="rclpy",
@@ -905,7 +912,7 @@ def main() -> None:
     busy = [_child([sys.executable, "-c", "while True: pass"]) for _ in range(args.busy)]
     with tempfile.TemporaryDirectory(prefix="bench_suite_baseline_") as tmp, _ended(busy):
         trees = compared_trees(args.baseline, Path(tmp), "working tree")
-        runs = [(CASES[name], tree, label) for _ in range(args.rounds) for name in args.case or CASES
+        runs = [(CASES[name], tree, label) for _ in range(args.rounds) for name in args.case or DEFAULT_CASES
                 for tree, label in trees]
         for case, tree, label in runs:
             try:

@@ -142,6 +142,11 @@ class RosSettings:
     publish_period: float = setting(0.005, "how long a status (MotionStatus, AxisStatus, /joint_states, /clock) may "
                                     "wait past its sample before it is published; 0: each as it falls due",
                                     unit="s", low=0.0, high=1.0, parameter=True)
+    # ros2_control's update thread does the same; opt-in, since a real-time thread that never slept
+    # would hold its core (docs/decisions.md, "The clock thread's priority")
+    clock_priority: int = setting(0, "the controller's clock thread runs under SCHED_FIFO at this priority, to keep "
+                                  "real time on a loaded machine (needs CAP_SYS_NICE or an rtprio limit; without, "
+                                  "the suite says why and runs on); 0: normal scheduling", low=0, high=99)
     crosscheck: bool = setting(False, "check every started or modified profile against ruckig (docs/profiles.md)",
                                parameter=True)
     # (ros/suite.py)

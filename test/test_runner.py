@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import logging
+import os
 import re
 import threading
 
@@ -280,3 +282,50 @@ def test_live_periodic_work_with_nothing_to_do_neither_runs_nor_ends_a_stretch()
     wanted[0] = False
     runner.step(40)
     assert live == [120, 140, 160]
+
+
+def _fifo_allowed() -> bool:
+    """Whether this process may put a thread under SCHED_FIFO (root, CAP_SYS_NICE or an
+    rtprio limit): tried on a thread of its own, which ends with it."""
+    allowed = []
+
+    def attempt() -> None:
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(1))
+            allowed.append(True)
+        except PermissionError:
+            allowed.append(False)
+
+    thread = threading.Thread(target=attempt)
+    thread.start()
+    thread.join()
+    return allowed[0]
+
+
+@pytest.mark.parametrize(("priority", "time_scale"), [(0, 1.0), (1, 1.0), (1, 0.0)])
+def test_the_clock_thread_runs_at_the_priority_asked_or_says_why_not(priority, time_scale, caplog):
+    # as fast as possible (0) it never sleeps: a real-time thread would hold its core
+    runner = ControllerRunner(config.load().build_controller(), time_scale=time_scale, priority=priority)
+    seen, ran = [], threading.Event()
+    runner.add_periodic(100.0, lambda ctl: seen.append((os.sched_getscheduler(0), os.sched_getparam(0).sched_priority))
+                        or ran.set())
+    with caplog.at_level(logging.WARNING, logger="mpi_ros.runner"):
+        runner.start()
+        try:
+            assert ran.wait(10.0)
+        finally:
+            runner.stop()
+    assert os.sched_getscheduler(0) == os.SCHED_OTHER  # the caller's thread as it was
+    refused = [r.getMessage() for r in caplog.records if "SCHED_FIFO" in r.getMessage()]
+    if priority and time_scale and _fifo_allowed():
+        assert seen[0] == (os.SCHED_FIFO, priority)
+        assert not refused
+    else:
+        assert seen[0] == (os.SCHED_OTHER, 0)
+        assert bool(refused) == bool(priority), refused
+
+
+@pytest.mark.parametrize("priority", [-1, 100])
+def test_a_priority_outside_sched_fifo_is_refused(priority):
+    with pytest.raises(ValueError, match="SCHED_FIFO priority"):
+        ControllerRunner(config.load().build_controller(), priority=priority)

@@ -56,7 +56,8 @@ class Suite:
                                   else robot_description)
         self.controller = config.build_controller()
         self.epoch_ns = convert.anchor(self.controller, epoch_ns)
-        self.runner = ControllerRunner(self.controller, time_scale, publish_period=config.ros.publish_period)
+        self.runner = ControllerRunner(self.controller, time_scale, publish_period=config.ros.publish_period,
+                                       priority=config.ros.clock_priority)
         # one Packer for every status topic: a supervisor's status holds its axes' bodies as packed
         # for their own topics, at the same sample (wire.Packer)
         packer = wire.Packer(self.controller.rate, self.epoch_ns, config.ros.namespace)
