@@ -94,11 +94,7 @@ class _Periodic:
     status: StatusCallback | None = None  # reads its sample's snapshots: may wait in a stretch
     snapshots: bool = False  # the status callback reads the snapshots (not only the sample)
     wanted: Callable[[], bool] | None = None  # (live) whether it has anything to do now; None: always
-
-    def passes(self, end: int) -> None:
-        """Its next stop moved past sample ``end`` without calling it."""
-        if self.next_sample <= end:
-            self.next_sample += self.every * ((end - self.next_sample) // self.every + 1)
+    idle: bool = False  # wanted answered False before the last stretch: its stops since then passed
 
 
 @dataclass(order=True, slots=True)
@@ -183,8 +179,21 @@ class ControllerRunner:
         return int(self.publish_period * self.ctl.rate + 1e-9) // fastest * fastest
 
     def _active(self) -> list[_Periodic]:
-        """The periodic work that has anything to do now (``add_periodic``'s wanted)."""
-        return [p for p in self._periodic if p.wanted is None or p.wanted()]
+        """Lock held: the periodic work that has anything to do now (``add_periodic``'s
+        wanted), in the order it was added. One that had nothing to do until now resumes at
+        its first stop after the current sample: the stops it passed had nothing to do."""
+        active = []
+        sample = self.ctl.sample
+        for periodic in self._periodic:
+            if periodic.wanted is not None:
+                if not periodic.wanted():
+                    periodic.idle = True
+                    continue
+                if periodic.idle:
+                    periodic.idle = False
+                    periodic.next_sample = (sample // periodic.every + 1) * periodic.every
+            active.append(periodic)
+        return active
 
     def _deadline(self, periodic: _Periodic, hold: int) -> int:
         """The sample by which ``periodic``'s next stop must have been stepped to."""
@@ -306,7 +315,9 @@ class ControllerRunner:
         """Seconds until the next periodic stop is due (at most ``period``): the clock thread
         wakes as it becomes due, steps to it and publishes at once."""
         scale = self.time_scale
-        active = self._active()  # (unlocked: a wake too early or late by a command, which wakes it anyway)
+        # (unlocked: as idle as the last stretch found it; what a command made wanted since, the
+        # command's wake brings in)
+        active = [p for p in self._periodic if not p.idle]
         if not active or self._anchor_wall is None or not scale:  # manual or as fast as possible
             return period
         hold = self._hold()
@@ -361,12 +372,9 @@ class ControllerRunner:
     def _stops(self, end: int, active: list[_Periodic]) -> dict[int, list[_Periodic]]:
         """The stops of the ``active`` periodic work up to ``end``, in sample order, each with
         its due callbacks in the order they were added; every one's next stop moved past
-        ``end`` (the others' without a call)."""
+        ``end``."""
         stops: dict[int, list[_Periodic]] = {}
-        for periodic in self._periodic:
-            if periodic not in active:
-                periodic.passes(end)
-                continue
+        for periodic in active:
             while periodic.next_sample <= end:
                 stops.setdefault(periodic.next_sample, []).append(periodic)
                 periodic.next_sample += periodic.every
@@ -375,15 +383,14 @@ class ControllerRunner:
 
     def _skip_passed(self, active: list[_Periodic]) -> None:
         """Periodic stops the controller has passed without the runner (stepped directly):
-        each such callback of the ``active`` work runs once, now, and every next stop is the
+        each such callback of the ``active`` work runs once, now, and its next stop is the
         first one ahead."""
         ctl = self.ctl
-        passed = [p for p in self._periodic if p.next_sample <= ctl.sample]
-        for periodic in passed:
-            periodic.passes(ctl.sample)
-        passed = [p for p in passed if p in active]
+        passed = [p for p in active if p.next_sample <= ctl.sample]
         if not passed:
             return
+        for periodic in passed:
+            periodic.next_sample += periodic.every * ((ctl.sample - periodic.next_sample) // periodic.every + 1)
         wanted = any(p.snapshots for p in passed)
         self._call(passed, ctl.sample, ctl.motion_snapshots() if wanted else None)
 
