@@ -121,6 +121,8 @@ class ControllerRunner:
         self.ctl = controller
         self.publish_period = publish_period
         self.priority = priority
+        self.scheduling = "normal"  # what the clock thread runs under (/diagnostics), once it runs
+        self.priority_refused = False  # it runs without the priority asked for
         self.time_scale = time_scale
         self.wake_period = wake_period
         self.lock = threading.RLock()
@@ -279,16 +281,20 @@ class ControllerRunner:
         normal scheduling, as ros2_control's update thread does."""
         if not self.priority:
             return
+        asked = f"SCHED_FIFO {self.priority}"
         if not self.time_scale:  # as fast as possible: it never sleeps, so it would hold its core
-            _log.warning("controller clock: SCHED_FIFO priority %d not taken: running as fast as possible, the "
-                         "clock thread never sleeps", self.priority)
+            self.scheduling, self.priority_refused = f"normal: {asked} not taken, as fast as possible", True
+            _log.warning("controller clock: %s not taken: running as fast as possible, the clock thread never "
+                         "sleeps", asked)
             return
         try:
             os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(self.priority))  # (0: this thread)
         except OSError as exc:
-            _log.warning("controller clock: SCHED_FIFO priority %d refused (%s), so the clock thread runs at "
-                         "normal scheduling; allow it with an rtprio limit (limits.conf) or CAP_SYS_NICE",
-                         self.priority, exc.strerror)
+            self.scheduling, self.priority_refused = f"normal: {asked} refused ({exc.strerror})", True
+            _log.warning("controller clock: %s refused (%s), so the clock thread runs at normal scheduling; "
+                         "allow it with an rtprio limit (limits.conf) or CAP_SYS_NICE", asked, exc.strerror)
+            return
+        self.scheduling = asked
 
     def _clock_target(self, due: int, period: float) -> int:
         """Where the clock thread steps to next.

@@ -320,9 +320,12 @@ def test_the_clock_thread_runs_at_the_priority_asked_or_says_why_not(priority, t
     if priority and time_scale and _fifo_allowed():
         assert seen[0] == (os.SCHED_FIFO, priority)
         assert not refused
+        assert (runner.scheduling, runner.priority_refused) == (f"SCHED_FIFO {priority}", False)
     else:
         assert seen[0] == (os.SCHED_OTHER, 0)
         assert bool(refused) == bool(priority), refused
+        assert runner.priority_refused == bool(priority)  # (/diagnostics: WARN)
+        assert runner.scheduling.startswith("normal")
 
 
 @pytest.mark.parametrize("priority", [-1, 100])

@@ -101,14 +101,18 @@ class Suite:
         behind = self.runner.due_sample() - self.controller.sample
         # Python's allocated blocks: whether the objects grow, apart from the allocators'
         # fragmentation and C's heaps that RSS also counts (cheap: a walk of pymalloc's arenas).
-        values = {"samples_behind": behind, "outputs_queued": self.runner.backlog(),
-                  "python_blocks": sys.getallocatedblocks()}
+        values: dict[str, object] = {"samples_behind": behind, "outputs_queued": self.runner.backlog(),
+                                     "python_blocks": sys.getallocatedblocks()}
         for node in self.supervisor_nodes:
             values.update({f"ms{node.number}.{key}": value for key, value in node.held().items()})
+        # ros.clock_priority: whether the clock thread got it (WARN: asked for, running without)
+        values["clock_scheduling"] = self.runner.scheduling
+        message = f"{behind} samples behind the wall clock"
+        if self.runner.priority_refused:
+            message += f"; clock thread at {self.runner.scheduling}"
         status = DiagnosticStatus(name=f"{self.config.ros.namespace.strip('/')}/suite",
-                                  hardware_id="mpi_ros simulated controller",
-                                  message=f"{behind} samples behind the wall clock")
-        status.level = DiagnosticStatus.OK
+                                  hardware_id="mpi_ros simulated controller", message=message)
+        status.level = DiagnosticStatus.WARN if self.runner.priority_refused else DiagnosticStatus.OK
         status.values = [KeyValue(key=k, value=str(v)) for k, v in values.items()]
         return status
 
