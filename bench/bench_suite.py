@@ -37,9 +37,10 @@ reproducibly (a shared machine's load comes and goes).
 
 Cases: 32 axes in 16 two-axis supervisors with status and joint states at 100 Hz; 8 axes
 in 4 two-axis supervisors with status and joint states at 1 kHz, at the default sample
-rate (2 kHz) and at 4 kHz (``8x1000@4k``); and, asked for by name, ``8x1000+fifo``: the clock
-thread under SCHED_FIFO (ros.clock_priority 10; run it with ``--busy``, ``--baseline none`` for
-a tree without that setting).
+rate (2 kHz) and at 4 kHz (``8x1000@4k``); and, asked for by name, each of them with ``+fifo``
+(``8x1000+fifo``, ``32x100+fifo``, ``8x1000@4k+fifo``): the clock thread under SCHED_FIFO
+(ros.clock_priority 10), beside the same case without it, idle or with ``--busy``
+(``--baseline none`` for a tree without that setting).
 
 The machines are shared and noisy, so each case also runs the suite of a baseline revision
 (``--baseline``, extracted with git archive), alternating with this tree, ``--rounds`` times;
@@ -76,7 +77,7 @@ import threading
 import time
 from collections import Counter
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -114,11 +115,11 @@ class Case:
         return self.axes // 2
 
 
-CASES = {case.name: case for case in (Case("32x100", 32, 100.0), Case("8x1000", 8, 1000.0),
-                                      Case("8x1000@4k", 8, 1000.0, 4000.0),
-                                      # the clock thread under SCHED_FIFO (ros.clock_priority): with --busy
-                                      Case("8x1000+fifo", 8, 1000.0, ros=(("clock_priority", 10),)))}
-DEFAULT_CASES = [name for name, case in CASES.items() if not case.ros]  # (any tree knows their settings)
+_PLAIN = (Case("32x100", 32, 100.0), Case("8x1000", 8, 1000.0), Case("8x1000@4k", 8, 1000.0, 4000.0))
+# each also with its clock thread under SCHED_FIFO (ros.clock_priority), asked for by name
+CASES = {case.name: case for plain in _PLAIN
+         for case in (plain, replace(plain, name=f"{plain.name}+fifo", ros=(("clock_priority", 10),)))}
+DEFAULT_CASES = [case.name for case in _PLAIN]  # (any tree knows their settings)
 SUBSCRIBER_PROCESSES = 3  # --subscribers rclpy: the status topics are shared out among these
 
 
@@ -866,7 +867,7 @@ def summary(results: list[Result]) -> list[str]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--case", action="append", choices=sorted(CASES), help="default: every case but 8x1000+fifo")
+    parser.add_argument("--case", action="append", choices=sorted(CASES), help="default: every case but the +fifo ones")
     parser.add_argument("--seconds", type=float, default=20.0, help="the measuring window (default 20)")
     parser.add_argument("--rounds", type=int, default=2, help="runs of each case and tree (default 2)")
     parser.add_argument("--subscribers", choices=("rclpy", "raw"), default="rclpy",

@@ -146,7 +146,8 @@ class RosSettings:
     # would hold its core (docs/decisions.md, "The clock thread's priority")
     clock_priority: int = setting(0, "the controller's clock thread runs under SCHED_FIFO at this priority, to keep "
                                   "real time on a loaded machine (needs CAP_SYS_NICE or an rtprio limit; without, "
-                                  "the suite says why and runs on); 0: normal scheduling", low=0, high=99)
+                                  "the suite says why and runs on); 0: normal scheduling", low=0, high=99,
+                                  parameter=True)
     crosscheck: bool = setting(False, "check every started or modified profile against ruckig (docs/profiles.md)",
                                parameter=True)
     # (ros/suite.py)
