@@ -110,7 +110,7 @@ class _Scheduled:
 
 class ControllerRunner:
     def __init__(self, controller: Controller, time_scale: float | None = 1.0, wake_period: float = 0.01,
-                 publish_period: float = 0.0, priority: int = 0):
+                 publish_period: float = 0.0, priority: int = 0, clock: Callable[[], float] = time.monotonic):
         if time_scale is not None and time_scale < 0:
             raise ValueError("time_scale must be >= 0 (0: as fast as possible) or None (manual)")
         if not publish_period >= 0:
@@ -124,6 +124,7 @@ class ControllerRunner:
         self.scheduling = "normal"  # what the clock thread runs under (/diagnostics), once it runs
         self.priority_refused = False  # it runs without the priority asked for
         self.time_scale = time_scale
+        self.clock = clock  # wall time, s (monotonic): what the controller keeps to
         self.wake_period = wake_period
         self.lock = threading.RLock()
         self.changed = threading.Condition(self.lock)
@@ -221,7 +222,7 @@ class ControllerRunner:
         if self.time_scale is None or self._thread is not None:
             return
         with self.lock:
-            self._anchor_wall = time.monotonic()
+            self._anchor_wall = self.clock()
             self._anchor_sample = self.ctl.sample
         self._running.set()
         self._thread = threading.Thread(target=self._loop, name="mpi-controller-clock", daemon=True)
@@ -330,7 +331,7 @@ class ControllerRunner:
         ahead = min(self._deadline(p, hold) for p in active) - self._anchor_sample
         due_at = self._anchor_wall + ahead / (scale * self.ctl.rate)
         # a little late rather than early: early, the sample due would still be the one before
-        return min(period, max(0.0, due_at - time.monotonic() + _WAKE_MARGIN))
+        return min(period, max(0.0, due_at - self.clock() + _WAKE_MARGIN))
 
     def backlog(self) -> int:
         """Outputs (publications) collected and not yet published."""
@@ -342,8 +343,15 @@ class ControllerRunner:
             return self.ctl.sample
         if self.time_scale == 0:
             return self.ctl.sample + FAST_BATCH
-        elapsed = time.monotonic() - self._anchor_wall
+        elapsed = self.clock() - self._anchor_wall
         return max(self.ctl.sample, self._anchor_sample + int(elapsed * self.time_scale * self.ctl.rate))
+
+    def samples_behind(self) -> int:
+        """How many samples the controller is behind its clock: 0 unless the clock thread
+        keeps it to the wall clock (manual, as fast as possible, not started)."""
+        if not self.time_scale or not self.running:
+            return 0
+        return self.due_sample() - self.ctl.sample
 
     def _catch_up(self) -> None:
         if self.running:

@@ -152,3 +152,18 @@ def probe(ros_context):
         executor.shutdown(timeout_sec=2.0)
         thread.join(timeout=2.0)
         node.destroy_node()
+
+
+class SetClock:
+    """Wall time (s) that moves only when the test says: a ControllerRunner's ``clock``."""
+
+    def __init__(self) -> None:
+        self.now = 1000.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+@pytest.fixture
+def set_clock() -> SetClock:
+    return SetClock()

@@ -21,6 +21,7 @@ from rclpy.executors import MultiThreadedExecutor
 
 from .. import description
 from ..config import SuiteConfig
+from ..pace import Pace
 from ..runner import ControllerRunner
 from . import convert, rcl, wire
 from .controller_node import ControllerNode
@@ -73,11 +74,12 @@ class Suite:
                            joints=config.axis_joints(), packer=packer, watchdogs=watchdogs, context=context)
             for spec in config.supervisors
         ]
+        self.pace = Pace(self.runner)
         self.configuration = self.controller_node.publish_configuration(config)
         self.crosscheck = self._crosscheck() if config.ros.crosscheck else None
         for node in self.supervisor_nodes:
             self.controller_node.add_diagnostic(node.trajectory_diagnostic)
-        self.controller_node.add_diagnostic(lambda ctl: [self._suite_status()])
+        self.controller_node.add_diagnostic(lambda ctl: [self.suite_status()])
         self.executors = [_executor(node, config.ros.executor_threads, context) for node in self.nodes]
         self.spinners: list[Spinner] = []
 
@@ -94,25 +96,34 @@ class Suite:
         self.controller_node.add_diagnostic(lambda ctl: [_crosscheck_status(name, monitor.summary())])
         return monitor
 
-    def _suite_status(self):
-        """/diagnostics "<ns>/suite": how far the controller is behind the wall clock and what
-        the suite holds (publications queued, goals per supervisor), so a long run shows
-        whether anything grows. Runner lock held."""
-        behind = self.runner.due_sample() - self.controller.sample
+    def suite_status(self) -> DiagnosticStatus:
+        """/diagnostics "<ns>/suite": whether the controller keeps to the wall clock (pace.py:
+        WARN, and a log line when it falls behind and when it is back) and what the suite holds
+        (publications queued, goals per supervisor), so a long run shows whether anything
+        grows. Runner lock held."""
+        pace = self.pace.report()
+        factor = pace.real_time_factor
         # Python's allocated blocks: whether the objects grow, apart from the allocators'
         # fragmentation and C's heaps that RSS also counts (cheap: a walk of pymalloc's arenas).
-        values: dict[str, object] = {"samples_behind": behind, "outputs_queued": self.runner.backlog(),
+        values: dict[str, object] = {"samples_behind": pace.samples_behind,
+                                     "real_time_factor": "manual" if factor is None else f"{factor:.4f}",
+                                     "outputs_queued": self.runner.backlog(),
                                      "python_blocks": sys.getallocatedblocks()}
         for node in self.supervisor_nodes:
             values.update({f"ms{node.number}.{key}": value for key, value in node.held().items()})
         # ros.clock_priority: whether the clock thread got it (WARN: asked for, running without)
         values["clock_scheduling"] = self.runner.scheduling
-        message = f"{behind} samples behind the wall clock"
+        message = pace.describe()
+        if pace.late and not self.runner.priority:
+            message += "; on a loaded machine ros.clock_priority keeps it in time"
+        if pace.turned:
+            log = self.controller_node.get_logger()
+            log.warning(f"controller clock {message}") if pace.late else log.info("controller clock back in real time")
         if self.runner.priority_refused:
             message += f"; clock thread at {self.runner.scheduling}"
         status = DiagnosticStatus(name=f"{self.config.ros.namespace.strip('/')}/suite",
                                   hardware_id="mpi_ros simulated controller", message=message)
-        status.level = DiagnosticStatus.WARN if self.runner.priority_refused else DiagnosticStatus.OK
+        status.level = DiagnosticStatus.WARN if self.runner.priority_refused or pace.late else DiagnosticStatus.OK
         status.values = [KeyValue(key=k, value=str(v)) for k, v in values.items()]
         return status
 

@@ -98,6 +98,7 @@ def test_diagnostics_go_to_error_on_e_stop(suite, client, probe, applied, drive)
     # publications of the batch being stepped (500 samples) queued until it ends, fewer than one a sample
     held = {v.key: v.value for v in diagnostics.messages[0].status[-1].values}
     assert held.pop("clock_scheduling") == "normal"  # ros.clock_priority 0 (test_runner: the others)
+    assert held.pop("real_time_factor") == "manual"  # (test_suite and test_pace: a clock that runs)
     held = {key: int(value) for key, value in held.items()}
     assert held.pop("outputs_queued") <= 500
     assert held.pop("python_blocks") > 10_000  # the suite's objects: rclpy, the controller, the interfaces
