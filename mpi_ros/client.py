@@ -42,6 +42,7 @@ from typing import Any, Self
 
 import rclpy
 from action_msgs.msg import GoalStatus
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.action import ActionClient
 from rclpy.action.client import ClientGoalHandle
 from rclpy.context import Context
@@ -65,6 +66,7 @@ from .ros.spinner import Spinner
 ACTION_QOS = action_qos(gn.ACTION_SERVICE_QOS)
 STATUS_QOS = profile(gn.STATUS_READER_QOS)
 EVENTS_QOS = profile(gn.EVENTS_QOS)
+DIAGNOSTICS_QOS = profile(gn.DIAGNOSTICS.qos)
 
 _POLL = 0.05  # s between graph queries (rclpy has no graph-change wait for node names)
 RESULT_RECHECK = 0.5  # s between looks for a goal's action server while waiting for its result
@@ -1041,6 +1043,7 @@ class Watcher(_Endpoint):
         self._changed = threading.Condition()
         self._supervisors: dict[int, MotionStatus] = {}
         self._axes: dict[int, AxisStatus] = {}
+        self._suite: DiagnosticStatus | None = None
         self._start_spinning()
 
     def axes_on_graph(self) -> list[int]:
@@ -1087,6 +1090,26 @@ class Watcher(_Endpoint):
                 missing += [gn.AXIS_STATUS.name(self.namespace, k) for k in wanted_axes if k not in self._axes]
                 raise NoResponse(f"no status from {', '.join(missing) or 'the suite'} within the timeout")
             return dict(self._supervisors), dict(self._axes)
+
+    # -- the suite's own health -----------------------------------------------------------------------
+    def follow_suite(self) -> None:
+        """Keep the latest ``<namespace>/suite`` entry of /diagnostics: whether the controller
+        keeps to the wall clock (WARN: behind real time) and what the suite holds (docs/reliability.md)."""
+        self.node.create_subscription(DiagnosticArray, gn.DIAGNOSTICS.name(self.namespace), self._keep_suite,
+                                      DIAGNOSTICS_QOS)
+
+    def _keep_suite(self, msg: DiagnosticArray) -> None:
+        name = f"{self.namespace.strip('/')}/suite"  # (/diagnostics is shared by the suites of a cell)
+        for status in msg.status:
+            if status.name == name:
+                with self._changed:
+                    self._suite = status
+                    self._changed.notify_all()
+
+    def suite_status(self) -> DiagnosticStatus | None:
+        """The latest ``<namespace>/suite`` entry (:meth:`follow_suite`), None before the first."""
+        with self._changed:
+            return self._suite
 
     # -- events and other topics ----------------------------------------------------------------------
     def follow_events(self, callback: Callable[[MotionEvent], None]) -> Any:

@@ -147,6 +147,30 @@ def twins_warning(endpoint) -> str | None:
             f"stop one of them")
 
 
+def suite_warning(watcher) -> str | None:
+    """The warning of the suite's /diagnostics entry (``<ns>/suite``), if it is WARN or worse:
+    its controller is behind the wall clock, or its clock thread runs without the priority asked
+    for (Watcher.follow_suite first)."""
+    status = watcher.suite_status()
+    if status is None or _level(status.level) < _WARN:
+        return None
+    return f"warning: the suite ({status.name} on /diagnostics): {status.message}"
+
+
+_WARN = 1  # diagnostic_msgs/DiagnosticStatus.WARN
+
+
+def _level(level: bytes | int) -> int:
+    return level[0] if isinstance(level, bytes) else level  # (rclpy gives a byte's field as bytes)
+
+
+def warnings(watcher) -> str | None:
+    """What a view of the suite should say above its table: two suites in one namespace, a
+    suite behind real time (None: nothing)."""
+    found = [w for w in (twins_warning(watcher), suite_warning(watcher)) if w is not None]
+    return "\n".join(found) or None
+
+
 def warn_twins(args: argparse.Namespace, endpoint) -> None:
     warning = twins_warning(endpoint)
     if warning is not None:

@@ -8,7 +8,9 @@ Per supervisor: state, axes, move id, motion type, pending moves, the last actio
 caused it. Per axis: state, command and actual position, following error, command velocity
 and the status bits DONE, AT_TARGET, IN_FINE_POSITION, SETTLED (D T F S below 128 columns;
 from 128 on also the actual velocity and the faults). Each supervisor's row and its axes
-come from one MotionStatus, so they are from the same sample. On a terminal the table fits
+come from one MotionStatus, so they are from the same sample. Above the table, a warning when
+two suites run under one namespace, and (live) when the suite's /diagnostics entry is WARN: its
+controller behind the wall clock (docs/reliability.md). On a terminal the table fits
 its width (80 columns and up) and is redrawn in place every 0.1 s on the alternate screen,
 the last one left on yours when you leave; otherwise a new table is printed every second.
 """
@@ -26,7 +28,7 @@ import time
 from collections.abc import Callable
 from typing import Any, TextIO
 
-from .console import OK, add_target_options, run_verb, twins_warning
+from .console import OK, add_target_options, run_verb, twins_warning, warnings
 
 STALE_AFTER = 2.0  # s without a newer sample before the header says so
 FLAGS = (("DONE", "done"), ("AT_TARGET", "at_target"), ("IN_FINE_POSITION", "in_fine_position"),
@@ -61,6 +63,7 @@ def _status(session, args: argparse.Namespace) -> int:
         print("\n".join(render(supervisor_statuses, axis_statuses, watcher.namespace, width=width,
                                warning=twins_warning(watcher))))
         return OK
+    watcher.follow_suite()  # a suite behind real time says so above the table
     tty = sys.stdout.isatty()
     interval = args.interval if args.interval is not None else (0.1 if tty else 1.0)
     with contextlib.suppress(KeyboardInterrupt):  # Ctrl-C is how a live view ends
@@ -92,7 +95,7 @@ def _live(watcher, out: TextIO, tty: bool, interval: float,
             stale = time.monotonic() - changed_at
             columns, rows = size() if tty else (PIPE_WIDTH, 0)
             lines = render(supervisors, axes, watcher.namespace, stale if stale > STALE_AFTER else None, columns,
-                           twins_warning(watcher))
+                           warnings(watcher))
             if tty:
                 out.write("\x1b[H" + "\x1b[K\n".join(_fit(lines, rows)) + "\x1b[K\x1b[J")
             else:
@@ -128,7 +131,8 @@ def render(supervisors: dict[int, Any], axes: dict[int, Any], namespace: str,
     header = f"{namespace}  sample {sample}"
     if stale is not None:
         header += f"  (no newer status for {stale:.0f} s: is the suite still running?)"
-    lines = [header, *(textwrap.wrap(warning, max(width - 1, 20)) if warning else []),
+    said = [line for text in (warning or "").splitlines() for line in textwrap.wrap(text, max(width - 1, 20))]
+    lines = [header, *said,
              f"{'ms':<4} {'state':<14} {'axes':<8} {'move':>5}  {'type':<12} {'pending':>7}  last action"]
     rows: list[Any] = []
     for number in sorted(supervisors):

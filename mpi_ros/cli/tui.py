@@ -29,7 +29,7 @@ import threading
 import time
 from typing import Any, ClassVar
 
-from .console import OK, UsageError, add_target_options, fail
+from .console import OK, UsageError, add_target_options, fail, suite_warning
 from .jog import Jogger, JogTarget
 
 REFRESH = 0.1  # s between table refreshes
@@ -155,6 +155,7 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
             table.can_focus = False  # the arrows are the jog's, not the table's scrolling
             table.add_columns("row", "state", "command", "actual", "error", "velocity", "bits", "faults")
             self.events = link.watcher.follow_events(self._from_ros)
+            link.watcher.follow_suite()  # a suite behind real time: said under the heading
             self.set_interval(REFRESH, self._refresh)
             self._refresh()
 
@@ -174,8 +175,10 @@ def make_app(link: Link, args: argparse.Namespace):  # noqa: C901 - the App clas
                     table.add_row(f"  axis{axis.number}{mark}", axis.state_name, f"{axis.command_position:.1f}",
                                   f"{axis.actual_position:.1f}", f"{axis.position_error:.1f}",
                                   f"{axis.command_velocity:.1f}", bits, ", ".join(axis.faults) or "-")
+            warning = suite_warning(link.watcher)
             self.heading.update(f"selected ms{self.selected} axis{self._axis_number(supervisors)}  "
-                                f"jog {args.jog_speed:g}/s  D done T at target F fine S settled")
+                                f"jog {args.jog_speed:g}/s  D done T at target F fine S settled"
+                                + (f"\n{warning}" if warning else ""))
             self.jogger.expire(time.monotonic())
             while self.jogger.said:
                 self.say(self.jogger.said.popleft())

@@ -139,12 +139,12 @@ class Terminal:
 
 
 class _Watcher:
-    """Serves the same tables, then Ctrl-C on look ``stop``."""
+    """Serves the same tables, then Ctrl-C on look ``stop``; ``suite``: the suite's /diagnostics entry."""
 
     namespace = "/mpi"
 
-    def __init__(self, stop: int = 3):
-        self.looks, self.stop, self.seen = 0, stop, []
+    def __init__(self, stop: int = 3, suite=None):
+        self.looks, self.stop, self.seen, self.suite = 0, stop, [], suite
 
     def latest(self):
         self.looks += 1
@@ -154,6 +154,9 @@ class _Watcher:
 
     def twins_on_graph(self) -> list[str]:
         return []  # one suite: no warning line
+
+    def suite_status(self):
+        return self.suite
 
 
 class _Frames(io.StringIO):
@@ -286,3 +289,34 @@ def test_every_console_verb_explains_itself_with_an_example(verb):
         assert "--namespace NS" in text
         assert "--supervisor N" in text
         assert "--timeout S" in text
+
+
+def _suite_entry(level: int, message: str):
+    from diagnostic_msgs.msg import DiagnosticStatus
+
+    return DiagnosticStatus(name="mpi/suite", level=bytes([level]), message=message)
+
+
+BEHIND = ("behind real time: 2.43 s behind the wall clock, real time factor 0.69; on a loaded machine "
+          "ros.clock_priority keeps it in time")
+
+
+def _live_lines(suite) -> list[str]:
+    out = io.StringIO()
+    with pytest.raises(KeyboardInterrupt):
+        _live(_Watcher(stop=2, suite=suite), out, tty=False, interval=0.0)
+    return out.getvalue().splitlines()
+
+
+@pytest.mark.parametrize("level", [1, 2], ids=["WARN", "ERROR"])
+def test_live_status_says_when_the_suite_is_behind_real_time(level):
+    lines = _live_lines(_suite_entry(level, BEHIND))
+    assert lines[:2] == ["/mpi  sample 100", f"warning: the suite (mpi/suite on /diagnostics): {BEHIND}"]
+
+
+@pytest.mark.parametrize("suite", [None, _suite_entry(0, "3 samples behind the wall clock")],
+                         ids=["before its first entry", "OK"])
+def test_live_status_says_nothing_of_a_suite_in_time(suite):
+    lines = _live_lines(suite)
+    assert lines[0] == "/mpi  sample 100"
+    assert lines[1].startswith("ms ")  # the table's titles, right under the header

@@ -94,6 +94,30 @@ def test_the_console_warns_about_nodes_on_the_graph_twice(suite_process, ros_con
         watcher.close()
 
 
+def test_the_views_follow_the_suites_diagnostics_entry(suite_process, ros_context):
+    from mpi_ros.cli.console import suite_warning
+    from mpi_ros.client import Watcher
+
+    watcher = Watcher(context=ros_context, timeout=WAIT, node_name="suite_watcher")
+    try:
+        watcher.wait_for_suite(WAIT)
+        assert watcher.suite_status() is None  # not followed yet
+        watcher.follow_suite()
+        pause, deadline = threading.Event(), time.monotonic() + WAIT
+        while watcher.suite_status() is None and time.monotonic() < deadline:
+            pause.wait(0.05)
+        status = watcher.suite_status()
+        assert status is not None
+        assert status.name == "mpi/suite"
+        assert {"samples_behind", "real_time_factor", "clock_scheduling"} <= {v.key for v in status.values}
+        # said above the views' tables when WARN (a loaded machine may put this suite behind)
+        level = status.level[0] if isinstance(status.level, bytes) else status.level
+        expected = None if level == 0 else f"warning: the suite (mpi/suite on /diagnostics): {status.message}"
+        assert suite_warning(watcher) == expected
+    finally:
+        watcher.close()
+
+
 def test_where_the_other_process_runs_is_read_from_its_guid(tmp_path):
     from mpi_ros.ros.twin import origin
 
