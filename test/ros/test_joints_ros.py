@@ -33,8 +33,11 @@ def test_joint_states_are_in_metres_and_radians_under_the_joint_names(suite, cli
     assert xy.wait(10.0).message == "MPIMessageOK"
     assert zc.wait(10.0).message == "MPIMessageOK"
     at = suite.controller.sample
+    # drive steps 20 samples at a time from 0, and /joint_states is published every 20 (100 Hz): the
+    # last one is of this very sample (an earlier one may differ by a count while the servo settles)
+    assert at % round(suite.controller.rate / suite.config.ros.joint_states_rate) == 0
     seen = joints.wait_for(lambda ms: bool(ms) and ms[-1].header.stamp.sec * 10**9 + ms[-1].header.stamp.nanosec
-                           >= suite.epoch_ns + round((at - 20) * 1e9 / suite.controller.rate))
+                           >= suite.epoch_ns + round(at * 1e9 / suite.controller.rate))
     last = seen[-1]
     assert list(last.name) == ["x", "y", "z", "c"]
     # within the fine in-position window (10 counts: 10 um; on C 10 counts are 6.3 mrad)
