@@ -27,7 +27,9 @@ LATE = 0.1  # s of wall time behind: late
 class PaceReport:
     samples_behind: int  # samples the controller is behind its clock (0 without one)
     seconds_behind: float  # the same in wall seconds
-    real_time_factor: float | None  # controller s per wall s since the last report (None: manual clock)
+    # controller s per wall s since the last report, or the first since the clock started (None: a
+    # manual clock, or no wall time yet)
+    real_time_factor: float | None
     late: bool  # more than LATE behind
     turned: bool  # late now and not at the last report, or the other way round
 
@@ -52,7 +54,7 @@ class Pace:
     def report(self) -> PaceReport:
         runner = self._runner
         now, sample = runner.clock(), runner.ctl.sample
-        mark = self._mark
+        mark = self._mark or runner.started  # (the first report: since the clock started)
         if mark is None or now > mark[0]:  # (two reports at one instant: the factor of the first)
             if mark is not None and runner.time_scale is not None:  # (a manual clock's pace is its caller's)
                 self._factor = (sample - mark[1]) / runner.ctl.rate / (now - mark[0])

@@ -346,6 +346,12 @@ class ControllerRunner:
         elapsed = self.clock() - self._anchor_wall
         return max(self.ctl.sample, self._anchor_sample + int(elapsed * self.time_scale * self.ctl.rate))
 
+    @property
+    def started(self) -> tuple[float, int] | None:
+        """(wall time, sample) when the clock thread started keeping the controller to the wall
+        clock; None before, and in manual mode."""
+        return (self._anchor_wall, self._anchor_sample) if self._thread is not None else None
+
     def samples_behind(self) -> int:
         """How many samples the controller is behind its clock: 0 unless the clock thread
         keeps it to the wall clock (manual, as fast as possible, not started)."""

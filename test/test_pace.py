@@ -49,6 +49,19 @@ def test_a_controller_kept_from_stepping_is_late_and_back_in_time_once_it_catche
         runner.stop()
 
 
+def test_the_first_report_counts_from_the_clocks_start(set_clock):
+    clock = set_clock
+    runner = started(clock, 1.0)
+    pace = Pace(runner)
+    try:
+        clock.now += 0.5
+        assert runner.wait(lambda ctl: ctl.sample >= runner.ctl.rate // 2, WAIT)  # in time: no status to wait for
+        with runner.lock:
+            assert pace.report() == PaceReport(0, 0.0, 1.0, late=False, turned=False)
+    finally:
+        runner.stop()
+
+
 def test_late_is_more_than_a_tenth_of_a_second_of_wall_time_at_any_time_scale(set_clock):
     clock = set_clock
     runner = started(clock, 2.0)  # two controller seconds a wall second

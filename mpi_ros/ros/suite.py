@@ -106,7 +106,8 @@ class Suite:
         # Python's allocated blocks: whether the objects grow, apart from the allocators'
         # fragmentation and C's heaps that RSS also counts (cheap: a walk of pymalloc's arenas).
         values: dict[str, object] = {"samples_behind": pace.samples_behind,
-                                     "real_time_factor": "manual" if factor is None else f"{factor:.4f}",
+                                     "real_time_factor": ("manual" if self.runner.time_scale is None
+                                                          else "unknown" if factor is None else f"{factor:.4f}"),
                                      "outputs_queued": self.runner.backlog(),
                                      "python_blocks": sys.getallocatedblocks()}
         for node in self.supervisor_nodes:
