@@ -26,9 +26,7 @@ Plain values, the same for both:
 from __future__ import annotations
 
 import logging
-import re
 import threading
-import warnings
 from typing import Any, Protocol
 
 from action_msgs.msg import GoalInfo
@@ -37,14 +35,6 @@ from rclpy.type_support import check_for_type_support
 from .. import graph_names
 from ..qos import profile
 from . import convert, rcl
-
-# rclpy reports a response that its client will not receive (rmw_fastrtps: the client's response
-# reader not matched within 0.1 s, a client that went away as it asked) as a RuntimeWarning on
-# stderr, where an error is raised otherwise. Made an error for this module's calls only, so that
-# respond() says it in the node's log either way (pyproject.toml's pytest filters repeat it: a
-# test's warning filters are its own).
-NOT_RECEIVED = r"failed to send response \(timeout\)"
-warnings.filterwarnings("error", message=NOT_RECEIVED, category=RuntimeWarning, module=re.escape(__name__) + "$")
 
 KINDS = ("goal", "cancel", "result")  # the action's services, in the order each round serves them
 # The action's services default to a history of 10: an E_STOP that ends more goals than
@@ -166,7 +156,7 @@ class LocalEndpoints:
         try:
             with self._lock:
                 self.services[kind].service_send_response(response, header)
-        except (rcl.RCLError, RuntimeWarning):  # the client went away; its goal (if accepted) runs without it
+        except rcl.RCLError:  # the client went away; its goal (if accepted) runs without it
             self._node.get_logger().warning(f"a {kind} response could not be sent (the client may have gone away)")
 
     def flush(self) -> None:
