@@ -164,7 +164,7 @@ def _level(level: bytes | int) -> int:
     return level[0] if isinstance(level, bytes) else level  # (rclpy gives a byte's field as bytes)
 
 
-def warnings(watcher) -> str | None:
+def view_warnings(watcher) -> str | None:
     """What a view of the suite should say above its table: two suites in one namespace, a
     suite behind real time (None: nothing)."""
     found = [w for w in (twins_warning(watcher), suite_warning(watcher)) if w is not None]

@@ -28,7 +28,7 @@ import time
 from collections.abc import Callable
 from typing import Any, TextIO
 
-from .console import OK, add_target_options, run_verb, twins_warning, warnings
+from .console import OK, add_target_options, run_verb, twins_warning, view_warnings
 
 STALE_AFTER = 2.0  # s without a newer sample before the header says so
 FLAGS = (("DONE", "done"), ("AT_TARGET", "at_target"), ("IN_FINE_POSITION", "in_fine_position"),
@@ -95,7 +95,7 @@ def _live(watcher, out: TextIO, tty: bool, interval: float,
             stale = time.monotonic() - changed_at
             columns, rows = size() if tty else (PIPE_WIDTH, 0)
             lines = render(supervisors, axes, watcher.namespace, stale if stale > STALE_AFTER else None, columns,
-                           warnings(watcher))
+                           view_warnings(watcher))
             if tty:
                 out.write("\x1b[H" + "\x1b[K\n".join(_fit(lines, rows)) + "\x1b[K\x1b[J")
             else:

@@ -117,9 +117,10 @@ class Suite:
         message = pace.describe()
         if pace.late and not self.runner.priority:
             message += "; on a loaded machine ros.clock_priority keeps it in time"
-        if pace.turned:
-            log = self.controller_node.get_logger()
-            log.warning(f"controller clock {message}") if pace.late else log.info("controller clock back in real time")
+        if pace.turned and pace.late:
+            self.controller_node.get_logger().warning(f"controller clock {message}")
+        elif pace.turned:
+            self.controller_node.get_logger().info("controller clock back in real time")
         if self.runner.priority_refused:
             message += f"; clock thread at {self.runner.scheduling}"
         status = DiagnosticStatus(name=f"{self.config.ros.namespace.strip('/')}/suite",
