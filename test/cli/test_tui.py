@@ -188,3 +188,21 @@ def test_the_command_line_takes_the_one_shot_verbs(link, ms0):
             assert "unknown command 'jump': the console takes move, modify, stop" in _log(app)
 
     asyncio.run(drive())
+
+
+def test_the_console_says_when_the_suite_is_behind_real_time(link, monkeypatch):
+    from diagnostic_msgs.msg import DiagnosticStatus
+
+    behind = ("behind real time: 2.43 s behind the wall clock, real time factor 0.69; on a loaded machine "
+              "ros.clock_priority keeps it in time")
+    entry = DiagnosticStatus(name="mpi/suite", level=DiagnosticStatus.WARN, message=behind)
+
+    async def drive():
+        app = make_app(link, _args())
+        async with app.run_test(size=(200, 50)) as pilot:
+            await _until(pilot, lambda: "selected ms0" in _screen(app), "the heading")
+            monkeypatch.setattr(link.watcher, "suite_status", lambda: entry)  # as the suite's entry reads when late
+            await _until(pilot, lambda: f"warning: the suite (mpi/suite on /diagnostics): {behind}" in _screen(app),
+                         "the warning under the heading")
+
+    asyncio.run(drive())
