@@ -48,7 +48,7 @@ class Pace:
     def __init__(self, runner: ControllerRunner):
         self._runner = runner
         self._mark: tuple[float, int] | None = None  # (wall time, sample) of the last report
-        self._factor: float | None = None  # since the report before the last (None: not yet)
+        self._factor: float | None = None  # the latest real time factor (None: none yet)
         self._late = False
 
     def report(self) -> PaceReport:
