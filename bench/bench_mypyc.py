@@ -14,7 +14,8 @@ compiled planner gives the same plans bit for bit.
 
 Modules left out: mypyc compiles them, but they fail at import or run time as they are written
 (axes/axis.py's descriptors, families.py's Enum with __init__, outcome.py's dataclass over a
-class with an annotated attribute, frames.py's Move.planned, which fills an object.__new__).
+class with an annotated attribute, and frames.py at the revisions measured in bench/RESULTS.md,
+whose Move.planned filled an object.__new__).
 
     python -P bench/bench_mypyc.py [--revision HEAD] [--count 2000] [--rounds 3] [--keep DIR]
 """

@@ -89,9 +89,9 @@ class _Derived(Generic[V]):
 
     def __set_name__(self, owner: type, name: str) -> None:
         self.slot = "_" + name
-        # At run time the attribute is a property with this __set__ and a getter in C: a
-        # descriptor's Python __get__ costs a frame per read, and the stepping reads these
-        # attributes tens of times per command piece. (__get__ below is what type checkers see.)
+        # At run time the attribute is a property with this __set__ and a getter in C, since
+        # the stepping reads these attributes tens of times per command piece. (__get__ below
+        # is what type checkers see.)
         setattr(owner, name, property(operator.attrgetter(self.slot), self.__set__))
 
     @overload

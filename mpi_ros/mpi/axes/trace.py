@@ -213,8 +213,7 @@ def _in_one_segment(bank: AxisBank, rows: np.ndarray, lo: np.ndarray, hi: np.nda
         plan = bank.plans[row]
         assert plan is not None  # (a planned row: written for its plan)
         table = plan.table
-        # SegmentTable.index of the two times (bisect_right is its searchsorted on two values,
-        # without numpy's cost per call)
+        # SegmentTable.index of the two times (bisect_right is its searchsorted, for one value)
         first, last = (min(bisect.bisect_right(table.end, x), table.count - 1) for x in (lo[i], hi[i]))
         if first == last:
             cmd.set_segment(row, plan, first)

@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 from mpi_ros.mpi.base.messages import Message
 
-# (read through a module name: a member looked up on its enum class costs ten times the
-# comparison in Python 3.11, and every check of every command asks ``ok``)
+# (a module name: Python 3.11 looks a member up on its enum class through a Python-level
+# hook, and every check of every command asks ``ok``)
 _OK = Message.MPIMessageOK
 
 

@@ -13,7 +13,7 @@ import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Self, cast, overload
+from typing import TYPE_CHECKING, cast, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -27,7 +27,6 @@ from mpi_ros.mpi.planning.profiles.segment import (
     SegmentTable,
     end_time,
     scaled_profile,
-    segment_from,
 )
 
 if TYPE_CHECKING:
@@ -64,8 +63,7 @@ class Listed:
     """Segments listed one by one (every plan but a vector axis' share). ``values``: Segments, or
     Rows (plain tuples, scurve.reshaped(rows=True): an axis' own point-to-point profile) when
     ``rows``, which the stepping reads as they are and which are made Segments the first time
-    they are asked for (a cross-check, a plot, a copy): a Segment, a tuple subclass, takes three
-    times as long to make as a tuple, and a modify is planned while its command waits."""
+    they are asked for (a cross-check, a plot, a copy): the stepping never needs the names."""
 
     values: Sequence[Row]
     planned_limits: Trajectory | None = None  # the limits the profile was planned with
@@ -75,7 +73,7 @@ class Listed:
 
     def segments(self) -> list[Segment]:
         if self.made is None:
-            self.made = list(map(segment_from, self.values)) if self.rows else cast("list[Segment]", self.values)
+            self.made = list(map(Segment._make, self.values)) if self.rows else cast("list[Segment]", self.values)
         return self.made
 
     def row_values(self) -> Sequence[Row]:
@@ -269,8 +267,7 @@ class AxisPlan:
         if rel >= self.duration:
             return self.duration, [self.target, self.final_velocity]
         table = self.table
-        # bisect_right is searchsorted(side="right") (a nan rel too goes past the end); on a
-        # handful of ends it costs a fraction of numpy's call, and it runs for every piece.
+        # bisect_right is searchsorted(side="right") for one time (a nan rel too goes past the end)
         i = min(bisect.bisect_right(table.end, rel), table.count - 1)
         _, p, v, a, j = self.source.row_values()[i]  # (the stepping reads Rows as they are)
         return float(table.start[i]), [p, v, a / 2.0, j / 6.0]
@@ -347,27 +344,6 @@ class Move:
             velocity = velocity or plan.velocity_target is not None  # AxisPlan.is_velocity
             moving = moving or plan.final_velocity != 0.0
         self.plan_axes, self.is_velocity, self.ends_moving = tuple(axes), velocity, moving
-
-    @classmethod
-    def planned(cls, supervisor: int, motion_type: MPIMotionType, attributes: MotionAttr, plans: list[AxisPlan],
-                id: int, element_id: int, event_mask: MPIEventType, stream: Stream | None) -> Self:
-        """``cls(supervisor, motion_type, attributes, plans, id, element_id, event_mask, 0, stream)``,
-        a planned move not yet taken (serial 0), as the dataclass' __init__ makes it: its slots are
-        filled here, without that call in between (compile_move makes a Move for every start and
-        modify while the command waits; test_frames checks every field)."""
-        move = object.__new__(cls)
-        move.supervisor = supervisor
-        move.type = motion_type
-        move.attributes = attributes
-        move.plans = plans
-        move.id = id
-        move.element_id = element_id
-        move.event_mask = event_mask
-        move.serial = 0
-        move.stream = stream
-        move.blend = 0.0
-        move.__post_init__()
-        return move
 
     @property
     def axes(self) -> list[int]:

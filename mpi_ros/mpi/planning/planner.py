@@ -55,13 +55,13 @@ from mpi_ros.mpi.planning.profiles.segment import (
 from mpi_ros.mpi.planning.start import AxisStart
 
 A = MotionAttr
-# The attributes planning tests, as plain ints: IntFlag's `in` and `&` run Python code (0.2 to
-# 1 us each, a dozen per move), an int's & does not.
+# The attributes planning tests, as plain ints: an IntFlag's `in` and `&` run Python code, an
+# int's do not.
 _RELATIVE, _FINAL_VEL, _NO_REVERSAL, _DELAY, _OUTPUT, _ID, _ELEMENT_ID, _EVENT = map(
     int, (A.RELATIVE, A.FINAL_VEL, A.NO_REVERSAL, A.DELAY, A.OUTPUT, A.ID, A.ELEMENT_ID, A.EVENT))
 _SYNC_START, _SYNC_END, _HOLDS = int(A.SYNC_START), int(A.SYNC_END), int(HOLD_ATTRS)
 _SYNC = _SYNC_START | _SYNC_END
-# Unions the planning tests, made once (each | of two globals would cost as much as the test)
+# Unions the planning tests, made once
 _IN_MOTION_REFUSED = _DELAY | _HOLDS  # a move that starts in motion may not wait first
 _PADDED = _SYNC | _DELAY  # profiles with wait frames: not reshape's chain of pieces
 _AXIS_BY_AXIS = _DELAY | _NO_REVERSAL  # a vector's axes made and checked one by one
@@ -69,8 +69,7 @@ _HOLD_OR_OUTPUT = _HOLDS | _OUTPUT
 # The attributes that change a point-to-point axis' plan: without them one axis is planned by
 # _lone_axis_plan, the general path's lists and tests left out
 _GENERAL = _RELATIVE | _FINAL_VEL | _SYNC | _DELAY | _NO_REVERSAL | _HOLD_OR_OUTPUT
-# Each type's family and ramps (families.py), looked up once: an enum member is a class
-# attribute lookup of ~0.1 us each time, a record's field another.
+# Each type's family and ramps (families.py), looked up here once, not for every move
 _KIND = {t: family.kind for t, family in FAMILIES.items()}
 _LINE = {t: family.line for t, family in FAMILIES.items() if family.line is not None}
 _STOP = {t: family.stop for t, family in FAMILIES.items() if family.stop is not None}
@@ -98,19 +97,12 @@ def _truncate_id(value: int, notes: PlanNotes) -> int:
 def _targets(params: MotionParams, bits: int, starts: list[AxisStart], notes: PlanNotes) -> list[float]:
     """Raw target positions; RELATIVE distances lose their fraction (firmware quirk)."""
     positions = params.position
-    # (check_params has found one position per axis; this is its guard here, as zip's strict=
-    # was, which costs eight times as much)
-    if len(positions) != len(starts):
-        raise ValueError(f"{len(positions)} positions for {len(starts)} axes")
     targets: list[float] = []
-    # (loops of appends over the starts, with the positions by index: for one or two axes a fifth
-    # cheaper than a zip of the two, half of a comprehension)
     if not bits & _RELATIVE:  # (the usual case)
-        for i, start in enumerate(starts):
-            targets.append(positions[i] + start.origin)
+        for position, start in zip(positions, starts, strict=True):
+            targets.append(position + start.origin)
         return targets
-    for i, start in enumerate(starts):
-        value = positions[i]
+    for value, start in zip(positions, starts, strict=True):
         distance = float(math.trunc(value))
         if distance != value:
             notes.events.append(
@@ -121,11 +113,15 @@ def _targets(params: MotionParams, bits: int, starts: list[AxisStart], notes: Pl
     return targets
 
 
+def _sound(segment: Row, limit: float) -> bool:
+    """A segment (or row) lasts from 0 to ``limit`` seconds and all its values are finite."""
+    return 0.0 <= segment[0] <= limit and all(map(math.isfinite, segment))
+
+
 def _check_finite(segments: list[Segment], axis: int) -> None:
     """A profile that overflowed (absurd distances or limits) cannot be calculated."""
-    for d, p, v, a, j in segments:
-        # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
-        if not (d >= 0.0 and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
+    for segment in segments:
+        if not _sound(segment, math.inf):
             raise ProfileError(f"axis {axis}: the profile cannot be calculated with these values (overflow)")
 
 
@@ -133,15 +129,7 @@ def _on_target(end: float, start: AxisStart, target: float) -> bool:
     """The plan's end is on the target within the rounding of the positions alone."""
     if not math.isfinite(end):
         return False
-    # max(1.0, |target|, |start|) by comparisons, as max makes them: a call of max costs ten
-    scale = 1.0
-    size = abs(target)
-    if size > scale:
-        scale = size
-    size = abs(start.position)
-    if size > scale:
-        scale = size
-    return abs(end - target) <= 1e-9 * scale
+    return abs(end - target) <= 1e-9 * max(1.0, abs(target), abs(start.position))
 
 
 def _end_position(segment: tuple[float, float, float, float, float]) -> float:
@@ -157,7 +145,8 @@ def _check_lands(segments: list[Segment], start: AxisStart, target: float, end: 
     where they end, not on the target within the rounding of the positions alone (_on_target,
     which _checked asks first: the travel can only widen the tolerance)."""
     scale = max(1.0, abs(target), abs(start.position))
-    # each segment's end velocity as Segment.state_at computes it, without a call per segment
+    # each segment's distance at the greater of its start and end speeds (its end velocity as
+    # Segment.state_at calculates it, on rows as well as Segments)
     travel = sum([max(abs(v), abs(v + t * (a + t * j / 2.0))) * t for t, _, v, a, j in segments])
     scale = max(scale, travel)
     if not math.isfinite(end) or abs(end - target) > 1e-9 * scale:
@@ -176,9 +165,8 @@ def _checked(segments: list[Segment], start: AxisStart, target: float, limit: fl
         _check_lands(segments, start, target, end)
     if duration is not None and _within(segments, duration, limit):
         return segments, False  # landed: finite (and reshape's pieces are positive)
-    for d, p, v, a, j in segments:
-        # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
-        if not (0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0):
+    for segment in segments:
+        if not _sound(segment, limit):
             _check_finite(segments, start.axis)
             return _cap_frames(segments, limit, start.axis, notes)
     return segments, False
@@ -212,9 +200,7 @@ def _line_passes(line: RowLine, limit: float, chained: bool) -> bool:
         return False
     if chained:
         return _finite_if_it_ends(end) and _within(segments, duration, limit)
-    # x - x is 0 for a finite x, NaN for an infinite or NaN one: one comparison for all five
-    return all(0.0 <= d <= limit and (d - d) + (p - p) + (v - v) + (a - a) + (j - j) == 0.0
-               for d, p, v, a, j in segments)
+    return all(_sound(segment, limit) for segment in segments)
 
 
 # Half a unit in the last place of the largest float: a finite x plus any |y| below it rounds to
@@ -365,23 +351,19 @@ def _vector_profiles(
     profile every axis has a share of (None when they have not: no move, or not one line).
     Plain floats: a vector has at most MEIXmpMAX_COORD_AXES components, too few for numpy to
     pay off."""
-    # (loops of appends, lists alike by index: for one or two axes they cost about half of
-    # list(map(...)) or a comprehension and less than a zip, each of which makes an object of its own)
     p0: list[float] = []
     v0: list[float] = []
     delta: list[float] = []
-    for i, start in enumerate(starts):
+    for start, target in zip(starts, targets, strict=True):
         p0.append(start.position)
         v0.append(start.velocity)
-        delta.append(targets[i] - start.position)  # (as many targets as starts: _targets makes them)
+        delta.append(target - start.position)
     length = math.hypot(*delta)  # no overflow for large components, unlike a sum of squares
     speed = math.hypot(*v0)
     if not (math.isfinite(length) and math.isfinite(speed)):
         raise ProfileError("the move's length cannot be calculated (overflow)")
     if length > 0.0:
-        unit: list[float] = []
-        for d in delta:
-            unit.append(d / length)
+        unit = [d / length for d in delta]
     elif speed > 0.0:
         unit = [v / speed for v in v0]
     else:
@@ -398,8 +380,8 @@ def _vector_profiles(
     line = _profile_from(motion_type, 0.0, along, accel, length, final_along, traj, True)
     segments, duration = line[0], line[2]
     profiles: list[Profile] = []
-    for i, u in enumerate(unit):  # (unit and p0 are made alike above)
-        profiles.append(Scaled(segments, u, p0[i], duration, traj))
+    for u, p in zip(unit, p0, strict=True):
+        profiles.append(Scaled(segments, u, p, duration, traj))
     return profiles, None, "", line
 
 
@@ -496,14 +478,13 @@ def compile_move(
             plans, stream = _path_plans(motion_type, params, attrs, starts)
     except ProfileError as exc:
         raise Refused(Message.MPIMotionMessagePROFILE_ERROR, str(exc)) from exc
-    # (positional: keywords are matched at a cost; serial is the supervisor's to give)
-    move = Move.planned(
+    move = Move(
         supervisor, motion_type, attrs, plans,
-        _truncate_id(params.id, notes) if bits & _ID else 0,  # id
-        int(params.element_id[0]) if bits & _ELEMENT_ID and params.element_id else 0,  # element_id
-        params.event_mask if bits & _EVENT else _NO_EVENTS,  # event_mask
-        stream,
-    )
+        id=_truncate_id(params.id, notes) if bits & _ID else 0,
+        element_id=int(params.element_id[0]) if bits & _ELEMENT_ID and params.element_id else 0,
+        event_mask=params.event_mask if bits & _EVENT else _NO_EVENTS,
+        stream=stream,
+    )  # (serial 0: the supervisor that takes the move gives it one)
     return move, notes
 
 

@@ -4,8 +4,6 @@ frame buffer overflow)."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 
@@ -166,16 +164,16 @@ def test_frames_needed_counts_per_axis():
 
 @pytest.mark.parametrize("final_velocity", [0.0, 5.0])
 @pytest.mark.parametrize("velocity_target", [None, 2.0])
-def test_a_planned_move_is_the_dataclass_move(final_velocity, velocity_target):
-    # Move.planned fills the slots itself (compile_move's): every field as Move(...) makes it
+def test_a_moves_facts_follow_its_plans(final_velocity, velocity_target):
+    # what the stepping asks of a move every stretch, taken once from its plans
     a = AxisPlan(2, Listed([Segment(1.0, 0.0, 1.0, 0.0, 0.0)]), 0.0, 1.0, final_velocity,
                  velocity_target=velocity_target)
     b = AxisPlan(0, Listed([Segment(1.0, 0.0, 1.0, 0.0, 0.0)]), 0.0, 1.0)
-    for plans in ([a], [a, b], []):
-        made = Move(3, T.S_CURVE, A.ID, plans, 7, 9, MPIEventType.MOTION_DONE, 0, None)
-        planned = Move.planned(3, T.S_CURVE, A.ID, plans, 7, 9, MPIEventType.MOTION_DONE, None)
-        assert type(planned) is Move
-        assert all(getattr(planned, f.name) == getattr(made, f.name) for f in dataclasses.fields(Move))
+    for plans in ([a], [a, b], [b, a], []):
+        move = Move(3, T.S_CURVE, A.ID, plans, 7, 9, MPIEventType.MOTION_DONE, 0, None)
+        assert move.plan_axes == tuple(plan.axis for plan in plans)
+        assert move.is_velocity is (velocity_target is not None and a in plans)
+        assert move.ends_moving is (final_velocity != 0.0 and a in plans)
 
 
 def test_frame_count_after_abort_and_reset(ctl, ms, bring):

@@ -13,7 +13,6 @@ acceleration for every ramp (MPI 000 MPIMotionVelocity: "deceleration is ignored
 from __future__ import annotations
 
 import math
-from functools import partial
 from typing import NamedTuple
 
 
@@ -22,7 +21,7 @@ class ProfileError(ValueError):
 
 
 class Ramp(NamedTuple):
-    """A tuple, made in one C call by ``_new(Ramp, values)`` when planning (as :class:`Segment` is)."""
+    """One ramp of a trapezoid: a RampRow (below) with names; ``Ramp._make(row)`` makes one."""
 
     duration: float
     v_start: float
@@ -37,19 +36,14 @@ class Ramp(NamedTuple):
         return 0.5 * (self.v_start + self.v_end) * self.duration
 
 
-# ``_new(Ramp, (duration, v_start, v_end))``: ``Ramp(duration, v_start, v_end)`` without the
-# Python-level __new__ of a NamedTuple (nor a partial in between, which costs a quarter more)
-_new = tuple.__new__
-_ramp_of = partial(_new, Ramp)  # (the Ramp of a RampRow, for map)
-
-# A ramp as a plain tuple (duration, v_start, v_end): the planner's trapezoid is made of them
-# (trapezoid_rows); a tuple is made and unpacked faster than a Ramp (a tuple subclass)
+# A ramp as a plain tuple (duration, v_start, v_end), a Ramp without the names: the planner's
+# trapezoid is made of them (trapezoid_rows) and reshaped into segments
 RampRow = tuple[float, float, float]
 
 
 def ramps_between(v_from: float, v_to: float, accel: float, decel: float) -> list[Ramp]:
     """The ramp(s) from one velocity to another, split at zero when the sign changes."""
-    return list(map(_ramp_of, ramp_rows(v_from, v_to, accel, decel)))
+    return list(map(Ramp._make, ramp_rows(v_from, v_to, accel, decel)))
 
 
 def ramp_rows(v_from: float, v_to: float, accel: float, decel: float) -> list[RampRow]:
@@ -63,11 +57,9 @@ def _add_ramps(rows: list[RampRow], v_from: float, v_to: float, accel: float, de
     """Append ramps_between's ramps to ``rows``, as plain tuples (trapezoid_rows')."""
     if v_from == v_to:
         return
-    if v_from * v_to < 0.0:
-        # to rest (lowering |v|: the deceleration), then from it (the acceleration): the ramps
-        # from v_from to 0.0 and from 0.0 to v_to, without a call each
-        rows.append((abs(v_from) / decel, v_from, 0.0))
-        rows.append((abs(v_to) / accel, 0.0, v_to))
+    if v_from * v_to < 0.0:  # through rest: down to it, then up from it
+        _add_ramps(rows, v_from, 0.0, accel, decel)
+        _add_ramps(rows, 0.0, v_to, accel, decel)
         return
     rate = accel if abs(v_to) > abs(v_from) else decel  # the ramp does not cross zero
     rows.append((abs(v_to - v_from) / rate, v_from, v_to))
@@ -93,16 +85,15 @@ def _peak_in_direction(
     piecewise alpha*w^2 + beta with breakpoints at u0 and uf; the fastest profile uses
     the largest w with F(w) <= x and cruises at w for the rest.
     """
-    # (conditionals where max and min would do: a call of either costs ten comparisons, and a
-    # modify is planned while its command waits; each is what max or min answers, NaN included)
+    # (conditionals for max and min, answering what they would, NaN included: a modify is
+    # planned while its command waits)
     size = abs(x)
     reach = x + 1e-12 * (size if size > 1.0 else 1.0)  # F(w) may exceed x by this much (rounding)
     if u0 == 0.0 and uf == 0.0 and reach < 0.0 and 1.0 / (2.0 * accel) + 1.0 / (2.0 * decel) < math.inf:
         # From rest to rest, away from the target: F(w) = alpha*w^2 with a finite alpha is 0 at
         # w = 0 and grows, so the scan below would find every breakpoint overshooting.
         return None
-    # the breakpoints, ascending: 0, u0 and uf where inside (0, vmax) (once if equal), vmax (by
-    # comparisons: a set of them sorted into a list makes two objects more)
+    # the breakpoints, ascending: 0, u0 and uf where inside (0, vmax) (once if equal), vmax
     inner_u0, inner_uf = 0.0 < u0 < vmax, 0.0 < uf < vmax
     if inner_u0 and inner_uf:
         points = [0.0, u0, uf, vmax] if u0 < uf else [0.0, uf, u0, vmax] if uf < u0 else [0.0, u0, vmax]
@@ -119,8 +110,7 @@ def _peak_in_direction(
     for k in range(top, -1, -1):
         lo, hi = points[k], points[k + 1]
         # F on this piece, alpha*w^2 + beta: the first ramp's (u0 -> w) alpha and beta plus the
-        # last's (w -> uf), at the rates a w inside the piece gives them (here, not in a function
-        # of their own: a call per piece costs as much as this arithmetic)
+        # last's (w -> uf), at the rates a w inside the piece gives them
         w = 0.5 * (lo + hi)
         if u0 < 0.0:
             a1, b1 = 1.0 / twice_accel, -u0 * u0 / twice_decel
@@ -168,9 +158,8 @@ def _peak_on(x: float, lo: float, hi: float, alpha: float, beta: float) -> float
 def _peak_to_rest(x: float, u0: float, vmax: float, accel: float, decel: float) -> tuple[float, float] | None:
     """_peak_in_direction(x, u0, uf, vmax, accel, decel) for a final velocity uf of ±0 and finite
     limits (greater than 0: plan_point_to_point's checks), the usual start or modify, which ends at
-    rest: the same operations on the pieces the scan looks at, written out for the one or two
-    pieces there are (the scan's list of breakpoints and its loop cost as much as its arithmetic,
-    and a modify is planned while its command waits).
+    rest: the same operations on the pieces the scan looks at, for the one or two pieces there
+    are, without the scan's list of breakpoints (a modify is planned while its command waits).
 
     With uf = ±0 the last ramp's coefficients are 1/(2 decel) and -uf*uf/(2 decel) = -0.0 on every
     piece (each piece's midpoint w is at least 0, so w >= uf), and beta + -0.0 is beta. The
@@ -250,7 +239,7 @@ def plan_point_to_point(
     limit (ramps down to it) and a start velocity toward or away from the target that
     cannot stop in time (decelerates, reverses and comes back).
     """
-    return list(map(_ramp_of, trapezoid_rows(distance, v_start, v_final, vmax, accel, decel)))
+    return list(map(Ramp._make, trapezoid_rows(distance, v_start, v_final, vmax, accel, decel)))
 
 
 def trapezoid_rows(distance: float, v_start: float, v_final: float, vmax: float, accel: float,
@@ -291,7 +280,7 @@ def trapezoid_rows(distance: float, v_start: float, v_final: float, vmax: float,
     if cruise > 0.0:
         plan.append((cruise, peak, peak))
     _add_ramps(plan, peak, v_final, accel, decel)
-    # each ramp's distance as Ramp.distance calculates it, without a call per ramp, added in order
+    # each ramp's distance (Ramp.distance's formula on the rows), added in order
     travelled = 0.0
     for duration, v0, v1 in plan:
         travelled += 0.5 * (v0 + v1) * duration
@@ -300,8 +289,7 @@ def trapezoid_rows(distance: float, v_start: float, v_final: float, vmax: float,
         raise ProfileError("the profile cannot be calculated with these values (overflow)")
     if cruise > 0.0:
         if peak != 0.0:
-            cruise += error / peak  # (not below 0: a conditional rather than max, as above)
-            cruise = cruise if cruise > 0.0 else 0.0
+            cruise = max(0.0, cruise + error / peak)
         plan[at] = (cruise, peak, peak)
     return plan
 

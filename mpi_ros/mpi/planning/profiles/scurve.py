@@ -10,11 +10,12 @@ f = 0 is the trapezoid itself.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any, Literal, overload
 
 from mpi_ros.mpi.planning.profiles.ramps import ProfileError, RampRow
-from mpi_ros.mpi.planning.profiles.segment import Row, Segment, segment_from
+from mpi_ros.mpi.planning.profiles.segment import Row, Segment
 
 
 def reshape(plan: Sequence[RampRow], p0: float, jerk_percent: float) -> list[Segment]:
@@ -44,7 +45,7 @@ def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
     The planner needs both of every profile; here they are a by-product of the loop that makes
     the segments (it calculates each segment's end to start the next), not a pass of their own.
     ``rows``: the segments as plain tuples (Rows), for a vector's line, whose axes' Segments are
-    made from it: a tuple is made in a third of the time a Segment takes (a tuple subclass)."""
+    made from it (segment.scaled_profile)."""
     if not 0.0 <= jerk_percent <= 100.0:
         raise ProfileError("jerkPercent must be within 0..100")
     fraction = jerk_percent / 100.0
@@ -54,14 +55,8 @@ def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
     flat = 1.0 - fraction  # the constant-acceleration phase
     kept = 1.0 - half  # peak acceleration = dv / (duration * kept)
     segments: list[Any] = []  # (Rows, made Segments at the end unless ``rows``)
-    append = segments.append  # (a local: a lookup per piece otherwise)
     p = p0
     total = -0.0  # end_time's sum: -0.0 + d is d for every d, as its first term is
-    # (each ramp's pieces written out in this loop, not a function of their own nor a loop over a
-    # tuple of them: a call per ramp costs as much as a segment's arithmetic, and a modify is
-    # planned while its command waits). Each piece ends where Segment.end_state puts it: its
-    # operations in their order, with the piece's constant acceleration or jerk written in
-    # (a / 2.0 of a = 0.0 is 0.0, which Python folds; every other operation is made).
     for duration, v, v_end in plan:
         dv = v_end - v
         jerk_time = half * duration
@@ -69,31 +64,21 @@ def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
         # cruise, f = 0, the jerk phases are too short to represent (tiny jerkPercent, or a ramp
         # of ~1e-324 s), or the jerk overflows (jerkPercent ~1e-308: the positions would be NaN).
         # Then the trapezoid's ramp.
+        pieces: tuple[tuple[float, float, float], ...] | None = None
         if not (v == v_end or jerk_time <= 0.0):
             peak = dv / (duration * kept)
             jerk = peak / jerk_time
-            if jerk - jerk == 0.0:  # finite (x - x is NaN for an infinite or NaN x): no call of isfinite
-                # jerk_time > 0 here (not <= 0, and not NaN: the jerk is finite): no test
-                t = jerk_time
-                append((t, p, v, 0.0, jerk))
-                p, v = p + t * (v + t * (0.0 / 2.0 + t * jerk / 6.0)), v + t * (0.0 + t * jerk / 2.0)
+            if math.isfinite(jerk):
+                pieces = ((jerk_time, 0.0, jerk), (flat * duration, peak, 0.0), (jerk_time, peak, -jerk))
+        if pieces is None:
+            pieces = ((duration, dv / duration if duration > 0.0 else 0.0, 0.0),)
+        for t, a, j in pieces:
+            if not t <= 0.0:  # (no piece of 0 s; a NaN one is kept)
+                segments.append((t, p, v, a, j))
+                # where it ends, as Segment.end_state calculates it: the next piece starts there
+                p, v = p + t * (v + t * (a / 2.0 + t * j / 6.0)), v + t * (a + t * j / 2.0)
                 total += t
-                t = flat * duration
-                if not t <= 0.0:  # (no piece of 0 s; a NaN one is kept, as the trapezoid's below)
-                    append((t, p, v, peak, 0.0))
-                    p, v = p + t * (v + t * (peak / 2.0 + t * 0.0 / 6.0)), v + t * (peak + t * 0.0 / 2.0)
-                    total += t
-                t, jerk = jerk_time, -jerk
-                append((t, p, v, peak, jerk))
-                p, v = p + t * (v + t * (peak / 2.0 + t * jerk / 6.0)), v + t * (peak + t * jerk / 2.0)
-                total += t
-                continue
-        if not duration <= 0.0:
-            a = dv / duration if duration > 0.0 else 0.0
-            append((duration, p, v, a, 0.0))
-            t = duration
-            p, v = p + t * (v + t * (a / 2.0 + t * 0.0 / 6.0)), v + t * (a + t * 0.0 / 2.0)
-            total += duration
     if not rows:
-        segments = list(map(segment_from, segments))
+        segments = list(map(Segment._make, segments))
     return segments, p, 0.0 + total  # (end_time's t0 + total, with t0 = 0.0)
+

@@ -7,8 +7,7 @@ seconds of profile time with jerk ``j``. A 1-D profile is a contiguous tuple of 
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
-from functools import partial
+from collections.abc import Iterable, Sequence
 from itertools import chain as _chain_iterables
 from typing import NamedTuple
 
@@ -16,9 +15,8 @@ import numpy as np
 
 
 class Segment(NamedTuple):
-    """A tuple (immutable, compared and hashed by value): planning makes one per constant-jerk
-    piece of every axis, and a tuple is made in one C call (:data:`segment_from`), a fraction of
-    a frozen dataclass' __init__ (a modify is planned while its command waits for its sample)."""
+    """One constant-jerk piece of an axis' profile, immutable and compared by value. A Row
+    (below) holds the same five values as a plain tuple; ``Segment._make(row)`` makes one of it."""
 
     duration: float
     p: float
@@ -39,8 +37,7 @@ class Segment(NamedTuple):
 
     def scaled(self, factor: float, offset: float) -> Segment:
         """The segment of an axis that moves ``factor`` times this 1-D profile."""
-        return segment_from((self.duration, offset + factor * self.p, factor * self.v, factor * self.a,
-                             factor * self.j))
+        return Segment(self.duration, offset + factor * self.p, factor * self.v, factor * self.a, factor * self.j)
 
 
 # A segment's values as a plain tuple, (duration, p, v, a, j): a vector's 1-D profile is made of
@@ -48,18 +45,10 @@ class Segment(NamedTuple):
 Row = tuple[float, float, float, float, float]
 
 
-# ``Segment(*values)`` without the Python-level __new__ of a NamedTuple: one C call. The loops
-# that make a segment per constant-jerk piece call ``new_tuple(Segment, values)``, a little
-# faster still (no partial in between).
-new_tuple = tuple.__new__
-segment_from: Callable[[tuple[float, float, float, float, float]], Segment] = partial(new_tuple, Segment)
-
-
 def scaled_profile(segments: Iterable[Row], factor: float, offset: float) -> list[Segment]:
     """``[seg.scaled(factor, offset) for seg in segments]``: the same operations, without a
     method call per segment (a vector move scales its profile for every axis)."""
-    return [new_tuple(Segment, (d, offset + factor * p, factor * v, factor * a, factor * j))
-            for d, p, v, a, j in segments]
+    return [Segment(d, offset + factor * p, factor * v, factor * a, factor * j) for d, p, v, a, j in segments]
 
 
 def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]]) -> list[Segment]:
@@ -73,7 +62,7 @@ def chain(p0: float, v0: float, a0: float, moves: Iterable[tuple[float, float]])
     for duration, jerk in moves:
         if duration <= 0.0:
             continue
-        seg = segment_from((duration, p, v, a, jerk))
+        seg = Segment(duration, p, v, a, jerk)
         out.append(seg)
         p, v, a = seg.end_state()
     return out
@@ -86,9 +75,9 @@ def total_duration(segments: Sequence[Segment]) -> float:
 def end_time(segments: Sequence[Row], t0: float = 0.0) -> float:
     """``SegmentTable(segments, t0).end[-1]`` without the arrays: the same additions in the
     same order as the table's cumulative sum (``segments`` must not be empty)."""
-    # A loop: reduce(add, map(attrgetter)) would make two calls per segment (every plan's
-    # duration is calculated here); segment[0], its duration, is an index where the name is a
-    # descriptor's call (a fifth of the loop). -0.0 + d is d for every d, as the sum's first term is.
+    # Added one by one in order (as the table's cumsum adds them; not sum(), whose float
+    # summation may change between Python versions); segment[0] is the duration of a Row or a
+    # Segment alike. -0.0 + d is d for every d, as the cumsum's first term is.
     total = -0.0
     for segment in segments:
         total += segment[0]
