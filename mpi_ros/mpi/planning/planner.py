@@ -327,9 +327,7 @@ def _along(vector: Sequence[float], unit: Sequence[float], scale: float) -> tupl
         return 0.0, True
     along = _dot(vector, unit)
     tolerance = 1e-9 * (1.0 + scale)
-    # (zip without strict=, which costs more than this loop: the vector and the unit have one
-    # component per axis, made so by the callers)
-    for x, u in zip(vector, unit):  # noqa: B905
+    for x, u in zip(vector, unit, strict=True):
         if not abs(x - along * u) <= tolerance + 1e-9 * abs(x):
             return along, False
     return along, True
@@ -453,7 +451,7 @@ def compile_move(
     would stop the axes dead. A cam (``cam_masters``: each slave's master, its position
     now and the origins it is read less) is planned by cams.py.
     """
-    notes = PlanNotes([])  # (its list given: the dataclass' default factory is a call more)
+    notes = PlanNotes([])
     bits = int(attrs)
     if bits & _IN_MOTION_REFUSED and any(s.velocity != 0.0 for s in starts):  # starts in motion
         if bits & _DELAY and any(d != 0.0 for d in params.delay):
@@ -549,9 +547,8 @@ def _point_to_point_plans(motion_type: MPIMotionType, params: MotionParams, bits
     shared = (vector is not None and isinstance(first, Scaled) and not bits & _AXIS_BY_AXIS
               and _line_passes(vector, limit, chained))
     plans: list[AxisPlan] = []
-    # (indexes rather than a zip of the four lists, which costs nearly twice as much: one target, final
-    # velocity and profile per start, made so above from a request check_params has found one
-    # value per axis in)
+    # (one target, final velocity and profile per start, by index: made so above from a request
+    # check_params has found one value per axis in)
     for i, start in enumerate(starts):
         target, final, profile = targets[i], finals[i], profiles[i]
         hold, outputs = _holds_and_outputs(params, bits, i) if bits & _HOLD_OR_OUTPUT else (None, [])

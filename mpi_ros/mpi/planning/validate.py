@@ -28,8 +28,8 @@ from mpi_ros.mpi.planning.families import FAMILIES, POINT_ARRAYS, Family, Kind
 
 A = MotionAttr
 # The attribute masks of each type's record as plain ints, for the checks every start and
-# modify runs: an IntFlag's & and ``in`` are Python calls (about a microsecond each in Python
-# 3.11), an int's cost nothing. (Types whose record has no list of the reference have none.)
+# modify runs: an IntFlag's & and ``in`` are Python calls, an int's are not. (Types whose
+# record has no list of the reference have none.)
 _DISALLOWED_BITS = {t: int(~f.allowed) for t, f in FAMILIES.items() if f.allowed is not None}
 _FORBIDDEN_BITS = {t: int(f.forbidden) for t, f in FAMILIES.items() if f.forbidden}
 _PATH_BITS, _CAM_BITS, _HOLD_BITS = int(PATH_ATTRS), int(CAM_ATTRS), int(HOLD_ATTRS)

@@ -94,8 +94,8 @@ class SegmentTable:
     __slots__ = ("a", "count", "end", "ends", "j", "p", "start", "v")
 
     def __init__(self, segments: Sequence[Row], t0: float = 0.0):
-        # One array of every segment's fields in a row (np.fromiter: five np.array calls on
-        # lists cost several times more for a few segments), whose columns are the fields.
+        # One array of every segment's fields in a row, whose columns are the fields: one
+        # np.fromiter rather than five np.array calls, for the few segments a plan has.
         values = np.fromiter(_chain_iterables.from_iterable(segments), float, 5 * len(segments))
         d, self.p, self.v, self.a, self.j = values.reshape(-1, 5).T
         self.end = t0 + np.cumsum(d)
