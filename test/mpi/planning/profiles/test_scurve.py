@@ -6,10 +6,13 @@ from __future__ import annotations
 import math
 
 import pytest
+from hypothesis import assume, given
+from hypothesis import strategies as st
 
 from mpi_ros.mpi.planning.profiles.point_to_point import point_to_point
-from mpi_ros.mpi.planning.profiles.ramps import ProfileError, Ramp, plan_point_to_point
-from mpi_ros.mpi.planning.profiles.scurve import reshape
+from mpi_ros.mpi.planning.profiles.ramps import ProfileError, Ramp, plan_point_to_point, trapezoid_rows
+from mpi_ros.mpi.planning.profiles.scurve import reshape, reshaped
+from mpi_ros.mpi.planning.profiles.segment import Segment, end_time
 
 
 def test_jerk_phases_and_peak():
@@ -112,3 +115,28 @@ def test_ramp_too_short_to_reshape(ramp, percent):
     # 5e-324 counts/s) is kept as the trapezoid's ramp instead of dividing by zero
     for segment in reshape([ramp], 0.0, percent):
         assert all(math.isfinite(x) for x in (*segment, *segment.end_state()))
+
+
+@given(distance=st.floats(-1e6, 1e6), v_start=st.floats(-2e4, 2e4), vmax=st.floats(1.0, 1e4),
+       accel=st.floats(10.0, 1e6), decel=st.floats(10.0, 1e6), percent=st.floats(0.0, 100.0),
+       p0=st.floats(-1e6, 1e6))
+def test_each_segment_starts_exactly_where_the_one_before_ends(distance, v_start, vmax, accel, decel, percent, p0):
+    # What the planner relies on (planner._finite_if_it_ends): each piece starts at the position
+    # Segment.end_state gives for the one before, to the bit; the end and the duration reshaped
+    # answers are end_state's and end_time's; Rows and Segments hold the same values.
+    try:
+        plan = trapezoid_rows(distance, v_start, 0.0, vmax, accel, decel)
+    except ProfileError:
+        assume(False)
+    segments, end, total = reshaped(plan, p0, percent)
+    rows, row_end, row_total = reshaped(plan, p0, percent, rows=True)
+    assert segments == [Segment._make(row) for row in rows]
+    assert all(type(segment) is Segment for segment in segments)
+    assert (row_end, row_total) == (end, total)
+    position = p0
+    for segment in segments:
+        assert segment.duration > 0.0
+        assert segment.p == position
+        position = segment.end_state()[0]
+    assert end == position
+    assert total == (end_time(segments) if segments else 0.0)
