@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from hypothesis import assume, given
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from mpi_ros.mpi.planning.profiles.point_to_point import point_to_point
@@ -117,6 +117,7 @@ def test_ramp_too_short_to_reshape(ramp, percent):
         assert all(math.isfinite(x) for x in (*segment, *segment.end_state()))
 
 
+@settings(max_examples=300, derandomize=True, deadline=None, database=None)
 @given(distance=st.floats(-1e6, 1e6), v_start=st.floats(-2e4, 2e4), vmax=st.floats(1.0, 1e4),
        accel=st.floats(10.0, 1e6), decel=st.floats(10.0, 1e6), percent=st.floats(0.0, 100.0),
        p0=st.floats(-1e6, 1e6))
