@@ -81,4 +81,3 @@ def reshaped(plan: Sequence[RampRow], p0: float, jerk_percent: float,
     if not rows:
         segments = list(map(Segment._make, segments))
     return segments, p, 0.0 + total  # (end_time's t0 + total, with t0 = 0.0)
-
