@@ -1,4 +1,4 @@
-"""The modify path compiled with mypyc, side by side with the same source interpreted (issue 35).
+"""The core compiled with mypyc, side by side with the same source interpreted (issue 35).
 
 Builds a scratch copy of this tree's package (git archive of ``--revision``) and compiles the
 modules a modify runs through (``MODULES``) with the mypyc that comes with the mypy in the
@@ -17,7 +17,21 @@ Modules left out: mypyc compiles them, but they fail at import or run time as th
 class with an annotated attribute, and frames.py at the revisions measured in bench/RESULTS.md,
 whose Move.planned filled an object.__new__).
 
+``--suite CASE`` (repeatable; bench_suite's cases) compiles instead the modules a stretch of the
+suite runs through (``SUITE_MODULES``: Controller.step_snapshots, its stepping, status templates
+and snapshots) and times, in both trees: a stretch as the suite steps it (``step_snapshots`` of
+32 axes in 16 supervisors, 20 samples with one status; of 8 in 4, 10 samples with five), its
+snapshots digested; then the suite through ROS as bench_suite runs it (rclpy subscriber
+processes, the suite's CPU from /proc), the trees alternating ``--rounds`` times. The modules it
+leaves out fail as written (axes/trace.py: mypyc passes a generator's items wrongly to a
+classmethod with a ``*``; base/params.py: the ROS layer reads its dataclasses' ``__slots__``,
+which a compiled class has not; axes/plant.py: mypyc rejects servo_effort's constrained
+TypeVar). One thing is adapted in the scratch copy only (``ADAPTATIONS``): the ROS layer keeps
+each controller's epoch by a weak reference to it, and a compiled Controller cannot be
+referenced weakly.
+
     python -P bench/bench_mypyc.py [--revision HEAD] [--count 2000] [--rounds 3] [--keep DIR]
+    python -P bench/bench_mypyc.py --suite 32x100 --suite 8x1000 [--seconds 10] [--rounds 3]
 """
 
 from __future__ import annotations
@@ -44,6 +58,15 @@ MODULES = [f"mpi_ros/mpi/{name}.py" for name in (
     "planning/start", "base/params", "base/clock", "supervisor/motion", "supervisor/moves",
     "supervisor/state", "supervisor/axis_list", "axes/plant",
 )]
+SUITE_MODULES = [f"mpi_ros/mpi/{name}.py" for name in (
+    "control", "snapshots", "base/snapshot", "base/events", "base/wrap", "base/clock", "supervisor/status",
+    "supervisor/moves", "supervisor/motion", "supervisor/state", "supervisor/stepping", "planning/frames",
+    "axes/status", "axes/bank", "axes/stretch", "axes/scratch", "faults/monitor",
+)]
+# (file, text as written, text in the compiled copy): see the docstring
+ADAPTATIONS = [("mpi_ros/ros/convert.py", "_EPOCHS: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()",
+                "_EPOCHS: dict[Any, int] = {}")]
+STRETCHES = [(32, 16, 20, 20), (8, 4, 10, 2)]  # axes, supervisors, samples, a status every ... samples
 
 
 # -- the measuring process ------------------------------------------------------------------
@@ -84,10 +107,44 @@ def measure(count: int) -> dict:
             "digest": digest.hexdigest(), "compiled": not planner.__file__.endswith(".py")}
 
 
+def measure_stretch(count: int) -> dict:
+    """The best CPU time of a stretch of each of STRETCHES (microseconds, best of 5 runs of
+    ``count``), a digest of every snapshot taken, and whether the core ran compiled."""
+    import hashlib
+
+    from mpi_ros.mpi import control
+
+    digest = hashlib.sha256()
+    figures = {f"{case[0]}/{case[1]}": _stretch(*case, count, digest) for case in STRETCHES}
+    return {"stretch": figures, "digest": digest.hexdigest(), "compiled": not control.__file__.endswith(".py")}
+
+
+def _stretch(axes: int, supervisors: int, samples: int, every: int, count: int, digest) -> float:
+    """measure_stretch's figure of one case; the snapshots of its first 20 stretches digested."""
+    from bench_controller import _controller, _velocity
+
+    ctl = _controller(axes, supervisors)
+    _velocity(ctl)
+
+    def stretch() -> dict:
+        return ctl.step_snapshots(samples, range(ctl.sample + every, ctl.sample + samples + 1, every))
+
+    for _ in range(20):
+        for motions, axis_snaps in stretch().values():
+            digest.update(repr((sorted(motions.items()), axis_snaps)).encode())
+    best = float("inf")
+    for _ in range(5):
+        start = time.process_time()
+        for _ in range(count):
+            stretch()
+        best = min(best, (time.process_time() - start) / count)
+    return best * 1e6
+
+
 # -- the build ------------------------------------------------------------------------------
-def scratch_tree(revision: str, into: Path) -> Path:
-    """The package and its mypy settings at ``revision`` (git archive), in ``into``."""
-    archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros", "pyproject.toml"],
+def scratch_tree(revision: str, into: Path, *more: str) -> Path:
+    """The package, its mypy settings and ``more`` paths at ``revision`` (git archive), in ``into``."""
+    archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "mpi_ros", "pyproject.toml", *more],
                              check=True, capture_output=True).stdout
     (into / "tree.tar").write_bytes(archive)
     with tarfile.open(into / "tree.tar") as tar:
@@ -95,12 +152,12 @@ def scratch_tree(revision: str, into: Path) -> Path:
     return into / "tree"
 
 
-def build(tree: Path) -> tuple[float, float]:
-    """Compile MODULES in place in ``tree``; the build's wall and CPU seconds (the compiler's
-    processes, gcc included)."""
+def build(tree: Path, modules: list[str]) -> tuple[float, float]:
+    """Compile ``modules`` in place in ``tree``; the build's wall and CPU seconds (the
+    compiler's processes, gcc included)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    subprocess.run([str(MYPYC), *MODULES], cwd=tree, check=True, capture_output=True)
+    subprocess.run([str(MYPYC), *modules], cwd=tree, check=True, capture_output=True)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -111,7 +168,7 @@ def main(revision: str, count: int, rounds: int, keep: Path | None) -> list[str]
         interpreted = scratch_tree(revision, Path(scratch))
         compiled = Path(scratch) / "compiled"
         shutil.copytree(interpreted, compiled)
-        wall, cpu = build(compiled)
+        wall, cpu = build(compiled, MODULES)
         runs: dict[str, list[dict]] = {"interpreted": [], "compiled": []}
         for _ in range(rounds):  # alternating, so that both see the same load
             runs["interpreted"].append(measure_in(interpreted, [count], "bench_mypyc"))
@@ -131,11 +188,54 @@ def main(revision: str, count: int, rounds: int, keep: Path | None) -> list[str]
             f"plans bit-identical: {'yes' if same else '**NO**'}"]
 
 
+def suite(revision: str, cases: list[str], seconds: float, rounds: int, count: int) -> list[str]:
+    """SUITE_MODULES compiled: a stretch, then the suite through ROS (bench_suite), side by side."""
+    import bench_suite
+
+    with tempfile.TemporaryDirectory() as scratch:
+        interpreted = scratch_tree(revision, Path(scratch), "config")
+        compiled = Path(scratch) / "compiled"
+        shutil.copytree(interpreted, compiled)
+        for name, written, adapted in ADAPTATIONS:
+            path = compiled / name
+            text = path.read_text(encoding="utf-8")
+            if written not in text:
+                raise SystemExit(f"bench_mypyc: {name} no longer has {written!r}: see ADAPTATIONS")
+            path.write_text(text.replace(written, adapted), encoding="utf-8")
+        wall, cpu = build(compiled, SUITE_MODULES)
+        trees = [(interpreted, "interpreted"), (compiled, "compiled")]
+        stretches: dict[str, list[dict]] = {"interpreted": [], "compiled": []}
+        for _ in range(rounds):
+            for tree, name in trees:
+                stretches[name].append(measure_in(tree, [count], "bench_mypyc", "measure_stretch"))
+        assert all(run["compiled"] == (name == "compiled") for name, runs in stretches.items() for run in runs)
+        same = len({run["digest"] for runs in stretches.values() for run in runs}) == 1
+        results = [bench_suite.run_case(bench_suite.CASES[case], seconds, tree=tree, label=name)
+                   for _ in range(rounds) for case in cases for tree, name in trees]
+    best = {name: {key: min(run["stretch"][key] for run in runs) for key in runs[0]["stretch"]}
+            for name, runs in stretches.items()}
+    keys = list(best["interpreted"])
+    return [f"mypyc build of {len(SUITE_MODULES)} modules: {wall:.1f} s wall, {cpu:.1f} s CPU",
+            "| tree | " + " | ".join(f"stretch {key} us" for key in keys) + " |", "| --- |" + " --- |" * len(keys),
+            *(f"| {name} | " + " | ".join(f"{best[name][key]:.1f}" for key in keys) + " |" for name in best),
+            "| interpreted / compiled | " + " | ".join(
+                f"{best['interpreted'][key] / best['compiled'][key]:.2f}x" for key in keys) + " |",
+            f"snapshots the same in both trees: {'yes' if same else '**NO**'}", "",
+            *bench_suite.summary(results), "", *bench_suite.report(results)]
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--revision", default="HEAD", help="commit whose package is built and measured")
     parser.add_argument("--count", type=int, default=2000, help="modifies per run")
     parser.add_argument("--rounds", type=int, default=3, help="runs of each tree (least median kept)")
     parser.add_argument("--keep", type=Path, help="copy the compiled tree here")
+    parser.add_argument("--suite", action="append", metavar="CASE",
+                        help="compile the stretch's modules and run this bench_suite case (repeatable)")
+    parser.add_argument("--seconds", type=float, default=10.0, help="--suite: each run's window")
     options = parser.parse_args()
-    print("\n".join(main(options.revision, options.count, options.rounds, options.keep)))
+    if options.suite:
+        print("\n".join(suite(options.revision, options.suite, options.seconds, options.rounds,
+                              max(20, options.count // 10))))
+    else:
+        print("\n".join(main(options.revision, options.count, options.rounds, options.keep)))
