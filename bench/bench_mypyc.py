@@ -23,12 +23,12 @@ and snapshots) and times, in both trees: a stretch as the suite steps it (``step
 32 axes in 16 supervisors, 20 samples with one status; of 8 in 4, 10 samples with five), its
 snapshots digested; then the suite through ROS as bench_suite runs it (rclpy subscriber
 processes, the suite's CPU from /proc), the trees alternating ``--rounds`` times. The modules it
-leaves out fail as written (axes/trace.py: mypyc passes a generator's items wrongly to a
-classmethod with a ``*``; base/params.py: the ROS layer reads its dataclasses' ``__slots__``,
-which a compiled class has not; axes/plant.py: mypyc rejects servo_effort's constrained
-TypeVar). One thing is adapted in the scratch copy only (``ADAPTATIONS``): the ROS layer keeps
-each controller's epoch by a weak reference to it, and a compiled Controller cannot be
-referenced weakly.
+leaves out fail as written (axes/trace.py: compiled, ``_Segments.of``'s call with ``*`` over
+a generator hands ``gathered`` a list iterator where an array is due; base/params.py: the ROS
+layer reads its dataclasses' ``__slots__``, which a compiled class has not; axes/plant.py: mypyc
+rejects servo_effort's constrained TypeVar). One thing is adapted in the scratch copy only
+(``ADAPTATIONS``): the ROS layer keeps each controller's epoch by a weak reference to it, and a
+compiled Controller cannot be referenced weakly.
 
     python -P bench/bench_mypyc.py [--revision HEAD] [--count 2000] [--rounds 3] [--keep DIR]
     python -P bench/bench_mypyc.py --suite 32x100 --suite 8x1000 [--seconds 10] [--rounds 3]
